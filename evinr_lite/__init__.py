@@ -1,0 +1,16 @@
+"""evinr-lite: event-camera video reconstruction with EvINR, as a small readable package.
+
+Modules, one job each:
+    events      the `Events` container (t seconds float64, x column, y row, p +-1, (H, W))
+    frames      `Frames`: ground-truth frames with timestamps
+    binning     event frames over fixed-duration or equal-count bins (Eq. 2)
+    fastmode    small sizes for tests and CI (EVINR_FAST)
+    device      CPU by default, a GPU when present
+"""
+from .binning import EventFrames, equal_count_boundaries, events_to_frames, fixed_duration_boundaries
+from .device import default_device
+from .events import EventDataError, Events, normalize_polarity
+from .fastmode import fast_mode, pick
+from .frames import Frames
+
+__version__ = "0.1.0"

@@ -1,0 +1,271 @@
+"""The one event container used everywhere: `Events`.
+
+Conventions (every module relies on them):
+
+- ``t``: float64 seconds, sorted (non-decreasing). Times are stored relative to
+  ``t_origin`` (also seconds), so that absolute clocks of about 1.5e9 s keep
+  nanosecond resolution: ``absolute_time = t_origin + t``. Readers pick an
+  integer ``t_origin`` (the whole seconds of the first event) when timestamps are
+  large, and 0 otherwise.
+- ``x``: column, ``y``: row, both integer pixel indices; images are indexed
+  ``[y, x]``.
+- ``p``: polarity in {-1, +1} (int8). Encodings {0, 1} and bool are converted
+  explicitly (0/False -> -1), never dropped.
+- ``sensor_size``: ``(H, W)``, rows first.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Events", "EventDataError", "normalize_polarity", "TIME_UNITS"]
+
+# Seconds per unit for timestamps given in other units.
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+
+
+class EventDataError(ValueError):
+    """Event data that cannot be used as given. The message names the problem and the fix."""
+
+
+def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
+    """Return polarities as int8 in {-1, +1}.
+
+    Args:
+        p: array [N] of polarities (bool, {0, 1} or {-1, +1}; any numeric dtype).
+        encoding: ``"auto"`` (decide from the values), ``"pm1"`` (must be -1/+1),
+            ``"01"`` (0 = OFF -> -1, 1 = ON -> +1) or ``"bool"`` (False -> -1).
+
+    Raises:
+        EventDataError: values outside the encoding, or a mix of encodings.
+    """
+    p = np.asarray(p)
+    if p.ndim != 1:
+        raise EventDataError(f"polarity must be a 1-D array, got shape {p.shape}")
+    if p.size == 0:
+        return p.astype(np.int8)
+    if p.dtype == bool:
+        if encoding not in ("auto", "bool"):
+            raise EventDataError(f"polarity is boolean but encoding={encoding!r} was requested; use encoding='bool' or 'auto'")
+        return np.where(p, 1, -1).astype(np.int8)
+    if not np.all(np.isfinite(p)):
+        raise EventDataError("polarity contains NaN or inf; every event needs a polarity of -1/+1 (or 0/1)")
+    values = np.unique(p)
+    if encoding == "auto":
+        if np.all(np.isin(values, (-1, 1))):
+            encoding = "pm1"
+        elif np.all(np.isin(values, (0, 1))):
+            encoding = "01"
+        else:
+            shown = ", ".join(str(v) for v in values[:6])
+            raise EventDataError(
+                f"polarity values {{{shown}}} are neither -1/+1 nor 0/1 "
+                "(a mix of both, or other numbers). Convert them to -1 (OFF) / +1 (ON) before loading."
+            )
+    if encoding == "pm1":
+        if not np.all(np.isin(values, (-1, 1))):
+            raise EventDataError(
+                f"polarity must be -1/+1 but contains {sorted(set(values.tolist()) - {-1, 1})[:6]}; "
+                "if OFF events are stored as 0, pass polarity='01'"
+            )
+        return p.astype(np.int8)
+    if encoding in ("01", "bool"):
+        if not np.all(np.isin(values, (0, 1))):
+            raise EventDataError(
+                f"polarity encoding {encoding!r} expects 0/1 but found {sorted(set(values.tolist()) - {0, 1})[:6]}"
+            )
+        return np.where(p > 0, 1, -1).astype(np.int8)
+    raise EventDataError(f"unknown polarity encoding {encoding!r}; use 'auto', 'pm1', '01' or 'bool'")
+
+
+def _check_sensor_size(sensor_size) -> tuple[int, int]:
+    try:
+        H, W = (int(v) for v in sensor_size)
+    except (TypeError, ValueError):
+        raise EventDataError(f"sensor_size must be (H, W), two positive integers; got {sensor_size!r}") from None
+    if H <= 0 or W <= 0:
+        raise EventDataError(f"sensor_size must be (H, W) with positive sizes; got {(H, W)}")
+    return H, W
+
+
+@dataclass(frozen=True, eq=False)
+class Events:
+    """A stream of N events on a sensor of ``sensor_size = (H, W)`` pixels.
+
+    Attributes:
+        t: float64 [N], seconds relative to ``t_origin``, non-decreasing.
+        x: int32 [N], column index in [0, W).
+        y: int32 [N], row index in [0, H).
+        p: int8 [N], polarity in {-1, +1}.
+        sensor_size: (H, W).
+        t_origin: float, seconds; absolute time of t = 0 (0 when times are already relative).
+
+    Construct with ``Events(t, x, y, p, sensor_size)``: inputs are validated and
+    converted; bad input raises :class:`EventDataError` naming the problem and the fix.
+    Use :meth:`from_arrays` for unsorted data, other time units or an explicit
+    polarity encoding.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    p: np.ndarray
+    sensor_size: tuple[int, int]
+    t_origin: float = 0.0
+    polarity_encoding: str = field(default="auto", repr=False)
+
+    def __post_init__(self):
+        H, W = _check_sensor_size(self.sensor_size)
+        t = np.asarray(self.t)
+        x = np.asarray(self.x)
+        y = np.asarray(self.y)
+        arrays = {"t": t, "x": x, "y": y, "p": np.asarray(self.p)}
+        for name, a in arrays.items():
+            if a.ndim != 1:
+                raise EventDataError(f"events.{name} must be a 1-D array, got shape {a.shape}")
+        n = {name: a.shape[0] for name, a in arrays.items()}
+        if len(set(n.values())) != 1:
+            raise EventDataError(f"t, x, y, p must have the same length, got {n}")
+        if t.dtype.kind not in "fiu":
+            raise EventDataError(f"timestamps must be numbers (seconds), got dtype {t.dtype}")
+        if t.dtype == np.float32 or t.dtype == np.float16:
+            raise EventDataError(
+                "timestamps are float32/float16, which loses microseconds (and whole seconds on absolute "
+                "clocks); keep them float64 (or integer us/ns with Events.from_arrays(..., time_unit='us'))"
+            )
+        t = t.astype(np.float64, copy=False)
+        if not np.all(np.isfinite(t)):
+            bad = int(np.flatnonzero(~np.isfinite(t))[0])
+            raise EventDataError(
+                f"timestamp {bad} is {t[bad]} (non-finite); drop or repair those events before loading"
+            )
+        if t.size > 1:
+            dec = np.flatnonzero(np.diff(t) < 0)
+            if dec.size:
+                i = int(dec[0])
+                raise EventDataError(
+                    f"timestamps are not sorted: t[{i}] = {t[i]!r} > t[{i + 1}] = {t[i + 1]!r} "
+                    f"({dec.size} decreasing steps); sort the events by time, e.g. "
+                    "Events.from_arrays(..., sort=True)"
+                )
+        for name, a, size, axis in (("x", x, W, "column, width W"), ("y", y, H, "row, height H")):
+            if a.dtype.kind == "f":
+                if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
+                    raise EventDataError(f"{name} coordinates must be whole pixel indices; found non-integer values")
+            elif a.dtype.kind not in "iu":
+                raise EventDataError(f"{name} coordinates must be integers, got dtype {a.dtype}")
+            if a.size and (a.min() < 0 or a.max() >= size):
+                raise EventDataError(
+                    f"{name} ({axis}) coordinates span [{a.min()}, {a.max()}] but sensor_size (H, W) = "
+                    f"{(H, W)} allows [0, {size - 1}]; check the sensor size (it is (H, W), rows first) "
+                    "and that x is the column and y the row"
+                )
+        p = normalize_polarity(arrays["p"], self.polarity_encoding)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "x", x.astype(np.int32, copy=False))
+        object.__setattr__(self, "y", y.astype(np.int32, copy=False))
+        object.__setattr__(self, "p", p)
+        object.__setattr__(self, "sensor_size", (H, W))
+        object.__setattr__(self, "t_origin", float(self.t_origin))
+        object.__setattr__(self, "polarity_encoding", "pm1")
+
+    # ---- construction -------------------------------------------------------------
+    @classmethod
+    def from_arrays(cls, t, x, y, p, sensor_size, *, time_unit: str = "s", polarity: str = "auto",
+                    sort: bool = False, t_origin: float = 0.0) -> "Events":
+        """Build events from raw columns.
+
+        Args:
+            t: [N] timestamps in ``time_unit`` ('s', 'ms', 'us' or 'ns').
+            x, y: [N] column and row indices.
+            p: [N] polarities; see :func:`normalize_polarity` for ``polarity``.
+            sensor_size: (H, W).
+            sort: sort by time (stable) instead of raising on unsorted input.
+            t_origin: seconds to add to ``t`` to get the absolute clock.
+        """
+        if time_unit not in TIME_UNITS:
+            raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
+        t = np.asarray(t)
+        if time_unit != "s":
+            t = t.astype(np.float64) * TIME_UNITS[time_unit]
+        if sort:
+            order = np.argsort(t, kind="stable")
+            t, x, y, p = (np.asarray(a)[order] for a in (t, x, y, p))
+        return cls(t, x, y, p, sensor_size, t_origin=t_origin, polarity_encoding=polarity)
+
+    @classmethod
+    def from_array(cls, array, sensor_size, *, columns: str = "txyp", **kwargs) -> "Events":
+        """Build events from an [N, 4] array whose columns are named by ``columns`` (e.g. 'txyp', 'xytp')."""
+        a = np.asarray(array)
+        if a.ndim != 2 or a.shape[1] != 4:
+            raise EventDataError(
+                f"an event array must have shape [N, 4] with columns {tuple(columns)}; got shape {a.shape}"
+            )
+        if sorted(columns) != sorted("txyp"):
+            raise EventDataError(f"columns must be a permutation of 'txyp', got {columns!r}")
+        col = {c: a[:, i] for i, c in enumerate(columns)}
+        x, y = col["x"], col["y"]
+        return cls.from_arrays(col["t"], x, y, col["p"], sensor_size, **kwargs)
+
+    @classmethod
+    def empty(cls, sensor_size, t_origin: float = 0.0) -> "Events":
+        z = np.zeros(0)
+        return cls(z, z.astype(np.int32), z.astype(np.int32), z.astype(np.int8), sensor_size, t_origin=t_origin)
+
+    @classmethod
+    def concatenate(cls, parts: list["Events"], sort: bool = True) -> "Events":
+        """Merge event streams on the same sensor and clock (sorted by time, stable)."""
+        if not parts:
+            raise EventDataError("nothing to concatenate: pass at least one Events")
+        size, origin = parts[0].sensor_size, parts[0].t_origin
+        for e in parts[1:]:
+            if e.sensor_size != size or e.t_origin != origin:
+                raise EventDataError("cannot concatenate events with different sensor_size or t_origin")
+        cat = [np.concatenate([getattr(e, k) for e in parts]) for k in "txyp"]
+        return cls.from_arrays(*cat, size, sort=sort, t_origin=origin)
+
+    # ---- views --------------------------------------------------------------------
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    def __repr__(self) -> str:
+        span = f"{self.t[0]:.6f}..{self.t[-1]:.6f} s" if len(self) else "empty"
+        return f"Events(n={len(self)}, sensor_size={self.sensor_size}, t={span}, t_origin={self.t_origin})"
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the first to the last event (0 for fewer than two events)."""
+        return float(self.t[-1] - self.t[0]) if len(self) > 1 else 0.0
+
+    def take(self, index) -> "Events":
+        """Events selected by a slice, boolean mask or sorted integer index (no re-validation of values)."""
+        new = object.__new__(Events)
+        for k in "txyp":
+            object.__setattr__(new, k, getattr(self, k)[index])
+        for k in ("sensor_size", "t_origin", "polarity_encoding"):
+            object.__setattr__(new, k, getattr(self, k))
+        return new
+
+    def slice_time(self, t_start: float | None = None, t_end: float | None = None,
+                   *, allow_empty: bool = False) -> "Events":
+        """Events with ``t_start <= t < t_end`` (seconds, same clock as ``self.t``).
+
+        Raises:
+            EventDataError: if the window is empty or reversed (unless ``allow_empty``).
+        """
+        lo = 0 if t_start is None else int(np.searchsorted(self.t, t_start, side="left"))
+        hi = len(self) if t_end is None else int(np.searchsorted(self.t, t_end, side="left"))
+        if t_start is not None and t_end is not None and t_end <= t_start:
+            raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
+        if hi <= lo and not allow_empty:
+            span = f"[{self.t[0]:.6f}, {self.t[-1]:.6f}] s" if len(self) else "nothing (no events)"
+            raise EventDataError(
+                f"no events in the window [{t_start}, {t_end}) s; the events cover {span} "
+                f"(relative to t_origin = {self.t_origin}); choose a window inside that range"
+            )
+        return self.take(slice(lo, hi))
+
+    def to_array(self) -> np.ndarray:
+        """[N, 4] float64 array with columns (t, x, y, p); t relative to ``t_origin``."""
+        return np.stack([self.t, self.x, self.y, self.p], axis=1).astype(np.float64)

@@ -1,0 +1,71 @@
+"""`Frames`: ground-truth intensity frames with their timestamps (e.g. DAVIS APS frames)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .events import EventDataError
+
+__all__ = ["Frames"]
+
+
+@dataclass(frozen=True, eq=False)
+class Frames:
+    """F grey frames of size (H, W) and their timestamps.
+
+    Attributes:
+        images: [F, H, W], uint8 (0..255) or float in [0, 1]; indexed [frame, y (row), x (column)].
+        t: float64 [F], seconds relative to ``t_origin`` (the same clock as the events they go with).
+        t_origin: float, seconds; absolute time of t = 0.
+    """
+
+    images: np.ndarray
+    t: np.ndarray
+    t_origin: float = 0.0
+
+    def __post_init__(self):
+        images = np.asarray(self.images)
+        if images.ndim == 4 and images.shape[-1] == 1:
+            images = images[..., 0]
+        if images.ndim != 3:
+            raise EventDataError(f"frames must have shape [F, H, W] (grey), got {images.shape}")
+        t = np.asarray(self.t, dtype=np.float64)
+        if t.shape != (images.shape[0],):
+            raise EventDataError(f"{images.shape[0]} frames but {t.shape[0] if t.ndim == 1 else t.shape} timestamps")
+        if not np.all(np.isfinite(t)):
+            raise EventDataError("frame timestamps contain NaN or inf; repair or drop those frames")
+        object.__setattr__(self, "images", images)
+        object.__setattr__(self, "t", t)
+        object.__setattr__(self, "t_origin", float(self.t_origin))
+
+    def __len__(self) -> int:
+        return int(self.images.shape[0])
+
+    def __repr__(self) -> str:
+        return f"Frames(n={len(self)}, size={self.size}, t_origin={self.t_origin})"
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(H, W)."""
+        return int(self.images.shape[1]), int(self.images.shape[2])
+
+    def as_float(self) -> np.ndarray:
+        """Images as float32 in [0, 1] (uint8 is divided by 255)."""
+        if self.images.dtype == np.uint8:
+            return self.images.astype(np.float32) / 255.0
+        return self.images.astype(np.float32)
+
+    def slice_time(self, t_start: float | None = None, t_end: float | None = None) -> "Frames":
+        """Frames with ``t_start <= t < t_end`` (seconds)."""
+        keep = np.ones(len(self), bool)
+        if t_start is not None:
+            keep &= self.t >= t_start
+        if t_end is not None:
+            keep &= self.t < t_end
+        return Frames(self.images[keep], self.t[keep], self.t_origin)
+
+    def sorted(self) -> "Frames":
+        """Frames in time order (some recordings store one frame out of order)."""
+        order = np.argsort(self.t, kind="stable")
+        return Frames(self.images[order], self.t[order], self.t_origin)
