@@ -145,7 +145,7 @@ class Events:
             if dec.size:
                 i = int(dec[0])
                 raise EventDataError(
-                    f"timestamps are not sorted: t[{i}] = {t[i]!r} > t[{i + 1}] = {t[i + 1]!r} "
+                    f"timestamps are not sorted: t[{i}] = {float(t[i])!r} > t[{i + 1}] = {float(t[i + 1])!r} "
                     f"({dec.size} decreasing steps); sort the events by time, e.g. "
                     "Events.from_arrays(..., sort=True)"
                 )

@@ -1,0 +1,29 @@
+"""Tone mapping (Eq. 12): log intensity F -> display values in [0, 1].
+
+I = exp(F) and Gamma(I) = (I / (I + 1))^gamma. Since I / (I + 1) = sigmoid(F), this is computed
+as sigmoid(F)^gamma, which never overflows. The result depends on the absolute level of F: adding a
+constant c to F (the unknown offset that events cannot see) brightens or darkens every pixel, so a
+reconstruction is only comparable with ground truth once its offset is anchored (see each solver).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["tonemap_reinhard"]
+
+
+def tonemap_reinhard(L, gamma: float = 0.6):
+    """(exp(L) / (exp(L) + 1)) ** gamma, elementwise; numpy array or torch tensor, any shape.
+
+    Args:
+        L: log intensity.
+        gamma: contrast exponent (paper: 0.6).
+    Returns:
+        Same type and shape as ``L``, values in (0, 1).
+    """
+    if not gamma > 0:
+        raise ValueError(f"gamma must be positive, got {gamma}")
+    if hasattr(L, "sigmoid"):  # torch tensor
+        return L.sigmoid() ** gamma
+    L = np.asarray(L, dtype=np.float64)
+    return (0.5 * (1.0 + np.tanh(0.5 * L))) ** gamma  # sigmoid without overflow warnings
