@@ -4,6 +4,11 @@ Modules, one job each:
     events      the `Events` container (t seconds float64, x column, y row, p +-1, (H, W))
     frames      `Frames`: ground-truth frames with timestamps
     binning     event frames over fixed-duration or equal-count bins (Eq. 2)
+    simulate    ESIM-style event simulation (1-D signals, videos, scenes)
+    scenes      synthetic scenes with ground truth at any time
+    integration direct event integration
+    tonemap     Reinhard tone mapping (Eq. 12)
+    metrics     MSE and SSIM with a stated protocol
     fastmode    small sizes for tests and CI (EVINR_FAST)
     device      CPU by default, a GPU when present
 """
@@ -12,5 +17,9 @@ from .device import default_device
 from .events import EventDataError, Events, normalize_polarity
 from .fastmode import fast_mode, pick
 from .frames import Frames
+from .integration import integrate_events
+from .scenes import MovingBarScene, MovingImageScene, make_scene
+from .simulate import simulate_events_1d, simulate_scene, simulate_video
+from .tonemap import tonemap_reinhard
 
 __version__ = "0.1.0"
