@@ -3,6 +3,7 @@
 Modules, one job each:
     events      the `Events` container (t seconds float64, x column, y row, p +-1, (H, W))
     frames      `Frames`: ground-truth frames with timestamps
+    readers     npy, IJRR text/folders, EVREAL folders, HQF-style h5 -> Recording(events, frames, meta)
     binning     event frames over fixed-duration or equal-count bins (Eq. 2)
     simulate    ESIM-style event simulation (1-D signals, videos, scenes)
     scenes      synthetic scenes with ground truth at any time
@@ -17,6 +18,7 @@ from .device import default_device
 from .events import EventDataError, Events, normalize_polarity
 from .fastmode import fast_mode, pick
 from .frames import Frames
+from .readers import Recording, read_events, read_recording
 from .integration import integrate_events
 from .scenes import MovingBarScene, MovingImageScene, make_scene
 from .simulate import simulate_events_1d, simulate_scene, simulate_video

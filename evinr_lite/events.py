@@ -19,10 +19,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Events", "EventDataError", "normalize_polarity", "TIME_UNITS"]
+import math
+
+__all__ = ["Events", "EventDataError", "normalize_polarity", "relative_seconds", "TIME_UNITS", "LARGE_T"]
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
+LARGE_T = 1e5  # seconds; clocks whose first timestamp is at least this large get a whole-second t_origin
 
 
 class EventDataError(ValueError):
@@ -77,6 +80,39 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
             )
         return np.where(p > 0, 1, -1).astype(np.int8)
     raise EventDataError(f"unknown polarity encoding {encoding!r}; use 'auto', 'pm1', '01' or 'bool'")
+
+
+def auto_origin(t_first: float) -> float:
+    """Whole seconds of the first timestamp when it is large (an absolute clock), else 0."""
+    return float(math.floor(t_first)) if math.isfinite(t_first) and abs(t_first) >= LARGE_T else 0.0
+
+
+def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
+    """Timestamps [N] in ``time_unit`` -> (float64 seconds relative to t_origin, t_origin in seconds).
+
+    t_origin is the whole seconds of the earliest timestamp on an absolute clock (>= 1e5 s), else 0.
+    Integer timestamps (us, ns) are shifted in integer arithmetic and then divided (correctly
+    rounded), so no precision is lost; float timestamps are shifted in float64 (exact for large values).
+    """
+    if time_unit not in TIME_UNITS:
+        raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
+    per_s = round(1 / TIME_UNITS[time_unit])  # 1, 1000, 10**6, 10**9 units per second
+    t = np.asarray(t)
+    if t.size == 0:
+        return t.astype(np.float64), 0.0
+    if t.dtype.kind in "iu":
+        t0 = int(t.min())
+        origin_units = (t0 // per_s) * per_s if abs(t0) >= LARGE_T * per_s else 0
+        rel = (t.astype(np.int64) - origin_units).astype(np.float64) / per_s
+        return rel, float(origin_units // per_s)
+    if t.dtype.kind != "f":
+        raise EventDataError(f"timestamps must be numbers, got dtype {t.dtype}")
+    if t.dtype != np.float64 and time_unit == "s":
+        return t, 0.0  # let Events refuse float32 seconds with its explanation
+    ts = t.astype(np.float64) / per_s
+    finite = ts[np.isfinite(ts)]
+    origin = auto_origin(float(finite.min())) if finite.size else 0.0
+    return ts - origin, origin
 
 
 def _check_sensor_size(sensor_size) -> tuple[int, int]:
@@ -177,7 +213,9 @@ class Events:
         """Build events from raw columns.
 
         Args:
-            t: [N] timestamps in ``time_unit`` ('s', 'ms', 'us' or 'ns').
+            t: [N] timestamps in ``time_unit`` ('s', 'ms', 'us' or 'ns'). Other units are converted
+                exactly; an absolute clock (>= 1e5 s) given in ms/us/ns is split into whole seconds,
+                added to ``t_origin``, and a relative ``t``.
             x, y: [N] column and row indices.
             p: [N] polarities; see :func:`normalize_polarity` for ``polarity``.
             sensor_size: (H, W).
@@ -188,7 +226,8 @@ class Events:
             raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
         t = np.asarray(t)
         if time_unit != "s":
-            t = t.astype(np.float64) * TIME_UNITS[time_unit]
+            t, shift = relative_seconds(t, time_unit)
+            t_origin = t_origin + shift
         if sort:
             order = np.argsort(t, kind="stable")
             t, x, y, p = (np.asarray(a)[order] for a in (t, x, y, p))

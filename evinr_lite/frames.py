@@ -16,7 +16,8 @@ class Frames:
 
     Attributes:
         images: [F, H, W], uint8 (0..255) or float in [0, 1]; indexed [frame, y (row), x (column)].
-        t: float64 [F], seconds relative to ``t_origin`` (the same clock as the events they go with).
+        t: float64 [F], seconds relative to ``t_origin`` (the same clock as the events they go with);
+            readers return them sorted, :meth:`sorted` sorts others.
         t_origin: float, seconds; absolute time of t = 0.
     """
 
@@ -28,6 +29,8 @@ class Frames:
         images = np.asarray(self.images)
         if images.ndim == 4 and images.shape[-1] == 1:
             images = images[..., 0]
+        if images.dtype != np.uint8 and images.dtype.kind != "f":
+            raise EventDataError(f"frames must be uint8 (0..255) or float in [0, 1], got dtype {images.dtype}")
         if images.ndim != 3:
             raise EventDataError(f"frames must have shape [F, H, W] (grey), got {images.shape}")
         t = np.asarray(self.t, dtype=np.float64)

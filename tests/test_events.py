@@ -141,3 +141,16 @@ def test_concatenate_merges_in_time_order():
     np.testing.assert_array_equal(ev.p, [1, -1, 1, -1])
     with pytest.raises(EventDataError, match="different sensor_size"):
         Events.concatenate([a, Events.empty((3, 3))])
+
+
+def test_integer_absolute_clock_in_ns_is_split_exactly():
+    t_ns = np.array([1468939802_123456789, 1468939802_123456790], dtype=np.int64)
+    ev = Events.from_arrays(t_ns, [0, 0], [0, 0], [1, 1], (1, 1), time_unit="ns")
+    assert ev.t_origin == 1468939802.0
+    assert ev.t[0] == 0.123456789 and ev.t[1] - ev.t[0] == pytest.approx(1e-9, abs=1e-15)
+
+
+def test_us_conversion_is_correctly_rounded():
+    t_us = np.arange(0, 100_000, 7)
+    ev = Events.from_arrays(t_us, np.zeros_like(t_us), np.zeros_like(t_us), np.ones_like(t_us), (1, 1), time_unit="us")
+    np.testing.assert_array_equal(ev.t, t_us / 1e6)
