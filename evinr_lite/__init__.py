@@ -10,6 +10,12 @@ Modules, one job each:
     integration direct event integration
     tonemap     Reinhard tone mapping (Eq. 12)
     metrics     MSE and SSIM with a stated protocol
+    siren       SIREN networks (sine activations, SIREN initialisation)
+    pde1d       the 1-D pieces of notebook 01 (window sums, Eq. 4, a 1-D SIREN fit)
+    exercises   exercise checks that say what is wrong, with fallback to the reference
+    widgets     `interact`: sliders in a live front end, one static figure otherwise
+    plotting    figures for the notebooks (the method modules never import matplotlib)
+    demo, cli   the `evinr-lite` command and the README's demo
     fastmode    small sizes for tests and CI (EVINR_FAST)
     device      CPU by default, a GPU when present
 """

@@ -20,6 +20,7 @@ def test_committed_without_outputs(path):
         src = "".join(cell["source"])
         if src.startswith("# NBVAL_CHECK_OUTPUT"):
             assert cell["outputs"], f"{path.name} cell {i} is a checked cell but has no stored output"
+            assert cell["execution_count"], f"{path.name} cell {i}: nbval needs an execution count on checked cells"
             continue
         assert not cell["outputs"], (f"{path.name} cell {i} has stored outputs; "
                                      "run `python tools/strip_notebooks.py notebooks/*.ipynb`")

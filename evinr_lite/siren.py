@@ -1,0 +1,149 @@
+"""SIREN: a multilayer perceptron with sine activations (Sitzmann et al., NeurIPS 2020).
+
+EvINR represents the log intensity as a SIREN (Sec. 3.2 of the paper): the 1-D teaching
+model F(t) of notebook 01 and the frame-based model F(t) -> H*W log intensities (Eq. 11)
+are both instances of :class:`Siren`.
+
+A sine layer computes ``sin(omega_0 * (W x + b))``. The initialisation keeps every
+layer's pre-activations close to a standard normal and its outputs close to the arcsine
+distribution on [-1, 1], whatever the depth:
+
+- first layer: ``W ~ U(-1/in, 1/in)`` (it sees raw coordinates, usually in [-1, 1]; its
+  frequency is set by ``first_omega_0``);
+- hidden layers (and the linear head): ``W ~ U(-sqrt(6/in)/omega_0, +sqrt(6/in)/omega_0)``.
+
+Biases keep PyTorch's default ``U(-1/sqrt(in), 1/sqrt(in))``.
+"""
+from __future__ import annotations
+
+import math
+
+import torch
+from torch import nn
+
+__all__ = ["SineLayer", "Siren", "input_gradient"]
+
+
+class SineLayer(nn.Module):
+    """``y = sin(omega_0 * (x @ W.T + b))``.
+
+    Args:
+        in_features, out_features: sizes of the input and output.
+        omega_0: frequency factor.
+        is_first: use the first-layer initialisation ``U(-1/in, 1/in)``.
+
+    Shapes: input [..., in_features] -> output [..., out_features].
+    """
+
+    def __init__(self, in_features: int, out_features: int, omega_0: float = 30.0, is_first: bool = False):
+        super().__init__()
+        self.omega_0 = float(omega_0)
+        self.is_first = bool(is_first)
+        self.linear = nn.Linear(in_features, out_features)
+        with torch.no_grad():
+            bound = 1.0 / in_features if is_first else math.sqrt(6.0 / in_features) / self.omega_0
+            self.linear.weight.uniform_(-bound, bound)
+
+    def preactivation(self, x: torch.Tensor) -> torch.Tensor:
+        """``omega_0 * (W x + b)``, the argument of the sine. [..., in] -> [..., out]."""
+        return self.omega_0 * self.linear(x)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return torch.sin(self.preactivation(x))
+
+    def extra_repr(self) -> str:
+        return f"omega_0={self.omega_0}, is_first={self.is_first}"
+
+
+class Siren(nn.Module):
+    """A SIREN: ``hidden_layers + 1`` sine layers followed by a linear (or sine) output layer.
+
+    Args:
+        in_features: input size (1 for F(t), 3 for F(x, y, t)).
+        out_features: output size (1 for one pixel, H*W for the frame-based model).
+        hidden_features: width of every hidden layer (the paper uses 512).
+        hidden_layers: number of hidden-to-hidden sine layers (the paper uses 3).
+        omega_0: frequency factor of the hidden layers (SIREN's default 30).
+        first_omega_0: frequency factor of the first layer; ``None`` means ``omega_0``.
+            It sets the highest frequency the network represents easily along its inputs.
+        outermost_linear: a linear output layer (True, for unbounded values such as log
+            intensity) or one more sine layer (False, outputs in [-1, 1]).
+
+    Shapes: input [..., in_features] -> output [..., out_features]. Inputs are expected
+    roughly in [-1, 1] (map times and coordinates there before calling).
+
+    Example::
+
+        net = Siren(1, 1, hidden_features=64, hidden_layers=2)
+        t = torch.linspace(-1, 1, 100)[:, None]      # [100, 1]
+        F = net(t)                                   # [100, 1]
+    """
+
+    def __init__(self, in_features: int, out_features: int, hidden_features: int = 512,
+                 hidden_layers: int = 3, omega_0: float = 30.0, first_omega_0: float | None = None,
+                 outermost_linear: bool = True):
+        super().__init__()
+        for name, value in (("in_features", in_features), ("out_features", out_features),
+                            ("hidden_features", hidden_features)):
+            if int(value) != value or value < 1:
+                raise ValueError(f"{name} must be a positive integer, got {value!r}")
+        if int(hidden_layers) != hidden_layers or hidden_layers < 0:
+            raise ValueError(f"hidden_layers must be a non-negative integer, got {hidden_layers!r}")
+        if not omega_0 > 0 or (first_omega_0 is not None and not first_omega_0 > 0):
+            raise ValueError(f"omega_0 and first_omega_0 must be positive, got {omega_0}, {first_omega_0}")
+        self.in_features = int(in_features)
+        self.out_features = int(out_features)
+        self.omega_0 = float(omega_0)
+        self.first_omega_0 = float(omega_0 if first_omega_0 is None else first_omega_0)
+        self.outermost_linear = bool(outermost_linear)
+
+        layers: list[nn.Module] = [SineLayer(in_features, hidden_features, self.first_omega_0, is_first=True)]
+        for _ in range(int(hidden_layers)):
+            layers.append(SineLayer(hidden_features, hidden_features, self.omega_0))
+        if outermost_linear:
+            head = nn.Linear(hidden_features, out_features)
+            with torch.no_grad():
+                bound = math.sqrt(6.0 / hidden_features) / self.omega_0
+                head.weight.uniform_(-bound, bound)
+            layers.append(head)
+        else:
+            layers.append(SineLayer(hidden_features, out_features, self.omega_0))
+        self.net = nn.Sequential(*layers)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        """[..., in_features] -> [..., out_features]."""
+        if x.shape[-1] != self.in_features:
+            raise ValueError(f"Siren expects inputs of shape [..., {self.in_features}], got {tuple(x.shape)}")
+        return self.net(x)
+
+    def activations(self, x: torch.Tensor) -> list[torch.Tensor]:
+        """Outputs of every layer, first to last (for looking at the initialisation).
+
+        Returns a list of ``len(self.net)`` tensors; entry k has shape [..., width of layer k].
+        """
+        out = []
+        for layer in self.net:
+            x = layer(x)
+            out.append(x)
+        return out
+
+    def num_parameters(self) -> int:
+        return sum(p.numel() for p in self.parameters())
+
+
+def input_gradient(y: torch.Tensor, x: torch.Tensor, create_graph: bool = True) -> torch.Tensor:
+    """d(sum of y)/dx by autograd; with ``create_graph=True`` a loss on it can be back-propagated
+    again ("double back-propagation", Eq. 5).
+
+    Args:
+        y: output that depends on ``x`` (any shape; its entries are summed, so for a network
+            applied row-wise to x [N, d] with one output per row this is the per-row gradient).
+        x: input tensor with ``requires_grad=True``.
+
+    Returns:
+        tensor shaped like ``x``.
+    """
+    if not x.requires_grad:
+        raise ValueError("input_gradient needs x.requires_grad=True before the forward pass")
+    (g,) = torch.autograd.grad(y, x, grad_outputs=torch.ones_like(y), create_graph=create_graph)
+    return g

@@ -1,0 +1,195 @@
+"""Exercise checks and fallbacks, and the reference solutions of notebook 01 (evinr_lite.pde1d)."""
+import warnings
+
+import numpy as np
+import pytest
+import torch
+
+from evinr_lite import exercises, pde1d
+from evinr_lite.binning import events_to_frames
+from evinr_lite.events import Events
+from evinr_lite.exercises import ExerciseWarning
+
+
+def _ref_scaled_cumsum(x, C):
+    return C * np.cumsum(x)
+
+
+def _inputs(rng):
+    return [dict(x=rng.choice([-1.0, 1.0], 6), C=0.2), dict(x=rng.choice([-1.0, 1.0], 9), C=0.5)]
+
+
+@pytest.fixture
+def toy():
+    exercises.register("toy_cumsum", _ref_scaled_cumsum, _inputs,
+                       hints={"did you forget the sign of the polarity?": lambda x, C: C * np.cumsum(np.abs(x))})
+    yield "toy_cumsum"
+    exercises._REGISTRY.pop("toy_cumsum", None)
+
+
+def _solution_with_markers(x, C):
+    ### BEGIN SOLUTION
+    return C * np.cumsum(x)
+    ### END SOLUTION
+
+
+def _student_stub(x, C):
+    raise NotImplementedError
+
+
+def test_correct_function_passes(toy, capsys):
+    assert exercises.check(toy, _solution_with_markers) is True
+    out = capsys.readouterr().out
+    assert out.startswith("✓ toy_cumsum") and "2 inputs" in out
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert exercises.use(toy, _solution_with_markers) is _solution_with_markers
+
+
+def test_stub_is_not_done_and_falls_back_with_a_warning(toy, capsys):
+    assert exercises.check(toy, _student_stub) is False
+    assert "not done yet" in capsys.readouterr().out
+    with pytest.warns(ExerciseWarning, match="toy_cumsum.*not done yet.*reference solution"):
+        fn = exercises.use(toy, _student_stub)
+    assert fn is _ref_scaled_cumsum
+    out = capsys.readouterr().out
+    assert "⚠ Exercise 'toy_cumsum' is not finished" in out and "reference solution" in out
+
+
+def test_wrong_values_name_the_input_the_index_and_the_hint(toy, capsys):
+    assert not exercises.check(toy, lambda x, C: C * np.cumsum(np.abs(x)))
+    out = capsys.readouterr().out
+    assert "✗ toy_cumsum" in out and "input #1 of 2" in out
+    assert "at index" in out and "got" in out and "expected" in out
+    assert "did you forget the sign of the polarity?" in out
+
+
+def test_generic_hints(toy, capsys):
+    exercises.check(toy, lambda x, C: np.cumsum(x))  # forgot C: a constant factor
+    assert "constant factor" in capsys.readouterr().out
+    exercises.check(toy, lambda x, C: -C * np.cumsum(x))
+    assert "sign is flipped" in capsys.readouterr().out
+    exercises.check(toy, lambda x, C: C * np.cumsum(x) + 1.0)
+    assert "constant offset of 1" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("fn, message", [
+    (lambda x, C: C * np.cumsum(x)[:-1], "wrong shape"),
+    (lambda x, C: np.cumsum(x).astype(int), "wrong dtype: got integer"),
+    (lambda x, C: None, "returned None"),
+    (lambda x, C: x[100], "raised IndexError"),
+    (lambda x, C: "text", "expected numbers"),
+    (42, "expected a function"),
+])
+def test_structural_problems_are_named(toy, capsys, fn, message):
+    assert exercises.check(toy, fn) is False  # never raises
+    assert message in capsys.readouterr().out
+
+
+def test_inputs_are_copied_so_mutation_does_not_leak(toy):
+    def mutating(x, C):
+        x *= 0
+        return C * np.cumsum(x)
+    assert not exercises.check(toy, mutating, verbose=False)
+    assert exercises.check(toy, _solution_with_markers, verbose=False)
+
+
+def test_unknown_exercise(capsys):
+    assert exercises.check("no_such_exercise", _student_stub) is False
+    assert "no exercise named 'no_such_exercise'" in capsys.readouterr().out
+    with pytest.raises(KeyError):
+        exercises.use("no_such_exercise", _student_stub)
+
+
+def test_decorator_registers(capsys):
+    @exercises.exercise("toy_square", lambda rng: [(np.arange(3.0),)])
+    def square(a):
+        return a ** 2
+    try:
+        assert exercises.reference("toy_square") is square
+        assert exercises.check("toy_square", lambda a: a * a)
+    finally:
+        exercises._REGISTRY.pop("toy_square")
+
+
+# ---- notebook 01's exercises --------------------------------------------------------
+
+NB01 = ["integrate_events_1d", "event_rate_derivative", "temporal_loss"]
+
+
+def test_notebook01_exercises_are_registered():
+    assert set(NB01) <= set(exercises.names())
+
+
+@pytest.mark.parametrize("name", NB01)
+def test_references_pass_and_stubs_fall_back(name, capsys):
+    ref = exercises.reference(name)
+    assert exercises.check(name, ref)
+    with pytest.warns(ExerciseWarning):
+        assert exercises.use(name, _stub_like(ref)) is ref
+
+
+def _stub_like(ref):
+    def stub(*args, **kwargs):
+        raise NotImplementedError
+    return stub
+
+
+@pytest.mark.parametrize("name, wrong, hint", [
+    ("integrate_events_1d", lambda t_events, p_events, C, t_query: pde1d.integrate_events_1d(t_events, np.abs(p_events), C, t_query),
+     "sign of the polarity"),
+    ("integrate_events_1d", lambda t_events, p_events, C, t_query: pde1d.integrate_events_1d(t_events, p_events, 1.0, t_query),
+     "multiply by the contrast threshold C"),
+    ("event_rate_derivative", lambda t_events, p_events, C, boundaries: pde1d.window_sums(t_events, p_events, C, boundaries),
+     "divide by the window length"),
+    ("temporal_loss", lambda dF_dt, delta_L, durations: torch.sum((delta_L - dF_dt * durations) ** 2), "mean over windows"),
+    ("temporal_loss", lambda dF_dt, delta_L, durations: torch.mean((delta_L - dF_dt) ** 2), "window length"),
+    ("temporal_loss", lambda dF_dt, delta_L, durations: float(torch.mean((delta_L - dF_dt * durations) ** 2)), "torch.Tensor"),
+])
+def test_typical_mistakes_get_their_hint(name, wrong, hint, capsys):
+    assert not exercises.check(name, wrong)
+    assert hint in capsys.readouterr().out
+
+
+def test_integrate_events_1d_values():
+    t = np.array([0.1, 0.2, 0.3, 0.5])
+    p = np.array([1, 1, -1, 1], dtype=np.int8)
+    got = pde1d.integrate_events_1d(t, p, 0.25, [0.0, 0.1, 0.25, 0.3, 1.0])
+    assert np.allclose(got, [0.0, 0.25, 0.5, 0.25, 0.5]) and got.dtype == np.float64
+
+
+def test_event_rate_derivative_agrees_with_binning():
+    rng = np.random.default_rng(3)
+    t = np.sort(rng.uniform(0, 1, 200))
+    p = rng.choice([-1, 1], 200)
+    b = np.linspace(0, 1, 9)
+    ev = Events(t, np.zeros(200, int), np.zeros(200, int), p, (1, 1))
+    frames = events_to_frames(ev, b, C=0.2)
+    assert np.allclose(pde1d.event_rate_derivative(t, p, 0.2, b), frames.frames[:, 0, 0] / frames.durations)
+    assert np.allclose(pde1d.window_sums(t, p, 0.2, b), frames.frames[:, 0, 0])
+
+
+def test_taylor_error_shrinks_like_window_squared():
+    # L = sin(2 pi t): slope over a window of length w about m is L'(m) * sinc-like factor,
+    # error = 2 pi |cos(2 pi m)| (1 - sin(pi w) / (pi w)) ~ 2 pi (pi w)^2 / 6 at m = 0
+    L, dL = (lambda t: np.sin(2 * np.pi * t)), (lambda t: 2 * np.pi * np.cos(2 * np.pi * t))
+    e1 = pde1d.taylor_error(L, [0.0], 0.01, dL)[0]
+    e2 = pde1d.taylor_error(L, [0.0], 0.02, dL)[0]
+    assert e1 == pytest.approx(2 * np.pi * (np.pi * 0.01) ** 2 / 6, rel=1e-3)
+    assert e2 / e1 == pytest.approx(4.0, rel=1e-2)
+    assert pde1d.taylor_error(L, [0.0], 0.02)[0] == pytest.approx(e2, rel=1e-3)  # numerical derivative
+
+
+def test_eq4_error_vs_window_has_both_regimes():
+    L, dL = (lambda t: 2 * np.sin(2 * np.pi * t)), (lambda t: 4 * np.pi * np.cos(2 * np.pi * t))
+    # ideal events of L with C = 0.05 (level crossings on a fine grid)
+    t = np.linspace(0, 1, 100001)
+    k = np.floor((L(t) - L(0)) / 0.05 + 0.5)
+    steps = np.diff(k)
+    idx = np.flatnonzero(steps)
+    te, pe = t[idx + 1], np.sign(steps[idx]).astype(np.int8)
+    res = pde1d.eq4_error_vs_window(L, [0.005, 0.05, 0.25], (0, 1), t_events=te, p_events=pe, C=0.05, dLdt=dL)
+    assert res["taylor"][0] < res["taylor"][1] < res["taylor"][2]
+    assert res["events"][0] > res["events"][1]  # quantisation dominates short windows
+    with pytest.raises(ValueError):
+        pde1d.eq4_error_vs_window(L, [2.0], (0, 1))
