@@ -1,19 +1,183 @@
 """data_fetch: download and convert real event datasets (IJRR, HQF, CED, MVSEC, AED) into one format.
 
-Only the cache location lives here so far; the downloaders and converters arrive with the
-real-data issue. Everything it produces is read by ``evinr_lite``'s readers.
+    import data_fetch
+    path = data_fetch.get("ijrr", "slider_depth")     # download (resumable, cached) + convert
+    rec = data_fetch.read(path, t_start=1.0, t_end=2.5) # evinr_lite Recording(events, frames, meta)
+
+The command line does the same: ``python -m data_fetch list | get <dataset> <sequence> |
+convert <raw path> [--out ...] | info <file.h5>``.
+
+Files live in :func:`cache_dir` (``$EVINR_DATA``, default ``~/.cache/evinr-lite``): raw downloads in
+``raw/<dataset>/``, converted sequences in ``<dataset>/<sequence>.h5`` (the canonical layout of
+:mod:`evinr_lite.canonical`). Heavy libraries (pooch, requests, gdown, rosbags, h5py) are imported
+only when a function needs them, so ``import data_fetch`` is fast.
 """
 from __future__ import annotations
 
+import logging
 import os
 from pathlib import Path
 
-__all__ = ["cache_dir"]
+from .errors import ChecksumError, ConversionError, DataFetchError, DownloadError, NotDownloadable
+
+__all__ = [
+    "cache_dir", "get", "get_all", "convert", "read", "info", "list_datasets", "raw_path", "canonical_path",
+    "DataFetchError", "DownloadError", "ChecksumError", "ConversionError", "NotDownloadable",
+]
 
 ENV_VAR = "EVINR_DATA"
+log = logging.getLogger("data_fetch")
 
 
 def cache_dir() -> Path:
     """Folder for downloads and converted sequences: ``$EVINR_DATA`` or ``~/.cache/evinr-lite``."""
     path = Path(os.environ.get(ENV_VAR) or Path.home() / ".cache" / "evinr-lite")
     return path.expanduser()
+
+
+def canonical_path(dataset: str, sequence: str) -> Path:
+    """Where the converted sequence is (or will be): ``<cache>/<dataset>/<sequence>.h5``."""
+    from .registry import get_dataset
+
+    return cache_dir() / get_dataset(dataset).name / f"{sequence}.h5"
+
+
+def raw_path(dataset: str, sequence: str) -> Path:
+    """Where the raw download is (or is to be placed by hand): ``<cache>/raw/<dataset>/<file>``."""
+    from .registry import get_dataset, get_sequence
+
+    ds = get_dataset(dataset)
+    if ds.method == "manual":
+        return cache_dir() / "raw" / ds.name / sequence
+    return cache_dir() / "raw" / ds.name / get_sequence(ds.name, sequence).raw_file
+
+
+def _manual_message(ds, sequence: str) -> str:
+    return (f"{ds.title} is not publicly downloadable. Ask the EvINR authors for it, then place "
+            f"the files of sequence {sequence!r} in {cache_dir() / 'raw' / ds.name / sequence}/ . Converting them "
+            f"(Quad Bayer demosaicing) belongs to the {ds.name.upper()} converter, which is not part of data_fetch "
+            f"yet; a sequence already converted to the canonical format is found at "
+            f"{cache_dir() / ds.name / (sequence + '.h5')} and returned by data_fetch.get.")
+
+
+def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str | None = None,
+        verify: bool = True, force: bool = False, keep_raw: bool = True, progress: bool = True,
+        retries: int = 3) -> Path:
+    """Download (if needed) and convert one sequence; return the canonical ``.h5`` path.
+
+    Args:
+        dataset: "ijrr" (alias "ecd"), "hqf", "ced", "mvsec" or "aed".
+        sequence: a sequence name (``python -m data_fetch list <dataset>``).
+        url: download from this address instead (a mirror); its checksum is ``known_hash``.
+        known_hash: checksum to verify ("sha256:<hex>" or "md5:<hex>"); default: the registry's.
+        verify: False skips checksum verification.
+        force: convert again even if the canonical file exists.
+        keep_raw: keep the raw download after conversion (False deletes it).
+        progress: progress bars and log lines.
+        retries: resumptions of a dropped connection within this call.
+
+    Raises:
+        DownloadError (unreachable, 404: the message says where to place the file by hand),
+        ChecksumError, ConversionError (damaged raw file), NotDownloadable (AED).
+    """
+    from evinr_lite.canonical import is_canonical
+
+    from .registry import get_dataset, get_sequence
+
+    if progress and not logging.getLogger().handlers and not log.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+    ds = get_dataset(dataset)
+    out = canonical_path(ds.name, sequence)
+    if not force and is_canonical(out):
+        return out
+    if ds.method == "manual":
+        raise NotDownloadable(_manual_message(ds, sequence))
+    seq = get_sequence(ds.name, sequence)
+    raw = raw_path(ds.name, seq.name)
+    pinned = known_hash if (known_hash or url) else seq.known_hash
+    pinned = pinned if verify else None
+    if seq.archive_member:                              # CED: a bag placed by hand wins over the zip
+        placed = raw.parent / seq.archive_member
+        if placed.exists():
+            raw, pinned = placed, None
+    from .download import fetch_gdrive_file, fetch_url
+
+    try:
+        if url or ds.method == "http":
+            fetch_url(url or seq.url, raw, known_hash=pinned, progress=progress, retries=retries,
+                      homepage=ds.homepage)
+        elif ds.method == "gdrive":
+            fetch_gdrive_file(ds.homepage, seq.raw_file, raw, progress=progress, known_hash=pinned)
+    except DownloadError as err:
+        if seq.name in ds.sequences:
+            raise
+        raise DownloadError(f"{err} Note: {seq.name!r} is not one of the registered {ds.name} sequences "
+                            f"({', '.join(ds.sequences)}); check the name.") from None
+    from .conversion import convert as _convert
+
+    path = _convert(raw, out, dataset=ds.name, sequence=seq.name, progress=progress)
+    if not keep_raw and raw.exists():
+        raw.unlink()
+    return path
+
+
+def get_all(dataset: str, **kwargs) -> dict[str, Path]:
+    """:func:`get` every registered evaluation sequence of a dataset; {sequence: path}."""
+    from .registry import get_dataset
+
+    ds = get_dataset(dataset)
+    if ds.method == "manual":
+        raise NotDownloadable(_manual_message(ds, "<sequence>"))
+    return {name: get(ds.name, name, **kwargs) for name, s in ds.sequences.items() if s.evaluation}
+
+
+def convert(raw, out=None, **kwargs) -> Path:
+    """Convert a raw recording to the canonical file; see :func:`data_fetch.conversion.convert`."""
+    from .conversion import convert as _convert
+
+    return _convert(raw, out, **kwargs)
+
+
+def read(path, t_start: float | None = None, t_end: float | None = None, **kwargs):
+    """Read a canonical file (optionally a time window) as an evinr_lite ``Recording``."""
+    from evinr_lite.canonical import read_canonical
+
+    return read_canonical(path, t_start, t_end, **kwargs)
+
+
+def info(path) -> dict:
+    """The attributes of a canonical file (dataset, sequence, sensor size, C, eval window, counts)."""
+    from evinr_lite.canonical import canonical_info
+
+    return canonical_info(path)
+
+
+def list_datasets(dataset: str | None = None) -> list[dict]:
+    """What can be fetched, with the local state of each sequence.
+
+    Returns one dict per sequence (or per dataset for AED): dataset, sequence, method, sensor_size,
+    C, eval_window, url, known_hash, raw (path or None if absent), converted (path or None).
+    """
+    from evinr_lite.canonical import is_canonical
+
+    from .registry import DATASETS, get_dataset
+
+    rows = []
+    for ds in ([get_dataset(dataset)] if dataset else DATASETS.values()):
+        if not ds.sequences:
+            rows.append(dict(dataset=ds.name, sequence=None, method=ds.method, sensor_size=ds.sensor_size, C=ds.C,
+                             eval_window=None, url=None, known_hash=None, raw=None, converted=None,
+                             evaluation=True, note=ds.note))
+            continue
+        for seq in ds.sequences.values():
+            raw = raw_path(ds.name, seq.name)
+            out = canonical_path(ds.name, seq.name)
+            rows.append(dict(dataset=ds.name, sequence=seq.name, method=ds.method, sensor_size=ds.sensor_size,
+                             C=ds.C, eval_window=seq.eval_window, url=seq.url or ds.homepage,
+                             known_hash=seq.known_hash, raw=raw if raw.exists() else None,
+                             converted=out if is_canonical(out) else None, evaluation=seq.evaluation,
+                             note=ds.note))
+    return rows

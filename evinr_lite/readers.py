@@ -40,7 +40,7 @@ __all__ = [
 SUPPORTED_FORMATS = (
     "an IJRR folder (events.txt, images.txt, images/, calib.txt); "
     "an EVREAL folder (events_ts.npy, events_xy.npy, events_p.npy, images.npy, images_ts.npy, metadata.json); "
-    "an HQF-style .h5/.hdf5 file; "
+    "a data_fetch canonical .h5 file; an HQF-style .h5/.hdf5 file; "
     "a `t x y p` .txt file (optional `W H` header line); "
     "an [N, 4] .npy array"
 )
@@ -658,7 +658,8 @@ def read_recording(path, **kwargs) -> Recording:
     """Read any supported recording, detecting the format from the path.
 
     Folder with events.txt -> :func:`read_ijrr_folder`; folder with events_ts.npy ->
-    :func:`read_evreal_folder`; .h5/.hdf5 -> :func:`read_h5`; .txt -> :func:`read_events_txt`;
+    :func:`read_evreal_folder`; .h5/.hdf5 -> the canonical data_fetch format
+    (:func:`evinr_lite.canonical.read_canonical`) or HQF-style :func:`read_h5`; .txt -> :func:`read_events_txt`;
     .npy -> :func:`read_events_npy` (the last two without frames). ``kwargs`` go to that reader.
     """
     path = Path(path)
@@ -673,6 +674,10 @@ def read_recording(path, **kwargs) -> Recording:
                              f"supported formats: {SUPPORTED_FORMATS}")
     suffix = path.suffix.lower()
     if suffix in (".h5", ".hdf5"):
+        from .canonical import is_canonical, read_canonical
+
+        if is_canonical(path):  # written by data_fetch
+            return read_canonical(path, **kwargs)
         return read_h5(path, **kwargs)
     if suffix == ".txt":
         return Recording(read_events_txt(path, **kwargs), None, {"format": "txt", "path": str(path)})

@@ -1,0 +1,161 @@
+"""Command line: ``python -m data_fetch list | get | convert | info``.
+
+    python -m data_fetch list                        datasets, sequences, what is already local
+    python -m data_fetch list ijrr                   one dataset's sequences with windows and URLs
+    python -m data_fetch get ijrr slider_depth       download + convert -> prints the .h5 path
+    python -m data_fetch get ijrr all                every evaluation sequence of a dataset
+    python -m data_fetch convert RAW [--out PATH]    a raw file you already have
+    python -m data_fetch info FILE.h5                what a converted file holds
+"""
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import sys
+
+from . import DataFetchError, cache_dir
+
+
+def _fmt_window(w) -> str:
+    if w is None or not all(math.isfinite(v) for v in w):
+        return "whole"
+    return f"[{w[0]:g}, {w[1]:g}] s"
+
+
+def _cmd_list(args) -> int:
+    from . import list_datasets
+    from .registry import DATASETS, get_dataset
+
+    print(f"cache folder: {cache_dir()}  (set EVINR_DATA to move it)")
+    if args.dataset is None:
+        for ds in DATASETS.values():
+            rows = list_datasets(ds.name)
+            n_eval = sum(1 for r in rows if r["sequence"] and r["evaluation"])
+            n_win = sum(1 for r in rows if r["eval_window"] is not None)
+            done = sum(1 for r in rows if r["converted"])
+            H, W = ds.sensor_size
+            how = {"http": "direct download", "gdrive": "Google Drive folder (gdown)",
+                   "manual": "NOT downloadable: place files by hand"}[ds.method]
+            windows = f" ({n_win} with an evaluation window, the rest scored whole)" if 0 < n_win < n_eval else ""
+            seqs = f"{n_eval} sequences{windows}" if ds.sequences else "sequences on request"
+            print(f"\n{ds.name:6s} {ds.title}\n       {W}x{H}, C = {ds.C:g}, {seqs}, {how}; {done} converted here")
+        print("\n`python -m data_fetch list <dataset>` lists the sequences; "
+              "`python -m data_fetch get <dataset> <sequence>` fetches one.")
+        return 0
+    ds = get_dataset(args.dataset)
+    print(f"{ds.name}: {ds.title}\n  {ds.note}\n  home: {ds.homepage}\n  cite: {ds.citation}")
+    if not ds.sequences:
+        print(f"  place the files of a sequence in {cache_dir() / 'raw' / ds.name}/<sequence>/ by hand")
+        return 0
+    print(f"\n  {'sequence':38s} {'window':16s} {'state':10s} checksum")
+    for r in list_datasets(ds.name):
+        if not r["evaluation"] and not args.all:
+            continue
+        state = "converted" if r["converted"] else ("raw" if r["raw"] else "-")
+        check = (r["known_hash"] or "none published").split(":")[0]
+        print(f"  {r['sequence']:38s} {_fmt_window(r['eval_window']):16s} {state:10s} {check}")
+    hidden = sum(1 for r in list_datasets(ds.name) if not r["evaluation"])
+    if hidden and not args.all:
+        print(f"  (+{hidden} sequences outside the evaluation protocol: --all)")
+    return 0
+
+
+def _cmd_get(args) -> int:
+    from . import get, get_all
+
+    kwargs = dict(url=args.url, known_hash=args.sha256 and f"sha256:{args.sha256}", verify=not args.no_verify,
+                  force=args.force, keep_raw=not args.delete_raw, progress=not args.quiet)
+    if args.sequences == ["all"]:
+        if args.url:
+            raise DataFetchError("--url names one file; it cannot be used with 'all'")
+        for name, path in get_all(args.dataset, **kwargs).items():
+            print(path)
+        return 0
+    for name in args.sequences:
+        print(get(args.dataset, name, **kwargs))
+    return 0
+
+
+def _cmd_convert(args) -> int:
+    from . import convert
+
+    print(convert(args.raw, args.out, dataset=args.dataset, sequence=args.sequence,
+                  sensor_size=tuple(args.sensor_size) if args.sensor_size else None, C=args.C,
+                  event_topic=args.event_topic, image_topic=args.image_topic, progress=not args.quiet))
+    return 0
+
+
+def _cmd_info(args) -> int:
+    from . import info
+
+    i = info(args.file)
+    H, W = i["sensor_size"]
+    print(f"{args.file}\n  {i.get('dataset') or '?'} / {i.get('sequence') or '?'}: {i.get('source', '')}")
+    print(f"  {i['n_events']} events over [{i['t_first']:.6f}, {i['t_last']:.6f}] s (t_origin {i['t_origin']:.0f} s), "
+          f"{i['n_frames']} frames, sensor {W}x{H}, C = {i['C']:g}")
+    print(f"  evaluation window {_fmt_window(i['eval_window'])} on the file's clock "
+          f"(published {_fmt_window(i.get('eval_window_published'))} after t_zero = {i['t_zero']:.6f} s)")
+    if i["meta"]:
+        print(f"  meta: {', '.join(sorted(i['meta']))}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="python -m data_fetch", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    q = sub.add_parser("list", help="datasets and sequences")
+    q.add_argument("dataset", nargs="?")
+    q.add_argument("--all", action="store_true", help="also sequences outside the evaluation protocol")
+    q.set_defaults(func=_cmd_list)
+    q = sub.add_parser("get", help="download and convert sequences")
+    q.add_argument("dataset")
+    q.add_argument("sequences", nargs="+", metavar="sequence", help="sequence names, or 'all'")
+    q.add_argument("--url", help="download from this address instead (a mirror)")
+    q.add_argument("--sha256", help="checksum to verify the download against")
+    q.add_argument("--no-verify", action="store_true", help="skip the pinned checksum")
+    q.add_argument("--force", action="store_true", help="convert again even if converted")
+    q.add_argument("--delete-raw", action="store_true", help="delete the raw download after converting")
+    q.add_argument("--quiet", action="store_true", help="no progress bars")
+    q.set_defaults(func=_cmd_get)
+    q = sub.add_parser("convert", help="convert a raw file you already have")
+    q.add_argument("raw")
+    q.add_argument("--out", help="output .h5 file or folder (default: the cache)")
+    q.add_argument("--dataset")
+    q.add_argument("--sequence")
+    q.add_argument("--sensor-size", nargs=2, type=int, metavar=("H", "W"))
+    q.add_argument("--C", type=float, help="contrast threshold to store (default: the dataset's)")
+    q.add_argument("--event-topic")
+    q.add_argument("--image-topic")
+    q.add_argument("--quiet", action="store_true")
+    q.set_defaults(func=_cmd_convert)
+    q = sub.add_parser("info", help="describe a converted .h5")
+    q.add_argument("file")
+    q.set_defaults(func=_cmd_info)
+    return p
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    log = logging.getLogger("data_fetch")
+    if not log.handlers:
+        handler = logging.StreamHandler()
+        handler.setFormatter(logging.Formatter("%(message)s"))
+        log.addHandler(handler)
+        log.propagate = False
+    log.setLevel(logging.WARNING if getattr(args, "quiet", False) else logging.INFO)
+    from evinr_lite.events import EventDataError
+
+    try:
+        return args.func(args)
+    except (DataFetchError, EventDataError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("interrupted; run the same command again to resume", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,157 @@
+"""`convert`: any supported raw recording -> canonical file (format detected from the path)."""
+from __future__ import annotations
+
+import logging
+import shutil
+import zipfile
+from pathlib import Path, PurePosixPath
+
+from .errors import ConversionError, DataFetchError
+from .registry import DATASETS, Dataset, Sequence
+
+__all__ = ["convert", "guess_sequence", "extract_member"]
+
+log = logging.getLogger("data_fetch")
+_UNSET = object()
+
+
+def guess_sequence(path: Path) -> tuple[Dataset, Sequence] | None:
+    """The registered (dataset, sequence) a raw file name belongs to, e.g. slider_depth.zip -> IJRR."""
+    stem = path.name if path.is_dir() else path.stem
+    for name in (stem, stem.removesuffix("_data")):
+        hits = [(ds, ds.sequences[name]) for ds in DATASETS.values() if name in ds.sequences]
+        if len(hits) == 1:
+            return hits[0]
+    return None
+
+
+def extract_member(archive: Path, member_name: str, dest: Path) -> Path:
+    """Copy the archive member whose base name is ``member_name`` to ``dest`` (streamed, atomic)."""
+    try:
+        with zipfile.ZipFile(archive) as z:
+            members = [n for n in z.namelist() if PurePosixPath(n).name == member_name and "__MACOSX" not in n]
+            if not members:
+                bags = sorted(PurePosixPath(n).name for n in z.namelist() if n.endswith(".bag"))
+                raise ConversionError(f"{archive} holds no {member_name}; it holds {bags or 'no bags'}")
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            tmp = dest.with_name(f".{dest.name}.partial")
+            with z.open(members[0]) as src, open(tmp, "wb") as out:
+                shutil.copyfileobj(src, out, 1 << 20)
+            tmp.replace(dest)
+    except (zipfile.BadZipFile, EOFError, OSError) as err:
+        if isinstance(err, DataFetchError):
+            raise
+        raise ConversionError(f"{archive}: cannot be read as a zip archive ({type(err).__name__}: {err}); it is "
+                              "damaged or incomplete: delete it and run the command again to download it anew") from None
+    return dest
+
+
+def _kind(path: Path) -> str:
+    if path.is_dir():
+        if (path / "events.txt").exists() or any(path.glob("*/events.txt")):
+            return "ijrr"
+        raise ConversionError(f"{path}: a folder without events.txt; data_fetch converts IJRR folders, .zip, "
+                              ".bag and .h5/.hdf5 files")
+    suffix = path.suffix.lower()
+    if suffix == ".bag":
+        return "bag"
+    if suffix in (".h5", ".hdf5"):
+        return "h5"
+    if suffix == ".zip":
+        try:
+            with zipfile.ZipFile(path) as z:
+                names = z.namelist()
+        except (zipfile.BadZipFile, OSError) as err:
+            raise ConversionError(f"{path}: not a readable zip archive ({err}); the download is damaged or "
+                                  "incomplete: delete it and run the command again to download it anew") from None
+        if any(PurePosixPath(n).name == "events.txt" for n in names):
+            return "ijrr"
+        if any(n.endswith(".bag") for n in names):
+            return "bag-zip"
+        raise ConversionError(f"{path}: a zip with neither events.txt (IJRR) nor .bag files (CED)")
+    if suffix == ".txt":
+        raise ConversionError(f"{path}: pass the IJRR folder or zip (events.txt with images.txt), not events.txt "
+                              "alone; or read a bare events.txt with evinr_lite.readers.read_events_txt")
+    raise ConversionError(f"{path}: unknown raw format {suffix or '(none)'!r}; data_fetch converts IJRR zips/folders, "
+                          "ROS1 .bag files, CED zips of bags, MVSEC .hdf5 and HQF-style .h5")
+
+
+def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None = None, sensor_size=None,
+            C: float | None = None, eval_window=_UNSET, event_topic: str | None = None, image_topic=None,
+            progress: bool = True) -> Path:
+    """Convert a raw recording to the canonical HDF5 file and return its path.
+
+    Args:
+        raw: an IJRR ``.zip`` or folder, a ROS1 ``.bag`` (HQF, CED, MVSEC, IJRR), a CED zip of bags
+            (pass ``sequence``), an MVSEC ``_data.hdf5`` or an HQF-style ``.h5``.
+        out: the ``.h5`` to write, or a folder for ``<sequence>.h5``; None:
+            ``<cache>/<dataset>/<sequence>.h5`` (``<cache>/converted/`` for unknown recordings).
+        dataset, sequence: registry names; guessed from the file name when None (e.g.
+            ``slider_depth.zip`` -> ijrr/slider_depth), which fills in sensor size, C and the
+            evaluation window.
+        sensor_size: (H, W), overrides the registry's.
+        C: contrast threshold to store (registry's, else 1.0).
+        eval_window: (start, end) seconds after the sequence's zero, or None for the whole
+            sequence; default: the registry's.
+        event_topic, image_topic: bag topics (defaults: see :func:`data_fetch.convert_bag.convert_bag`).
+    """
+    from . import cache_dir
+
+    raw = Path(raw).expanduser()
+    if not raw.exists():
+        raise DataFetchError(f"no such file or folder: {raw}")
+    ds = seq = None
+    if dataset is not None:
+        from .registry import get_dataset, get_sequence
+
+        ds = get_dataset(dataset)
+        if sequence is not None and ds.method != "manual":
+            seq = get_sequence(ds.name, sequence)
+    else:
+        guess = guess_sequence(raw)
+        if guess is not None and sequence in (None, guess[1].name):
+            ds, seq = guess
+            log.info("data_fetch: %s is %s / %s", raw.name, ds.name, seq.name)
+    name = sequence or (seq.name if seq else (raw.name if raw.is_dir() else raw.stem.removesuffix("_data")))
+    kind = _kind(raw)
+    if ds is not None and ds.method == "manual":
+        raise DataFetchError(f"{ds.name} recordings are converted by the {ds.name.upper()} converter, which is not "
+                             "part of data_fetch yet; see `python -m data_fetch list aed`")
+    if out is None:
+        out = cache_dir() / (ds.name if ds else "converted") / f"{name}.h5"
+    else:
+        out = Path(out).expanduser()
+        if out.is_dir() or out.suffix.lower() not in (".h5", ".hdf5"):
+            out = out / f"{name}.h5"
+    if out.resolve() == raw.resolve():
+        raise DataFetchError(f"the output {out} is the raw file itself; choose another --out")
+    common = dict(
+        sensor_size=sensor_size if sensor_size is not None else (ds.sensor_size if ds else None),
+        C=float(C if C is not None else (ds.C if ds else 1.0)),
+        eval_window=(seq.eval_window if seq else None) if eval_window is _UNSET else eval_window,
+        dataset=ds.name if ds else "", sequence=name, source=(ds.title if ds else ""),
+        source_url=(seq.url or ds.homepage) if (ds and seq) else "", progress=progress)
+    if ds is None and C is None:
+        log.warning("data_fetch: %s is not a registered sequence; storing C = 1.0 and no evaluation window", raw)
+
+    if kind == "ijrr":
+        from .convert_ijrr import convert_ijrr
+
+        return convert_ijrr(raw, out, **common)
+    if kind == "h5":
+        from .convert_h5 import convert_h5
+
+        return convert_h5(raw, out, **common)
+    from .convert_bag import convert_bag
+
+    topics = dict(event_topic=event_topic or (ds.event_topic if ds else None),
+                  image_topic=image_topic or ((ds.image_topics or None) if ds else None))
+    if kind == "bag":
+        return convert_bag(raw, out, **common, **topics)
+    # a CED-style zip of bags: take out the one bag, convert it, delete the copy
+    member = (seq.archive_member if seq and seq.archive_member else f"{name}.bag")
+    bag = extract_member(raw, member, out.parent / f".{member}")
+    try:
+        return convert_bag(bag, out, **common, **topics)
+    finally:
+        bag.unlink(missing_ok=True)

@@ -1,0 +1,260 @@
+"""ROS1 bags (HQF, CED, MVSEC, IJRR .bag) -> canonical file, message by message.
+
+The bag is read with rosbags (pure Python: no ROS installation). Image messages
+(sensor_msgs/Image, a few thousand per bag) are decoded by rosbags' deserializer. Event messages
+(dvs_msgs/EventArray, up to 10^8 events per bag) are decoded here with one numpy view per message:
+after the header come height, width, the event count and then packed 13-byte events
+(uint16 x, uint16 y, uint32 sec, uint32 nsec, uint8 polarity), which is far faster than building a
+Python object per event. The numpy path is used only when the connection's message definition has
+the dvs_msgs/EventArray md5; any other definition goes through rosbags' deserializer.
+"""
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from evinr_lite.events import LARGE_T, EventDataError
+from evinr_lite.readers import NS, _to_grey_uint8
+
+from .canonical import CanonicalWriter
+from .errors import ConversionError
+
+__all__ = ["convert_bag", "decode_event_array", "decode_image", "EVENT_DTYPE", "EVENT_ARRAY_MD5"]
+
+log = logging.getLogger("data_fetch")
+
+EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("sec", "<u4"), ("nsec", "<u4"), ("p", "u1")])
+EVENT_ARRAY_MD5 = "5e8beee5a6c107e504c2e78903c224b8"   # dvs_msgs/EventArray (as generated from its definition)
+EVENT_ARRAY_TYPE = "dvs_msgs/msg/EventArray"
+IMAGE_TYPE = "sensor_msgs/msg/Image"
+PREFERRED_EVENT_TOPICS = ("/dvs/events", "/davis/left/events")
+PREFERRED_IMAGE_TOPICS = ("/dvs/image_raw", "/davis/left/image_raw", "/dvs/image_color")
+
+
+def _u32(raw, offset: int) -> int:
+    return int.from_bytes(raw[offset:offset + 4], "little")
+
+
+def decode_event_array(raw) -> tuple[int, int, np.ndarray]:
+    """Serialized ROS1 dvs_msgs/EventArray -> (height, width, structured events [N] of EVENT_DTYPE)."""
+    raw = memoryview(raw)
+    off = 12 + 4 + _u32(raw, 12)              # header: seq, stamp (sec, nsec), frame_id (length + bytes)
+    if off + 12 > len(raw):
+        raise ConversionError("an EventArray message is cut short (header); the bag is damaged")
+    height, width, n = _u32(raw, off), _u32(raw, off + 4), _u32(raw, off + 8)
+    off += 12
+    if off + n * EVENT_DTYPE.itemsize != len(raw):
+        raise ConversionError(f"an EventArray message announces {n} events but holds "
+                              f"{(len(raw) - off) / EVENT_DTYPE.itemsize:g}; the bag is damaged")
+    return height, width, np.frombuffer(raw, EVENT_DTYPE, count=n, offset=off)
+
+
+def _events_from_message(msg) -> tuple[int, int, np.ndarray]:
+    """A deserialized EventArray (rosbags object) -> the same as decode_event_array."""
+    ev = np.zeros(len(msg.events), EVENT_DTYPE)
+    for i, e in enumerate(msg.events):
+        ev[i] = (e.x, e.y, e.ts.sec, e.ts.nanosec, bool(e.polarity))
+    return int(msg.height), int(msg.width), ev
+
+
+def decode_image(msg, source: str = "image") -> np.ndarray:
+    """sensor_msgs/Image (rosbags object) -> grey uint8 [H, W].
+
+    Supports mono8/8UC1, mono16/16UC1, rgb8, bgr8, rgba8, bgra8 (colour is converted to grey with
+    ITU-R 709 weights). Bayer mosaics are refused: use the bag's demosaiced colour topic.
+    """
+    h, w, step, enc = int(msg.height), int(msg.width), int(msg.step), msg.encoding.lower()
+    data = np.asarray(msg.data, dtype=np.uint8)
+    if data.size < h * step:
+        raise ConversionError(f"{source}: image data holds {data.size} bytes, expected {h} x {step}")
+    rows = data[:h * step].reshape(h, step)
+    if enc in ("mono8", "8uc1"):
+        img = rows[:, :w]
+    elif enc in ("mono16", "16uc1"):
+        img = rows[:, :2 * w].copy().view(">u2" if msg.is_bigendian else "<u2").astype(np.uint16)
+    elif enc in ("rgb8", "bgr8", "rgba8", "bgra8", "8uc3"):
+        c = 4 if "a" in enc[3:] else 3
+        img = rows[:, :c * w].reshape(h, w, c)
+        if enc.startswith("bgr"):
+            img = img[..., [2, 1, 0]]
+    else:
+        raise ConversionError(f"{source}: image encoding {msg.encoding!r} is not supported (mono8, mono16, rgb8, "
+                              "bgr8); for a Bayer mosaic pick the demosaiced colour topic with image_topic=")
+    try:
+        return _to_grey_uint8(img, source)
+    except EventDataError as err:
+        raise ConversionError(str(err)) from None
+
+
+def _pick(connections, msgtype: str, wanted, preferred, kind: str, path) -> object | None:
+    found = {c.topic: c for c in connections if c.msgtype == msgtype}
+    if wanted:
+        for topic in ([wanted] if isinstance(wanted, str) else wanted):
+            if topic in found:
+                return found[topic]
+        if isinstance(wanted, str):
+            raise ConversionError(f"{path}: no {kind} topic {wanted!r}; its {msgtype} topics are "
+                                  f"{sorted(found) or 'none'}")
+    for topic in preferred:
+        if topic in found:
+            return found[topic]
+    if len(found) == 1:
+        return next(iter(found.values()))
+    if len(found) > 1:
+        raise ConversionError(f"{path}: several {kind} topics {sorted(found)}; choose one "
+                              f"({'event_topic' if kind == 'event' else 'image_topic'}=...)")
+    return None
+
+
+class _Ordered:
+    """Feeds event blocks to the writer in time order, merging a message that overlaps the previous one."""
+
+    def __init__(self, writer_factory):
+        self.writer_factory = writer_factory
+        self.writer = None
+        self.pending = None          # (t, x, y, p) not yet written
+        self.merged = 0
+        self.unsorted = 0
+
+    def add(self, t, x, y, p):
+        if t.size == 0:
+            return
+        if np.any(np.diff(t) < 0):
+            order = np.argsort(t, kind="stable")
+            t, x, y, p = t[order], x[order], y[order], p[order]
+            self.unsorted += 1
+        if self.pending is not None:
+            if t[0] < self.pending[0][-1]:   # overlaps the previous message: merge the two
+                cat = [np.concatenate([a, b]) for a, b in zip(self.pending, (t, x, y, p))]
+                order = np.argsort(cat[0], kind="stable")
+                self.pending = tuple(a[order] for a in cat)
+                self.merged += 1
+                return
+            self.flush()
+        self.pending = (t, x, y, p)
+
+    def flush(self):
+        if self.pending is not None:
+            if self.writer is None:
+                self.writer = self.writer_factory()
+            self.writer.add_events(*self.pending, where="bag events")
+            self.pending = None
+
+
+def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None, dataset: str = "",
+                sequence: str | None = None, source: str = "", source_url: str = "",
+                event_topic: str | None = None, image_topic=None, progress: bool = True) -> Path:
+    """Convert a ROS1 bag with dvs_msgs/EventArray events (and sensor_msgs/Image frames) to ``out``.
+
+    Args:
+        path: the ``.bag`` file.
+        out: canonical ``.h5`` to write (atomically).
+        sensor_size: (H, W) expected; the EventArray messages' own height/width win when they
+            differ (with a warning), since a few sequences (e.g. CED driving_city_3) differ.
+        event_topic: topic of the events; None: /dvs/events, /davis/left/events, or the only one.
+        image_topic: topic (or list of topics in order of preference) of the frames; None:
+            /dvs/image_raw, /davis/left/image_raw, /dvs/image_color, or the only one.
+    """
+    from rosbags.rosbag1 import Reader, ReaderError
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+    from tqdm.auto import tqdm
+
+    path = Path(path)
+    sequence = sequence or path.stem
+    damaged = (f"the bag is damaged or incomplete (or not a ROS1 bag): delete {path} and run the command "
+               "again to download it anew")
+    try:
+        reader = Reader(path)
+        reader.open()
+    except (ReaderError, OSError, ValueError) as err:
+        raise ConversionError(f"{path}: cannot be opened as a ROS1 bag ({err}); {damaged}") from None
+    writer_box: dict = {}
+    try:
+        ev_conn = _pick(reader.connections, EVENT_ARRAY_TYPE, event_topic, PREFERRED_EVENT_TOPICS, "event", path)
+        if ev_conn is None:
+            topics = sorted(f"{c.topic} ({c.msgtype})" for c in reader.connections)
+            raise ConversionError(f"{path}: no dvs_msgs/EventArray topic; the bag holds {topics}")
+        img_conn = _pick(reader.connections, IMAGE_TYPE, image_topic, PREFERRED_IMAGE_TOPICS, "image", path)
+        if img_conn is None:
+            log.warning("data_fetch: %s: no sensor_msgs/Image topic, so no ground-truth frames", path)
+        store = get_typestore(Stores.ROS1_NOETIC)
+        fast = ev_conn.digest == EVENT_ARRAY_MD5
+        if not fast:
+            types = get_types_from_msg(ev_conn.msgdef.data, ev_conn.msgtype)
+            store.register({k: v for k, v in types.items() if k not in store.types})
+            log.info("data_fetch: %s: EventArray definition differs from dvs_msgs'; decoding with rosbags", path)
+
+        state = {"size": None, "origin": None}
+        frames: list[tuple[int, int, np.ndarray]] = []   # (sec, nsec, image) until the writer exists
+
+        def make_writer():
+            H, W = state["size"]
+            w = CanonicalWriter(out, sensor_size=(H, W), t_origin=float(state["origin"]), dataset=dataset,
+                                sequence=sequence, source=source, source_url=source_url, raw_file=path.name,
+                                C=C, eval_window=eval_window, converter="data_fetch.convert_bag",
+                                meta={"event_topic": ev_conn.topic,
+                                      "image_topic": img_conn.topic if img_conn is not None else None})
+            writer_box["w"] = w
+            return w
+
+        ordered = _Ordered(make_writer)
+
+        def drain():
+            w_ = writer_box.get("w")
+            if w_ is None:
+                return
+            for sec, nsec, im in frames:
+                if im.shape != tuple(state["size"]):
+                    raise ConversionError(f"{path}: frames on {img_conn.topic} are {im.shape} but the events' "
+                                          f"sensor is {tuple(state['size'])} (H, W); pick another image_topic")
+                w_.add_frame(im, ((sec - state["origin"]) * NS + nsec) / NS)
+            frames.clear()
+
+        conns = [ev_conn] + ([img_conn] if img_conn is not None else [])
+        total = sum(c.msgcount for c in conns)
+        with tqdm(total=total, unit="msg", desc=f"{sequence}: bag", disable=not progress) as bar:
+            for conn, _, raw in reader.messages(connections=conns):
+                bar.update(1)
+                if conn is ev_conn:
+                    if fast:
+                        h, w, ev = decode_event_array(raw)
+                    else:
+                        h, w, ev = _events_from_message(store.deserialize_ros1(raw, conn.msgtype))
+                    if ev.size == 0:
+                        continue
+                    if state["size"] is None:
+                        msg_size = (h, w) if h and w else None
+                        given = tuple(int(v) for v in sensor_size) if sensor_size is not None else None
+                        if msg_size and given and msg_size != given:
+                            log.warning("data_fetch: %s: the events report a %dx%d sensor, not the expected %dx%d; "
+                                        "using the events' size", path, w, h, given[1], given[0])
+                        state["size"] = msg_size or given
+                        if state["size"] is None:
+                            raise ConversionError(f"{path}: the EventArray messages give no sensor size; pass "
+                                                  "sensor_size=(H, W) (--sensor-size H W)")
+                        first_sec = int(ev["sec"][0])
+                        state["origin"] = first_sec if first_sec >= LARGE_T else 0
+                    rel_ns = (ev["sec"].astype(np.int64) - state["origin"]) * NS + ev["nsec"].astype(np.int64)
+                    ordered.add(rel_ns / NS, ev["x"], ev["y"], np.where(ev["p"] > 0, 1, -1).astype(np.int8))
+                else:
+                    msg = store.deserialize_ros1(raw, conn.msgtype)
+                    image = decode_image(msg, f"{path}:{conn.topic}")
+                    frames.append((int(msg.header.stamp.sec), int(msg.header.stamp.nanosec), image))
+                drain()
+        ordered.flush()
+        writer = writer_box.get("w")
+        if writer is None:
+            raise ConversionError(f"{path}: the topic {ev_conn.topic} holds no events")
+        drain()
+        if ordered.merged or ordered.unsorted:
+            writer.meta["event_messages_reordered"] = ordered.merged + ordered.unsorted
+        writer.meta["n_event_messages"] = ev_conn.msgcount
+        return writer.close()
+    except (ReaderError, EOFError) as err:
+        raise ConversionError(f"{path}: reading failed ({err}); {damaged}") from None
+    finally:
+        if "w" in writer_box:
+            writer_box["w"].abort()
+        reader.close()

@@ -1,0 +1,316 @@
+"""IJRR / Event Camera Dataset text release (a .zip or its unzipped folder) -> canonical file.
+
+events.txt (`t x y p` per line, p in {0, 1}) is read in blocks of whole lines and parsed with
+evinr_lite.readers' vectorised text helpers (exact: timestamps are split into whole seconds and
+nanoseconds as integers before the whole-second origin is subtracted), so a multi-GB events.txt
+inside the zip is never held in memory. Frames come from images.txt + images/*.png, the
+calibration from calib.txt (kept in the file's meta).
+"""
+from __future__ import annotations
+
+import io
+import logging
+import zipfile
+import zlib
+from pathlib import Path, PurePosixPath
+
+import numpy as np
+
+from evinr_lite.events import EventDataError
+from evinr_lite.readers import (
+    NS,
+    _BadToken,
+    _first_time_origin,
+    _line_text,
+    _parse_number,
+    _parse_time,
+    _to_grey_uint8,
+    _tokenize,
+)
+
+from .canonical import CanonicalWriter
+from .errors import ConversionError
+
+__all__ = ["convert_ijrr", "IJRRSource", "PolarityMapper"]
+
+log = logging.getLogger("data_fetch")
+BLOCK_BYTES = 2 << 20   # events.txt is parsed 2 MiB of whole lines at a time (bounded memory, cache-friendly)
+
+
+class PolarityMapper:
+    """Map raw polarities to -1/+1 consistently over a whole file read in pieces.
+
+    Accepts {0, 1}, {-1, +1} and bool; a file mixing 0 and -1 is refused (it is ambiguous).
+    """
+
+    def __init__(self, source: str):
+        self.source = source
+        self.seen: set[int] = set()
+
+    def __call__(self, p, where: str = "") -> np.ndarray:
+        p = np.asarray(p)
+        if p.dtype == bool:
+            return np.where(p, 1, -1).astype(np.int8)
+        values = set(np.unique(p).tolist())
+        if not values <= {-1, 0, 1}:
+            bad = sorted(values - {-1, 0, 1})[:6]
+            raise ConversionError(f"{self.source}{where}: polarity values {bad} are not 0/1 or -1/+1; "
+                                  "the file is not an event file of this format or is damaged")
+        self.seen |= values
+        if 0 in self.seen and -1 in self.seen:
+            raise ConversionError(f"{self.source}{where}: polarities mix 0 and -1, so OFF events are encoded "
+                                  "two ways; fix the file (OFF must be 0 everywhere, or -1 everywhere)")
+        return np.where(p > 0, 1, -1).astype(np.int8)
+
+
+class IJRRSource:
+    """Files of an IJRR sequence inside a zip (at its root or in one sub-folder) or a folder."""
+
+    def __init__(self, path):
+        self.path = Path(path)
+        self.zip = None
+        if self.path.is_dir():
+            self.names = [p.relative_to(self.path).as_posix() for p in self.path.rglob("*") if p.is_file()]
+        else:
+            try:
+                self.zip = zipfile.ZipFile(self.path)
+            except (zipfile.BadZipFile, OSError) as err:
+                raise ConversionError(f"{self.path}: not a readable zip archive ({err}); the download is damaged "
+                                      "or incomplete: delete the file and run the command again to download it "
+                                      "anew") from None
+            self.names = [n for n in self.zip.namelist() if not n.endswith("/") and "__MACOSX" not in n]
+        events = sorted((n for n in self.names if PurePosixPath(n).name == "events.txt"),
+                        key=lambda n: (n.count("/"), n))
+        if not events:
+            raise ConversionError(f"{self.path}: no events.txt inside; an IJRR sequence holds events.txt, "
+                                  "images.txt, images/ and calib.txt")
+        self.prefix = str(PurePosixPath(events[0]).parent)
+        self.prefix = "" if self.prefix == "." else self.prefix + "/"
+
+    def member(self, name: str) -> str | None:
+        full = self.prefix + name
+        return full if full in self.names else None
+
+    def size(self, member: str) -> int:
+        if self.zip is not None:
+            return self.zip.getinfo(member).file_size
+        return (self.path / member).stat().st_size
+
+    def open(self, member: str):
+        if self.zip is not None:
+            return self.zip.open(member)
+        return open(self.path / member, "rb")
+
+    def read(self, member: str) -> bytes:
+        with self.open(member) as f:
+            return f.read()
+
+    def close(self):
+        if self.zip is not None:
+            self.zip.close()
+
+
+def _blocks(fh, size: int):
+    """Blocks of whole lines read from a binary stream: yields bytes ending at a newline (or EOF)."""
+    rest = b""
+    while True:
+        data = fh.read(size)
+        if not data:
+            if rest:
+                yield rest
+            return
+        data = rest + data
+        cut = data.rfind(b"\n")
+        if cut < 0:
+            rest = data
+            continue
+        yield data[:cut + 1]
+        rest = data[cut + 1:]
+
+
+def _damaged(src: IJRRSource, member: str, err) -> ConversionError:
+    return ConversionError(f"{src.path}: {member} cannot be read ({type(err).__name__}: {err}); the archive is "
+                           "damaged or was cut off: delete it and run the command again to download it anew")
+
+
+def _frame_list(src: IJRRSource, origin_ns: int):
+    """[(t seconds since origin, member name)] from images.txt."""
+    listing = src.member("images.txt")
+    if listing is None:
+        return []
+    buf = np.frombuffer(src.read(listing), dtype=np.uint8)
+    starts, ends, counts, newlines = _tokenize(buf)
+    bad = np.flatnonzero((counts != 0) & (counts != 2))
+    if bad.size:
+        i = int(bad[0])
+        raise ConversionError(f"{src.path}: images.txt line {i + 1} has {counts[i]} columns, expected "
+                              f"`t images/frame_%08d.png` (line reads {_line_text(buf, newlines, i)!r})")
+    if len(starts) == 0:
+        return []
+    starts, ends = starts.reshape(-1, 2), ends.reshape(-1, 2)
+    try:
+        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
+    except _BadToken as err:
+        raise ConversionError(f"{src.path}: images.txt row {err.row + 1}: the timestamp is not a number") from None
+    names = [bytes(buf[s:e]).decode() for s, e in zip(starts[:, 1], ends[:, 1])]
+    return list(zip(t.tolist(), names))
+
+
+def _load_image(src: IJRRSource, name: str) -> np.ndarray:
+    from PIL import Image
+
+    member = src.member(name)
+    if member is None:
+        raise ConversionError(f"{src.path}: images.txt lists {name}, which is not in the archive; the archive is "
+                              "incomplete: delete it and download it again")
+    try:
+        with Image.open(io.BytesIO(src.read(member))) as im:
+            array = np.asarray(im)
+    except (zipfile.BadZipFile, zlib.error, EOFError) as err:
+        raise _damaged(src, member, err) from None
+    except OSError as err:
+        raise ConversionError(f"{src.path}: {member} is not a readable image ({err}); the archive is damaged: "
+                              "delete it and download it again") from None
+    try:
+        return _to_grey_uint8(array, f"{src.path}:{member}")
+    except EventDataError as err:
+        raise ConversionError(str(err)) from None
+
+
+def _parse_block(block: bytes, origin_ns, line_base: int, src, first: bool):
+    """One block of whole lines -> (t, x, y, p raw, header (H, W) or None, origin_ns, n_lines)."""
+    buf = np.frombuffer(block, dtype=np.uint8)
+    starts, ends, counts, newlines = _tokenize(buf)
+    n_lines = len(newlines) + (0 if block.endswith(b"\n") else 1)
+
+    def fail(line, problem):
+        raise ConversionError(f"{src.path}: events.txt line {line_base + line + 1}: {problem} "
+                              f"(line reads {_line_text(buf, newlines, line)!r})")
+
+    header = None
+    if first and counts.any():
+        line = int(np.flatnonzero(counts)[0])
+        words = [bytes(buf[s:e]) for s, e in zip(starts[:2], ends[:2])]
+        if counts[line] == 2 and all(w.isdigit() for w in words):  # rpg_e2vid header `W H`
+            header = (int(words[1]), int(words[0]))
+            counts[line], starts, ends = 0, starts[2:], ends[2:]
+    bad = np.flatnonzero((counts != 0) & (counts != 4))
+    if bad.size:
+        fail(int(bad[0]), f"found {counts[bad[0]]} columns, expected 4: `t x y p`")
+    if len(starts) == 0:
+        return None, header, origin_ns, n_lines
+    starts, ends = starts.reshape(-1, 4), ends.reshape(-1, 4)
+
+    def row_line(row):
+        return int(np.searchsorted(newlines, starts[row, 0]))
+
+    if origin_ns is None:
+        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0])
+    try:
+        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
+    except _BadToken as err:
+        fail(row_line(err.row), "the timestamp is not a number")
+    cols = []
+    for c, name in ((1, "x"), (2, "y"), (3, "p")):
+        try:
+            v = _parse_number(buf, starts[:, c], ends[:, c])
+        except _BadToken as err:
+            fail(row_line(err.row), f"{name} is not a number")
+        if v.dtype.kind == "f":
+            whole = np.isfinite(v) & (v == np.round(v))
+            if not whole.all():
+                fail(row_line(int(np.flatnonzero(~whole)[0])), f"{name} must be a whole number")
+            v = v.astype(np.int64)
+        cols.append(v)
+    nonfinite = np.flatnonzero(~np.isfinite(t))
+    if nonfinite.size:
+        fail(row_line(int(nonfinite[0])), "the timestamp is not finite")
+    return (t, *cols), header, origin_ns, n_lines
+
+
+def convert_ijrr(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None, dataset: str = "ijrr",
+                 sequence: str | None = None, source: str = "", source_url: str = "",
+                 progress: bool = True, t_origin=None) -> Path:
+    """Convert an IJRR text sequence (zip or folder) to the canonical file ``out``.
+
+    Args:
+        path: ``<sequence>.zip`` as downloaded, or the unzipped folder.
+        out: canonical ``.h5`` to write (atomically).
+        sensor_size: (H, W); None: from a `W H` header line or the frames.
+        C, eval_window, dataset, sequence, source, source_url: stored as attributes.
+        t_origin: seconds subtracted from all timestamps; None: the whole seconds of the first
+            event when the clock is absolute (>= 1e5 s), else 0.
+    """
+    from tqdm.auto import tqdm
+
+    path = Path(path)
+    src = IJRRSource(path)
+    try:
+        sequence = sequence or (path.stem if path.is_file() else path.name)
+        origin_ns = None if t_origin is None else int(round(t_origin * NS))
+        events_member = src.member("events.txt")
+        # The sensor size must be known before the first event is checked: take it from the frames.
+        frame_size = None
+        listing = _frame_list(src, 0)
+        if listing:
+            frame_size = _load_image(src, listing[0][1]).shape
+        if sensor_size is not None:
+            sensor_size = tuple(int(v) for v in sensor_size)
+            if frame_size is not None and frame_size != sensor_size:
+                raise ConversionError(f"{path}: the frames are {frame_size} (H, W) but the sensor size is "
+                                      f"{sensor_size}; pass the right sensor size")
+        calib = None
+        calib_member = src.member("calib.txt")
+        if calib_member:
+            values = src.read(calib_member).split()
+            try:
+                values = [float(v) for v in values]
+                names = ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")
+                calib = dict(zip(names, values)) if len(values) == len(names) else values
+            except ValueError:
+                log.warning("data_fetch: %s: calib.txt is not a list of numbers; ignored", path)
+        meta = {"calib": calib} if calib is not None else {}
+        polarity = PolarityMapper(f"{path}: events.txt")
+        writer = None
+        line_base, first = 0, True
+        bar = tqdm(total=src.size(events_member), unit="B", unit_scale=True, unit_divisor=1024,
+                   desc=f"{sequence}: events.txt", disable=not progress)
+        try:
+            with src.open(events_member) as fh:
+                for block in _blocks(fh, BLOCK_BYTES):
+                    bar.update(len(block))
+                    parsed, header, origin_ns, n_lines = _parse_block(block, origin_ns, line_base, src, first)
+                    if first and header is not None:
+                        if sensor_size is not None and header != sensor_size:
+                            raise ConversionError(f"{path}: events.txt's header `{header[1]} {header[0]}` (W H) "
+                                                  f"disagrees with the sensor size {sensor_size} (H, W)")
+                        sensor_size = header
+                    first = False
+                    if parsed is not None:
+                        t, x, y, p = parsed
+                        if writer is None:
+                            size = sensor_size or frame_size
+                            if size is None:
+                                raise ConversionError(
+                                    f"{path}: the sensor size is unknown (no frames, no `W H` header); pass "
+                                    "sensor_size=(H, W) (e.g. --sensor-size 180 240 for a DAVIS240C)")
+                            writer = CanonicalWriter(
+                                out, sensor_size=size, t_origin=origin_ns / NS, dataset=dataset,
+                                sequence=sequence, source=source, source_url=source_url, raw_file=path.name,
+                                C=C, eval_window=eval_window, converter="data_fetch.convert_ijrr", meta=meta)
+                        writer.add_events(t, x, y, polarity(p, f", events.txt lines {line_base + 1}.."),
+                                          where=f"events.txt lines {line_base + 1}-{line_base + n_lines}")
+                    line_base += n_lines
+            if writer is None:
+                raise ConversionError(f"{path}: events.txt holds no events")
+            for t_frame, name in _frame_list(src, origin_ns):
+                writer.add_frame(_load_image(src, name), t_frame)
+            return writer.close()
+        except (zipfile.BadZipFile, zlib.error, EOFError) as err:
+            raise _damaged(src, events_member, err) from None
+        finally:
+            bar.close()
+            if writer is not None:
+                writer.abort()
+    finally:
+        src.close()
