@@ -12,7 +12,8 @@ import numpy as np
 
 from .events import EventDataError, Events
 
-__all__ = ["EventFrames", "fixed_duration_boundaries", "equal_count_boundaries", "events_to_frames"]
+__all__ = ["EventFrames", "fixed_duration_boundaries", "equal_count_boundaries", "events_to_frames",
+           "bisect_boundaries"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,3 +114,31 @@ def events_to_frames(events: Events, boundaries, C: float = 1.0) -> EventFrames:
     frames = (C * sums).astype(np.float32).reshape(B, H, W)
     counts = np.bincount(idx, minlength=B).astype(np.int64)
     return EventFrames(frames=frames, boundaries=b, counts=counts)
+
+
+def bisect_boundaries(events: Events, boundaries) -> np.ndarray:
+    """Split every bin into two halves holding equal numbers of events (coarse-to-fine, Sec. 3.3).
+
+    A bin (b_i, b_{i+1}] holding n >= 2 events is cut half-way between its event n//2 - 1 and
+    event n//2 (0-based, in time order); a bin with fewer than 2 events, or whose cut would
+    coincide with an edge, is cut at its time mid-point. Returns float64 [2B + 1].
+    """
+    b = np.asarray(boundaries, dtype=np.float64)
+    t = events.t
+    # index range of each bin's events under the (b_i, b_{i+1}] convention (bin 0 closed on the left)
+    start = np.searchsorted(t, b[:-1], side="right")
+    start[0] = np.searchsorted(t, b[0], side="left")
+    stop = np.searchsorted(t, b[1:], side="right")
+    n = stop - start
+    k = start + n // 2
+    enough = n >= 2
+    cut = 0.5 * (b[:-1] + b[1:])
+    kk = np.clip(k, 1, max(len(t) - 1, 1))
+    if len(t) >= 2:
+        median_cut = 0.5 * (t[kk - 1] + t[kk])
+        ok = enough & (median_cut > b[:-1]) & (median_cut < b[1:])
+        cut = np.where(ok, median_cut, cut)
+    out = np.empty(2 * len(b) - 1)
+    out[0::2] = b
+    out[1::2] = cut
+    return out

@@ -12,8 +12,9 @@ def default_device(preference: str | None = None) -> torch.device:
     """The torch device to use.
 
     Args:
-        preference: "cpu", "cuda", "mps" or None (auto: cuda, then mps, then cpu). The
-            environment variable ``EVINR_DEVICE`` overrides auto.
+        preference: "cpu", "cuda" or None (auto: cuda when available, else cpu). The
+            environment variable ``EVINR_DEVICE`` overrides auto. (Apple's "mps" can be asked for
+            explicitly, but it has no float64, which event timestamps need, so auto never picks it.)
 
     Raises:
         RuntimeError: if a device is asked for that this machine does not have.
@@ -22,8 +23,6 @@ def default_device(preference: str | None = None) -> torch.device:
     if preference == "auto":
         if torch.cuda.is_available():
             return torch.device("cuda")
-        if getattr(torch.backends, "mps", None) is not None and torch.backends.mps.is_available():
-            return torch.device("mps")
         return torch.device("cpu")
     if preference.startswith("cuda") and not torch.cuda.is_available():
         raise RuntimeError("device 'cuda' requested but no CUDA GPU is available here; use device='cpu'")

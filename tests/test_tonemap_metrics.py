@@ -43,3 +43,21 @@ def test_ssim_uses_data_range_one():
     b = np.clip(a + rng.normal(0, 0.05, a.shape), 0, 1)
     ref = structural_similarity(a, b, gaussian_weights=True, sigma=1.5, use_sample_covariance=False, data_range=1.0)
     assert ssim(a, b) == pytest.approx(ref)
+
+
+def test_equalization_and_frame_scores():
+    from evinr_lite.metrics import equalize, score_frames
+    rng = np.random.default_rng(2)
+    img = 0.3 + 0.1 * rng.uniform(0, 1, (32, 40))   # low contrast
+    for method in ("global", "clahe"):
+        eq = equalize(img, method)
+        assert eq.shape == img.shape and eq.std() > 2 * img.std()
+    np.testing.assert_allclose(equalize(img, "none"), img)
+    with pytest.raises(ValueError, match="equalization must be one of"):
+        equalize(img, "hist")
+    stack = np.stack([img, img])
+    s = score_frames(stack, stack, "clahe")
+    assert s["ssim"] == pytest.approx(1.0) and s["mse"] == 0.0 and "clahe" in s["protocol"]
+    # CLAHE ignores a global brightness offset that plain SSIM punishes
+    brighter = np.clip(stack + 0.2, 0, 1)
+    assert score_frames(brighter, stack, "clahe")["ssim"] > score_frames(brighter, stack, "none")["ssim"]

@@ -1,0 +1,381 @@
+"""EvINR's solver: train frame-based INRs on events and query them at any time.
+
+    rec = reconstruct(events, query_times, EvINRConfig(C=0.2))
+    rec.frames          # [Q, H, W] tone-mapped, in [0, 1]
+    rec.log_intensity   # [Q, H, W] log intensity
+    rec.at(t)           # log intensity at other times
+
+The recipe (paper Sec. 3-4; defaults in :class:`EvINRConfig`):
+
+1. Cut [t_start, t_end] into N overlapping windows of at most ``tau`` seconds (ensembling), one
+   network each, all trained together in one batched computation (:class:`~evinr_lite.models.FrameINR`).
+2. Stack each window's events into event frames. With coarse-to-fine, training starts with bins
+   4x longer than ``bin_duration`` and bisects every bin into halves of equal event count at
+   iterations 100 and 200, ending at ``bin_duration``; without it, training uses the final
+   resolution throughout (the paper's Base).
+3. Minimise temporal loss + lambda * spatial regularizer with Adam (lr 1e-4, x0.95 every 10 steps).
+4. Align the networks: each network's per-pixel offset is matched to its predecessor's over their
+   overlap, and predictions are cross-faded linearly across the overlap, so no seam shows.
+5. Anchor the brightness. Events only constrain changes of log intensity: adding any constant to
+   F leaves every loss unchanged, and a per-pixel constant is only set by the regularizer. The
+   global level is therefore a choice, not a measurement: by default F is shifted so that its mean
+   over the sequence tone-maps to ``display_mean`` (0.5, mid-grey). Metrics with histogram
+   equalisation (CLAHE) are insensitive to it; others should say how the level was set.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+import torch
+
+from .binning import bisect_boundaries, equal_count_boundaries, events_to_frames
+from .device import default_device
+from .events import EventDataError, Events
+from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
+from .models import FrameINR
+from .tonemap import tonemap_reinhard
+
+__all__ = ["EvINRConfig", "Reconstruction", "reconstruct", "split_windows", "train_frame_inr"]
+
+
+@dataclass
+class EvINRConfig:
+    """Every setting of the frame-based solver. Defaults are the paper's unless noted.
+
+    Events and bins:
+        C: contrast threshold (log units per event; paper: 1 for IJRR/HQF, 0.25 for AED).
+        bin_duration: final event-frame length in seconds (paper: 1/32 s).
+        binning: "fixed" (paper: fixed-duration bins) or "equal_count" (the reference code).
+        events_per_bin: final events per bin for "equal_count" (reference code: 100).
+    Losses:
+        temporal_loss: "derivative" (paper, Eq. 5-6: dF/dt at bin mid-points times bin length) or
+            "difference" (F(b_{i+1}) - F(b_i) at bin boundaries: exact integral form).
+        regularizer: "tikhonov" (paper, Eq. 9), "tv" (reference code) or "none".
+        lam: weight lambda of the regularizer (paper: 0.05; finite differences in pixel units).
+    Network (SIREN):
+        hidden_features, hidden_layers: width and depth (paper: 512, 3).
+        omega_0: frequency factor of the hidden layers (SIREN's default 30).
+        first_omega_0: frequency factor of the first layer, which sets how fast F can vary in time
+            (not in the paper; the reference code uses 10 everywhere). With 30, the network fits
+            dF/dt at the bin mid-points while wandering between them, so integrated changes are
+            wrong (notebook 01 shows the same in 1-D); 10 keeps F smooth at the scale of a bin.
+    Optimisation:
+        n_iters: iterations (paper: 300). lr, lr_decay, lr_decay_every: Adam with lr x lr_decay
+            every lr_decay_every iterations (paper: 1e-4, 0.95, 10).
+        head_lr_scale: learning-rate factor for the H*W output layer. Not in the paper: the public
+            reference code multiplies the head's output by omega_0, which under Adam makes the head
+            learn omega_0 times faster. We keep SIREN's small initial output and scale the head's
+            learning rate instead (default 30 = omega_0); with 1, 300 iterations at lr 1e-4 leave
+            the frames far from converged (see benchmarks/solver_quality.py).
+        coarse_to_fine: bisect the bins at ``c2f_iters`` (paper: 3 stages, at 100 and 200).
+    Ensembling:
+        tau: longest window per network in seconds (paper: 5); None for one network.
+        overlap: seconds shared by neighbouring windows (used to align and cross-fade them).
+    Output:
+        gamma: tone-mapping exponent (paper: 0.6). display_mean: the tone-mapped value that the
+            mean log intensity is anchored to (see the module docstring).
+    Runtime:
+        seed: seeds the initialisation. device: "cpu", "cuda" or None (GPU when present).
+        progress: show a progress bar (terminal or notebook).
+    """
+
+    C: float = 1.0
+    bin_duration: float = 1 / 32
+    binning: str = "fixed"
+    events_per_bin: int = 100
+    temporal_loss: str = "derivative"
+    regularizer: str = "tikhonov"
+    lam: float = 0.05
+    hidden_features: int = 512
+    hidden_layers: int = 3
+    omega_0: float = 30.0
+    first_omega_0: float | None = 10.0
+    n_iters: int = 300
+    lr: float = 1e-4
+    lr_decay: float = 0.95
+    lr_decay_every: int = 10
+    head_lr_scale: float = 30.0
+    coarse_to_fine: bool = True
+    c2f_iters: tuple = (100, 200)
+    tau: float | None = 5.0
+    overlap: float = 0.5
+    gamma: float = 0.6
+    display_mean: float = 0.5
+    seed: int = 0
+    device: str | None = None
+    progress: bool = True
+
+    def __post_init__(self):
+        choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
+                   "regularizer": ("tikhonov", "tv", "none")}
+        for name, allowed in choices.items():
+            if getattr(self, name) not in allowed:
+                raise ValueError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+        for name in ("C", "bin_duration", "lr", "gamma"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
+        if not 0 < self.display_mean < 1:
+            raise ValueError(f"display_mean must be in (0, 1), got {self.display_mean}")
+        if self.tau is not None and not self.tau > self.overlap >= 0:
+            raise ValueError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
+        self.c2f_iters = tuple(int(i) for i in self.c2f_iters)
+
+    @classmethod
+    def base(cls, **overrides) -> "EvINRConfig":
+        """The paper's ablation 'Base': no spatial regularization, no coarse-to-fine."""
+        return cls(**{"regularizer": "none", "coarse_to_fine": False, **overrides})
+
+    @classmethod
+    def reference_code(cls, **overrides) -> "EvINRConfig":
+        """The public reference code's choices where they differ from the paper (as far as this
+        solver expresses them): anisotropic TV, equal-count bins, a boundary-difference temporal
+        term (evaluated at the boundaries, without the code's half-bin shift), omega_0 = 10."""
+        return cls(**{"regularizer": "tv", "binning": "equal_count", "temporal_loss": "difference",
+                      "omega_0": 10.0, "head_lr_scale": 10.0, **overrides})
+
+    @property
+    def n_bisections(self) -> int:
+        """How many times the bins are halved during training."""
+        return len(self.c2f_iters) if self.coarse_to_fine else 0
+
+
+def split_windows(t_start: float, t_end: float, tau: float | None, overlap: float) -> np.ndarray:
+    """N equal windows covering [t_start, t_end], each at most ``tau`` s, neighbours sharing ``overlap`` s.
+
+    Returns float64 [N, 2] (seconds). N = 1 when tau is None or the span fits in one window.
+    """
+    span = t_end - t_start
+    if not span > 0:
+        raise EventDataError(f"time span [{t_start}, {t_end}] is empty; t_end must exceed t_start")
+    if tau is None or span <= tau:
+        return np.array([[t_start, t_end]], dtype=np.float64)
+    n = math.ceil((span - overlap) / (tau - overlap))
+    length = (span + (n - 1) * overlap) / n
+    starts = t_start + np.arange(n) * (length - overlap)
+    windows = np.stack([starts, starts + length], axis=1)
+    windows[-1, 1] = t_end
+    return windows
+
+
+def _initial_boundaries(events: Events, windows: np.ndarray, cfg: EvINRConfig) -> list[np.ndarray]:
+    """Bin edges per window at the coarsest stage: 2^n_bisections times coarser than the final bins."""
+    factor = 2 ** cfg.n_bisections
+    out = []
+    if cfg.binning == "fixed":
+        n_final = max(factor, int(round((windows[0, 1] - windows[0, 0]) / cfg.bin_duration)))
+        n0 = max(1, int(round(n_final / factor)))
+        for lo, hi in windows:
+            out.append(np.linspace(lo, hi, n0 + 1))
+        return out
+    for lo, hi in windows:
+        ev = events.slice_time(lo, hi, allow_empty=True)
+        n0 = max(1, int(round(len(ev) / (cfg.events_per_bin * factor))))
+        if len(ev) < 2 * n0:
+            raise EventDataError(f"window [{lo:.3f}, {hi:.3f}] s holds {len(ev)} events, too few for equal-count "
+                                 "bins; use binning='fixed' or a longer window")
+        b = equal_count_boundaries(ev, n_bins=n0)
+        b[0], b[-1] = lo, hi
+        out.append(b)
+    n = {len(b) for b in out}
+    if len(n) > 1:  # equal-count bins must agree in number across networks to batch them
+        n0 = min(n) - 1
+        out = [np.interp(np.linspace(0, len(b) - 1, n0 + 1), np.arange(len(b)), b) for b in out]
+    return out
+
+
+@dataclass
+class _Bins:
+    """Event frames of all windows, stacked for batched training (tensors on the device)."""
+
+    boundaries: torch.Tensor   # float64 [N, B + 1] seconds
+    centers: torch.Tensor      # float64 [N, B]
+    durations: torch.Tensor    # float32 [N, B]
+    frames: torch.Tensor       # float32 [N, B, H, W], C * sum of p per bin
+
+    @classmethod
+    def build(cls, events: Events, boundaries: list[np.ndarray], C: float, device) -> "_Bins":
+        b = np.stack(boundaries)
+        frames = np.stack([events_to_frames(events, bb, C).frames for bb in boundaries])
+        return cls(
+            boundaries=torch.as_tensor(b, device=device),
+            centers=torch.as_tensor(0.5 * (b[:, 1:] + b[:, :-1]), device=device),
+            durations=torch.as_tensor(np.diff(b, axis=1), dtype=torch.float32, device=device),
+            frames=torch.as_tensor(frames, device=device),
+        )
+
+
+def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=None):
+    """Train one FrameINR per window, all in one batched computation.
+
+    Returns:
+        (model, history) with history = {"loss", "temporal", "regularizer": per-iteration floats,
+        "n_bins": bins per network at each iteration, "train_time_s": float}.
+    """
+    device = default_device(cfg.device)
+    model = FrameINR(events.sensor_size, windows, cfg.hidden_features, cfg.hidden_layers,
+                     cfg.omega_0, cfg.first_omega_0, seed=cfg.seed).to(device)
+    head = [model.head_weight, model.head_bias]
+    trunk = [p for n, p in model.named_parameters() if not n.startswith("head_")]
+    opt = torch.optim.Adam([{"params": trunk}, {"params": head, "lr": cfg.lr * cfg.head_lr_scale}], lr=cfg.lr)
+    sched = torch.optim.lr_scheduler.StepLR(opt, step_size=cfg.lr_decay_every, gamma=cfg.lr_decay)
+    boundaries = _initial_boundaries(events, windows, cfg)
+    bins = _Bins.build(events, boundaries, cfg.C, device)
+    regularize = {"tikhonov": tikhonov, "tv": total_variation, "none": None}[cfg.regularizer]
+    history = {"loss": [], "temporal": [], "regularizer": [], "n_bins": []}
+    bisect_at = set(cfg.c2f_iters) if cfg.coarse_to_fine else set()
+
+    from tqdm.auto import tqdm
+
+    t0 = time.perf_counter()
+    bar = tqdm(range(cfg.n_iters), desc="EvINR", disable=not cfg.progress, leave=False)
+    for it in bar:
+        if it in bisect_at:
+            boundaries = [bisect_boundaries(events, b) for b in boundaries]
+            bins = _Bins.build(events, boundaries, cfg.C, device)
+        if cfg.temporal_loss == "derivative":
+            F, dF = model.forward_with_derivative(bins.centers)
+            temporal = temporal_loss_derivative(dF, bins.frames, bins.durations)
+        else:
+            F = model(bins.boundaries)
+            temporal = temporal_loss_difference(F, bins.frames)
+        reg = regularize(F) if regularize is not None and cfg.lam > 0 else torch.zeros((), device=device)
+        loss = temporal + cfg.lam * reg
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        opt.step()
+        sched.step()
+        history["loss"].append(loss.item())
+        history["temporal"].append(temporal.item())
+        history["regularizer"].append(reg.item())
+        history["n_bins"].append(int(bins.frames.shape[1]))
+        if it % 10 == 0:
+            bar.set_postfix(loss=f"{history['loss'][-1]:.4g}", bins=history["n_bins"][-1])
+    bar.close()
+    history["train_time_s"] = time.perf_counter() - t0
+    return model, history
+
+
+@dataclass(eq=False)
+class Reconstruction:
+    """A trained EvINR and its predictions.
+
+    Attributes:
+        times: float64 [Q] query times (seconds, the events' clock).
+        log_intensity: float32 [Q, H, W] anchored log intensity at ``times``.
+        frames: float32 [Q, H, W] tone-mapped frames in [0, 1].
+        model: the trained FrameINR (N networks). windows: [N, 2] their time windows (s).
+        offsets: float32 [N, H, W] per-network offsets added by the alignment and the anchor.
+        config: the EvINRConfig used. history: training curves and time (see train_frame_inr).
+    """
+
+    times: np.ndarray
+    log_intensity: np.ndarray
+    frames: np.ndarray
+    model: FrameINR
+    windows: np.ndarray
+    offsets: np.ndarray
+    config: EvINRConfig
+    history: dict = field(repr=False)
+
+    def at(self, times, chunk: int = 256) -> np.ndarray:
+        """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W]."""
+        return _blend(self.model, self.windows, np.atleast_1d(np.asarray(times, np.float64)), self.offsets, chunk)
+
+    def frames_at(self, times) -> np.ndarray:
+        """Tone-mapped frames in [0, 1] at any times: float32 [Q, H, W]."""
+        return tonemap_reinhard(self.at(times), self.config.gamma).astype(np.float32)
+
+
+@torch.no_grad()
+def _predict(model: FrameINR, times: np.ndarray, chunk: int = 256) -> np.ndarray:
+    """Every network at every time: float32 [N, Q, H, W] (no offsets)."""
+    device = model.head_weight.device
+    out = []
+    for i in range(0, len(times), chunk):
+        t = torch.as_tensor(times[i:i + chunk], device=device).expand(model.n_models, -1)
+        out.append(model(t).float().cpu().numpy())
+    return np.concatenate(out, axis=1)
+
+
+def _blend_weights(windows: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """[N, Q] weights: linear ramps across overlaps, zero outside a window, summing to 1."""
+    lo, hi = windows[:, :1], windows[:, 1:]
+    inside = (times >= lo - 1e-9) & (times <= hi + 1e-9)
+    if not np.all(inside.any(axis=0)):
+        bad = times[~inside.any(axis=0)][0]
+        raise EventDataError(f"query time {bad} s is outside the reconstructed span "
+                             f"[{windows[0, 0]}, {windows[-1, 1]}] s")
+    if len(windows) == 1:
+        return inside.astype(np.float64)
+    overlap = max(windows[0, 1] - windows[1, 0], 1e-9)
+    ramp = np.clip(np.minimum(times - lo, hi - times) / overlap, 1e-6, 1.0)
+    ramp[0] = np.where(times < windows[1, 0], 1.0, ramp[0])      # no fade-in at the sequence start
+    ramp[-1] = np.where(times > windows[-2, 1], 1.0, ramp[-1])   # nor fade-out at its end
+    w = np.where(inside, ramp, 0.0)
+    return w / w.sum(axis=0, keepdims=True)
+
+
+def _blend(model, windows, times, offsets, chunk=256) -> np.ndarray:
+    F = _predict(model, times, chunk) + offsets[:, None]
+    w = _blend_weights(windows, times)
+    return np.einsum("nq,nqhw->qhw", w, F).astype(np.float32)
+
+
+def _alignment_offsets(model: FrameINR, windows: np.ndarray, n_samples: int = 8) -> np.ndarray:
+    """Per-network, per-pixel offsets [N, H, W] chaining each network onto its predecessor.
+
+    Over the overlap of windows k-1 and k, offset_k = offset_{k-1} + mean_t (F_{k-1}(t) - F_k(t)).
+    """
+    H, W = model.sensor_size
+    offsets = np.zeros((len(windows), H, W), np.float32)
+    for k in range(1, len(windows)):
+        ts = np.linspace(windows[k, 0], windows[k - 1, 1], n_samples)
+        F = _predict(model, ts)
+        offsets[k] = offsets[k - 1] + (F[k - 1] - F[k]).mean(axis=0)
+    return offsets
+
+
+def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, *,
+                t_start: float | None = None, t_end: float | None = None) -> Reconstruction:
+    """Reconstruct log intensity and tone-mapped frames at ``query_times`` from events alone.
+
+    Args:
+        events: the events (their sensor_size gives H, W).
+        query_times: [Q] seconds on the events' clock, inside [t_start, t_end].
+        config: EvINRConfig (paper defaults when None).
+        t_start, t_end: span to reconstruct (seconds); default: from the first to the last event,
+            widened to include the query times.
+
+    Returns:
+        Reconstruction with frames [Q, H, W] in [0, 1] and log intensities [Q, H, W].
+    """
+    cfg = config or EvINRConfig()
+    q = np.atleast_1d(np.asarray(query_times, dtype=np.float64))
+    if len(events) < 2:
+        raise EventDataError(f"need at least 2 events to reconstruct, got {len(events)}; choose a longer window")
+    if q.size == 0 or not np.all(np.isfinite(q)):
+        raise EventDataError("query_times must be a non-empty array of finite seconds")
+    t_start = min(events.t[0], q.min()) if t_start is None else float(t_start)
+    t_end = max(events.t[-1], q.max()) if t_end is None else float(t_end)
+    if q.min() < t_start or q.max() > t_end:
+        raise EventDataError(f"query times span [{q.min()}, {q.max()}] s, outside [t_start, t_end] = "
+                             f"[{t_start}, {t_end}] s; widen the span or drop those times")
+    events = events.slice_time(t_start, np.nextafter(t_end, np.inf), allow_empty=True)
+    if len(events) < 2:
+        raise EventDataError(f"fewer than 2 events in [{t_start}, {t_end}] s; choose a window with events")
+    windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
+    model, history = train_frame_inr(events, windows, cfg)
+    model.eval()
+    offsets = _alignment_offsets(model, windows)
+    # anchor: mean log intensity over the sequence tone-maps to display_mean
+    grid = np.linspace(t_start, t_end, min(64, 8 * len(windows)))
+    mean_L = float(_blend(model, windows, grid, offsets).mean())
+    s = cfg.display_mean ** (1 / cfg.gamma)
+    offsets += np.float32(math.log(s / (1 - s)) - mean_L)
+    L = _blend(model, windows, q, offsets)
+    frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)
+    history["config"] = asdict(cfg)
+    return Reconstruction(q, L, frames, model, windows, offsets, cfg, history)
