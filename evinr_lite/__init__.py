@@ -8,6 +8,9 @@ Modules, one job each:
     simulate    ESIM-style event simulation (1-D signals, videos, scenes)
     scenes      synthetic scenes with ground truth at any time
     integration direct event integration
+    models      FrameINR: N frame-based SIRENs F(t) -> [H, W] with stacked weights (Eq. 11)
+    losses      temporal losses (derivative Eq. 5-6, boundary difference), Tikhonov (Eq. 9), TV
+    solver      EvINRConfig and reconstruct(): training, coarse-to-fine, ensembles, anchoring
     tonemap     Reinhard tone mapping (Eq. 12)
     metrics     MSE and SSIM with a stated protocol
     siren       SIREN networks (sine activations, SIREN initialisation)
@@ -28,6 +31,7 @@ from .readers import Recording, read_events, read_recording
 from .integration import integrate_events
 from .scenes import MovingBarScene, MovingImageScene, make_scene
 from .simulate import simulate_events_1d, simulate_scene, simulate_video
+from .solver import EvINRConfig, Reconstruction, reconstruct
 from .tonemap import tonemap_reinhard
 
 __version__ = "0.1.0"
