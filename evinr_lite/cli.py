@@ -27,6 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--duration", type=float, default=2.0, help="seconds of events (default: 2)")
     demo.add_argument("--C", type=float, default=0.2, help="contrast threshold (default: 0.2)")
     demo.add_argument("--frames", type=int, default=8, help="number of frames to reconstruct (default: 8)")
+    demo.add_argument("--iters", type=int, default=300, help="EvINR training iterations (default: 300, the paper's)")
     demo.add_argument("--seed", type=int, default=0)
     demo.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     return parser
@@ -39,9 +40,12 @@ def main(argv=None) -> int:
     try:
         if args.command == "demo":
             from .demo import run_demo
+            from .solver import EvINRConfig
 
+            config = EvINRConfig(C=args.C, n_iters=args.iters, seed=args.seed,
+                                 c2f_iters=(args.iters // 3, 2 * args.iters // 3))
             run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
-                     n_frames=args.frames, seed=args.seed, overwrite=args.overwrite)
+                     n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)
     except (EventDataError, FileExistsError, ValueError) as exc:
         print(f"evinr-lite: error: {exc}", file=sys.stderr)
         return 2

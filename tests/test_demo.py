@@ -6,28 +6,33 @@ import sys
 import pytest
 
 from evinr_lite.demo import run_demo
+from evinr_lite.solver import EvINRConfig
 
 
 def test_demo_writes_frames_and_scores(tmp_path):
     out = tmp_path / "demo"
-    summary = run_demo(out, sensor_size=(40, 56), duration=0.5, n_frames=3, log=lambda *a: None)
+    cfg = EvINRConfig(C=0.2, n_iters=60, c2f_iters=(20, 40), hidden_features=64, hidden_layers=2, progress=False)
+    summary = run_demo(out, sensor_size=(40, 56), duration=0.5, n_frames=3, config=cfg, log=lambda *a: None)
     saved = json.loads((out / "metrics.json").read_text())
     assert saved["n_events"] == summary["n_events"] > 1000
     assert len(list((out / "gt").glob("*.png"))) == 3
     assert (out / "overview.png").exists()
     m = saved["methods"]
-    oracle, blind = m["integration (L0 = true first frame)"], m["integration (L0 = 0)"]
-    assert len(list((out / oracle["folder"]).glob("*.png"))) == 3
+    assert set(m) == {"EvINR", "integration (L0 = 0)", "integration (L0 = true first frame, oracle)"}
+    for r in m.values():
+        assert len(list((out / r["folder"]).glob("*.png"))) == 3
+        assert 0 <= r["mse_none"] < 1 and -1 <= r["ssim_clahe"] <= 1
+    oracle, blind = m["integration (L0 = true first frame, oracle)"], m["integration (L0 = 0)"]
     # handing the integrator the first frame must beat not knowing it
-    assert oracle["mse"] < blind["mse"] and oracle["ssim"] > blind["ssim"]
-    assert "data_range 1.0" in saved["protocol"]
+    assert oracle["mse_none"] < blind["mse_none"] and oracle["ssim_none"] > blind["ssim_none"]
+    assert "data_range 1" in saved["protocol"] and saved["evinr_config"]["n_iters"] == 60
 
 
 def test_demo_command_refuses_existing_output(tmp_path):
     out = tmp_path / "demo"
     out.mkdir()
     r = subprocess.run([sys.executable, "-m", "evinr_lite", "demo", "--out", str(out), "--size", "20x24",
-                        "--duration", "0.2", "--frames", "2"], capture_output=True, text=True)
+                        "--duration", "0.2", "--frames", "2", "--iters", "3"], capture_output=True, text=True)
     assert r.returncode == 2
     assert "already exists" in r.stderr and "--overwrite" in r.stderr and "Traceback" not in r.stderr
 
