@@ -15,6 +15,8 @@ Modules, one job each:
     metrics     MSE and SSIM with a stated protocol
     siren       SIREN networks (sine activations, SIREN initialisation)
     pde1d       the 1-D pieces of notebook 01 (window sums, Eq. 4, a 1-D SIREN fit)
+    events2d    notebook 02's exercise references (one pixel's ESIM step, event frames)
+    viz         looking at events: x-y-t scatter, polarity images, rates, animations
     exercises   exercise checks that say what is wrong, with fallback to the reference
     widgets     `interact`: sliders in a live front end, one static figure otherwise
     plotting    figures for the notebooks (the method modules never import matplotlib)
