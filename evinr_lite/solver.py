@@ -11,8 +11,9 @@ The recipe (paper Sec. 3-4; defaults in :class:`EvINRConfig`):
    network each, all trained together in one batched computation (:class:`~evinr_lite.models.FrameINR`).
 2. Stack each window's events into event frames. With coarse-to-fine, training starts with bins
    4x longer than ``bin_duration`` and bisects every bin into halves of equal event count at
-   iterations 100 and 200, ending at ``bin_duration``; without it, training uses the final
-   resolution throughout (the paper's Base).
+   iterations 100 and 200, ending at ``bin_duration`` on average (with "fixed" binning the final
+   bins are equal-count halves, so their lengths vary with the event rate); without it, training
+   uses fixed bins of ``bin_duration`` throughout (the paper's Base).
 3. Minimise temporal loss + lambda * spatial regularizer with Adam (lr 1e-4, x0.95 every 10 steps).
 4. Align the networks: each network's per-pixel offset is matched to its predecessor's over their
    overlap, and predictions are cross-faded linearly across the overlap, so no seam shows.
@@ -38,7 +39,8 @@ from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov
 from .models import FrameINR
 from .tonemap import tonemap_reinhard
 
-__all__ = ["EvINRConfig", "Reconstruction", "reconstruct", "split_windows", "train_frame_inr"]
+__all__ = ["EvINRConfig", "Reconstruction", "reconstruct", "split_windows", "train_frame_inr",
+           "predict_networks", "blend_weights", "blend_networks", "alignment_offsets"]
 
 
 @dataclass
@@ -62,6 +64,8 @@ class EvINRConfig:
             (not in the paper; the reference code uses 10 everywhere). With 30, the network fits
             dF/dt at the bin mid-points while wandering between them, so integrated changes are
             wrong (notebook 01 shows the same in 1-D); 10 keeps F smooth at the scale of a bin.
+            Each network maps its own window to [-1, 1], so shorter ensemble windows allow faster
+            wiggles per second: with short windows prefer temporal_loss="difference" (notebook 06).
     Optimisation:
         n_iters: iterations (paper: 300). lr, lr_decay, lr_decay_every: Adam with lr x lr_decay
             every lr_decay_every iterations (paper: 1e-4, 0.95, 10).
@@ -154,6 +158,9 @@ def split_windows(t_start: float, t_end: float, tau: float | None, overlap: floa
         return np.array([[t_start, t_end]], dtype=np.float64)
     n = math.ceil((span - overlap) / (tau - overlap))
     length = (span + (n - 1) * overlap) / n
+    if length < 2 * overlap:  # then three windows would share some instants
+        raise EventDataError(f"windows of {length:.3g} s with overlap {overlap:g} s would overlap three at a "
+                             "time; use tau of at least twice the overlap")
     starts = t_start + np.arange(n) * (length - overlap)
     windows = np.stack([starts, starts + length], axis=1)
     windows[-1, 1] = t_end
@@ -242,12 +249,13 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
             F = model(bins.boundaries)
             temporal = temporal_loss_difference(F, bins.frames)
         reg = regularize(F) if regularize is not None and cfg.lam > 0 else torch.zeros((), device=device)
-        loss = temporal + cfg.lam * reg
+        # per-network means summed over networks: each network gets its own gradient, whatever N
+        loss = model.n_models * (temporal + cfg.lam * reg)
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
         sched.step()
-        history["loss"].append(loss.item())
+        history["loss"].append(loss.item() / model.n_models)
         history["temporal"].append(temporal.item())
         history["regularizer"].append(reg.item())
         history["n_bins"].append(int(bins.frames.shape[1]))
@@ -282,7 +290,7 @@ class Reconstruction:
 
     def at(self, times, chunk: int = 256) -> np.ndarray:
         """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W]."""
-        return _blend(self.model, self.windows, np.atleast_1d(np.asarray(times, np.float64)), self.offsets, chunk)
+        return blend_networks(self.model, self.windows, np.atleast_1d(np.asarray(times, np.float64)), self.offsets, chunk)
 
     def frames_at(self, times) -> np.ndarray:
         """Tone-mapped frames in [0, 1] at any times: float32 [Q, H, W]."""
@@ -290,7 +298,7 @@ class Reconstruction:
 
 
 @torch.no_grad()
-def _predict(model: FrameINR, times: np.ndarray, chunk: int = 256) -> np.ndarray:
+def predict_networks(model: FrameINR, times: np.ndarray, chunk: int = 256) -> np.ndarray:
     """Every network at every time: float32 [N, Q, H, W] (no offsets)."""
     device = model.head_weight.device
     out = []
@@ -300,7 +308,7 @@ def _predict(model: FrameINR, times: np.ndarray, chunk: int = 256) -> np.ndarray
     return np.concatenate(out, axis=1)
 
 
-def _blend_weights(windows: np.ndarray, times: np.ndarray) -> np.ndarray:
+def blend_weights(windows: np.ndarray, times: np.ndarray) -> np.ndarray:
     """[N, Q] weights: linear ramps across overlaps, zero outside a window, summing to 1."""
     lo, hi = windows[:, :1], windows[:, 1:]
     inside = (times >= lo - 1e-9) & (times <= hi + 1e-9)
@@ -318,13 +326,15 @@ def _blend_weights(windows: np.ndarray, times: np.ndarray) -> np.ndarray:
     return w / w.sum(axis=0, keepdims=True)
 
 
-def _blend(model, windows, times, offsets, chunk=256) -> np.ndarray:
-    F = _predict(model, times, chunk) + offsets[:, None]
-    w = _blend_weights(windows, times)
+def blend_networks(model, windows, times, offsets, chunk=256) -> np.ndarray:
+    """The ensemble's log intensity at times [Q]: each network plus its offset [N, H, W], blended
+    with :func:`blend_weights`. Returns float32 [Q, H, W]."""
+    F = predict_networks(model, times, chunk) + offsets[:, None]
+    w = blend_weights(windows, times)
     return np.einsum("nq,nqhw->qhw", w, F).astype(np.float32)
 
 
-def _alignment_offsets(model: FrameINR, windows: np.ndarray, n_samples: int = 8) -> np.ndarray:
+def alignment_offsets(model: FrameINR, windows: np.ndarray, n_samples: int = 8) -> np.ndarray:
     """Per-network, per-pixel offsets [N, H, W] chaining each network onto its predecessor.
 
     Over the overlap of windows k-1 and k, offset_k = offset_{k-1} + mean_t (F_{k-1}(t) - F_k(t)).
@@ -333,7 +343,7 @@ def _alignment_offsets(model: FrameINR, windows: np.ndarray, n_samples: int = 8)
     offsets = np.zeros((len(windows), H, W), np.float32)
     for k in range(1, len(windows)):
         ts = np.linspace(windows[k, 0], windows[k - 1, 1], n_samples)
-        F = _predict(model, ts)
+        F = predict_networks(model, ts)
         offsets[k] = offsets[k - 1] + (F[k - 1] - F[k]).mean(axis=0)
     return offsets
 
@@ -369,13 +379,13 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
     model, history = train_frame_inr(events, windows, cfg)
     model.eval()
-    offsets = _alignment_offsets(model, windows)
+    offsets = alignment_offsets(model, windows)
     # anchor: mean log intensity over the sequence tone-maps to display_mean
     grid = np.linspace(t_start, t_end, min(64, 8 * len(windows)))
-    mean_L = float(_blend(model, windows, grid, offsets).mean())
+    mean_L = float(blend_networks(model, windows, grid, offsets).mean())
     s = cfg.display_mean ** (1 / cfg.gamma)
     offsets += np.float32(math.log(s / (1 - s)) - mean_L)
-    L = _blend(model, windows, q, offsets)
+    L = blend_networks(model, windows, q, offsets)
     frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)
     history["config"] = asdict(cfg)
     return Reconstruction(q, L, frames, model, windows, offsets, cfg, history)

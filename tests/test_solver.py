@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from evinr_lite import EventDataError, make_scene, simulate_scene
-from evinr_lite.solver import EvINRConfig, _blend, reconstruct, split_windows
+from evinr_lite.solver import EvINRConfig, blend_networks, reconstruct, split_windows
 
 SMALL = dict(hidden_features=64, hidden_layers=2, progress=False, lr=3e-4)
 
@@ -23,6 +23,8 @@ def test_split_windows_cover_span_with_equal_overlapping_windows():
     assert split_windows(0.0, 3.0, tau=5.0, overlap=0.5).shape == (1, 2)
     with pytest.raises(EventDataError, match="empty"):
         split_windows(1.0, 1.0, 5.0, 0.5)
+    with pytest.raises(EventDataError, match="three at a time"):
+        split_windows(0.0, 10.0, tau=0.6, overlap=0.5)
 
 
 def test_config_validates_choices():
@@ -91,7 +93,7 @@ def test_ensemble_has_no_seam():
         seams |= (mid_q > rec.windows[k, 0]) & (mid_q < rec.windows[k - 1, 1])
     assert step[seams].max() <= 1.5 * np.median(step[~seams]), (step[seams].max(), np.median(step[~seams]))
     # the same networks, switched hard at the overlap centres and without offsets, jump there
-    raw = np.concatenate([_blend(rec.model, rec.windows[k:k + 1], q[(q >= c0) & (q < c1)], 0 * rec.offsets[k:k + 1])
+    raw = np.concatenate([blend_networks(rec.model, rec.windows[k:k + 1], q[(q >= c0) & (q < c1)], 0 * rec.offsets[k:k + 1])
                           for k, (c0, c1) in enumerate(zip([0, *((rec.windows[1:, 0] + rec.windows[:-1, 1]) / 2)],
                                                            [*((rec.windows[1:, 0] + rec.windows[:-1, 1]) / 2), 9]))])
     raw_step = np.abs(np.diff(raw, axis=0)).mean(axis=(1, 2))
