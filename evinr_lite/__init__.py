@@ -11,6 +11,7 @@ Modules, one job each:
     models      FrameINR: N frame-based SIRENs F(t) -> [H, W] with stacked weights (Eq. 11)
     losses      temporal losses (derivative Eq. 5-6, boundary difference), Tikhonov (Eq. 9), TV
     solver      EvINRConfig and reconstruct(): training, coarse-to-fine, ensembles, anchoring
+    coordinate  the paper's basic coordinate network F(x, y, t) with autograd derivatives
     tonemap     Reinhard tone mapping (Eq. 12)
     metrics     MSE and SSIM with a stated protocol
     siren       SIREN networks (sine activations, SIREN initialisation)
