@@ -50,7 +50,7 @@ from torch import nn
 from . import exercises
 from .binning import events_to_frames, fixed_duration_boundaries
 from .device import default_device
-from .events import EventDataError, Events
+from .events import EventDataError, Events, check_sensor_size
 from .siren import Siren
 from .tonemap import tonemap_reinhard
 
@@ -90,12 +90,7 @@ class CoordinateINR(nn.Module):
     def __init__(self, sensor_size, t_range, hidden_features: int = 256, hidden_layers: int = 3,
                  omega_0: float = 30.0, seed: int = 0, first_omega_0: float | None = None):
         super().__init__()
-        try:
-            H, W = (int(v) for v in sensor_size)
-        except (TypeError, ValueError):
-            raise EventDataError(f"sensor_size must be (H, W), two positive integers; got {sensor_size!r}") from None
-        if H <= 0 or W <= 0:
-            raise EventDataError(f"sensor_size must be (H, W) with positive sizes; got {(H, W)}")
+        H, W = check_sensor_size(sensor_size)
         self.sensor_size = (H, W)
         self.t_range = _check_range(t_range)
         with torch.random.fork_rng(devices=[]):

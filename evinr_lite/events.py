@@ -21,7 +21,7 @@ import numpy as np
 
 import math
 
-__all__ = ["Events", "EventDataError", "normalize_polarity", "relative_seconds", "TIME_UNITS", "LARGE_T"]
+__all__ = ["Events", "EventDataError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T"]
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
@@ -115,7 +115,8 @@ def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
     return ts - origin, origin
 
 
-def _check_sensor_size(sensor_size) -> tuple[int, int]:
+def check_sensor_size(sensor_size) -> tuple[int, int]:
+    """(H, W) as two positive ints, or an EventDataError that says what is wrong."""
     try:
         H, W = (int(v) for v in sensor_size)
     except (TypeError, ValueError):
@@ -152,7 +153,7 @@ class Events:
     polarity_encoding: str = field(default="auto", repr=False)
 
     def __post_init__(self):
-        H, W = _check_sensor_size(self.sensor_size)
+        H, W = check_sensor_size(self.sensor_size)
         t = np.asarray(self.t)
         x = np.asarray(self.x)
         y = np.asarray(self.y)

@@ -22,6 +22,8 @@ import math
 import torch
 from torch import nn
 
+from .events import check_sensor_size
+
 __all__ = ["FrameINR"]
 
 
@@ -47,7 +49,7 @@ class FrameINR(nn.Module):
     def __init__(self, sensor_size, windows, hidden_features: int = 512, hidden_layers: int = 3,
                  omega_0: float = 30.0, first_omega_0: float | None = None, seed: int = 0):
         super().__init__()
-        H, W = (int(v) for v in sensor_size)
+        H, W = check_sensor_size(sensor_size)
         windows = torch.as_tensor(windows, dtype=torch.float64).reshape(-1, 2)
         if torch.any(windows[:, 1] <= windows[:, 0]):
             raise ValueError("every network window [t_lo, t_hi] needs t_hi > t_lo (seconds)")

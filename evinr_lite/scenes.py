@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from .events import EventDataError
+from .events import EventDataError, check_sensor_size
 from .frames import Frames
 
 __all__ = ["Scene", "MovingImageScene", "MovingBarScene", "make_scene", "IMAGE_NAMES", "SCENE_NAMES"]
@@ -29,16 +29,6 @@ IMAGE_NAMES = ("camera", "astronaut", "coffee", "chelsea", "cat", "coins", "moon
                "grass", "gravel", "text", "page", "clock", "hubble_deep_field", "immunohistochemistry")
 SCENE_NAMES = IMAGE_NAMES + ("bar",)
 _RENDER_CHUNK = 1 << 20     # pixels x times computed at once inside log_intensity
-
-
-def _check_size(sensor_size) -> tuple[int, int]:
-    try:
-        H, W = (int(v) for v in sensor_size)
-    except (TypeError, ValueError):
-        raise EventDataError(f"sensor_size must be (H, W), two positive integers; got {sensor_size!r}") from None
-    if H <= 0 or W <= 0:
-        raise EventDataError(f"sensor_size must be (H, W) with positive sizes; got {(H, W)}")
-    return H, W
 
 
 def _check_range(intensity_range) -> tuple[float, float]:
@@ -65,7 +55,7 @@ class Scene:
     max_speed: float
 
     def __init__(self, sensor_size=(120, 160), duration: float = 2.0):
-        self.sensor_size = _check_size(sensor_size)
+        self.sensor_size = check_sensor_size(sensor_size)
         if not (np.isfinite(duration) and duration > 0):
             raise EventDataError(f"duration must be a positive number of seconds, got {duration!r}")
         self.duration = float(duration)
