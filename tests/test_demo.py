@@ -3,7 +3,6 @@ import json
 import subprocess
 import sys
 
-import pytest
 
 from evinr_lite.demo import run_demo
 from evinr_lite.solver import EvINRConfig
