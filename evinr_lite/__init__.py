@@ -17,6 +17,8 @@ Modules, one job each:
     siren       SIREN networks (sine activations, SIREN initialisation)
     pde1d       the 1-D pieces of notebook 01 (window sums, Eq. 4, a 1-D SIREN fit)
     events2d    notebook 02's exercise references (one pixel's ESIM step, event frames)
+    frame_exercises, accel_exercises   exercise references and helpers of notebooks 04-06
+    plot_frames frame grids and loss curves for the notebooks
     viz         looking at events: x-y-t scatter, polarity images, rates, animations
     exercises   exercise checks that say what is wrong, with fallback to the reference
     widgets     `interact`: sliders in a live front end, one static figure otherwise
