@@ -56,7 +56,7 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
     t1 = time.perf_counter()
     rec = reconstruct(events, t_query, cfg, t_start=0.0, t_end=duration)
     log(f"EvINR trained in {rec.history['train_time_s']:.1f} s ({cfg.n_iters} iterations, "
-        f"{len(rec.windows)} network(s), {rec.model.num_parameters():,} parameters each batch)")
+        f"{len(rec.windows)} network(s), {rec.model.num_parameters():,} parameters in all)")
     t2 = time.perf_counter()
     L_int = integrate_events(events, t_query, C=C)
     L_oracle = integrate_events(events, t_query, C=C, L0=sc.log_intensity(0.0))
