@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from pathlib import Path
@@ -24,13 +23,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from evinr_lite import integrate_events, make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
 from evinr_lite.metrics import score_frames  # noqa: E402
+from evinr_lite.tonemap import anchor_mean  # noqa: E402
 from evinr_lite.solver import EvINRConfig, reconstruct  # noqa: E402
-
-
-def anchor(L, gamma=0.6, display_mean=0.5):
-    """Shift log intensities so that their mean tone-maps to display_mean (what the solver does)."""
-    s = display_mean ** (1 / gamma)
-    return L + (math.log(s / (1 - s)) - L.mean())
 
 
 def variants(C: float, iters: int) -> dict:
@@ -65,7 +59,7 @@ def run(size=(120, 160), duration=2.0, C=0.2, iters=300, n_frames=10, scene_name
 
     t0 = time.perf_counter()
     L_int = integrate_events(events, q, C=C)
-    score("direct integration (L0 = 0)", tonemap_reinhard(anchor(L_int)), time.perf_counter() - t0)
+    score("direct integration (L0 = 0)", tonemap_reinhard(anchor_mean(L_int)), time.perf_counter() - t0)
     for name, cfg in variants(C, iters).items():
         rec = reconstruct(events, q, cfg)
         score(name, rec.frames, rec.history["train_time_s"])

@@ -52,7 +52,7 @@ from .binning import events_to_frames, fixed_duration_boundaries
 from .device import default_device
 from .events import EventDataError, Events, check_sensor_size
 from .siren import Siren
-from .tonemap import tonemap_reinhard
+from .tonemap import anchor_level, tonemap_reinhard
 
 __all__ = ["CoordinateINR", "CoordinateConfig", "CoordinateBins", "CoordinateReconstruction",
            "bin_events", "split_index", "temporal_loss", "tikhonov_autograd", "train_coordinate_inr",
@@ -396,8 +396,7 @@ def anchor_offset(mean_log_intensity: float, gamma: float = 0.6, display_mean: f
     Reinhard tone mapping is sigmoid(L) ** gamma, so that mean log intensity tone-maps to
     ``display_mean`` (the same rule as :func:`evinr_lite.solver.reconstruct`).
     """
-    s = display_mean ** (1.0 / gamma)
-    return math.log(s / (1.0 - s)) - float(mean_log_intensity)
+    return anchor_level(gamma, display_mean) - float(mean_log_intensity)
 
 
 def predict_anchored(model: CoordinateINR, query_times, gamma: float = 0.6, display_mean: float = 0.5,

@@ -11,7 +11,6 @@ beside them, and score them against the ground truth:
 """
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -22,14 +21,9 @@ from .output import atomic_output_dir, save_json, save_png
 from .scenes import make_scene
 from .simulate import simulate_scene
 from .solver import EvINRConfig, reconstruct
-from .tonemap import tonemap_reinhard
+from .tonemap import anchor_mean, tonemap_reinhard
 
 __all__ = ["run_demo"]
-
-
-def _anchored(L, gamma: float, display_mean: float = 0.5):
-    s = display_mean ** (1 / gamma)
-    return L + (math.log(s / (1 - s)) - L.mean())
 
 
 def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 160), duration: float = 2.0,
@@ -63,7 +57,7 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
     t3 = time.perf_counter()
     methods = {
         ("EvINR", "evinr"): (rec.frames, t2 - t1),
-        ("integration (L0 = 0)", "integration"): (tonemap_reinhard(_anchored(L_int, cfg.gamma), cfg.gamma), t3 - t2),
+        ("integration (L0 = 0)", "integration"): (tonemap_reinhard(anchor_mean(L_int, cfg.gamma), cfg.gamma), t3 - t2),
         ("integration (L0 = true first frame, oracle)", "integration_oracle"):
             (tonemap_reinhard(L_oracle, cfg.gamma), t3 - t2),
     }

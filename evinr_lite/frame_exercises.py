@@ -20,13 +20,13 @@ Helpers used by both notebooks:
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 import torch
 
 from . import exercises
 from .losses import spatial_differences
+from .tonemap import anchor_level
 
 __all__ = ["sine_layer_derivative", "temporal_loss_boundary", "reinhard_tonemap", "total_variation",
            "anchor_log_intensity", "best_offsets", "static_residual", "ghost_strength"]
@@ -199,12 +199,9 @@ def anchor_log_intensity(L, gamma: float = 0.6, display_mean: float = 0.5, refer
     rule of :func:`evinr_lite.solver.reconstruct` (which takes the mean over the whole sequence:
     pass log intensities on a time grid as ``reference`` to do the same). numpy, any shape.
     """
-    if not 0 < display_mean < 1:
-        raise ValueError(f"display_mean must be in (0, 1), got {display_mean}")
-    s = display_mean ** (1.0 / gamma)
     L = np.asarray(L, dtype=np.float64)
     mean = L.mean() if reference is None else float(np.mean(reference))
-    return L + (math.log(s / (1.0 - s)) - mean)
+    return L + (anchor_level(gamma, display_mean) - mean)
 
 
 def best_offsets(L, regularizer: str = "tikhonov", n_iters: int = 400, lr: float = 0.05, seed: int = 0):

@@ -37,7 +37,7 @@ from .device import default_device
 from .events import EventDataError, Events
 from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
 from .models import FrameINR
-from .tonemap import tonemap_reinhard
+from .tonemap import anchor_level, tonemap_reinhard
 
 __all__ = ["EvINRConfig", "Reconstruction", "reconstruct", "split_windows", "train_frame_inr",
            "predict_networks", "blend_weights", "blend_networks", "alignment_offsets"]
@@ -383,8 +383,7 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     # anchor: mean log intensity over the sequence tone-maps to display_mean
     grid = np.linspace(t_start, t_end, min(64, 8 * len(windows)))
     mean_L = float(blend_networks(model, windows, grid, offsets).mean())
-    s = cfg.display_mean ** (1 / cfg.gamma)
-    offsets += np.float32(math.log(s / (1 - s)) - mean_L)
+    offsets += np.float32(anchor_level(cfg.gamma, cfg.display_mean) - mean_L)
     L = blend_networks(model, windows, q, offsets)
     frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)
     history["config"] = asdict(cfg)

@@ -7,9 +7,11 @@ reconstruction is only comparable with ground truth once its offset is anchored 
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["tonemap_reinhard"]
+__all__ = ["tonemap_reinhard", "anchor_level", "anchor_mean"]
 
 
 def tonemap_reinhard(L, gamma: float = 0.6):
@@ -27,3 +29,21 @@ def tonemap_reinhard(L, gamma: float = 0.6):
         return L.sigmoid() ** gamma
     L = np.asarray(L, dtype=np.float64)
     return (0.5 * (1.0 + np.tanh(0.5 * L))) ** gamma  # sigmoid without overflow warnings
+
+
+def anchor_level(gamma: float = 0.6, display_mean: float = 0.5) -> float:
+    """The log intensity that tone-maps to ``display_mean``: logit(display_mean ** (1 / gamma)).
+
+    Events fix log intensity only up to a constant; the solvers shift their output so that its
+    mean sits at this level (mid-grey on screen by default).
+    """
+    if not 0 < display_mean < 1:
+        raise ValueError(f"display_mean must be in (0, 1), got {display_mean}")
+    s = display_mean ** (1.0 / gamma)
+    return math.log(s / (1.0 - s))
+
+
+def anchor_mean(L, gamma: float = 0.6, display_mean: float = 0.5):
+    """``L`` shifted by one constant so that its mean is :func:`anchor_level` (numpy array)."""
+    L = np.asarray(L)
+    return L + (anchor_level(gamma, display_mean) - float(L.mean()))

@@ -61,3 +61,14 @@ def test_equalization_and_frame_scores():
     # CLAHE ignores a global brightness offset that plain SSIM punishes
     brighter = np.clip(stack + 0.2, 0, 1)
     assert score_frames(brighter, stack, "clahe")["ssim"] > score_frames(brighter, stack, "none")["ssim"]
+
+
+def test_anchor_level_tone_maps_to_the_display_mean():
+    from evinr_lite.tonemap import anchor_level, anchor_mean
+    for gamma in (0.4, 0.6, 1.0):
+        assert tonemap_reinhard(np.array(anchor_level(gamma, 0.5)), gamma) == pytest.approx(0.5)
+    L = np.random.default_rng(3).normal(size=(4, 5))
+    A = anchor_mean(L, 0.6, 0.3)
+    assert A.mean() == pytest.approx(anchor_level(0.6, 0.3)) and np.allclose(A - L, (A - L).flat[0])
+    with pytest.raises(ValueError, match="display_mean"):
+        anchor_level(0.6, 1.0)
