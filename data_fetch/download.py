@@ -167,6 +167,16 @@ def file_hash(path, alg: str = "sha256") -> str:
     return h.hexdigest()
 
 
+def _already_here(dest: Path, known_hash) -> bool:
+    """Make dest's folder; True when dest is already there (and matches known_hash, if given)."""
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    if not dest.exists():
+        return False
+    if known_hash:
+        _check_existing(dest, known_hash)
+    return True
+
+
 def _check_existing(dest: Path, known_hash: str) -> None:
     alg, _, expected = known_hash.rpartition(":")
     alg = alg or "sha256"
@@ -217,10 +227,7 @@ def fetch_url(url: str, dest, *, known_hash: str | None = None, progress: bool =
     import pooch
 
     dest = Path(dest)
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    if dest.exists():
-        if known_hash:
-            _check_existing(dest, known_hash)
+    if _already_here(dest, known_hash):
         return dest
     lock = _lock(dest)
     try:
@@ -281,10 +288,7 @@ def fetch_gdrive_file(folder_url: str, filename: str, dest, *, progress: bool = 
     resumes from it on the next call.
     """
     dest = Path(dest)
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    if dest.exists():
-        if known_hash:
-            _check_existing(dest, known_hash)
+    if _already_here(dest, known_hash):
         return dest
     hint = (f"To place it by hand: open {folder_url} in a browser, download {filename} and copy it to "
             f"{dest} (exactly this path; set the cache folder with the EVINR_DATA environment variable), "
