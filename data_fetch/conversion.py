@@ -51,7 +51,7 @@ def _kind(path: Path) -> str:
         if (path / "events.txt").exists() or any(path.glob("*/events.txt")):
             return "ijrr"
         raise ConversionError(f"{path}: a folder without events.txt; data_fetch converts IJRR folders, .zip, "
-                              ".bag and .h5/.hdf5 files")
+                              ".bag and .h5/.hdf5 files (an AED sequence folder: add --dataset aed)")
     suffix = path.suffix.lower()
     if suffix == ".bag":
         return "bag"
@@ -83,7 +83,9 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
 
     Args:
         raw: an IJRR ``.zip`` or folder, a ROS1 ``.bag`` (HQF, CED, MVSEC, IJRR), a CED zip of bags
-            (pass ``sequence``), an MVSEC ``_data.hdf5`` or an HQF-style ``.h5``.
+            (pass ``sequence``), an MVSEC ``_data.hdf5``, an HQF-style ``.h5``, or an AED sequence
+            folder with ``dataset="aed"`` (layout: :mod:`data_fetch.convert_aed`; ``sensor_size`` is
+            then the raw Quad Bayer event sensor).
         out: the ``.h5`` to write, or a folder for ``<sequence>.h5``; None:
             ``<cache>/<dataset>/<sequence>.h5`` (``<cache>/converted/`` for unknown recordings).
         dataset, sequence: registry names; guessed from the file name when None (e.g.
@@ -113,10 +115,6 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
             ds, seq = guess
             log.info("data_fetch: %s is %s / %s", raw.name, ds.name, seq.name)
     name = sequence or (seq.name if seq else (raw.name if raw.is_dir() else raw.stem.removesuffix("_data")))
-    kind = _kind(raw)
-    if ds is not None and ds.method == "manual":
-        raise DataFetchError(f"{ds.name} recordings are converted by the {ds.name.upper()} converter, which is not "
-                             "part of data_fetch yet; see `python -m data_fetch list aed`")
     if out is None:
         out = cache_dir() / (ds.name if ds else "converted") / f"{name}.h5"
     else:
@@ -125,6 +123,13 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
             out = out / f"{name}.h5"
     if out.resolve() == raw.resolve():
         raise DataFetchError(f"the output {out} is the raw file itself; choose another --out")
+    if ds is not None and ds.method == "manual":   # AED: a sequence folder placed by hand (layout: convert_aed.py)
+        from .convert_aed import convert_aed
+
+        return convert_aed(raw, out, raw_sensor_size=sensor_size, C=float(C if C is not None else ds.C),
+                           eval_window=None if eval_window is _UNSET else eval_window, dataset=ds.name,
+                           sequence=name, source=ds.title, progress=progress)
+    kind = _kind(raw)
     common = dict(
         sensor_size=sensor_size if sensor_size is not None else (ds.sensor_size if ds else None),
         C=float(C if C is not None else (ds.C if ds else 1.0)),
