@@ -1,10 +1,24 @@
-"""The ``evinr-lite`` command (also ``python -m evinr_lite``)."""
+"""The ``evinr-lite`` command (also ``python -m evinr_lite``).
+
+    evinr-lite info RECORDING                 what a recording holds (format, sensor, events, frames)
+    evinr-lite reconstruct RECORDING --out DIR [--sensor HxW] [--C C] [--fps N | --at TIMES]
+                                              [--start S] [--end S] [--device cpu|cuda] [--overwrite]
+    evinr-lite demo [--out DIR]               the built-in synthetic scene, no download
+
+Bad input (missing file, unknown format, wrong sensor size, empty window, existing output folder)
+prints ``evinr-lite: error: ...`` and exits with status 2; Ctrl-C exits with 130 and leaves no
+output folder behind.
+"""
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 
-__all__ = ["main"]
+__all__ = ["main", "build_parser"]
+
+EXIT_ERROR = 2
+EXIT_INTERRUPTED = 130
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -18,8 +32,41 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="evinr-lite", description=__doc__)
+    from .readers import SUPPORTED_FORMATS
+
+    parser = argparse.ArgumentParser(prog="evinr-lite", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True)
+
+    info = sub.add_parser("info", help="what a recording holds: format, sensor size, events, frames",
+                          description=f"Supported formats: {SUPPORTED_FORMATS}.")
+    info.add_argument("recording", help="file or folder (format detected from content and name)")
+    info.add_argument("--sensor", type=_size, help="sensor size HxW, for files that do not record it (.npy, "
+                                                   "text without a header, some Prophesee .raw)")
+    info.add_argument("--json", action="store_true", help="print the description as JSON")
+
+    rec = sub.add_parser("reconstruct", help="reconstruct frames from a recording with EvINR",
+                         description="Reconstruct frames with EvINR and write PNGs, an MP4 and a GIF; when the "
+                                     "recording has frames, score against them (metrics.json / metrics.csv). "
+                                     f"Supported formats: {SUPPORTED_FORMATS}.")
+    rec.add_argument("recording", help="file or folder (format detected from content and name)")
+    rec.add_argument("--out", required=True, help="output folder (refused if it exists, unless --overwrite)")
+    rec.add_argument("--sensor", type=_size, help="sensor size HxW (rows x columns), for files that do not "
+                                                  "record it; checked against the file's otherwise")
+    rec.add_argument("--C", type=float, help="contrast threshold (default: the file's, else 1 as in the paper)")
+    when = rec.add_mutually_exclusive_group()
+    when.add_argument("--fps", type=float, help="reconstruct this many frames per second over the window")
+    when.add_argument("--at", help="reconstruct at these times (seconds, comma-separated, or a file with "
+                                   "one per line); default: the ground-truth frame times, else 30 per second")
+    rec.add_argument("--start", type=float, help="window start, seconds on the recording's clock (see `info`)")
+    rec.add_argument("--end", type=float, help="window end, seconds on the recording's clock (see `info`)")
+    rec.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
+    rec.add_argument("--iters", type=int, default=300, help="training iterations (default: 300, the paper's)")
+    rec.add_argument("--seed", type=int, default=0)
+    rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
+    rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
+    rec.add_argument("--quiet", action="store_true", help="no progress bar")
+
     demo = sub.add_parser("demo", help="reconstruct a built-in synthetic scene and score it (no download)")
     demo.add_argument("--out", default="evinr_demo", help="output folder (default: evinr_demo)")
     demo.add_argument("--scene", default="camera", help="built-in scene: camera, astronaut, bar, ... (default: camera)")
@@ -33,23 +80,58 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _info(args) -> None:
+    from .recon_job import describe_recording, format_info, read_any
+
+    rec = read_any(args.recording, sensor_size=args.sensor)
+    info = describe_recording(rec)
+    print(json.dumps(info, indent=2) if args.json else format_info(info))
+
+
+def _reconstruct(args) -> None:
+    from .recon_job import run_reconstruct
+
+    run_reconstruct(args.recording, args.out, sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
+                    t_start=args.start, t_end=args.end, device=args.device, n_iters=args.iters, seed=args.seed,
+                    overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet)
+
+
+def _demo(args) -> None:
+    from pathlib import Path
+
+    from .demo import run_demo
+    from .solver import EvINRConfig
+
+    if Path(args.out).exists() and not args.overwrite:  # say so before training, not after
+        raise FileExistsError(f"output folder {args.out} already exists; choose another --out or pass --overwrite")
+    config = EvINRConfig(C=args.C, n_iters=args.iters, seed=args.seed,
+                         c2f_iters=(args.iters // 3, 2 * args.iters // 3))
+    run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
+             n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)
+
+
+def _message(exc: BaseException) -> str:
+    text = str(exc) or type(exc).__name__
+    if "sensor_size=(H, W)" in text:
+        text += " (on the command line: --sensor HxW)"
+    return text
+
+
 def main(argv=None) -> int:
+    """Run the command; returns the exit status (0 ok, 2 bad input, 130 interrupted)."""
     args = build_parser().parse_args(argv)
     from .events import EventDataError
 
+    commands = {"info": _info, "reconstruct": _reconstruct, "demo": _demo}
     try:
-        if args.command == "demo":
-            from .demo import run_demo
-            from .solver import EvINRConfig
-
-            config = EvINRConfig(C=args.C, n_iters=args.iters, seed=args.seed,
-                                 c2f_iters=(args.iters // 3, 2 * args.iters // 3))
-            run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
-                     n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)
-    except (EventDataError, FileExistsError, ValueError) as exc:
-        print(f"evinr-lite: error: {exc}", file=sys.stderr)
-        return 2
+        commands[args.command](args)
+    except (EventDataError, FileExistsError, FileNotFoundError, PermissionError, IsADirectoryError,
+            NotADirectoryError, ValueError) as exc:
+        print(f"evinr-lite: error: {_message(exc)}", file=sys.stderr)
+        return EXIT_ERROR
     except KeyboardInterrupt:
-        print("evinr-lite: interrupted; nothing was written", file=sys.stderr)
-        return 130
+        out = getattr(args, "out", None)
+        where = f"; {out} was not written or changed" if out else ""
+        print(f"\nevinr-lite: interrupted{where} (partial results are deleted)", file=sys.stderr)
+        return EXIT_INTERRUPTED
     return 0

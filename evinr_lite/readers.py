@@ -1,4 +1,5 @@
-"""Readers for event recordings: IJRR text folders, rpg_e2vid text, EVREAL npy folders, HQF h5, npy.
+"""Readers for event recordings: IJRR text folders, rpg_e2vid text, EVREAL npy folders, HQF h5, npy
+(AEDAT4 and Prophesee files: :mod:`evinr_lite.formats`).
 
 Every reader returns :class:`~evinr_lite.events.Events` (or a :class:`Recording`: events plus
 ground-truth frames plus metadata) in the package conventions: t float64 seconds relative to
@@ -9,7 +10,7 @@ resolution (the spacing of float64 near 1.5e9 is 2.4e-7 s). The text readers the
 timestamp into whole seconds and nanoseconds as integers and subtract a whole-second ``t_origin``
 exactly, before any float is formed. Frames of the same recording are read on the same origin.
 
-Use :func:`read_recording` (format detected from the path) or the per-format readers.
+Use :func:`read_recording` (format detected from content and name) or the per-format readers.
 """
 from __future__ import annotations
 
@@ -35,6 +36,8 @@ __all__ = [
     "read_h5",
     "read_recording",
     "read_events",
+    "detect_format",
+    "SUPPORTED_FORMATS",
 ]
 
 SUPPORTED_FORMATS = (
@@ -42,7 +45,9 @@ SUPPORTED_FORMATS = (
     "an EVREAL folder (events_ts.npy, events_xy.npy, events_p.npy, images.npy, images_ts.npy, metadata.json); "
     "a data_fetch canonical .h5 file; an HQF-style .h5/.hdf5 file; "
     "a `t x y p` .txt file (optional `W H` header line); "
-    "an [N, 4] .npy array"
+    "an [N, 4] .npy array; "
+    "an AEDAT4 file (.aedat4, DV / DAVIS, with its frames); "
+    "a Prophesee EVT2/EVT3 .raw or DAT .dat file"
 )
 NS = 10**9              # nanoseconds per second
 CHUNK_BYTES = 1 << 20   # the text parser works on 1 MiB of whole lines at a time (cache-friendly)
@@ -654,38 +659,96 @@ def read_h5(path, *, t_start=None, t_end=None) -> Recording:
     return Recording(events, frames, meta)
 
 
-def read_recording(path, **kwargs) -> Recording:
-    """Read any supported recording, detecting the format from the path.
+def _looks_like_event_text(path: Path) -> bool:
+    """True when the first lines of a file are `t x y p` numbers (after an optional `W H` line)."""
+    with open(path, "rb") as f:
+        head = f.read(4096)
+    try:
+        lines = [line.split() for line in head.decode("ascii").splitlines()[:3] if line.strip()]
+    except UnicodeDecodeError:
+        return False
+    if lines and len(lines[0]) == 2:
+        lines = lines[1:]
+    if not lines or len(lines[0]) != 4:
+        return False
+    try:
+        [float(v) for v in lines[0]]
+    except ValueError:
+        return False
+    return True
 
-    Folder with events.txt -> :func:`read_ijrr_folder`; folder with events_ts.npy ->
-    :func:`read_evreal_folder`; .h5/.hdf5 -> the canonical data_fetch format
-    (:func:`evinr_lite.canonical.read_canonical`) or HQF-style :func:`read_h5`; .txt -> :func:`read_events_txt`;
-    .npy -> :func:`read_events_npy` (the last two without frames). ``kwargs`` go to that reader.
+
+def detect_format(path) -> str:
+    """The format of a recording, from its content first and its name second.
+
+    Returns one of "ijrr", "evreal" (folders), "canonical", "h5", "aedat4", "prophesee_raw",
+    "prophesee_dat", "txt", "npy". Raises EventDataError naming the supported formats otherwise.
     """
+    from .formats import sniff_format
+
     path = Path(path)
     if not path.exists():
-        raise EventDataError(f"no such file or folder: {path}; supported formats: {SUPPORTED_FORMATS}")
+        raise EventDataError(f"no such file or folder: {path}; check the path")
     if path.is_dir():
         if (path / "events.txt").exists():
-            return read_ijrr_folder(path, **kwargs)
+            return "ijrr"
         if (path / "events_ts.npy").exists():
-            return read_evreal_folder(path, **kwargs)
+            return "evreal"
         raise EventDataError(f"{path}: folder of unknown format (no events.txt or events_ts.npy); "
                              f"supported formats: {SUPPORTED_FORMATS}")
     suffix = path.suffix.lower()
-    if suffix in (".h5", ".hdf5"):
-        from .canonical import is_canonical, read_canonical
+    kind = sniff_format(path)
+    if kind == "hdf5":
+        from .canonical import is_canonical
 
-        if is_canonical(path):  # written by data_fetch
-            return read_canonical(path, **kwargs)
+        return "canonical" if is_canonical(path) else "h5"
+    if kind in ("aedat4", "npy", "prophesee_raw", "prophesee_dat"):
+        return kind
+    if kind in ("aedat2", "aedat3"):
+        raise EventDataError(f"{path}: an {kind.upper()} file; only AEDAT4 is read: convert it with iniVation's "
+                             "DV software (Convert to AEDAT4) or export the events to a `t x y p` text file")
+    if kind == "zip":
+        raise EventDataError(f"{path}: a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or "
+                             "the file inside")
+    if suffix == ".txt" or _looks_like_event_text(path):
+        return "txt"
+    raise EventDataError(f"{path}: unknown format {suffix or '(no extension)'!r} (and its content is none of "
+                         f"the known ones); supported formats: {SUPPORTED_FORMATS}")
+
+
+def read_recording(path, **kwargs) -> Recording:
+    """Read any supported recording; the format is detected by :func:`detect_format`.
+
+    IJRR folder -> :func:`read_ijrr_folder`; EVREAL folder -> :func:`read_evreal_folder`; HDF5 ->
+    the canonical data_fetch format (:func:`evinr_lite.canonical.read_canonical`) or HQF-style
+    :func:`read_h5`; AEDAT4 -> :func:`evinr_lite.formats.read_aedat4`; Prophesee .raw / .dat ->
+    :func:`evinr_lite.formats.read_prophesee`; `t x y p` text -> :func:`read_events_txt`;
+    .npy -> :func:`read_events_npy` (the last two without frames). ``kwargs`` go to that reader.
+    ``meta["format"]`` names the format read.
+    """
+    path = Path(path)
+    kind = detect_format(path)
+    if kind == "ijrr":
+        return read_ijrr_folder(path, **kwargs)
+    if kind == "evreal":
+        return read_evreal_folder(path, **kwargs)
+    if kind == "canonical":
+        from .canonical import read_canonical
+
+        return read_canonical(path, **kwargs)
+    if kind == "h5":
         return read_h5(path, **kwargs)
-    if suffix == ".txt":
+    if kind == "aedat4":
+        from .formats import read_aedat4
+
+        return read_aedat4(path, **kwargs)
+    if kind in ("prophesee_raw", "prophesee_dat"):
+        from .formats import read_prophesee
+
+        return read_prophesee(path, **kwargs)
+    if kind == "txt":
         return Recording(read_events_txt(path, **kwargs), None, {"format": "txt", "path": str(path)})
-    if suffix == ".npy":
-        return Recording(read_events_npy(path, **kwargs), None, {"format": "npy", "path": str(path)})
-    hint = "; unzip it first and pass the folder" if suffix == ".zip" else ""
-    raise EventDataError(f"{path}: unknown format {suffix or '(no extension)'!r}{hint}; "
-                         f"supported formats: {SUPPORTED_FORMATS}")
+    return Recording(read_events_npy(path, **kwargs), None, {"format": "npy", "path": str(path)})
 
 
 def read_events(path, **kwargs) -> Events:
