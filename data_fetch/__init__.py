@@ -22,6 +22,7 @@ from .errors import ChecksumError, ConversionError, DataFetchError, DownloadErro
 
 __all__ = [
     "cache_dir", "get", "get_all", "convert", "read", "info", "list_datasets", "raw_path", "canonical_path",
+    "weights_dir", "get_weights",
     "DataFetchError", "DownloadError", "ChecksumError", "ConversionError", "NotDownloadable",
 ]
 
@@ -60,6 +61,39 @@ def _manual_message(ds, sequence: str) -> str:
             f"{cache_dir() / ds.name / (sequence + '.h5')} and returned by data_fetch.get.")
 
 
+def weights_dir(name: str) -> Path:
+    """Folder of a weight set (e.g. "lpips"): ``<cache>/weights/<name>``."""
+    from .registry import get_weight_set
+
+    get_weight_set(name)
+    return cache_dir() / "weights" / name.lower()
+
+
+def get_weights(name: str, files=("all",), *, verify: bool = True, progress: bool = True,
+                retries: int = 3, **_ignored) -> dict[str, Path]:
+    """Download (once, sha256-verified, atomic) the files of a weight set; {file name: path}.
+
+    ``python -m data_fetch get lpips all`` does the same from the command line.
+    """
+    from .download import fetch_url
+    from .registry import get_weight_set
+
+    entries = get_weight_set(name)
+    wanted = list(entries) if "all" in files else list(files)
+    unknown = [f for f in wanted if f not in entries]
+    if unknown:
+        raise DataFetchError(f"weight set {name!r} has no file {unknown[0]!r}; known: {', '.join(entries)}, all")
+    folder = weights_dir(name)
+    return {f: fetch_url(entries[f].url, folder / entries[f].file, known_hash=entries[f].known_hash if verify else None,
+                         progress=progress, retries=retries) for f in wanted}
+
+
+def _is_weight_set(name: str) -> bool:
+    from .registry import WEIGHTS
+
+    return name.lower() in WEIGHTS
+
+
 def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str | None = None,
         verify: bool = True, force: bool = False, keep_raw: bool = True, progress: bool = True,
         retries: int = 3) -> Path:
@@ -84,6 +118,12 @@ def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str 
 
     from .registry import get_dataset, get_sequence
 
+    if _is_weight_set(dataset):        # model weights (e.g. "lpips"): no conversion
+        if url:
+            raise DataFetchError(f"--url is not supported for weight files; place the file by hand in "
+                                 f"{weights_dir(dataset)}/ instead")
+        paths = get_weights(dataset, (sequence,), verify=verify, progress=progress, retries=retries)
+        return weights_dir(dataset) if sequence == "all" else paths[sequence]
     if progress and not logging.getLogger().handlers and not log.handlers:
         handler = logging.StreamHandler()
         handler.setFormatter(logging.Formatter("%(message)s"))
@@ -128,6 +168,8 @@ def get_all(dataset: str, **kwargs) -> dict[str, Path]:
     """:func:`get` every registered evaluation sequence of a dataset; {sequence: path}."""
     from .registry import get_dataset
 
+    if _is_weight_set(dataset):
+        return get_weights(dataset, ("all",), **kwargs)
     ds = get_dataset(dataset)
     if ds.method == "manual":
         raise NotDownloadable(_manual_message(ds, "<sequence>"))

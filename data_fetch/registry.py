@@ -15,7 +15,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-__all__ = ["Dataset", "Sequence", "DATASETS", "get_dataset", "get_sequence"]
+__all__ = ["Dataset", "Sequence", "DATASETS", "get_dataset", "get_sequence", "WeightFile", "WEIGHTS",
+           "get_weight_set"]
 
 IJRR_BASE = "https://rpg.ifi.uzh.ch/datasets/davis/"
 HQF_FOLDER = "https://drive.google.com/drive/folders/18Xdr6pxJX0ZXTrXW9tK0hC3ZpmKDIt6_"
@@ -191,7 +192,9 @@ def _aed() -> Dataset:
         "aed", "ALPIX Event Dataset (AED), ALPIX-Eiger", "manual", (306, 408), 0.25, "manual",
         "(distributed by the EvINR authors on request)", {},
         note="not publicly downloadable: request it from the authors and place the files by hand; events "
-             "1632x1224 Quad Bayer, demosaiced to 408x306; frames 816x612 grey; about 10 s per sequence",
+             "1632x1224 Quad Bayer, demosaiced to 408x306; frames 816x612 grey; about 10 s per sequence; "
+             "convert a placed folder with `python -m data_fetch convert <folder> --dataset aed` "
+             "(expected layout: data_fetch/convert_aed.py)",
         citation="Wang et al., EvINR, ECCV 2024",
     )
 
@@ -224,3 +227,50 @@ def get_sequence(dataset: str, name: str) -> Sequence:
         return Sequence(name, name, None, None, None, evaluation=False)
     known = ", ".join(ds.sequences)
     raise DataFetchError(f"{ds.name} has no sequence {name!r}; known sequences: {known}")
+
+
+# ---- model weights (not datasets): fetched with `python -m data_fetch get <name> all` ----------
+
+@dataclass(frozen=True)
+class WeightFile:
+    """One published weight file, stored as ``<cache>/weights/<set>/<file>``.
+
+    Attributes:
+        name: its name on the command line. file: the file name (kept as published).
+        url: where to download it. known_hash: pinned checksum ("sha256:..."), or None.
+        note: where the checksum comes from.
+    """
+
+    name: str
+    file: str
+    url: str
+    known_hash: str | None
+    note: str = ""
+
+
+# LPIPS (AlexNet, v0.1) for evinr_lite.lpips. Checksums: torchvision names its file after the first
+# 8 hex digits of the sha256 (7be5be79); the full digest is the one other public projects pin for
+# the same file. The v0.1 heads are byte-identical to lpips/weights/v0.1/alex.pth in the `lpips`
+# 0.1.4 wheel on PyPI, whose sha256 was computed from that wheel.
+WEIGHTS: dict[str, dict[str, WeightFile]] = {
+    "lpips": {
+        "alexnet": WeightFile(
+            "alexnet", "alexnet-owt-7be5be79.pth", "https://download.pytorch.org/models/alexnet-owt-7be5be79.pth",
+            "sha256:7be5be791159472b1fbf3c69796f7cb30dca7ad8466c2df70058c37116cdee02",
+            "torchvision ImageNet AlexNet (IMAGENET1K_V1), 233 MB; only its `features` are used"),
+        "alex_v0.1": WeightFile(
+            "alex_v0.1", "alex.pth",
+            "https://github.com/richzhang/PerceptualSimilarity/raw/master/lpips/weights/v0.1/alex.pth",
+            "sha256:df73285e35b22355a2df87cdb6b70b343713b667eddbda73e1977e0c860835c0",
+            "LPIPS v0.1 linear heads for AlexNet, 6 kB"),
+    },
+}
+
+
+def get_weight_set(name: str) -> dict[str, WeightFile]:
+    from .errors import DataFetchError
+
+    key = name.lower()
+    if key not in WEIGHTS:
+        raise DataFetchError(f"unknown weight set {name!r}; known: {', '.join(WEIGHTS)}")
+    return WEIGHTS[key]

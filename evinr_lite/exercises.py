@@ -56,7 +56,8 @@ __all__ = [
 # unknown name, so ``check`` works without the notebook importing them first.
 REFERENCE_MODULES = ["evinr_lite.pde1d", "evinr_lite.events2d", "evinr_lite.accel_exercises",
                      "evinr_lite.coordinate", "evinr_lite.frame_exercises", "evinr_lite.realdata",
-                     "evinr_lite.aed_exercises", "evinr_lite.recording_exercises"]
+                     "evinr_lite.aed_exercises", "evinr_lite.recording_exercises",
+                     "evinr_lite.baselines", "evinr_lite.enhance"]
 
 SEED = 0
 

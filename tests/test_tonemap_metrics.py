@@ -72,3 +72,78 @@ def test_anchor_level_tone_maps_to_the_display_mean():
     assert A.mean() == pytest.approx(anchor_level(0.6, 0.3)) and np.allclose(A - L, (A - L).flat[0])
     with pytest.raises(ValueError, match="display_mean"):
         anchor_level(0.6, 1.0)
+
+
+# ---- the protocol, checked against independent computations ----------------------------------
+
+def reference_ssim(a, b, sigma=1.5, truncate=3.5, K1=0.01, K2=0.03, L=1.0):
+    """SSIM after Wang et al. (2004), written out with scipy: gaussian-weighted local means,
+    population (co)variances, the map averaged over pixels at least radius px from the border."""
+    from scipy.ndimage import gaussian_filter
+
+    def blur(img):
+        return gaussian_filter(img, sigma, truncate=truncate)
+
+    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
+    mu_a, mu_b = blur(a), blur(b)
+    var_a = blur(a * a) - mu_a ** 2
+    var_b = blur(b * b) - mu_b ** 2
+    cov = blur(a * b) - mu_a * mu_b
+    C1, C2 = (K1 * L) ** 2, (K2 * L) ** 2
+    s = ((2 * mu_a * mu_b + C1) * (2 * cov + C2)) / ((mu_a ** 2 + mu_b ** 2 + C1) * (var_a + var_b + C2))
+    r = int(truncate * sigma + 0.5)
+    return float(s[r:-r, r:-r].mean())
+
+
+@pytest.mark.parametrize("seed, noise", [(0, 0.05), (1, 0.2), (2, 0.5)])
+def test_ssim_and_mse_match_an_independent_computation_on_noisy_pairs(seed, noise):
+    rng = np.random.default_rng(seed)
+    y, x = np.mgrid[0:48, 0:64]
+    img = 0.5 + 0.4 * np.sin(x / 5.0) * np.cos(y / 7.0)              # structure, values in [0.1, 0.9]
+    noisy = np.clip(img + rng.normal(0, noise, img.shape), 0, 1)
+    assert ssim(noisy, img) == pytest.approx(reference_ssim(noisy, img), abs=1e-10)
+    assert ssim(img, noisy) == pytest.approx(reference_ssim(img, noisy), abs=1e-10)
+    assert ssim(noisy, img) < 1.0
+    assert mse(noisy, img) == pytest.approx(((noisy - img) ** 2).sum() / img.size, rel=1e-12)
+    # the prediction (first argument) is clipped to [0, 1] before scoring
+    assert mse(img + 2.0, img) == pytest.approx(np.mean((1.0 - img) ** 2))
+
+
+def test_ssim_of_an_image_with_itself_is_one_for_any_content():
+    rng = np.random.default_rng(4)
+    for img in (rng.uniform(0, 1, (20, 30)), np.full((16, 16), 0.3), np.zeros((12, 40))):
+        assert ssim(img, img) == pytest.approx(1.0, abs=1e-12)
+    with pytest.raises(ValueError, match="at least 11"):
+        ssim(np.zeros((8, 8)), np.zeros((8, 8)))
+
+
+def test_clahe_and_global_equal_opencv_on_uint8():
+    import cv2
+
+    from evinr_lite.metrics import equalize, to_uint8
+    rng = np.random.default_rng(5)
+    img = np.clip(0.35 + 0.1 * rng.standard_normal((60, 80)), 0, 1)
+    u = np.round(img * 255).astype(np.uint8)
+    np.testing.assert_array_equal(to_uint8(img), u)
+    clahe = cv2.createCLAHE(clipLimit=2.0, tileGridSize=(8, 8)).apply(u)
+    np.testing.assert_array_equal(equalize(img, "clahe"), clahe / 255.0)
+    np.testing.assert_array_equal(equalize(img, "global"), cv2.equalizeHist(u) / 255.0)
+    np.testing.assert_array_equal(equalize(u, "clahe"), clahe / 255.0)      # uint8 input directly
+    np.testing.assert_array_equal(equalize(u, "none"), u / 255.0)           # uint8 scaled, not clipped
+    with pytest.raises(ValueError, match=r"\[H, W\]"):
+        equalize(np.zeros((2, 8, 8)), "clahe")
+
+
+def test_protocol_text_names_every_parameter():
+    from evinr_lite.metrics import PROTOCOLS, protocol_description, score_frames
+    for eq in ("none", "global", "clahe"):
+        text = protocol_description(eq)
+        assert text == PROTOCOLS[eq]
+        for part in ("sigma 1.5", "data_range 1.0", "K1 0.01", "v0.1", "[-1, 1]"):
+            assert part in text
+    assert "clipLimit=2.0" in protocol_description("clahe") and "(8, 8)" in protocol_description("clahe")
+    assert "equalizeHist" in protocol_description("global")
+    stack = np.random.default_rng(6).uniform(0, 1, (2, 16, 16))
+    assert protocol_description("clahe") in score_frames(stack, stack, "clahe")["protocol"]
+    with pytest.raises(ValueError, match="equalization must be one of"):
+        protocol_description("local")
