@@ -55,9 +55,8 @@ def raw_path(dataset: str, sequence: str) -> Path:
 
 def _manual_message(ds, sequence: str) -> str:
     return (f"{ds.title} is not publicly downloadable. Ask the EvINR authors for it, then place "
-            f"the files of sequence {sequence!r} in {cache_dir() / 'raw' / ds.name / sequence}/ . Converting them "
-            f"(Quad Bayer demosaicing) belongs to the {ds.name.upper()} converter, which is not part of data_fetch "
-            f"yet; a sequence already converted to the canonical format is found at "
+            f"the files of sequence {sequence!r} in {cache_dir() / 'raw' / ds.name / sequence}/ . and run this command again: it "
+            f"converts them (Quad Bayer demosaicing; expected layout in data_fetch/convert_aed.py). A sequence already converted to the canonical format is found at "
             f"{cache_dir() / ds.name / (sequence + '.h5')} and returned by data_fetch.get.")
 
 
@@ -134,6 +133,10 @@ def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str 
     if not force and is_canonical(out):
         return out
     if ds.method == "manual":
+        placed = raw_path(ds.name, sequence)
+        if placed.is_dir():
+            from .conversion import convert as _convert
+            return _convert(placed, out, dataset=ds.name, sequence=sequence, progress=progress)
         raise NotDownloadable(_manual_message(ds, sequence))
     seq = get_sequence(ds.name, sequence)
     raw = raw_path(ds.name, seq.name)

@@ -40,6 +40,9 @@ def _cmd_list(args) -> int:
             windows = f" ({n_win} with an evaluation window, the rest scored whole)" if 0 < n_win < n_eval else ""
             seqs = f"{n_eval} sequences{windows}" if ds.sequences else "sequences on request"
             print(f"\n{ds.name:6s} {ds.title}\n       {W}x{H}, C = {ds.C:g}, {seqs}, {how}; {done} converted here")
+        from .registry import WEIGHTS
+        for name, files in WEIGHTS.items():
+            print(f"\n{name:6s} weights: {', '.join(f.file for f in files.values())} (`python -m data_fetch get {name} all`)")
         print("\n`python -m data_fetch list <dataset>` lists the sequences; "
               "`python -m data_fetch get <dataset> <sequence>` fetches one.")
         return 0

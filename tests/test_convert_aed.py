@@ -253,3 +253,14 @@ def test_write_aed_folder_round_trip(tmp_path):
     assert np.all(rec.frames.images == 128)
     with pytest.raises(FileExistsError):
         write_aed_folder(tmp_path / "seq", ev)
+
+
+def test_get_converts_a_folder_placed_in_the_cache(fake, tmp_path, monkeypatch):
+    monkeypatch.setenv("EVINR_DATA", str(tmp_path / "cache"))
+    with pytest.raises(data_fetch.NotDownloadable, match="place the files"):
+        data_fetch.get("aed", "seq1", progress=False)
+    cols, frames = fake
+    _write(data_fetch.raw_path("aed", "seq1"), cols, frames, meta={"event_sensor_size": list(RAW)})
+    path = data_fetch.get("aed", "seq1", progress=False)
+    assert path == data_fetch.canonical_path("aed", "seq1")
+    _check_file(path, cols, frames)
