@@ -57,7 +57,7 @@ __all__ = [
 REFERENCE_MODULES = ["evinr_lite.pde1d", "evinr_lite.events2d", "evinr_lite.accel_exercises",
                      "evinr_lite.coordinate", "evinr_lite.frame_exercises", "evinr_lite.realdata",
                      "evinr_lite.aed_exercises", "evinr_lite.recording_exercises",
-                     "evinr_lite.baselines", "evinr_lite.enhance"]
+                     "evinr_lite.baselines", "evinr_lite.enhance", "evinr_lite.ablation_exercises"]
 
 SEED = 0
 
