@@ -40,7 +40,8 @@ Modules, one job each:
     fastmode    small sizes for tests and CI (EVINR_FAST)
     device      CPU by default, a GPU when present
 """
-from .binning import EventFrames, equal_count_boundaries, events_to_frames, fixed_duration_boundaries
+from .binning import (EventFrames, equal_count_boundaries, events_to_frames, events_to_frames_chunked,
+                      fixed_duration_boundaries)
 from .device import default_device
 from .events import EventDataError, Events, normalize_polarity
 from .fastmode import fast_mode, pick

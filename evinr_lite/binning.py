@@ -13,7 +13,7 @@ import numpy as np
 from .events import EventDataError, Events
 
 __all__ = ["EventFrames", "fixed_duration_boundaries", "equal_count_boundaries", "events_to_frames",
-           "bisect_boundaries"]
+           "events_to_frames_chunked", "bisect_boundaries"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,6 +84,52 @@ def equal_count_boundaries(events: Events, events_per_bin: int | None = None, n_
     return np.concatenate([[t[0]], inner, [t[-1]]])
 
 
+_GROUP_CELLS = 1 << 16   # bins x pixels summed per np.bincount call: small enough to stay in cache
+
+
+def _check_boundaries(boundaries) -> np.ndarray:
+    b = np.asarray(boundaries, dtype=np.float64)
+    if b.ndim != 1 or b.size < 2:
+        raise EventDataError(f"boundaries must be a 1-D array of at least 2 edges, got shape {b.shape}")
+    if np.any(np.diff(b) <= 0):
+        raise EventDataError("boundaries must be strictly increasing")
+    return b
+
+
+def _bin_edges(t: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """int64 [B + 1] event indices: bin i holds events e[i]:e[i+1] (b[i] < t <= b[i+1]; t == b[0] in bin 0).
+
+    Events are sorted by time, so B + 1 binary searches replace one per event.
+    """
+    e = np.searchsorted(t, b, side="right")
+    e[0] = np.searchsorted(t, b[0], side="left")
+    return e
+
+
+def _polarity_sums(events: Events, e: np.ndarray):
+    """Yield (i0, i1, sums) for runs of consecutive bins [i0, i1) that hold events.
+
+    sums: float64 [(i1 - i0) * H * W], the polarity sum per (bin, row, column), flattened. Each run
+    covers about ``_GROUP_CELLS`` cells, so np.bincount's counters stay in cache; the flat index is
+    built in place in one int64 array (pixel = y * W + x, plus the bin's offset).
+    """
+    H, W = events.sensor_size
+    HW = H * W
+    per = max(1, _GROUP_CELLS // HW)
+    B = len(e) - 1
+    for i0 in range(0, B, per):
+        i1 = min(B, i0 + per)
+        s, stop = int(e[i0]), int(e[i1])
+        if stop == s:
+            continue
+        flat = events.y[s:stop].astype(np.int64)
+        flat *= W
+        flat += events.x[s:stop]
+        if i1 - i0 > 1:
+            flat += np.repeat(np.arange(i1 - i0, dtype=np.int64) * HW, np.diff(e[i0:i1 + 1]))
+        yield i0, i1, np.bincount(flat, weights=events.p[s:stop], minlength=(i1 - i0) * HW)
+
+
 def events_to_frames(events: Events, boundaries, C: float = 1.0) -> EventFrames:
     """Sum p * C per pixel and bin (vectorised; no Python loop over events).
 
@@ -96,23 +142,66 @@ def events_to_frames(events: Events, boundaries, C: float = 1.0) -> EventFrames:
     Returns:
         EventFrames with frames [B, H, W] float32, the boundaries and per-bin counts.
     """
-    b = np.asarray(boundaries, dtype=np.float64)
-    if b.ndim != 1 or b.size < 2:
-        raise EventDataError(f"boundaries must be a 1-D array of at least 2 edges, got shape {b.shape}")
-    if np.any(np.diff(b) <= 0):
-        raise EventDataError("boundaries must be strictly increasing")
+    b = _check_boundaries(boundaries)
     H, W = events.sensor_size
     B = b.size - 1
-    # bin index: b[i] < t <= b[i+1]  ->  searchsorted(left) - 1; t == b[0] joins bin 0
-    lo = int(np.searchsorted(events.t, b[0], side="left"))
-    hi = int(np.searchsorted(events.t, b[-1], side="right"))
-    t = events.t[lo:hi]
-    idx = np.searchsorted(b, t, side="left") - 1
-    np.maximum(idx, 0, out=idx)
-    flat = idx * (H * W) + events.y[lo:hi].astype(np.int64) * W + events.x[lo:hi]
-    sums = np.bincount(flat, weights=events.p[lo:hi], minlength=B * H * W)
-    frames = (C * sums).astype(np.float32).reshape(B, H, W)
-    counts = np.bincount(idx, minlength=B).astype(np.int64)
+    e = _bin_edges(events.t, b)
+    frames = np.zeros((B, H, W), np.float32)
+    flat = frames.reshape(-1)
+    for i0, i1, sums in _polarity_sums(events, e):
+        np.multiply(sums, C, out=flat[i0 * H * W:i1 * H * W], casting="unsafe")
+    return EventFrames(frames=frames, boundaries=b, counts=np.diff(e))
+
+
+def events_to_frames_chunked(chunks, boundaries, C: float = 1.0, sensor_size=None) -> EventFrames:
+    """:func:`events_to_frames` of a recording given as time-ordered chunks of Events.
+
+    For recordings that do not fit in memory (e.g. ``evinr_lite.canonical.iter_canonical_events``):
+    only one chunk of events is held at a time, plus the frames themselves. Per-pixel polarity
+    sums are accumulated exactly (int32) and multiplied by C at the end, so the result equals
+    ``events_to_frames`` of all the events at once, bit for bit.
+
+    Args:
+        chunks: iterable of Events, in time order, all on one sensor (chunks may be empty).
+        boundaries: float64 [B + 1] bin edges (seconds). C: contrast threshold.
+        sensor_size: (H, W); default: the first chunk's.
+
+    Returns:
+        EventFrames with frames [B, H, W] float32 and counts [B].
+    """
+    b = _check_boundaries(boundaries)
+    B = b.size - 1
+    sums = counts = None
+    t_last = -np.inf
+    for events in chunks:
+        if sums is None:
+            H, W = events.sensor_size if sensor_size is None else sensor_size
+            sums = np.zeros((B, H, W), np.int32)
+            counts = np.zeros(B, np.int64)
+        if tuple(events.sensor_size) != (H, W):
+            raise EventDataError(f"chunk on a sensor of {tuple(events.sensor_size)} but the frames are {(H, W)}; "
+                                 "all chunks must come from one recording")
+        if len(events) == 0:
+            continue
+        if events.t[0] < t_last:
+            raise EventDataError(f"chunks are not in time order (a chunk starts at {events.t[0]} s after one "
+                                 f"that ended at {t_last} s); pass them in time order")
+        t_last = events.t[-1]
+        e = _bin_edges(events.t, b)
+        counts += np.diff(e)
+        flat = sums.reshape(-1)
+        for i0, i1, s in _polarity_sums(events, e):
+            flat[i0 * H * W:i1 * H * W] += s.astype(np.int32)
+    if sums is None:
+        if sensor_size is None:
+            raise EventDataError("no chunks given and no sensor_size; pass sensor_size=(H, W)")
+        H, W = sensor_size
+        sums, counts = np.zeros((B, H, W), np.int32), np.zeros(B, np.int64)
+    # int32 -> float32 in place, a few bins at a time (no second [B, H, W] array)
+    frames = sums.view(np.float32)
+    step = max(1, _GROUP_CELLS // (H * W))
+    for i in range(0, B, step):
+        frames[i:i + step] = C * sums[i:i + step].astype(np.float64)
     return EventFrames(frames=frames, boundaries=b, counts=counts)
 
 

@@ -97,9 +97,16 @@ class FrameINR(nn.Module):
                 dh = torch.cos(z) * (self.omega_0 * torch.bmm(dh, w))
         return h, dh
 
-    def forward(self, t: torch.Tensor) -> torch.Tensor:
-        """Log intensity F at times t [N, T] (seconds) -> [N, T, H, W]."""
+    def forward(self, t: torch.Tensor, out: torch.Tensor | None = None) -> torch.Tensor:
+        """Log intensity F at times t [N, T] (seconds) -> [N, T, H, W].
+
+        ``out``: optional float32 tensor [N, T, H, W] to write into (no gradient), so that a long
+        query fills one preallocated result instead of allocating and copying every batch.
+        """
         h, _ = self.features(t)
+        if out is not None:
+            torch.baddbmm(self.head_bias, h, self.head_weight, out=out.view(*out.shape[:2], -1))
+            return out
         F = torch.baddbmm(self.head_bias, h, self.head_weight)
         return F.reshape(*F.shape[:2], *self.sensor_size)
 
@@ -111,6 +118,17 @@ class FrameINR(nn.Module):
         F = (out[:, :T] + self.head_bias).reshape(-1, T, *self.sensor_size)
         dF = out[:, T:].reshape(-1, T, *self.sensor_size)
         return F, dF
+
+    def network(self, k: int) -> "FrameINR":
+        """A one-network FrameINR holding a copy of network k's weights (same device and window)."""
+        if not -self.n_models <= k < self.n_models:
+            raise IndexError(f"network {k} does not exist; this FrameINR holds {self.n_models}")
+        k = k % self.n_models
+        d = self.weights[0].shape[-1]
+        single = FrameINR(self.sensor_size, self.windows[k:k + 1].cpu(), d, len(self.weights) - 1,
+                          self.omega_0, self.first_omega_0)
+        single.load_state_dict({name: v[k:k + 1].clone() for name, v in self.state_dict().items()})
+        return single.to(self.head_weight.device)
 
     def num_parameters(self) -> int:
         return sum(p.numel() for p in self.parameters())

@@ -35,7 +35,7 @@ import torch
 from .binning import bisect_boundaries, equal_count_boundaries, events_to_frames
 from .device import default_device
 from .events import EventDataError, Events
-from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
+from .losses import head_losses, temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
 from .models import FrameINR
 from .tonemap import anchor_level, tonemap_reinhard
 
@@ -214,25 +214,79 @@ class _Bins:
         )
 
 
-def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=None):
+def make_adam(param_groups, lr: float) -> torch.optim.Optimizer:
+    """Adam, fused into one kernel per step where this torch build has it (CPU and CUDA float32).
+
+    The same update as the default implementation up to float rounding; on a 240x180 head
+    (22 M weights) the fused step reads and writes each state tensor once instead of about ten
+    times (see benchmarks/train_step.py).
+    """
+    try:
+        return torch.optim.Adam(param_groups, lr=lr, fused=True)
+    except (RuntimeError, TypeError, ValueError):   # no fused kernel for this device / dtype
+        return torch.optim.Adam(param_groups, lr=lr)
+
+
+def step_losses(model: FrameINR, bins: "_Bins", temporal_loss: str, regularizer: str, fused: bool = True,
+                buffers: dict | None = None):
+    """(temporal loss, regularizer) of one training step, scalars averaged over networks, bins and pixels.
+
+    ``fused=False`` is the readable path (``model.forward_with_derivative`` or ``model(...)``, then
+    the functions of :mod:`evinr_lite.losses`); ``fused=True`` computes the same numbers with the
+    output layer and the losses in one autograd node (:func:`~evinr_lite.losses.head_losses`),
+    which touches the [N, B, H, W] tensors far fewer times. ``buffers``: a dict kept across the steps
+    of one training loop, in which the fused path reuses its large work arrays.
+    """
+    times = bins.centers if temporal_loss == "derivative" else bins.boundaries
+    if fused:
+        h, dh = model.features(times, with_derivative=temporal_loss == "derivative")
+        return head_losses(h, dh, model.head_weight, model.head_bias, bins.frames,
+                           bins.durations if dh is not None else None, regularizer, buffers)
+    if temporal_loss == "derivative":
+        F, dF = model.forward_with_derivative(times)
+        temporal = temporal_loss_derivative(dF, bins.frames, bins.durations)
+    else:
+        F = model(times)
+        temporal = temporal_loss_difference(F, bins.frames)
+    regularize = {"tikhonov": tikhonov, "tv": total_variation, "none": None}[regularizer]
+    reg = regularize(F) if regularize is not None else torch.zeros((), device=F.device)
+    return temporal, reg
+
+
+def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=None, *,
+                    model: FrameINR | None = None, fast: bool = True):
     """Train one FrameINR per window, all in one batched computation.
+
+    Args:
+        events, windows ([N, 2] seconds), cfg: what to train on and how.
+        model: a FrameINR with N networks to start from (trained in place, on its own device);
+            None builds one from ``cfg`` (seeded by ``cfg.seed``).
+        fast: True uses the fused Adam kernel and the fused output layer + losses
+            (:func:`step_losses`); False the readable reference path. Same results up to float
+            rounding (tests/test_perf_equivalence.py).
 
     Returns:
         (model, history) with history = {"loss", "temporal", "regularizer": per-iteration floats,
         "n_bins": bins per network at each iteration, "train_time_s": float}.
     """
-    device = default_device(cfg.device)
-    model = FrameINR(events.sensor_size, windows, cfg.hidden_features, cfg.hidden_layers,
-                     cfg.omega_0, cfg.first_omega_0, seed=cfg.seed).to(device)
+    if model is None:
+        device = default_device(cfg.device)
+        model = FrameINR(events.sensor_size, windows, cfg.hidden_features, cfg.hidden_layers,
+                         cfg.omega_0, cfg.first_omega_0, seed=cfg.seed).to(device)
+    device = model.head_weight.device
+    if model.n_models != len(windows):
+        raise ValueError(f"model holds {model.n_models} networks but {len(windows)} windows were given")
     head = [model.head_weight, model.head_bias]
     trunk = [p for n, p in model.named_parameters() if not n.startswith("head_")]
-    opt = torch.optim.Adam([{"params": trunk}, {"params": head, "lr": cfg.lr * cfg.head_lr_scale}], lr=cfg.lr)
+    groups = [{"params": trunk}, {"params": head, "lr": cfg.lr * cfg.head_lr_scale}]
+    opt = make_adam(groups, lr=cfg.lr) if fast else torch.optim.Adam(groups, lr=cfg.lr)
     sched = torch.optim.lr_scheduler.StepLR(opt, step_size=cfg.lr_decay_every, gamma=cfg.lr_decay)
     boundaries = _initial_boundaries(events, windows, cfg)
     bins = _Bins.build(events, boundaries, cfg.C, device)
-    regularize = {"tikhonov": tikhonov, "tv": total_variation, "none": None}[cfg.regularizer]
+    regularizer = cfg.regularizer if cfg.lam > 0 else "none"
     history = {"loss": [], "temporal": [], "regularizer": [], "n_bins": []}
     bisect_at = set(cfg.c2f_iters) if cfg.coarse_to_fine else set()
+    buffers = {}   # the fused path's work arrays, reused from step to step
 
     from tqdm.auto import tqdm
 
@@ -242,13 +296,7 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
         if it in bisect_at:
             boundaries = [bisect_boundaries(events, b) for b in boundaries]
             bins = _Bins.build(events, boundaries, cfg.C, device)
-        if cfg.temporal_loss == "derivative":
-            F, dF = model.forward_with_derivative(bins.centers)
-            temporal = temporal_loss_derivative(dF, bins.frames, bins.durations)
-        else:
-            F = model(bins.boundaries)
-            temporal = temporal_loss_difference(F, bins.frames)
-        reg = regularize(F) if regularize is not None and cfg.lam > 0 else torch.zeros((), device=device)
+        temporal, reg = step_losses(model, bins, cfg.temporal_loss, regularizer, fused=fast, buffers=buffers)
         # per-network means summed over networks: each network gets its own gradient, whatever N
         loss = model.n_models * (temporal + cfg.lam * reg)
         opt.zero_grad(set_to_none=True)
@@ -262,6 +310,8 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
         if it % 10 == 0:
             bar.set_postfix(loss=f"{history['loss'][-1]:.4g}", bins=history["n_bins"][-1])
     bar.close()
+    if device.type == "cuda":
+        torch.cuda.synchronize(device)
     history["train_time_s"] = time.perf_counter() - t0
     return model, history
 
@@ -301,11 +351,17 @@ class Reconstruction:
 def predict_networks(model: FrameINR, times: np.ndarray, chunk: int = 256) -> np.ndarray:
     """Every network at every time: float32 [N, Q, H, W] (no offsets)."""
     device = model.head_weight.device
-    out = []
+    times = np.asarray(times, dtype=np.float64)
+    # torch's allocation (64-byte aligned) keeps the matmul's rounding the same from run to run
+    out = torch.empty((model.n_models, len(times), *model.sensor_size), dtype=torch.float32)
+    in_place = device.type == "cpu" and model.n_models == 1 and model.head_weight.dtype == torch.float32
     for i in range(0, len(times), chunk):
         t = torch.as_tensor(times[i:i + chunk], device=device).expand(model.n_models, -1)
-        out.append(model(t).float().cpu().numpy())
-    return np.concatenate(out, axis=1)
+        if in_place:
+            model(t, out=out[:, i:i + chunk])                            # written in place: no copy
+        else:
+            out[:, i:i + chunk] = model(t).float().cpu()
+    return out.numpy()
 
 
 def blend_weights(windows: np.ndarray, times: np.ndarray) -> np.ndarray:
