@@ -31,9 +31,9 @@ from pathlib import Path
 import numpy as np
 
 try:
-    from benchmarks.common import alternate, print_table, row, write_json
+    from benchmarks.common import alternate, parser, report, row
 except ImportError:  # run as a script
-    from common import alternate, print_table, row, write_json
+    from common import alternate, parser, report, row
 
 from evinr_lite import Events  # noqa: E402
 from evinr_lite.binning import events_to_frames, fixed_duration_boundaries  # noqa: E402
@@ -187,11 +187,8 @@ def run(quick: bool = False, repeats: int | None = None, large: bool = True, log
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="2e6 events in memory, a 1e7-event file")
+    p = parser(__doc__, "2e6 events in memory, a 1e7-event file", device=False)
     p.add_argument("--no-large", action="store_true", help="skip the large-file benchmark")
-    p.add_argument("--repeats", type=int, default=None)
-    p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     p.add_argument("--worker", nargs=3, metavar=("PHASE", "PATH", "N"), help=argparse.SUPPRESS)
     a = p.parse_args(argv)
     if a.worker:
@@ -199,10 +196,7 @@ def main(argv=None) -> int:
         print(json.dumps((worker_write if phase == "write" else worker_bin)(path, int(n))))
         return 0
     rows = run(a.quick, a.repeats, not a.no_large)
-    print()
-    print_table(rows)
-    if a.json:
-        write_json(a.json, rows)
+    report(rows, a.json)
     return 0
 
 

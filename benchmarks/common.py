@@ -6,6 +6,7 @@ is a ratio of two quantities measured in the same process, alternately, under th
 """
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import platform
@@ -147,3 +148,23 @@ def devices(requested: str | None = None) -> list[str]:
     if requested:
         return [requested]
     return ["cpu", "cuda"] if torch.cuda.is_available() else ["cpu"]
+
+
+def parser(doc: str, quick_help: str, *, device: bool = True, repeats: bool = True) -> argparse.ArgumentParser:
+    """The options every benchmark script takes: --quick, --device, --repeats, --json."""
+    p = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--quick", action="store_true", help=quick_help)
+    if device:
+        p.add_argument("--device", default=None, help="cpu or cuda (default: cpu, and cuda when present)")
+    if repeats:
+        p.add_argument("--repeats", type=int, default=None)
+    p.add_argument("--json", default=None, help="also write the rows to this JSON file")
+    return p
+
+
+def report(rows: list[dict], json_path=None) -> None:
+    """Print the rows' table and, when asked, write them to a JSON file."""
+    print()
+    print_table(rows)
+    if json_path:
+        write_json(json_path, rows)

@@ -22,7 +22,6 @@ and after it and the faster of its two times is reported. ``--no-reference`` ski
 """
 from __future__ import annotations
 
-import argparse
 import functools
 import sys
 import time
@@ -30,9 +29,9 @@ import time
 import numpy as np
 
 try:
-    from benchmarks.common import devices, print_table, row, sync, write_json
+    from benchmarks.common import devices, parser, report, row, sync
 except ImportError:  # run as a script
-    from common import devices, print_table, row, sync, write_json
+    from common import devices, parser, report, row, sync
 
 from evinr_lite import make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
 from evinr_lite.metrics import score_frames  # noqa: E402
@@ -115,17 +114,11 @@ def run(quick: bool = False, device: str | None = None, reference: bool = True, 
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="120x160, 2 s, 100 iterations")
-    p.add_argument("--device", default=None, help="cpu or cuda (default: cpu, and cuda when present)")
+    p = parser(__doc__, "120x160, 2 s, 100 iterations", repeats=False)
     p.add_argument("--no-reference", action="store_true", help="skip the run with the reference training path")
-    p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     a = p.parse_args(argv)
     rows = run(a.quick, a.device, not a.no_reference)
-    print()
-    print_table(rows)
-    if a.json:
-        write_json(a.json, rows)
+    report(rows, a.json)
     return 0
 
 

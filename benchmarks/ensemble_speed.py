@@ -23,7 +23,6 @@ Events are uniform random (their content does not change the amount of work).
 """
 from __future__ import annotations
 
-import argparse
 import copy
 import sys
 import time
@@ -32,9 +31,9 @@ import numpy as np
 import torch
 
 try:
-    from benchmarks.common import devices, print_table, row, sync, write_json
+    from benchmarks.common import devices, parser, report, row, sync
 except ImportError:  # run as a script
-    from common import devices, print_table, row, sync, write_json
+    from common import devices, parser, report, row, sync
 
 from evinr_lite import Events  # noqa: E402
 from evinr_lite.models import FrameINR  # noqa: E402
@@ -136,17 +135,10 @@ def run(quick: bool = False, device: str | None = None, repeats: int | None = No
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="fewer steps, one repeat")
-    p.add_argument("--device", default=None, help="cpu or cuda (default: cpu, and cuda when present)")
-    p.add_argument("--repeats", type=int, default=None)
-    p.add_argument("--json", default=None, help="also write the rows to this JSON file")
+    p = parser(__doc__, "fewer steps, one repeat")
     a = p.parse_args(argv)
     rows = run(a.quick, a.device, a.repeats)
-    print()
-    print_table(rows)
-    if a.json:
-        write_json(a.json, rows)
+    report(rows, a.json)
     return 0 if all(r["same_predictions"] for r in rows) else 1
 
 

@@ -16,16 +16,15 @@ the target here is batched, on this CPU: at least 1000 fps at 240x180.
 """
 from __future__ import annotations
 
-import argparse
 import sys
 
 import numpy as np
 import torch
 
 try:
-    from benchmarks.common import best_time, devices, print_table, row, write_json
+    from benchmarks.common import best_time, devices, parser, report, row
 except ImportError:  # run as a script
-    from common import best_time, devices, print_table, row, write_json
+    from common import best_time, devices, parser, report, row
 
 from evinr_lite.models import FrameINR  # noqa: E402
 from evinr_lite.solver import predict_networks  # noqa: E402
@@ -59,17 +58,10 @@ def run(quick: bool = False, device: str | None = None, repeats: int | None = No
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="256 query times, fewer repeats")
-    p.add_argument("--device", default=None, help="cpu or cuda (default: cpu, and cuda when present)")
-    p.add_argument("--repeats", type=int, default=None)
-    p.add_argument("--json", default=None, help="also write the rows to this JSON file")
+    p = parser(__doc__, "256 query times, fewer repeats")
     a = p.parse_args(argv)
     rows = run(a.quick, a.device, a.repeats)
-    print()
-    print_table(rows)
-    if a.json:
-        write_json(a.json, rows)
+    report(rows, a.json)
     return 0
 
 

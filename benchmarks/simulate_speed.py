@@ -12,16 +12,15 @@ of the scene, not of the simulator: it is timed and reported separately, as is t
 """
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 
 import numpy as np
 
 try:
-    from benchmarks.common import best_time, print_table, row, write_json
+    from benchmarks.common import best_time, parser, report, row
 except ImportError:  # run as a script
-    from common import best_time, print_table, row, write_json
+    from common import best_time, parser, report, row
 
 from evinr_lite import make_scene, simulate_scene, simulate_video  # noqa: E402
 
@@ -54,17 +53,11 @@ def run(quick: bool = False, repeats: int | None = None, n_frames: int | None = 
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="250 frames, one repeat")
+    p = parser(__doc__, "250 frames, one repeat", device=False)
     p.add_argument("--frames", type=int, default=None)
-    p.add_argument("--repeats", type=int, default=None)
-    p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     a = p.parse_args(argv)
     rows = run(a.quick, a.repeats, a.frames)
-    print()
-    print_table(rows)
-    if a.json:
-        write_json(a.json, rows)
+    report(rows, a.json)
     return 0
 
 

@@ -19,16 +19,15 @@ The first layer (input width 1) and the sines are elementwise and not counted.
 """
 from __future__ import annotations
 
-import argparse
 import sys
 
 import numpy as np
 import torch
 
 try:
-    from benchmarks.common import alternate, devices, matmul_peak_gflops, print_table, row, write_json
+    from benchmarks.common import alternate, devices, matmul_peak_gflops, parser, report, row
 except ImportError:  # run as a script
-    from common import alternate, devices, matmul_peak_gflops, print_table, row, write_json
+    from common import alternate, devices, matmul_peak_gflops, parser, report, row
 
 from evinr_lite.models import FrameINR  # noqa: E402
 from evinr_lite.solver import _Bins, make_adam, step_losses  # noqa: E402
@@ -133,18 +132,11 @@ def run(quick: bool = False, device: str | None = None, repeats: int | None = No
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--quick", action="store_true", help="only B = 160, fewer repeats")
-    p.add_argument("--device", default=None, help="cpu or cuda (default: cpu, and cuda when present)")
-    p.add_argument("--repeats", type=int, default=None)
+    p = parser(__doc__, "only B = 160, fewer repeats")
     p.add_argument("--profile", action="store_true", help="print the top operations of each path")
-    p.add_argument("--json", default=None, help="also write the rows to this JSON file")
     a = p.parse_args(argv)
     rows = run(a.quick, a.device, a.repeats, a.profile)
-    print()
-    print_table(rows)
-    if a.json:
-        write_json(a.json, rows)
+    report(rows, a.json)
     return 0
 
 
