@@ -200,7 +200,10 @@ def test_ctrl_c_during_training(ijrr_folder, tmp_path):
     env = {**os.environ, "EVINR_FAST": "1"}
     proc = subprocess.Popen([sys.executable, "-m", "evinr_lite", "reconstruct", str(ijrr_folder), "--out",
                              str(tmp_path / "out"), "--iters", "100000", "--quiet"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            # a job started in the background by a non-interactive shell (as CI may be)
+                            # inherits SIGINT ignored; a terminal's Ctrl-C is what this test imitates
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.time() + 60
     for line in proc.stdout:          # wait until training has started
         if line.startswith("reconstructing") or time.time() > deadline:
