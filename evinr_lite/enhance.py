@@ -36,11 +36,16 @@ def render_event_counts(L_boundaries, C: float) -> np.ndarray:
         int64 [B, H, W]: n_k = trunc((L(b_{k+1}) - r_k) / C) with r_0 = L(b_0) and
         r_{k+1} = r_k + n_k C (the reference moves by whole steps; the rest carries over).
     """
+    return _render(L_boundaries, C, np.trunc)
+
+
+def _render(L_boundaries, C, whole_steps):
+    """Counts from a moving reference: n_k = whole_steps((L(b_{k+1}) - r_k) / C), r_{k+1} = r_k + n_k C."""
     L = np.asarray(L_boundaries, dtype=np.float64)
     ref = L[0].copy()
     out = np.empty((L.shape[0] - 1,) + L.shape[1:], dtype=np.int64)
     for k in range(1, L.shape[0]):
-        n = np.trunc((L[k] - ref) / C)
+        n = whole_steps((L[k] - ref) / C)
         ref += n * C
         out[k - 1] = n
     return out
@@ -138,14 +143,7 @@ def _no_carry(L_boundaries, C):
 
 
 def _round_nearest(L_boundaries, C):
-    L = np.asarray(L_boundaries, dtype=np.float64)
-    ref = L[0].copy()
-    out = np.empty((L.shape[0] - 1,) + L.shape[1:], dtype=np.int64)
-    for k in range(1, L.shape[0]):
-        n = np.round((L[k] - ref) / C)
-        ref += n * C
-        out[k - 1] = n
-    return out
+    return _render(L_boundaries, C, np.round)
 
 
 def _reference_to_level(L_boundaries, C):
