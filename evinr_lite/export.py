@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from .metrics import to_uint8 as metrics_to_uint8
 from .output import save_png
 
 __all__ = ["to_uint8", "save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv"]
@@ -22,9 +23,7 @@ def to_uint8(frames) -> np.ndarray:
     frames = np.asarray(frames)
     if frames.ndim != 3:
         raise ValueError(f"frames must have shape [F, H, W] (grey), got {frames.shape}")
-    if frames.dtype == np.uint8:
-        return frames
-    return (np.clip(frames, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    return metrics_to_uint8(frames)
 
 
 def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:

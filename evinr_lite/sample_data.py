@@ -9,7 +9,6 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import numpy as np
 
 __all__ = ["find_shared_data", "sample_recording_path", "synthetic_recording", "SLIDER_DEPTH_CHUNK"]
 
@@ -43,16 +42,15 @@ def sample_recording_path(name: str = SLIDER_DEPTH_CHUNK, start=None) -> Path | 
 
 def synthetic_recording(sensor_size=(90, 120), duration: float = 0.5, n_frames: int = 6, C: float = 0.2,
                         seed: int = 0):
-    """A stand-in Recording when no real data is around: the 'camera' scene's events and
-    ``n_frames`` ground-truth frames (tone-mapped, uint8) spread over ``duration`` seconds."""
-    from .frames import Frames
-    from .readers import Recording
-    from .scenes import make_scene
-    from .simulate import simulate_scene
-    from .tonemap import tonemap_reinhard
+    """A stand-in Recording when no real data is around: the 'camera' scene's events and ``n_frames``
+    ground-truth frames spread over ``duration`` seconds (written and read back as an IJRR folder by
+    :func:`evinr_lite.recon_job.write_example_recording`)."""
+    import tempfile
 
-    scene = make_scene("camera", sensor_size=sensor_size, duration=duration)
-    events = simulate_scene(scene, 0.0, duration, C=C, seed=seed)
-    t = np.linspace(0.0, duration, n_frames)
-    images = np.round(255 * tonemap_reinhard(scene.log_intensity(t))).astype(np.uint8)
-    return Recording(events, Frames(images, t), {"format": "synthetic", "path": "", "scene": "camera", "C": C})
+    from .readers import read_recording
+    from .recon_job import write_example_recording
+
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = write_example_recording(Path(tmp) / "synthetic", sensor_size=sensor_size, duration=duration, C=C,
+                                         frame_rate=(n_frames - 1) / duration, seed=seed)
+        return read_recording(folder)
