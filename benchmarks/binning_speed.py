@@ -10,7 +10,7 @@ and checked equal to it.
 
 Large file: a synthetic recording of 10^8 events (1 M events/s for 100 s, 240x180) is written in
 chunks into a canonical h5 (``data_fetch.canonical.CanonicalWriter``, the converters' writer) in a
-temporary folder, then read back chunk by chunk (``evinr_lite.canonical.iter_canonical_events``)
+temporary folder, then read back chunk by chunk (``evinr_lite.io.canonical.iter_canonical_events``)
 and binned incrementally at 1/32 s (``events_to_frames_chunked``: 3200 frames). Each phase runs in
 its own subprocess, so its peak resident memory (VmHWM of /proc/self/status; ru_maxrss elsewhere)
 is that job's alone; the file is deleted afterwards.
@@ -36,7 +36,7 @@ except ImportError:  # run as a script
     from common import alternate, parser, report, row
 
 from evinr_lite import Events  # noqa: E402
-from evinr_lite.binning import events_to_frames, fixed_duration_boundaries  # noqa: E402
+from evinr_lite.method.binning import events_to_frames, fixed_duration_boundaries  # noqa: E402
 
 SENSOR = (180, 240)
 RATE = 1e6            # events per second of the synthetic large recording
@@ -120,8 +120,8 @@ def worker_write(path: str, n: int) -> dict:
 
 
 def worker_bin(path: str, n: int) -> dict:
-    from evinr_lite.binning import events_to_frames_chunked
-    from evinr_lite.canonical import iter_canonical_events
+    from evinr_lite.method.binning import events_to_frames_chunked
+    from evinr_lite.io.canonical import iter_canonical_events
 
     t0 = time.perf_counter()
     b = fixed_duration_boundaries(0.0, n / RATE, 1 / 32)

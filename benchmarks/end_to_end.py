@@ -34,9 +34,9 @@ except ImportError:  # run as a script
     from common import devices, parser, report, row, sync
 
 from evinr_lite import make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
-from evinr_lite.metrics import score_frames  # noqa: E402
-from evinr_lite import solver  # noqa: E402
-from evinr_lite.solver import EvINRConfig, reconstruct  # noqa: E402
+from evinr_lite.evaluation.metrics import score_frames  # noqa: E402
+from evinr_lite.method import solver  # noqa: E402
+from evinr_lite.method.solver import EvINRConfig, reconstruct  # noqa: E402
 
 PAPER_SECONDS = 8.0   # per sequence on one RTX 3090 (Sec. 4)
 

@@ -30,8 +30,8 @@ import torch
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from evinr_lite import make_scene, simulate_scene  # noqa: E402
-from evinr_lite.accel_exercises import VaryingSpeedScene, batched_vs_sequential  # noqa: E402
-from evinr_lite.solver import split_windows  # noqa: E402
+from evinr_lite.teaching.accel_exercises import VaryingSpeedScene, batched_vs_sequential  # noqa: E402
+from evinr_lite.method.solver import split_windows  # noqa: E402
 
 
 def run(n_models=(1, 2, 4, 8), size=(64, 80), duration=4.0, hidden=256, layers=3, iters=50, repeats=3,

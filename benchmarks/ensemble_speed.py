@@ -36,8 +36,8 @@ except ImportError:  # run as a script
     from common import devices, parser, report, row, sync
 
 from evinr_lite import Events  # noqa: E402
-from evinr_lite.models import FrameINR  # noqa: E402
-from evinr_lite.solver import EvINRConfig, predict_networks, split_windows, train_frame_inr  # noqa: E402
+from evinr_lite.method.models import FrameINR  # noqa: E402
+from evinr_lite.method.solver import EvINRConfig, predict_networks, split_windows, train_frame_inr  # noqa: E402
 
 SETTINGS = {
     "paper": dict(size=(180, 240), hidden=512, layers=3, tau=5.0, overlap=0.5, iters=3, c2f=False, rate=5e4),

@@ -26,8 +26,8 @@ try:
 except ImportError:  # run as a script
     from common import best_time, devices, parser, report, row
 
-from evinr_lite.models import FrameINR  # noqa: E402
-from evinr_lite.solver import predict_networks  # noqa: E402
+from evinr_lite.method.models import FrameINR  # noqa: E402
+from evinr_lite.method.solver import predict_networks  # noqa: E402
 
 PAPER_FPS = {(180, 240): 178, (306, 408): 55}
 

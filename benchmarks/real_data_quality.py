@@ -4,7 +4,7 @@
     python benchmarks/real_data_quality.py --iters 100     # shorter training
 
 Every method is scored at the APS frame timestamps inside the events' span, without equalisation
-and with CLAHE (evinr_lite.evaluation). The largest training loss of the first 100 iterations is
+and with CLAHE (evinr_lite.evaluation.scoring). The largest training loss of the first 100 iterations is
 printed too: spikes there mean a learning rate too high for the data.
 """
 from __future__ import annotations
@@ -18,11 +18,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from evinr_lite.evaluation import evaluate, results_table  # noqa: E402
-from evinr_lite.readers import read_recording  # noqa: E402
-from evinr_lite.realdata import frames_to_score  # noqa: E402
-from evinr_lite.sample_data import sample_recording_path  # noqa: E402
-from evinr_lite.solver import EvINRConfig  # noqa: E402
+from evinr_lite.evaluation.scoring import evaluate, results_table  # noqa: E402
+from evinr_lite.io.readers import read_recording  # noqa: E402
+from evinr_lite.evaluation.scoring import frames_to_score  # noqa: E402
+from evinr_lite.io.sample_data import sample_recording_path  # noqa: E402
+from evinr_lite.method.solver import EvINRConfig  # noqa: E402
 
 
 def variants(n_iters: int) -> dict[str, EvINRConfig]:

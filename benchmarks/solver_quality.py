@@ -3,7 +3,7 @@
     python benchmarks/solver_quality.py                     # 120x160, 2 s, C = 0.2 (about 3 minutes)
     python benchmarks/solver_quality.py --size 48x64 --duration 1 --iters 100   # a quick look
 
-Protocol (evinr_lite.ablation.run_variants, printed under the table): frames at ``--frames`` evenly
+Protocol (evinr_lite.evaluation.ablation.run_variants, printed under the table): frames at ``--frames`` evenly
 spaced times; ground truth = tonemap_reinhard(true log intensity, gamma 0.6); predictions are the
 solvers' tone-mapped frames with their own brightness anchor (mean tone-mapped level 0.5;
 integration is anchored the same way). MSE and SSIM (gaussian sigma 1.5, data_range 1) with no
@@ -22,12 +22,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from evinr_lite import ablation, make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
-from evinr_lite.solver import EvINRConfig  # noqa: E402
+from evinr_lite.evaluation import ablation  # noqa: E402
+from evinr_lite import make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
+from evinr_lite.method.solver import EvINRConfig  # noqa: E402
 
 
 def variants(C: float, iters: int) -> dict:
-    """Table 2's four variants (evinr_lite.ablation.table2_variants), the reference code's loss and
+    """Table 2's four variants (evinr_lite.evaluation.ablation.table2_variants), the reference code's loss and
     regularizer on top of Full, and direct integration."""
     common = dict(C=C, n_iters=iters, c2f_iters=(iters // 3, 2 * iters // 3))
     table2 = ablation.table2_variants(**common)

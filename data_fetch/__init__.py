@@ -9,13 +9,12 @@ convert <raw path> [--out ...] | info <file.h5>``.
 
 Files live in :func:`cache_dir` (``$EVINR_DATA``, default ``~/.cache/evinr-lite``): raw downloads in
 ``raw/<dataset>/``, converted sequences in ``<dataset>/<sequence>.h5`` (the canonical layout of
-:mod:`evinr_lite.canonical`). Heavy libraries (pooch, requests, gdown, rosbags, h5py) are imported
+:mod:`evinr_lite.io.canonical`). Heavy libraries (pooch, requests, gdown, rosbags, h5py) are imported
 only when a function needs them, so ``import data_fetch`` is fast.
 """
 from __future__ import annotations
 
 import logging
-import os
 from pathlib import Path
 
 from .errors import ChecksumError, ConversionError, DataFetchError, DownloadError, NotDownloadable
@@ -26,14 +25,15 @@ __all__ = [
     "DataFetchError", "DownloadError", "ChecksumError", "ConversionError", "NotDownloadable",
 ]
 
-ENV_VAR = "EVINR_DATA"
 log = logging.getLogger("data_fetch")
 
 
 def cache_dir() -> Path:
-    """Folder for downloads and converted sequences: ``$EVINR_DATA`` or ``~/.cache/evinr-lite``."""
-    path = Path(os.environ.get(ENV_VAR) or Path.home() / ".cache" / "evinr-lite")
-    return path.expanduser()
+    """Folder for downloads and converted sequences: ``$EVINR_DATA`` or ``~/.cache/evinr-lite``
+    (:func:`evinr_lite.core.runtime.cache_dir`, so the kit and data_fetch agree)."""
+    from evinr_lite.core import runtime   # imported here: `import data_fetch` stays light
+
+    return runtime.cache_dir()
 
 
 def canonical_path(dataset: str, sequence: str) -> Path:
@@ -64,8 +64,10 @@ def weights_dir(name: str) -> Path:
     """Folder of a weight set (e.g. "lpips"): ``<cache>/weights/<name>``."""
     from .registry import get_weight_set
 
+    from evinr_lite.core import runtime
+
     get_weight_set(name)
-    return cache_dir() / "weights" / name.lower()
+    return runtime.weights_dir(name)
 
 
 def get_weights(name: str, files=("all",), *, verify: bool = True, progress: bool = True,
@@ -113,7 +115,7 @@ def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str 
         DownloadError (unreachable, 404: the message says where to place the file by hand),
         ChecksumError, ConversionError (damaged raw file), NotDownloadable (AED).
     """
-    from evinr_lite.canonical import is_canonical
+    from evinr_lite.io.canonical import is_canonical
 
     from .registry import get_dataset, get_sequence
 
@@ -188,14 +190,14 @@ def convert(raw, out=None, **kwargs) -> Path:
 
 def read(path, t_start: float | None = None, t_end: float | None = None, **kwargs):
     """Read a canonical file (optionally a time window) as an evinr_lite ``Recording``."""
-    from evinr_lite.canonical import read_canonical
+    from evinr_lite.io.canonical import read_canonical
 
     return read_canonical(path, t_start, t_end, **kwargs)
 
 
 def info(path) -> dict:
     """The attributes of a canonical file (dataset, sequence, sensor size, C, eval window, counts)."""
-    from evinr_lite.canonical import canonical_info
+    from evinr_lite.io.canonical import canonical_info
 
     return canonical_info(path)
 
@@ -206,7 +208,7 @@ def list_datasets(dataset: str | None = None) -> list[dict]:
     Returns one dict per sequence (or per dataset for AED): dataset, sequence, method, sensor_size,
     C, eval_window, url, known_hash, raw (path or None if absent), converted (path or None).
     """
-    from evinr_lite.canonical import is_canonical
+    from evinr_lite.io.canonical import is_canonical
 
     from .registry import DATASETS, get_dataset
 

@@ -148,7 +148,7 @@ def main(argv=None) -> int:
         log.addHandler(handler)
         log.propagate = False
     log.setLevel(logging.WARNING if getattr(args, "quiet", False) else logging.INFO)
-    from evinr_lite.events import EventDataError
+    from evinr_lite.core.events import EventDataError
 
     try:
         return args.func(args)

@@ -71,7 +71,7 @@ def _kind(path: Path) -> str:
         raise ConversionError(f"{path}: a zip with neither events.txt (IJRR) nor .bag files (CED)")
     if suffix == ".txt":
         raise ConversionError(f"{path}: pass the IJRR folder or zip (events.txt with images.txt), not events.txt "
-                              "alone; or read a bare events.txt with evinr_lite.readers.read_events_txt")
+                              "alone; or read a bare events.txt with evinr_lite.io.readers.read_events_txt")
     raise ConversionError(f"{path}: unknown raw format {suffix or '(none)'!r}; data_fetch converts IJRR zips/folders, "
                           "ROS1 .bag files, CED zips of bags, MVSEC .hdf5 and HQF-style .h5")
 

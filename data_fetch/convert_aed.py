@@ -28,7 +28,7 @@ What is written (C = 0.25, the paper's value for AED, unless given):
 
 - events: every event kept, timestamp and polarity unchanged, (x, y) -> (x // 4, y // 4): one grey
   pixel per 4 x 4 Quad Bayer tile, 1632 x 1224 -> 408 x 306
-  (:func:`evinr_lite.quadbayer.demosaic_events`; each merged event stands for C_photosite / 16 of
+  (:func:`evinr_lite.sim.quadbayer.demosaic_events`; each merged event stands for C_photosite / 16 of
   grey log intensity, see that module).
 - ``frames/images``: grey frames **at the events' grid** (306 x 408), because reconstructions have
   the events' size and are scored against these: the frame is reduced to grey at a quarter of its
@@ -51,10 +51,11 @@ from pathlib import Path
 
 import numpy as np
 
-from evinr_lite.events import TIME_UNITS, LARGE_T
-from evinr_lite.quadbayer import demosaic_grey, reduce_mean
+from evinr_lite.core.events import TIME_UNITS, LARGE_T
+from evinr_lite.io.canonical import COMPRESSION
+from evinr_lite.sim.quadbayer import demosaic_grey, reduce_mean
 
-from .canonical import COMPRESSION, CanonicalWriter
+from .canonical import CanonicalWriter
 from .convert_ijrr import PolarityMapper
 from .errors import ConversionError
 
@@ -376,7 +377,7 @@ def convert_aed(folder, out, *, raw_sensor_size=None, time_unit: str | None = No
             "raw_event_sensor_size": [H, W], "phase": list(phase), "time_unit": clock.unit,
             "event_reduction": f"(x, y) -> (x // {TILE}, y // {TILE}): every event kept, one grey pixel per "
                                f"{TILE}x{TILE} Quad Bayer tile; each event stands for C_photosite / {TILE * TILE} "
-                               "of grey log intensity (evinr_lite.quadbayer)",
+                               "of grey log intensity (evinr_lite.sim.quadbayer)",
             **frame_info})
         path = writer.close()
     finally:
@@ -452,7 +453,7 @@ def write_aed_folder(folder, events, frames=None, frame_times=None, *, phase=(0,
     """
     from PIL import Image
 
-    from evinr_lite.output import atomic_output_dir
+    from evinr_lite.io.output import atomic_output_dir
 
     origin_us = int(round(events.t_origin)) * 10**6
     if events.t_origin != int(round(events.t_origin)):

@@ -15,8 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from evinr_lite.events import LARGE_T, EventDataError
-from evinr_lite.readers import NS, _to_grey_uint8
+from evinr_lite.core.events import LARGE_T, EventDataError
+from evinr_lite.io.text import NS
+from evinr_lite.core.frames import to_grey_uint8 as _to_grey_uint8
 
 from .canonical import CanonicalWriter
 from .errors import ConversionError

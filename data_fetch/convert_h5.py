@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from evinr_lite.events import auto_origin
-from evinr_lite.readers import _to_grey_uint8
+from evinr_lite.core.events import auto_origin
+from evinr_lite.core.frames import to_grey_uint8 as _to_grey_uint8
 
 from .canonical import CanonicalWriter
 from .convert_ijrr import PolarityMapper
@@ -136,4 +136,4 @@ def convert_h5(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None,
         if layout == "hqf":
             return _hqf(f, path, args, sensor_size, progress)
     raise ConversionError(f"{path}: unknown HDF5 layout (neither MVSEC davis/left/events nor HQF events/xs..); "
-                          "if it is already a canonical file, read it with evinr_lite.canonical.read_canonical")
+                          "if it is already a canonical file, read it with evinr_lite.io.canonical.read_canonical")

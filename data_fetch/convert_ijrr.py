@@ -1,7 +1,7 @@
 """IJRR / Event Camera Dataset text release (a .zip or its unzipped folder) -> canonical file.
 
 events.txt (`t x y p` per line, p in {0, 1}) is read in blocks of whole lines and parsed with
-evinr_lite.readers' vectorised text helpers (exact: timestamps are split into whole seconds and
+evinr_lite.io.text's vectorised parser (the one the reader uses) (exact: timestamps are split into whole seconds and
 nanoseconds as integers before the whole-second origin is subtracted), so a multi-GB events.txt
 inside the zip is never held in memory. Frames come from images.txt + images/*.png, the
 calibration from calib.txt (kept in the file's meta).
@@ -16,17 +16,9 @@ from pathlib import Path, PurePosixPath
 
 import numpy as np
 
-from evinr_lite.events import EventDataError
-from evinr_lite.readers import (
-    NS,
-    _BadToken,
-    _first_time_origin,
-    _line_text,
-    _parse_number,
-    _parse_time,
-    _to_grey_uint8,
-    _tokenize,
-)
+from evinr_lite.core.events import EventDataError
+from evinr_lite.core.frames import to_grey_uint8
+from evinr_lite.io.text import NS, parse_event_block, parse_frame_list
 
 from .canonical import CanonicalWriter
 from .errors import ConversionError
@@ -138,21 +130,10 @@ def _frame_list(src: IJRRSource, origin_ns: int):
     listing = src.member("images.txt")
     if listing is None:
         return []
-    buf = np.frombuffer(src.read(listing), dtype=np.uint8)
-    starts, ends, counts, newlines = _tokenize(buf)
-    bad = np.flatnonzero((counts != 0) & (counts != 2))
-    if bad.size:
-        i = int(bad[0])
-        raise ConversionError(f"{src.path}: images.txt line {i + 1} has {counts[i]} columns, expected "
-                              f"`t images/frame_%08d.png` (line reads {_line_text(buf, newlines, i)!r})")
-    if len(starts) == 0:
-        return []
-    starts, ends = starts.reshape(-1, 2), ends.reshape(-1, 2)
     try:
-        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
-    except _BadToken as err:
-        raise ConversionError(f"{src.path}: images.txt row {err.row + 1}: the timestamp is not a number") from None
-    names = [bytes(buf[s:e]).decode() for s, e in zip(starts[:, 1], ends[:, 1])]
+        t, names, _ = parse_frame_list(src.read(listing), origin_ns, source=f"{src.path}: images.txt")
+    except EventDataError as err:
+        raise ConversionError(str(err)) from None
     return list(zip(t.tolist(), names))
 
 
@@ -172,60 +153,19 @@ def _load_image(src: IJRRSource, name: str) -> np.ndarray:
         raise ConversionError(f"{src.path}: {member} is not a readable image ({err}); the archive is damaged: "
                               "delete it and download it again") from None
     try:
-        return _to_grey_uint8(array, f"{src.path}:{member}")
+        return to_grey_uint8(array, f"{src.path}:{member}")
     except EventDataError as err:
         raise ConversionError(str(err)) from None
 
 
 def _parse_block(block: bytes, origin_ns, line_base: int, src, first: bool):
-    """One block of whole lines -> (t, x, y, p raw, header (H, W) or None, origin_ns, n_lines)."""
-    buf = np.frombuffer(block, dtype=np.uint8)
-    starts, ends, counts, newlines = _tokenize(buf)
-    n_lines = len(newlines) + (0 if block.endswith(b"\n") else 1)
-
-    def fail(line, problem):
-        raise ConversionError(f"{src.path}: events.txt line {line_base + line + 1}: {problem} "
-                              f"(line reads {_line_text(buf, newlines, line)!r})")
-
-    header = None
-    if first and counts.any():
-        line = int(np.flatnonzero(counts)[0])
-        words = [bytes(buf[s:e]) for s, e in zip(starts[:2], ends[:2])]
-        if counts[line] == 2 and all(w.isdigit() for w in words):  # rpg_e2vid header `W H`
-            header = (int(words[1]), int(words[0]))
-            counts[line], starts, ends = 0, starts[2:], ends[2:]
-    bad = np.flatnonzero((counts != 0) & (counts != 4))
-    if bad.size:
-        fail(int(bad[0]), f"found {counts[bad[0]]} columns, expected 4: `t x y p`")
-    if len(starts) == 0:
-        return None, header, origin_ns, n_lines
-    starts, ends = starts.reshape(-1, 4), ends.reshape(-1, 4)
-
-    def row_line(row):
-        return int(np.searchsorted(newlines, starts[row, 0]))
-
-    if origin_ns is None:
-        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0])
+    """One block of whole lines -> (t, x, y, p raw or None, header (H, W) or None, origin_ns, n_lines)."""
     try:
-        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
-    except _BadToken as err:
-        fail(row_line(err.row), "the timestamp is not a number")
-    cols = []
-    for c, name in ((1, "x"), (2, "y"), (3, "p")):
-        try:
-            v = _parse_number(buf, starts[:, c], ends[:, c])
-        except _BadToken as err:
-            fail(row_line(err.row), f"{name} is not a number")
-        if v.dtype.kind == "f":
-            whole = np.isfinite(v) & (v == np.round(v))
-            if not whole.all():
-                fail(row_line(int(np.flatnonzero(~whole)[0])), f"{name} must be a whole number")
-            v = v.astype(np.int64)
-        cols.append(v)
-    nonfinite = np.flatnonzero(~np.isfinite(t))
-    if nonfinite.size:
-        fail(row_line(int(nonfinite[0])), "the timestamp is not finite")
-    return (t, *cols), header, origin_ns, n_lines
+        b = parse_event_block(block, origin_ns, source=f"{src.path}: events.txt", line_base=line_base, first=first)
+    except EventDataError as err:
+        raise ConversionError(str(err)) from None
+    parsed = (b.t, b.x, b.y, b.p) if len(b.t) else None
+    return parsed, b.header, b.origin_ns, b.n_lines
 
 
 def convert_ijrr(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None, dataset: str = "ijrr",

@@ -248,7 +248,7 @@ class WeightFile:
     note: str = ""
 
 
-# LPIPS (AlexNet, v0.1) for evinr_lite.lpips. Checksums: torchvision names its file after the first
+# LPIPS (AlexNet, v0.1) for evinr_lite.evaluation.lpips. Checksums: torchvision names its file after the first
 # 8 hex digits of the sha256 (7be5be79); the full digest is the one other public projects pin for
 # the same file. The v0.1 heads are byte-identical to lpips/weights/v0.1/alex.pth in the `lpips`
 # 0.1.4 wheel on PyPI, whose sha256 was computed from that wheel.

@@ -1,4 +1,4 @@
-"""evinr_lite.ablation (run, tabulate, plot named EvINR variants) and notebook 07's exercises."""
+"""evinr_lite.evaluation.ablation (run, tabulate, plot named EvINR variants) and notebook 07's exercises."""
 from dataclasses import asdict
 
 import matplotlib
@@ -7,10 +7,13 @@ import pytest
 
 matplotlib.use("Agg")
 
-from evinr_lite import ablation as ab  # noqa: E402
-from evinr_lite import ablation_exercises, exercises, make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
-from evinr_lite.events import EventDataError  # noqa: E402
-from evinr_lite.solver import EvINRConfig, split_windows  # noqa: E402
+from evinr_lite import viz  # noqa: E402
+from evinr_lite.evaluation import ablation as ab  # noqa: E402
+from evinr_lite.io.sample_data import find_shared_data, sample_recording_path  # noqa: E402
+from evinr_lite.teaching import ablation_exercises, exercises  # noqa: E402
+from evinr_lite import make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
+from evinr_lite.core.events import EventDataError  # noqa: E402
+from evinr_lite.method.solver import EvINRConfig, split_windows  # noqa: E402
 
 TINY = dict(C=0.2, n_iters=12, c2f_iters=(4, 8), hidden_features=16, hidden_layers=1, lr=3e-4, tau=None)
 
@@ -156,13 +159,13 @@ def test_ablation_table_marks_the_best_and_keeps_the_protocol():
 def test_plot_ablation_bars_and_lines():
     import matplotlib.pyplot as plt
 
-    fig = ab.plot_ablation(_rows())
+    fig = viz.plot_ablation(_rows())
     assert len(fig.axes) == 2 and len(fig.axes[0].patches) == 4 and len(fig.axes[1].patches) == 2
-    fig = ab.plot_ablation(_rows(), x=[0.01, 0.1], xscale="log")
+    fig = viz.plot_ablation(_rows(), x=[0.01, 0.1], xscale="log")
     assert fig.axes[0].get_xscale() == "log" and len(fig.axes[0].lines) == 2
     with pytest.raises(ValueError, match="one number per row"):
-        ab.plot_ablation(_rows(), x=[1.0])
-    ax = ab.plot_tradeoff(_rows())
+        viz.plot_ablation(_rows(), x=[1.0])
+    ax = viz.plot_tradeoff(_rows())
     assert len(ax.texts) == 2
     plt.close("all")
 
@@ -231,10 +234,10 @@ def test_exercise_inputs_exercise_ties_and_both_directions():
 
 def test_sample_recording_path_follows_the_environment(tmp_path, monkeypatch):
     monkeypatch.setenv("EVINR_SHARED_DATA", str(tmp_path))
-    assert ab.sample_recording_path() is None
+    assert sample_recording_path() is None
     (tmp_path / "ijrr_slider_depth_chunk").mkdir()
-    assert ab.sample_recording_path() == tmp_path / "ijrr_slider_depth_chunk"
-    assert ab.find_shared_data() == tmp_path
+    assert sample_recording_path() == tmp_path / "ijrr_slider_depth_chunk"
+    assert find_shared_data() == tmp_path
 
 
 def test_a_real_reduced_table2_runs(slider_depth_dir):

@@ -1,4 +1,4 @@
-"""Notebook 06's exercises and helpers (evinr_lite.accel_exercises): references agree with the solver,
+"""Notebook 06's exercises and helpers (evinr_lite.teaching.accel_exercises): references agree with the solver,
 the checks recognise the common mistakes, and batched and sequential training give the same networks."""
 import warnings
 
@@ -6,13 +6,14 @@ import numpy as np
 import pytest
 import torch
 
-from evinr_lite import accel_exercises as accel
-from evinr_lite import exercises, make_scene, simulate_scene
-from evinr_lite.binning import bisect_boundaries
-from evinr_lite.events import EventDataError, Events
-from evinr_lite.exercises import ExerciseWarning
-from evinr_lite.models import FrameINR
-from evinr_lite.solver import EvINRConfig, blend_weights, reconstruct, split_windows
+from evinr_lite.teaching import accel_exercises as accel
+from evinr_lite.teaching import exercises
+from evinr_lite import make_scene, simulate_scene
+from evinr_lite.method.binning import bisect_boundaries
+from evinr_lite.core.events import EventDataError, Events
+from evinr_lite.teaching.exercises import ExerciseWarning
+from evinr_lite.method.models import FrameINR
+from evinr_lite.method.solver import EvINRConfig, blend_weights, reconstruct, split_windows
 
 TINY = dict(hidden_features=16, hidden_layers=1, progress=False, lr=3e-4)
 

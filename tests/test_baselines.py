@@ -4,9 +4,10 @@ import math
 import numpy as np
 import pytest
 
-from evinr_lite import Events, exercises, integrate_events
-from evinr_lite.baselines import (highpass_filter, highpass_per_event, leaky_integration, reconstruct_baseline)
-from evinr_lite.tonemap import anchor_level
+from evinr_lite import Events, integrate_events
+from evinr_lite.teaching import exercises
+from evinr_lite.method.baselines import (highpass_filter, highpass_per_event, leaky_integration, reconstruct_baseline)
+from evinr_lite.method.tonemap import anchor_level
 
 
 def random_events(n=400, H=5, W=7, seed=0, t_span=(0.1, 1.0)):

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from evinr_lite import EventDataError, Events, equal_count_boundaries, events_to_frames, fixed_duration_boundaries
+from evinr_lite import EventDataError, Events, events_to_frames, fixed_duration_boundaries
+from evinr_lite.method.binning import equal_count_boundaries
 
 
 def random_events(n=2000, H=5, W=7, T=1.0, seed=0):

@@ -12,8 +12,8 @@ import pytest
 from PIL import Image
 
 from evinr_lite import read_recording
-from evinr_lite.cli import main
-from evinr_lite.recon_job import write_example_recording
+from evinr_lite.apps.cli import main
+from evinr_lite.sim.recordings import write_example_recording
 
 ROOT = Path(__file__).resolve().parents[1]
 FAST = ["--iters", "4", "--quiet"]
@@ -169,12 +169,12 @@ def test_existing_output_folder_is_refused_unless_overwrite(capsys, ijrr_folder,
 
 
 def test_interrupted_export_leaves_nothing_that_looks_complete(capsys, ijrr_folder, tmp_path, monkeypatch):
-    import evinr_lite.export
+    import evinr_lite.io.export
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(evinr_lite.export, "save_gif", interrupted)   # after the PNGs, before run.json
+    monkeypatch.setattr(evinr_lite.io.export, "save_gif", interrupted)   # after the PNGs, before run.json
     code, _, err = run(capsys, "reconstruct", ijrr_folder, "--out", tmp_path / "new", *FAST)
     assert code == 130 and "interrupted" in err and "Traceback" not in err
     assert not (tmp_path / "new").exists()

@@ -11,8 +11,8 @@ from data_fetch.__main__ import main as cli
 from data_fetch.convert_aed import convert_aed
 from data_fetch.errors import ConversionError
 from evinr_lite import simulate_scene
-from evinr_lite.canonical import read_canonical
-from evinr_lite.quadbayer import QuadBayerScene
+from evinr_lite.io.canonical import read_canonical
+from evinr_lite.sim.quadbayer import QuadBayerScene
 
 RAW = (48, 64)              # (H, W) event photosites -> grey event grid 12 x 16
 FRAME = (96, 128)           # frame pixels -> 24 x 32 grey (the "816 x 612"), -> 12 x 16 at the event grid
@@ -238,7 +238,7 @@ def test_microseconds_stored_as_floats_need_a_unit(fake, tmp_path):
 
 def test_write_aed_folder_round_trip(tmp_path):
     from data_fetch.convert_aed import write_aed_folder
-    from evinr_lite.quadbayer import demosaic_events
+    from evinr_lite.sim.quadbayer import demosaic_events
 
     scene = QuadBayerScene("chelsea", (16, 24), 0.2, phase=(3, 1), velocity=(30.0, 0.0), rotation=0.0, zoom=0.0)
     ev = simulate_scene(scene, 0.0, 0.2, C=0.3, seed=0)

@@ -27,8 +27,8 @@ from PIL import Image
 import data_fetch
 from data_fetch import ChecksumError, ConversionError, DataFetchError, DownloadError, NotDownloadable
 from data_fetch.__main__ import main as cli
-from evinr_lite.canonical import find_time_index, iter_canonical_events, read_canonical
-from evinr_lite.readers import _to_grey_uint8
+from evinr_lite.io.canonical import find_time_index, iter_canonical_events, read_canonical
+from evinr_lite.core.frames import to_grey_uint8 as _to_grey_uint8
 
 NS = 10**9
 ORIGIN = 1468941032          # whole seconds of an absolute DAVIS clock (IJRR-like)
@@ -264,7 +264,7 @@ def test_get_ijrr_downloads_converts_and_caches(server, cache, ijrr, small_senso
     server.files["/davis/slider_depth.zip"] = data
     # small parse blocks and HDF5 chunks, so that the streaming paths run many times
     monkeypatch.setattr("data_fetch.convert_ijrr.BLOCK_BYTES", 300)
-    monkeypatch.setattr("data_fetch.canonical.CHUNK_EVENTS", 64)
+    monkeypatch.setattr("evinr_lite.io.canonical.CHUNK_EVENTS", 64)
     path = data_fetch.get("ijrr", "slider_depth", url=server.url + "/davis/slider_depth.zip", progress=False)
     assert path == cache / "ijrr" / "slider_depth.h5"
     assert (cache / "raw" / "ijrr" / "slider_depth.zip").read_bytes() == data
@@ -432,7 +432,7 @@ def test_bag_event_decoder_matches_rosbags_deserializer(tmp_path):
 
 
 def test_get_mvsec_bag_left_camera_with_pinned_md5(server, cache, small_sensor, tmp_path, monkeypatch):
-    monkeypatch.setattr("data_fetch.canonical.CHUNK_EVENTS", 128)
+    monkeypatch.setattr("evinr_lite.io.canonical.CHUNK_EVENTS", 128)
     ev, frames = make_events(1500, seed=7), make_frames(5)
     right = make_events(1500, seed=8)
     bag = make_bag(tmp_path / "indoor_flying4_data.bag", ev, frames,
@@ -588,7 +588,7 @@ def test_hqf_h5_conversion_repairs_an_out_of_order_frame_time(tmp_path, small_se
 def test_canonical_windows_and_chunks_read_only_what_is_asked(tmp_path, monkeypatch):
     from data_fetch.canonical import CanonicalWriter
 
-    monkeypatch.setattr("data_fetch.canonical.CHUNK_EVENTS", 50)
+    monkeypatch.setattr("evinr_lite.io.canonical.CHUNK_EVENTS", 50)
     rng = np.random.default_rng(4)
     n = 5000
     t = np.sort(rng.integers(0, 2000, n)) * 1e-3         # many ties

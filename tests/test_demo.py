@@ -4,8 +4,8 @@ import subprocess
 import sys
 
 
-from evinr_lite.demo import run_demo
-from evinr_lite.solver import EvINRConfig
+from evinr_lite.apps.demo import run_demo
+from evinr_lite.method.solver import EvINRConfig
 
 
 def test_demo_writes_frames_and_scores(tmp_path):

@@ -3,20 +3,20 @@ import numpy as np
 import pytest
 import torch
 
-from evinr_lite import EvINRConfig, exercises, make_scene, simulate_scene, simulate_video
-from evinr_lite.enhance import (add_background_noise, count_scores, event_counts, model_event_counts,
-                                render_event_counts, signed_to_polarity_counts)
-from evinr_lite.evaluation import (evaluate, match_frames, measure_inference_fps, plot_results, pool,
-                                   results_table, score_sequence)
-from evinr_lite.lpips import ALEXNET_FILE, LINEAR_FILE, load_lpips
-from evinr_lite.tonemap import tonemap_reinhard
+from evinr_lite import EvINRConfig, make_scene, simulate_scene, simulate_video
+from evinr_lite.teaching import exercises
+from evinr_lite.evaluation.enhance import (add_background_noise, count_scores, event_counts, model_event_counts, render_event_counts, signed_to_polarity_counts)
+from evinr_lite.evaluation.scoring import (evaluate, match_frames, measure_inference_fps, pool, results_table, score_sequence)
+from evinr_lite.viz.results import plot_results
+from evinr_lite.evaluation.lpips import ALEXNET_FILE, LINEAR_FILE, load_lpips
+from evinr_lite.method.tonemap import tonemap_reinhard
 
 
 @pytest.fixture(autouse=True)
 def empty_cache(tmp_path, monkeypatch):
     """No LPIPS weights anywhere: the 'unavailable' path, whatever the machine's cache holds."""
     monkeypatch.setenv("EVINR_DATA", str(tmp_path / "cache"))
-    monkeypatch.setattr("evinr_lite.evaluation._LPIPS_CACHE", {})
+    monkeypatch.setattr("evinr_lite.evaluation.scoring._LPIPS_CACHE", {})
 
 
 # ---- matching ------------------------------------------------------------------------------
@@ -127,7 +127,7 @@ def test_evaluate_scores_evinr_and_baselines_through_one_path():
 
 
 def test_measure_inference_fps_reports_its_setting():
-    from evinr_lite.models import FrameINR
+    from evinr_lite.method.models import FrameINR
     model = FrameINR((6, 8), [[0.0, 1.0]], hidden_features=16, hidden_layers=1)
     r = measure_inference_fps(model, n_frames=8, batch_size=4, repeats=2)
     assert r["fps"] > 0 and len(r["all_seconds"]) == 2 and r["sensor_size"] == (6, 8) and r["device"] == "cpu"

@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from evinr_lite import EventDataError, Events, normalize_polarity
+from evinr_lite import EventDataError, Events
+from evinr_lite.core.events import normalize_polarity
 
 
 def make(n=5, H=4, W=6, p=None):

@@ -1,14 +1,14 @@
-"""Exercise checks and fallbacks, and the reference solutions of notebook 01 (evinr_lite.pde1d)."""
+"""Exercise checks and fallbacks, and the reference solutions of notebook 01 (evinr_lite.teaching.pde1d)."""
 import warnings
 
 import numpy as np
 import pytest
 import torch
 
-from evinr_lite import exercises, pde1d
-from evinr_lite.binning import events_to_frames
-from evinr_lite.events import Events
-from evinr_lite.exercises import ExerciseWarning
+from evinr_lite.teaching import exercises, pde1d
+from evinr_lite.method.binning import events_to_frames
+from evinr_lite.core.events import Events
+from evinr_lite.teaching.exercises import ExerciseWarning
 
 
 def _ref_scaled_cumsum(x, C):
@@ -149,6 +149,19 @@ def _stub_like(ref):
 def test_typical_mistakes_get_their_hint(name, wrong, hint, capsys):
     assert not exercises.check(name, wrong)
     assert hint in capsys.readouterr().out
+
+
+def test_integrate_events_1d_agrees_with_the_library():
+    """pde1d.integrate_events_1d re-implements method.integration.integrate_events for one pixel; pin them."""
+    from evinr_lite import Events, integrate_events
+
+    rng = np.random.default_rng(3)
+    t = np.sort(rng.uniform(0.0, 1.0, 200))
+    p = rng.choice(np.array([-1, 1]), t.size)
+    q = np.concatenate([rng.uniform(0.0, 1.0, 20), t[::17]])           # queries on event times too (t <= t_q)
+    events = Events.from_arrays(t, np.zeros(t.size, int), np.zeros(t.size, int), p, (1, 1))
+    np.testing.assert_allclose(pde1d.integrate_events_1d(t, p, 0.2, q), integrate_events(events, q, C=0.2)[:, 0, 0],
+                               atol=1e-12)
 
 
 def test_integrate_events_1d_values():

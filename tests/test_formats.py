@@ -6,8 +6,8 @@ import pytest
 faery = pytest.importorskip("faery")
 
 from evinr_lite import EventDataError, read_recording  # noqa: E402
-from evinr_lite.formats import read_aedat4, read_prophesee, sniff_format  # noqa: E402
-from evinr_lite.readers import SUPPORTED_FORMATS, detect_format  # noqa: E402
+from evinr_lite.io.formats import read_aedat4, read_prophesee, sniff_format  # noqa: E402
+from evinr_lite.io.readers import SUPPORTED_FORMATS, detect_format  # noqa: E402
 
 H, W = 30, 40
 T0_US = 1_600_000_123_456_789   # an absolute clock in microseconds (2020), not on a whole second
@@ -106,7 +106,7 @@ def test_raw_without_size_needs_sensor_size(tmp_path):
     body = body[body.index(b"\n") + 1:]
     bare = tmp_path / "bare.raw"
     bare.write_bytes(b"% evt 2.0\n" + body)    # the header names the encoding but not the size
-    with pytest.raises(EventDataError, match=r"does not give the sensor size.*--sensor HxW.*sensor_size=\(H, W\)"):
+    with pytest.raises(EventDataError, match=r"does not give the sensor size.*sensor_size=\(H, W\)"):
         read_recording(bare)
     rec = read_recording(bare, sensor_size=(H, W))
     assert rec.events.sensor_size == (H, W) and rec.meta["sensor_size_from"] == "sensor_size argument"

@@ -1,5 +1,4 @@
-"""Notebooks 04-05: exercise references and checks (evinr_lite.frame_exercises), teaching helpers, figures."""
-import math
+"""Notebooks 04-05: exercise references and checks (evinr_lite.teaching.frame_exercises), teaching helpers, figures."""
 
 import matplotlib
 import numpy as np
@@ -9,11 +8,12 @@ import torch
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from evinr_lite import exercises, frame_exercises as fe, tonemap_reinhard  # noqa: E402
-from evinr_lite.exercises import ExerciseWarning  # noqa: E402
-from evinr_lite.losses import temporal_loss_difference, tikhonov, total_variation  # noqa: E402
-from evinr_lite.models import FrameINR  # noqa: E402
-from evinr_lite.plot_frames import plot_histories, show_frames, show_images  # noqa: E402
+from evinr_lite.teaching import exercises, frame_exercises as fe  # noqa: E402
+from evinr_lite import tonemap_reinhard  # noqa: E402
+from evinr_lite.teaching.exercises import ExerciseWarning  # noqa: E402
+from evinr_lite.method.losses import temporal_loss_difference, tikhonov, total_variation  # noqa: E402
+from evinr_lite.method.models import FrameINR  # noqa: E402
+from evinr_lite.viz.frames import plot_histories, show_frames, show_images  # noqa: E402
 
 NAMES = ["sine_layer_derivative", "temporal_loss_boundary", "reinhard_tonemap", "total_variation"]
 
@@ -101,20 +101,6 @@ def test_tonemap_hint_does_not_warn():
 
 
 # ---- helpers ---------------------------------------------------------------------------------
-
-def test_anchor_log_intensity():
-    rng = np.random.default_rng(0)
-    L = rng.normal(-1.0, 0.7, (4, 6, 8))
-    for gamma, mean in ((0.6, 0.5), (1.0, 0.3), (2.2, 0.7)):
-        A = fe.anchor_log_intensity(L, gamma, mean)
-        assert tonemap_reinhard(A.mean(), gamma) == pytest.approx(mean, rel=1e-12)
-        np.testing.assert_allclose(np.diff(A, axis=0), np.diff(L, axis=0), atol=1e-12)   # one constant only
-    ref = L[:2]
-    A = fe.anchor_log_intensity(L[3], 0.6, 0.5, reference=ref)
-    assert tonemap_reinhard(np.mean(ref + (A - L[3]).mean()), 0.6) == pytest.approx(0.5)
-    with pytest.raises(ValueError, match="display_mean"):
-        fe.anchor_log_intensity(L, 0.6, 1.0)
-
 
 @pytest.fixture(scope="module")
 def moving_edge():

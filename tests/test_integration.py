@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from evinr_lite.events import EventDataError, Events
-from evinr_lite.integration import integrate_events
+from evinr_lite.core.events import EventDataError, Events
+from evinr_lite.method.integration import integrate_events
 
 
 def random_events(n=400, size=(5, 7), seed=0):

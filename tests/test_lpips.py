@@ -9,8 +9,7 @@ import pytest
 import torch
 import torch.nn.functional as F
 
-from evinr_lite.lpips import (ALEXNET_FILE, FETCH_COMMAND, LINEAR_FILE, LPIPS, LPIPSUnavailable, load_lpips,
-                              lpips_distance, lpips_distances, lpips_paths)
+from evinr_lite.evaluation.lpips import (ALEXNET_FILE, FETCH_COMMAND, LINEAR_FILE, LPIPS, LPIPSUnavailable, load_lpips, lpips_distance, lpips_distances, lpips_paths)
 
 # torchvision's AlexNet `features` (IMAGENET1K_V1) and LPIPS v0.1 heads: the published shapes
 ALEX_SHAPES = {

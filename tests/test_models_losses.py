@@ -4,9 +4,9 @@ import pytest
 import torch
 
 from evinr_lite import Events
-from evinr_lite.binning import bisect_boundaries, events_to_frames
-from evinr_lite.losses import temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
-from evinr_lite.models import FrameINR
+from evinr_lite.method.binning import bisect_boundaries, events_to_frames
+from evinr_lite.method.losses import (temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation)
+from evinr_lite.method.models import FrameINR
 
 
 def small_model(N=2, size=(3, 4), **kw):

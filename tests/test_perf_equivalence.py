@@ -9,12 +9,12 @@ import pytest
 import torch
 
 from evinr_lite import Events
-from evinr_lite import binning, losses
-from evinr_lite.binning import events_to_frames, events_to_frames_chunked
-from evinr_lite.losses import (head_losses, temporal_loss_derivative, temporal_loss_difference, tikhonov,
-                               total_variation)
-from evinr_lite.models import FrameINR
-from evinr_lite.solver import EvINRConfig, predict_networks, split_windows, train_frame_inr
+from evinr_lite.method import binning, fused as fused_kernel
+from evinr_lite.method.binning import events_to_frames, events_to_frames_chunked
+from evinr_lite.method.fused import head_losses
+from evinr_lite.method.losses import (temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation)
+from evinr_lite.method.models import FrameINR
+from evinr_lite.method.solver import EvINRConfig, predict_networks, split_windows, train_frame_inr
 
 
 # ---- binning --------------------------------------------------------------------------------
@@ -119,7 +119,7 @@ def test_batched_frame_inr_equals_a_plain_loop_over_networks():
 @pytest.mark.parametrize("regularizer", ["tikhonov", "tv", "none"])
 @pytest.mark.parametrize("chunk_cells", [1 << 20, 500, 130, 1])   # all at once; per network; 2 frames; 1 frame
 def test_fused_head_losses_equal_the_readable_losses(monkeypatch, temporal, regularizer, chunk_cells):
-    monkeypatch.setattr(losses, "_CHUNK_CELLS", chunk_cells)
+    monkeypatch.setattr(fused_kernel, "_CHUNK_CELLS", chunk_cells)
     torch.manual_seed(0)
     H, W, B = 7, 9, 5
     model = FrameINR((H, W), [[0.0, 1.0], [0.8, 2.0]], 32, 2, omega_0=30.0, first_omega_0=10.0, seed=2)

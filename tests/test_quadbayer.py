@@ -3,12 +3,9 @@ import numpy as np
 import pytest
 
 from evinr_lite import EvINRConfig, Events, EventDataError, integrate_events, simulate_scene
-from evinr_lite import aed_exercises, exercises
-from evinr_lite.colour import channel_offsets_from, chroma_correlation, reconstruct_colour
-from evinr_lite.quadbayer import (BAYER, QuadBayerScene, cfa_channel, cfa_pattern, cfa_tile, demosaic_events,
-                                  demosaic_events_rgb, demosaic_grey, demosaic_rgb, demosaic_rgb_full,
-                                  checker_amplitude, effective_thresholds, mosaic, mosaic_display,
-                                  photosites_per_window, reduce_mean, simulate_colour_video)
+from evinr_lite.teaching import aed_exercises, exercises
+from evinr_lite.method.colour import channel_offsets_from, chroma_correlation, reconstruct_colour
+from evinr_lite.sim.quadbayer import (BAYER, QuadBayerScene, cfa_channel, cfa_pattern, cfa_tile, demosaic_events, demosaic_events_rgb, demosaic_grey, demosaic_rgb, demosaic_rgb_full, checker_amplitude, effective_thresholds, mosaic, mosaic_display, photosites_per_window, reduce_mean, simulate_colour_video)
 
 PHASES = [(0, 0), (1, 0), (0, 1), (1, 3), (3, 2), (2, 2)]
 

@@ -6,18 +6,9 @@ import numpy as np
 import pytest
 from skimage.io import imsave
 
-from evinr_lite.events import EventDataError, Events
-from evinr_lite.readers import (
-    Recording,
-    read_events,
-    read_events_npy,
-    read_events_txt,
-    read_evreal_folder,
-    read_frames_ijrr,
-    read_h5,
-    read_ijrr_folder,
-    read_recording,
-)
+from evinr_lite.core.events import EventDataError, Events
+from evinr_lite.core.recording import Recording
+from evinr_lite.io.readers import (read_events, read_events_npy, read_events_txt, read_evreal_folder, read_frames_ijrr, read_h5, read_ijrr_folder, read_recording)
 
 # Five events on a 3 x 5 sensor (H = 3 rows, W = 5 columns); p written as 0/1.
 T = ["0.000100000", "0.000250000", "0.000250000", "0.001000001", "0.002500000"]
@@ -138,7 +129,7 @@ def test_txt_empty(tmp_path):
 
 def test_txt_many_chunks(tmp_path, monkeypatch):
     """Chunked parsing: line numbers and sortedness are tracked across chunk boundaries."""
-    import evinr_lite.readers as readers
+    import evinr_lite.io.text as readers
 
     monkeypatch.setattr(readers, "CHUNK_BYTES", 64)
     n = 200

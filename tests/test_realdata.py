@@ -2,11 +2,14 @@
 import numpy as np
 import pytest
 
-from evinr_lite import exercises
-from evinr_lite.events import EventDataError, Events
-from evinr_lite.realdata import event_rate, frames_to_score
-from evinr_lite.recording_exercises import estimate_contrast_threshold, frame_log_changes
-from evinr_lite.sample_data import find_shared_data, sample_recording_path, synthetic_recording
+from evinr_lite.teaching import exercises
+from evinr_lite.core.events import EventDataError, Events
+from evinr_lite.teaching.realdata_exercises import event_rate
+from evinr_lite.evaluation.scoring import frames_to_score
+from evinr_lite.method.binning import event_rate as library_event_rate
+from evinr_lite.method.contrast import estimate_contrast_threshold, frame_log_changes
+from evinr_lite.io.sample_data import find_shared_data, sample_recording_path
+from evinr_lite.sim.recordings import synthetic_recording
 
 
 def test_event_rate_counts_every_event_once():
@@ -15,6 +18,22 @@ def test_event_rate_counts_every_event_once():
     assert np.isclose((rate * 0.1).sum(), len(t))
     assert np.isclose(centers[0], t[0] + 0.05) and np.all(np.diff(centers) > 0)
     assert centers[-1] - 0.05 <= t[-1] < centers[-1] + 0.05
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_teaching_event_rate_agrees_with_the_library(seed):
+    """The exercise's reference re-implements method.binning.event_rate on purpose; pin the two."""
+    rng = np.random.default_rng(seed)
+    bin_s = 0.05
+    t = np.sort(rng.uniform(1.0, 1.0 + rng.uniform(0.3, 0.9), 500))
+    t = t[np.abs((t - t[0]) / bin_s - np.round((t - t[0]) / bin_s)) > 1e-6]   # no event on a bin edge
+    t = np.concatenate([[1.0 - 0.01], t])
+    p = rng.choice(np.array([-1, 1]), t.size)
+    events = Events.from_arrays(t, np.zeros(t.size, int), np.zeros(t.size, int), p, (1, 1))
+    centers, rate = event_rate(t, bin_s)
+    edges, on, off = library_event_rate(events, bin_s)
+    np.testing.assert_allclose(rate * bin_s, (on + off) * np.diff(edges), atol=1e-9)   # the same counts
+    np.testing.assert_allclose(centers[:-1], 0.5 * (edges[:-2] + edges[1:-1]))        # full bins: same centres
 
 
 def test_exercise_reference_passes_its_check():
@@ -49,7 +68,7 @@ def test_synthetic_recording_is_deterministic():
 
 
 def test_slider_depth_frames_and_threshold(slider_depth_dir):
-    from evinr_lite.readers import read_recording
+    from evinr_lite.io.readers import read_recording
     rec = read_recording(slider_depth_dir)
     idx = frames_to_score(rec.frames.t, rec.events)
     assert np.all(rec.frames.t[idx] >= rec.events.t[0] - 0.005) and np.all(rec.frames.t[idx] <= rec.events.t[-1] + 0.005)

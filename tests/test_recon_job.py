@@ -6,13 +6,14 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from evinr_lite import EventDataError, exercises, read_recording
-from evinr_lite.export import save_gif, save_mp4
-from evinr_lite.recon_job import (choose_times, describe_recording, load_recording, run_reconstruct,
-                                  write_example_recording)
-from evinr_lite.recording_exercises import (ENV_VAR, estimate_contrast_threshold, event_count_windows,
-                                            find_recording, frame_log_changes, window_table,
-                                            windows_from_indices)
+from evinr_lite import EventDataError, read_recording
+from evinr_lite.teaching import exercises
+from evinr_lite.io.export import save_gif, save_mp4
+from evinr_lite.apps.recon_job import choose_times, describe_recording, load_recording, run_reconstruct
+from evinr_lite.io.sample_data import ENV_VAR as SHARED_ENV_VAR
+from evinr_lite.teaching.recording_exercises import event_count_windows, window_table, windows_from_indices
+from evinr_lite.method.contrast import estimate_contrast_threshold, frame_log_changes
+from evinr_lite.sim.recordings import find_recording, write_example_recording
 
 
 @pytest.fixture(scope="module")
@@ -70,23 +71,24 @@ def test_windows_and_table(example):
 
 
 def test_find_recording_order(tmp_path, monkeypatch):
-    monkeypatch.delenv(ENV_VAR, raising=False)
+    monkeypatch.delenv(SHARED_ENV_VAR, raising=False)
     shared = tmp_path / "project" / "shared" / "data" / "ijrr_slider_depth_chunk"
     shared.mkdir(parents=True)
     (shared / "events.txt").write_text("0.1 1 1 1\n")
     deep = tmp_path / "project" / "main" / "notebooks"
     deep.mkdir(parents=True)
     assert find_recording(start=deep) == (shared, "the shared IJRR slider_depth chunk")
-    monkeypatch.setenv(ENV_VAR, str(shared.parent))
-    assert find_recording(start=deep)[0] == shared.parent
-    monkeypatch.setenv(ENV_VAR, str(tmp_path / "gone"))
+    assert find_recording(shared.parent, start=deep) == (shared.parent, "given")
     with pytest.raises(EventDataError, match="no such recording"):
+        find_recording(tmp_path / "gone", start=deep)
+    # the one environment variable of shared data: a data folder without the chunk -> synthetic
+    monkeypatch.setenv(SHARED_ENV_VAR, str(tmp_path / "elsewhere"))
+    with pytest.raises(EventDataError, match="no recording found"):
         find_recording(start=deep)
-    monkeypatch.delenv(ENV_VAR)
-    lonely = tmp_path / "elsewhere"
-    lonely.mkdir()
-    path, origin = find_recording(scratch=tmp_path / "scratch", start=lonely)
+    path, origin = find_recording(scratch=tmp_path / "scratch", start=deep)
     assert "synthetic" in origin and read_recording(path).frames is not None
+    monkeypatch.setenv(SHARED_ENV_VAR, str(shared.parent))
+    assert find_recording(start=tmp_path)[0] == shared
 
 
 def test_choose_times(example):
@@ -98,7 +100,7 @@ def test_choose_times(example):
     np.testing.assert_allclose(times, 0.1 + (np.arange(10) + 0.5) / 50)
     times, _ = choose_times(rec, at="0.25, 0.15")
     np.testing.assert_array_equal(times, [0.15, 0.25])
-    with pytest.raises(EventDataError, match="either --fps or --at"):
+    with pytest.raises(EventDataError, match="either fps= or at="):
         choose_times(rec, fps=10, at="0.2")
     with pytest.raises(EventDataError, match="outside the reconstructed window"):
         choose_times(rec, at=[0.05])

@@ -2,10 +2,10 @@
 import numpy as np
 import pytest
 
-from evinr_lite.events import EventDataError
-from evinr_lite.frames import Frames
-from evinr_lite.scenes import MovingBarScene, MovingImageScene, Scene, make_scene
-from evinr_lite.simulate import simulate_scene
+from evinr_lite.core.events import EventDataError
+from evinr_lite.core.frames import Frames
+from evinr_lite.sim.scenes import MovingBarScene, MovingImageScene, Scene, make_scene
+from evinr_lite.sim.simulate import simulate_scene
 
 SMALL = (24, 32)
 

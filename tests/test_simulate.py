@@ -2,11 +2,10 @@
 import numpy as np
 import pytest
 
-from evinr_lite.events import EventDataError, Events
-from evinr_lite.integration import integrate_events
-from evinr_lite.scenes import make_scene
-from evinr_lite.simulate import (sample_thresholds, simulate_events_1d, simulate_scene,
-                                 simulate_video)
+from evinr_lite.core.events import EventDataError, Events
+from evinr_lite.method.integration import integrate_events
+from evinr_lite.sim.scenes import make_scene
+from evinr_lite.sim.simulate import sample_thresholds, simulate_events_1d, simulate_scene, simulate_video
 
 ASYMMETRIC = [(0.2, 0.2), (0.15, 0.3)]
 

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 import torch
 
-from evinr_lite import pde1d
-from evinr_lite.siren import Siren, SineLayer, input_gradient
+from evinr_lite.teaching import pde1d
+from evinr_lite.method.siren import Siren, SineLayer, input_gradient
 
 
 def test_output_shape_and_batch_dims():

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from evinr_lite import EventDataError, make_scene, simulate_scene
-from evinr_lite.solver import EvINRConfig, blend_networks, reconstruct, split_windows
+from evinr_lite.method.solver import EvINRConfig, blend_networks, reconstruct, split_windows
 
 SMALL = dict(hidden_features=64, hidden_layers=2, progress=False, lr=3e-4)
 

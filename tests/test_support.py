@@ -8,7 +8,7 @@ import pytest
 import torch
 
 from evinr_lite import default_device, fast_mode, pick
-from evinr_lite.output import atomic_output_dir
+from evinr_lite.io.output import atomic_output_dir
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -35,7 +35,7 @@ def test_atomic_output_dir_refuses_existing_and_cleans_up(tmp_path):
     with atomic_output_dir(out) as tmp:
         (tmp / "a.txt").write_text("x")
     assert (out / "a.txt").read_text() == "x"
-    with pytest.raises(FileExistsError, match="--overwrite"):
+    with pytest.raises(FileExistsError, match="overwrite=True"):
         with atomic_output_dir(out):
             pass
     with pytest.raises(KeyboardInterrupt):

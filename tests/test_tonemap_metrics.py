@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 import torch
 
-from evinr_lite.metrics import mse, ssim
-from evinr_lite.tonemap import tonemap_reinhard
+from evinr_lite.evaluation.metrics import mse, ssim
+from evinr_lite.method.tonemap import anchor_mean, tonemap_reinhard
 
 
 def test_reinhard_matches_definition_and_is_stable():
@@ -46,7 +46,7 @@ def test_ssim_uses_data_range_one():
 
 
 def test_equalization_and_frame_scores():
-    from evinr_lite.metrics import equalize, score_frames
+    from evinr_lite.evaluation.metrics import equalize, score_frames
     rng = np.random.default_rng(2)
     img = 0.3 + 0.1 * rng.uniform(0, 1, (32, 40))   # low contrast
     for method in ("global", "clahe"):
@@ -64,7 +64,7 @@ def test_equalization_and_frame_scores():
 
 
 def test_anchor_level_tone_maps_to_the_display_mean():
-    from evinr_lite.tonemap import anchor_level, anchor_mean
+    from evinr_lite.method.tonemap import anchor_level, anchor_mean
     for gamma in (0.4, 0.6, 1.0):
         assert tonemap_reinhard(np.array(anchor_level(gamma, 0.5)), gamma) == pytest.approx(0.5)
     L = np.random.default_rng(3).normal(size=(4, 5))
@@ -120,7 +120,8 @@ def test_ssim_of_an_image_with_itself_is_one_for_any_content():
 def test_clahe_and_global_equal_opencv_on_uint8():
     import cv2
 
-    from evinr_lite.metrics import equalize, to_uint8
+    from evinr_lite.evaluation.metrics import equalize
+    from evinr_lite.core.frames import to_uint8
     rng = np.random.default_rng(5)
     img = np.clip(0.35 + 0.1 * rng.standard_normal((60, 80)), 0, 1)
     u = np.round(img * 255).astype(np.uint8)
@@ -135,7 +136,7 @@ def test_clahe_and_global_equal_opencv_on_uint8():
 
 
 def test_protocol_text_names_every_parameter():
-    from evinr_lite.metrics import PROTOCOLS, protocol_description, score_frames
+    from evinr_lite.evaluation.metrics import PROTOCOLS, protocol_description, score_frames
     for eq in ("none", "global", "clahe"):
         text = protocol_description(eq)
         assert text == PROTOCOLS[eq]
@@ -147,3 +148,17 @@ def test_protocol_text_names_every_parameter():
     assert protocol_description("clahe") in score_frames(stack, stack, "clahe")["protocol"]
     with pytest.raises(ValueError, match="equalization must be one of"):
         protocol_description("local")
+
+
+def test_anchor_mean_with_reference():
+    rng = np.random.default_rng(0)
+    L = rng.normal(-1.0, 0.7, (4, 6, 8))
+    for gamma, mean in ((0.6, 0.5), (1.0, 0.3), (2.2, 0.7)):
+        A = anchor_mean(L, gamma, mean)
+        assert tonemap_reinhard(A.mean(), gamma) == pytest.approx(mean, rel=1e-12)
+        np.testing.assert_allclose(np.diff(A, axis=0), np.diff(L, axis=0), atol=1e-12)   # one constant only
+    ref = L[:2]
+    A = anchor_mean(L[3], 0.6, 0.5, reference=ref)
+    assert tonemap_reinhard(np.mean(ref + (A - L[3]).mean()), 0.6) == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="display_mean"):
+        anchor_mean(L, 0.6, 1.0)

@@ -8,10 +8,11 @@ import pytest  # noqa: E402
 from matplotlib.colors import to_rgb  # noqa: E402
 from matplotlib.image import AxesImage  # noqa: E402
 
-from evinr_lite import events2d, exercises, plotting, viz  # noqa: E402
-from evinr_lite.binning import events_to_frames  # noqa: E402
-from evinr_lite.events import EventDataError, Events  # noqa: E402
-from evinr_lite.simulate import simulate_video  # noqa: E402
+from evinr_lite.teaching import events2d, exercises  # noqa: E402
+from evinr_lite.viz import signals as plotting, events as viz  # noqa: E402
+from evinr_lite.method.binning import events_to_frames  # noqa: E402
+from evinr_lite.core.events import EventDataError, Events  # noqa: E402
+from evinr_lite.sim.simulate import simulate_video  # noqa: E402
 
 WHITE = (1.0, 1.0, 1.0)
 

@@ -6,8 +6,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from evinr_lite import plotting, widgets  # noqa: E402
-from evinr_lite.widgets import Control, interact, parse_controls  # noqa: E402
+from evinr_lite.viz import signals as plotting, widgets  # noqa: E402
+from evinr_lite.viz.frames import plot_histories  # noqa: E402
+from evinr_lite.viz.widgets import Control, interact, parse_controls  # noqa: E402
 
 
 def test_parse_controls():
@@ -105,7 +106,8 @@ def test_plot_reconstruction_and_loss():
     ax = plotting.plot_reconstruction_1d(t, {"a": t, "b": 2 * t}, truth=t)
     assert [line.get_label() for line in ax.lines] == ["true L(t)", "a", "b"]
     plt.close(ax.figure)
-    ax = plotting.plot_loss({"loss": [1.0, 0.1, 0.0], "temporal": [1.0, 0.1, 0.0]}, keys=("loss", "temporal"))
+    hist = {"loss": [1.0, 0.1, 0.0], "temporal": [1.0, 0.1, 0.0]}
+    ax = plot_histories({"loss": hist, "temporal": hist["temporal"]})
     assert len(ax.lines) == 2 and ax.get_yscale() == "log"
     plt.close(ax.figure)
     res = {"window": np.array([0.01, 0.1]), "taylor": np.array([1e-3, 1e-1]), "events": np.array([1.0, 0.1])}

@@ -1,0 +1,392 @@
+"""The reconstruct job: load a recording -> pick a window and times -> EvINR -> score -> export.
+
+The ``evinr-lite reconstruct`` command is :func:`run_reconstruct`; notebook 11 calls the steps
+one by one::
+
+    rec = load_recording("my_recording.aedat4", t_start=1.0, t_end=2.5)   # events + frames of a window
+    print(format_info(describe_recording(rec)))
+    times, source = choose_times(rec, fps=30)          # or at=[...]; default: the GT frame times
+    result = reconstruct_recording(rec, times, EvINRConfig(C=1.0))
+    scores = score_recording(result, rec.frames)       # None without frames
+    export_reconstruction("out", rec, result, scores)  # PNGs, MP4, GIF, metrics.json/.csv, run.json
+
+Times are seconds on the recording's clock: relative to its ``t_origin`` (the whole seconds of the
+first event on an absolute clock, else 0), as ``describe_recording`` prints them.
+"""
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..core.events import EventDataError
+from ..core.frames import Frames
+from ..core.recording import Recording
+from ..io.readers import detect_format, read_recording
+from ..evaluation.scoring import score_sequence
+from ..method.solver import EvINRConfig, Reconstruction, reconstruct
+
+__all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
+           "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
+           "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS"]
+
+DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
+DEFAULT_C = 1.0         # the paper's contrast threshold for DAVIS recordings (IJRR, HQF)
+EQUALIZATIONS = ("none", "clahe")   # scored without equalisation, and with CLAHE (the paper's)
+SIZE_FREE_FORMATS = ("txt", "npy")   # formats that may not record the sensor size
+READER_WINDOW_FORMATS = ("canonical", "h5", "aedat4", "prophesee_raw", "prophesee_dat")  # read only a window
+
+
+# ---- load ------------------------------------------------------------------------------------
+
+def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None) -> Recording:
+    """Read a recording of any supported format, the sensor size checked or supplied.
+
+    Args:
+        path: file or folder; the format is detected (:func:`evinr_lite.io.readers.detect_format`).
+        sensor_size: (H, W). Needed for formats that do not record it (.npy, text without a
+            `W H` header, some Prophesee .raw); for the others it must match the file's.
+        t_start, t_end: passed to readers that read only a window from disk (the others read all).
+    Raises:
+        EventDataError: missing file, unknown format, wrong or missing sensor size.
+    """
+    kind = detect_format(path)
+    kwargs = {}
+    if kind in SIZE_FREE_FORMATS + ("aedat4", "prophesee_raw", "prophesee_dat") and sensor_size is not None:
+        kwargs["sensor_size"] = sensor_size
+    if kind in READER_WINDOW_FORMATS:
+        kwargs.update(t_start=t_start, t_end=t_end)
+    rec = read_recording(path, **kwargs)
+    if sensor_size is not None and tuple(int(v) for v in sensor_size) != rec.events.sensor_size:
+        H, W = rec.events.sensor_size
+        raise EventDataError(f"{path}: the recording's sensor is (H, W) = {rec.events.sensor_size} ({H}x{W}) but "
+                             f"sensor size {tuple(int(v) for v in sensor_size)} was given; leave it out or pass {H}x{W}")
+    return Recording(rec.events, rec.frames, {**rec.meta, "format": rec.meta.get("format", kind)})
+
+
+def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None) -> Recording:
+    """Read a recording (any supported format) restricted to the window [t_start, t_end).
+
+    Args:
+        path, sensor_size: see :func:`read_any`.
+        t_start, t_end: seconds on the recording's clock; None: from the first / to the last event.
+    Returns:
+        Recording whose events lie in the window and whose frames lie in [start, end], the span
+        to reconstruct, stored as ``meta["window"]`` = (start, end) seconds.
+    Raises:
+        EventDataError: missing file, unknown format, wrong sensor size, empty window (each
+            message says what to do).
+    """
+    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end)
+    events, frames = rec.events, rec.frames
+    if rec.meta["format"] not in READER_WINDOW_FORMATS:
+        events = events.slice_time(t_start, t_end)
+    if len(events) < 2:
+        raise EventDataError(f"{path}: only {len(events)} event(s) in the window [{t_start}, {t_end}) s; "
+                             "choose a longer window (see `evinr-lite info` for the time span)")
+    start = float(events.t[0]) if t_start is None else float(t_start)
+    end = float(events.t[-1]) if t_end is None else float(t_end)
+    if frames is not None:  # only frames the events can reach: inside [start, end]
+        keep = (frames.t >= start) & (frames.t <= end)
+        frames = Frames(frames.images[keep], frames.t[keep], frames.t_origin) if keep.any() else None
+    return Recording(events, frames, {**rec.meta, "window": (start, end)})
+
+
+def describe_recording(rec: Recording) -> dict:
+    """What a recording holds: format, sensor, time span, event count and rate, polarity balance,
+    frames. Times are seconds on the recording's clock (relative to ``t_origin``)."""
+    ev = rec.events
+    H, W = ev.sensor_size
+    duration = ev.duration
+    info = {
+        "format": rec.meta.get("format"), "path": rec.meta.get("path"),
+        "sensor_size": [H, W], "t_origin": ev.t_origin,
+        "t_first": float(ev.t[0]) if len(ev) else None, "t_last": float(ev.t[-1]) if len(ev) else None,
+        "duration_s": duration, "n_events": len(ev),
+        "event_rate_per_s": len(ev) / duration if duration > 0 else None,
+        "events_per_pixel": len(ev) / (H * W),
+        "on_fraction": float(np.mean(ev.p > 0)) if len(ev) else None,
+        "n_frames": 0,
+    }
+    if rec.frames is not None and len(rec.frames):
+        fr = rec.frames
+        info.update(n_frames=len(fr), frame_size=list(fr.size), frames_t_first=float(fr.t[0]),
+                    frames_t_last=float(fr.t[-1]),
+                    frame_rate_per_s=(len(fr) - 1) / float(fr.t[-1] - fr.t[0]) if len(fr) > 1 and fr.t[-1] > fr.t[0] else None)
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding"):
+        if rec.meta.get(key) is not None:
+            value = rec.meta[key]
+            info[key] = list(value) if isinstance(value, tuple) else value
+    return info
+
+
+def format_info(info: dict) -> str:
+    """Human-readable lines for :func:`describe_recording`'s dict."""
+    H, W = info["sensor_size"]
+    lines = [f"format        {info['format']}  ({info['path']})",
+             f"sensor        {H}x{W} (H x W)"]
+    if info["n_events"]:
+        rate = info["event_rate_per_s"]
+        lines += [f"events        {info['n_events']:,}" + (f"  ({rate:,.0f} per s, {rate / (H * W):.2f} per pixel "
+                                                             "per s)" if rate else ""),
+                  f"time span     {info['t_first']:.6f} .. {info['t_last']:.6f} s  ({info['duration_s']:.6f} s; "
+                  f"times relative to t_origin = {info['t_origin']:.0f} s)",
+                  f"polarity      {100 * info['on_fraction']:.1f}% ON, {100 * (1 - info['on_fraction']):.1f}% OFF"]
+    else:
+        lines.append("events        none")
+    if info["n_frames"]:
+        fr = info.get("frame_rate_per_s")
+        lines.append(f"frames        {info['n_frames']} of {info['frame_size'][0]}x{info['frame_size'][1]}, "
+                     f"{info['frames_t_first']:.6f} .. {info['frames_t_last']:.6f} s"
+                     + (f" ({fr:.1f} per s)" if fr else "") + "  -> reconstructions are scored against them")
+    else:
+        lines.append("frames        none (nothing to score against)")
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding"):
+        if key in info:
+            lines.append(f"{key:<13} {info[key]}")
+    return "\n".join(lines)
+
+
+# ---- times and reconstruction ----------------------------------------------------------------
+
+def _parse_times(at) -> np.ndarray:
+    """Seconds from an array, a list, '0.1,0.2' text, or a file with one time per line."""
+    if isinstance(at, (str, Path)) and Path(at).is_file():
+        text = Path(at).read_text()
+        at = [tok for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")
+              for tok in line.replace(",", " ").split()[-1:]]
+    elif isinstance(at, str):
+        at = [tok for tok in at.replace(",", " ").split()]
+    try:
+        times = np.atleast_1d(np.asarray(at, dtype=np.float64))
+    except ValueError:
+        raise EventDataError(f"could not read times from at={at!r}; give seconds separated by commas "
+                             "(e.g. 0.5,0.75,1.0) or a file with one time per line") from None
+    if times.size == 0 or not np.all(np.isfinite(times)):
+        raise EventDataError("at=: give at least one finite time in seconds")
+    return np.sort(times)
+
+
+def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[np.ndarray, str]:
+    """The times to reconstruct and where they come from.
+
+    Args:
+        fps: frames per second over the window (the first half a frame period after its start).
+        at: explicit times (array, '0.1,0.2' text, or a file with one time per line).
+        Neither: the ground-truth frame times when the recording has frames, else DEFAULT_FPS.
+    Returns:
+        (times float64 [Q] seconds, a short description of the choice).
+    """
+    if fps is not None and at is not None:
+        raise EventDataError("give either fps= or at=, not both")
+    lo, hi = rec.meta["window"]
+    if at is not None:
+        times = _parse_times(at)
+        outside = times[(times < lo) | (times > hi)]
+        if outside.size:
+            raise EventDataError(f"requested time {outside[0]} s is outside the reconstructed window "
+                                 f"[{lo:.6f}, {hi:.6f}] s; choose times inside it (or widen t_start=/t_end=)")
+        return times, f"{len(times)} requested times"
+    if fps is None and rec.frames is not None:
+        inside = rec.frames.t[(rec.frames.t >= lo) & (rec.frames.t <= hi)]
+        if inside.size:
+            return inside.copy(), f"the {inside.size} ground-truth frame times"
+    fps = DEFAULT_FPS if fps is None else float(fps)
+    if not (math.isfinite(fps) and fps > 0):
+        raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
+    n = int(math.floor((hi - lo) * fps))
+    times = lo + (np.arange(n) + 0.5) / fps if n >= 1 else np.array([0.5 * (lo + hi)])
+    return times, f"{len(times)} frames at {fps:g} per second"
+
+
+def reconstruct_recording(rec: Recording, times, config: EvINRConfig | None = None) -> Reconstruction:
+    """EvINR over the recording's window (``meta["window"]``), queried at ``times`` (seconds)."""
+    lo, hi = rec.meta["window"]
+    return reconstruct(rec.events, times, config or EvINRConfig(), t_start=lo, t_end=hi)
+
+
+# ---- scoring ---------------------------------------------------------------------------------
+
+def _score_one(pred, pred_times, gt: Frames, equalization: str) -> dict:
+    """One protocol of :func:`evinr_lite.evaluation.scoring.score_sequence`, as JSON-ready lists."""
+    s = score_sequence(pred, pred_times, gt.images, gt.t, equalization=equalization)
+    per = s["per_frame"]
+    return {"mse": s["mse"], "ssim": s["ssim"], "lpips": s.get("lpips"), "n_frames": s["n_frames"],
+            "protocol": s["protocol"], "per_frame_index": np.asarray(per["gt_index"]).tolist(),
+            "per_frame_mse": np.asarray(per["mse"]).tolist(), "per_frame_ssim": np.asarray(per["ssim"]).tolist()}
+
+
+def score_predictions(pred_frames, pred_times, gt: Frames) -> dict:
+    """Score frames [Q, H, W] in [0, 1] at ``pred_times`` against ground truth, without equalisation
+    and with CLAHE: {"none": {...}, "clahe": {...}}, each with mse, ssim, lpips (None unless its
+    weights are present), n_frames, protocol (text) and per-frame lists (per_frame_t_s the GT times)."""
+    pred_times = np.asarray(pred_times, np.float64)
+    scores = {eq: _score_one(np.asarray(pred_frames), pred_times, gt, eq) for eq in EQUALIZATIONS}
+    for s in scores.values():
+        s["per_frame_t_s"] = gt.t[s["per_frame_index"]].tolist()
+    return scores
+
+
+def score_recording(result: Reconstruction, gt: Frames | None) -> dict | None:
+    """Score the reconstruction at every ground-truth frame time (see :func:`score_predictions`).
+
+    The trained network is queried at the frames' own timestamps, so the scores do not depend on
+    which times were exported. Returns None when no frame lies in the reconstructed span.
+    """
+    if gt is None or not len(gt):
+        return None
+    lo, hi = result.windows[0, 0], result.windows[-1, 1]
+    keep = (gt.t >= lo) & (gt.t <= hi)
+    if not keep.any():
+        return None
+    gt = Frames(gt.images[keep], gt.t[keep], gt.t_origin)
+    if tuple(gt.size) != tuple(result.frames.shape[1:]):
+        raise EventDataError(f"ground-truth frames are {gt.size} but the events' sensor is "
+                             f"{tuple(result.frames.shape[1:])} (H, W); they cannot be compared")
+    return score_predictions(result.frames_at(gt.t), gt.t, gt)
+
+
+# ---- export ----------------------------------------------------------------------------------
+
+def _video_fps(times: np.ndarray) -> float:
+    """Playback rate: the median spacing of the frames, kept between 2 and 60 frames per second."""
+    if len(times) < 2:
+        return 10.0
+    step = float(np.median(np.diff(times)))
+    return float(np.clip(1.0 / step, 2.0, 60.0)) if step > 0 else 10.0
+
+
+def export_reconstruction(out_dir, rec: Recording, result: Reconstruction, scores: dict | None = None, *,
+                          settings: dict | None = None, overwrite: bool = False, video: bool = True,
+                          log=print) -> dict:
+    """Write a finished reconstruction into ``out_dir`` (atomically: all or nothing).
+
+    Layout: ``frames/frame_00000.png`` ... (the reconstruction), ``timestamps.txt`` (one time per
+    frame), ``reconstruction.mp4`` and ``.gif`` (``video``), ``gt/`` (the ground-truth frames in the
+    window) with ``metrics.json`` and ``metrics.csv`` (per frame, both protocols) when scored, and
+    ``run.json`` (input, format, window, settings, EvINR config, timings).
+
+    Returns:
+        The contents of run.json.
+    Raises:
+        FileExistsError: ``out_dir`` exists and ``overwrite`` is False.
+    """
+    from ..io.export import save_csv, save_frames_png, save_gif, save_mp4, save_timestamps
+    from ..io.output import atomic_output_dir, save_json
+
+    out_dir = Path(out_dir)
+    written = ["frames/", "timestamps.txt"]
+    run = {"input": rec.meta.get("path"), "format": rec.meta.get("format"),
+           "sensor_size": list(rec.events.sensor_size), "t_origin": rec.events.t_origin,
+           "window_s": list(rec.meta["window"]), "n_events": len(rec.events),
+           "n_frames_written": len(result.times), "times_s": result.times.tolist(),
+           **(settings or {}), "evinr_config": result.history.get("config"),
+           "train_time_s": result.history.get("train_time_s")}
+    with atomic_output_dir(out_dir, overwrite=overwrite) as tmp:
+        save_frames_png(tmp / "frames", result.frames)
+        save_timestamps(tmp / "timestamps.txt", result.times, rec.events.t_origin)
+        if video:
+            fps = _video_fps(result.times)
+            save_gif(tmp / "reconstruction.gif", result.frames, fps)
+            written.append("reconstruction.gif")
+            try:
+                save_mp4(tmp / "reconstruction.mp4", result.frames, fps)
+                written.append("reconstruction.mp4")
+            except RuntimeError as err:
+                log(f"warning: {err}")
+            run["video_fps"] = fps
+        if scores is not None:
+            gt = rec.frames
+            save_frames_png(tmp / "gt", gt.images)
+            save_timestamps(tmp / "gt" / "timestamps.txt", gt.t, gt.t_origin)
+            summary = {eq: {k: v for k, v in s.items() if not k.startswith("per_frame")} for eq, s in scores.items()}
+            save_json(tmp / "metrics.json", {"scored_at": "the ground-truth frame times in the window",
+                                             "protocols": summary,
+                                             "per_frame": {eq: {k: v for k, v in s.items() if k.startswith("per_frame")}
+                                                           for eq, s in scores.items()}})
+            first = next(iter(scores.values()))
+            rows = []
+            for k, gi in enumerate(first["per_frame_index"]):
+                row = {"gt_index": gi, "t_s": f"{first['per_frame_t_s'][k]:.9f}"}
+                for eq, s in scores.items():
+                    row[f"mse_{eq}"] = f"{s['per_frame_mse'][k]:.6f}"
+                    row[f"ssim_{eq}"] = f"{s['per_frame_ssim'][k]:.6f}"
+                rows.append(row)
+            save_csv(tmp / "metrics.csv", rows)
+            written += ["gt/", "metrics.json", "metrics.csv"]
+            run["scores"] = summary
+        run["files"] = written + ["run.json"]
+        save_json(tmp / "run.json", _jsonable(run))
+    return run
+
+
+def _jsonable(obj):
+    """numpy scalars/arrays and tuples -> plain JSON types."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+# ---- the whole job ---------------------------------------------------------------------------
+
+def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, fps: float | None = None, at=None,
+                    t_start: float | None = None, t_end: float | None = None, device: str | None = None,
+                    n_iters: int = 300, seed: int = 0, overwrite: bool = False, video: bool = True,
+                    progress: bool = True, log=print) -> dict:
+    """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
+
+    Every check that can fail (output folder, device, file, format, sensor size, window, times)
+    runs before training. C: the contrast threshold; None takes the file's (canonical files
+    store it), else DEFAULT_C = 1 (the paper's for DAVIS data).
+    Returns the contents of run.json (with "scores" when the recording has frames).
+    """
+    from ..core.runtime import default_device
+
+    t0 = time.perf_counter()
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not overwrite:
+        raise FileExistsError(f"output folder {out_dir} already exists; choose another out_dir= or pass overwrite=True")
+    try:
+        device_name = str(default_device(device))
+    except RuntimeError as err:
+        raise EventDataError(str(err)) from None
+    if n_iters < 1:
+        raise EventDataError(f"n_iters= must be at least 1, got {n_iters}")
+    rec = load_recording(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end)
+    times, source = choose_times(rec, fps=fps, at=at)
+    C_source = "given" if C is not None else ("from the file" if rec.meta.get("C") else "default (pass C=)")
+    C = float(C if C is not None else rec.meta.get("C") or DEFAULT_C)
+    lo, hi = rec.meta["window"]
+    H, W = rec.events.sensor_size
+    log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
+        + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
+        + f" in {time.perf_counter() - t0:.1f} s")
+    log(f"reconstructing {source} with EvINR (C = {C:g} {C_source}, {n_iters} iterations, {device_name})")
+    c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
+    config = EvINRConfig(C=C, n_iters=n_iters, c2f_iters=c2f, coarse_to_fine=bool(c2f), seed=seed,
+                         device=device, progress=progress)
+    result = reconstruct_recording(rec, times, config)
+    scores = score_recording(result, rec.frames)
+    settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
+    run = export_reconstruction(out_dir, rec, result, scores, settings=settings, overwrite=overwrite,
+                                video=video, log=log)
+    seconds = time.perf_counter() - t0
+    line = (f"wrote {len(times)} frames to {out_dir}/ in {seconds:.1f} s "
+            f"(training {result.history['train_time_s']:.1f} s)")
+    if scores:
+        parts = [f"{eq}: MSE {s['mse']:.4f} SSIM {s['ssim']:.3f}" + (f" LPIPS {s['lpips']:.3f}" if s.get("lpips") else "")
+                 for eq, s in scores.items()]
+        line += f"; scored against {scores['none']['n_frames']} ground-truth frames ({'; '.join(parts)})"
+    else:
+        line += "; no ground-truth frames, not scored"
+    log(line)
+    run["total_time_s"] = seconds
+    return run

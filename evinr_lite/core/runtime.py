@@ -1,0 +1,66 @@
+"""Runtime choices shared by every layer: where torch runs, fast mode, and the cache folder.
+
+- ``default_device``: a GPU when present, never required (``EVINR_DEVICE`` overrides).
+- ``fast_mode`` / ``pick``: smaller sizes and fewer iterations so that every notebook runs in CI
+  within minutes. Switched by ``EVINR_FAST`` ("1" on, "0" off); when it is unset, fast mode is on
+  under pytest/nbval (``tests/conftest.py`` sets it) and in CI (``CI`` set).
+- ``cache_dir`` / ``weights_dir``: where downloads, converted sequences and model weights live
+  (``$EVINR_DATA`` or ``~/.cache/evinr-lite``); ``data_fetch`` writes there, the kit reads there.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+__all__ = ["default_device", "fast_mode", "pick", "cache_dir", "weights_dir", "FAST_ENV_VAR", "CACHE_ENV_VAR"]
+
+CACHE_ENV_VAR = "EVINR_DATA"
+
+
+def default_device(preference: str | None = None) -> "torch.device":
+    """The torch device to use.
+
+    Args:
+        preference: "cpu", "cuda" or None (auto: cuda when available, else cpu). The
+            environment variable ``EVINR_DEVICE`` overrides auto. (Apple's "mps" can be asked for
+            explicitly, but it has no float64, which event timestamps need, so auto never picks it.)
+
+    Raises:
+        RuntimeError: if a device is asked for that this machine does not have.
+    """
+    import torch   # here, not at the top: data_fetch and the command's --help stay light
+
+    preference = preference or os.environ.get("EVINR_DEVICE") or "auto"
+    if preference == "auto":
+        if torch.cuda.is_available():
+            return torch.device("cuda")
+        return torch.device("cpu")
+    if preference.startswith("cuda") and not torch.cuda.is_available():
+        raise RuntimeError("device 'cuda' requested but no CUDA GPU is available here; use device='cpu'")
+    return torch.device(preference)
+
+
+FAST_ENV_VAR = "EVINR_FAST"
+
+
+def fast_mode() -> bool:
+    """True when notebooks and examples should use their small sizes."""
+    value = os.environ.get(FAST_ENV_VAR)
+    if value is not None:
+        return value.strip().lower() not in ("", "0", "false", "no", "off")
+    return bool(os.environ.get("CI")) or "PYTEST_CURRENT_TEST" in os.environ
+
+
+def pick(fast, full):
+    """``fast`` in fast mode, ``full`` otherwise (e.g. ``n_iters = pick(50, 300)``)."""
+    return fast if fast_mode() else full
+
+
+def cache_dir() -> Path:
+    """Folder for downloads, converted sequences and weights: ``$EVINR_DATA`` or ``~/.cache/evinr-lite``."""
+    return Path(os.environ.get(CACHE_ENV_VAR) or Path.home() / ".cache" / "evinr-lite").expanduser()
+
+
+def weights_dir(name: str) -> Path:
+    """Folder of a weight set (e.g. "lpips"): ``<cache>/weights/<name>``."""
+    return cache_dir() / "weights" / name.lower()

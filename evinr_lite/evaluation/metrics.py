@@ -1,0 +1,119 @@
+"""Image quality metrics with a stated protocol: MSE, SSIM (and LPIPS in :mod:`evinr_lite.evaluation.lpips`).
+
+The protocol follows EVREAL's current one (``../shared/notes/evaluation-and-datasets.md``):
+
+- images are grey [H, W] floats in [0, 1]; the prediction is clipped to [0, 1];
+- MSE is the mean of squared differences on [0, 1] (not x 255^2);
+- SSIM (Wang et al. 2004) uses a gaussian window of sigma 1.5 (truncated at 3.5 sigma: 11 x 11),
+  population (co)variances, K1 = 0.01, K2 = 0.03 and data_range = 1.0 (scikit-image would assume
+  2 for floats and inflate SSIM), averaged over the pixels at least 5 px from the border;
+- optionally, both images are histogram-equalised first (:func:`equalize`): "none", "global"
+  (``cv2.equalizeHist``) or "clahe" (``cv2.createCLAHE(clipLimit=2.0, tileGridSize=(8, 8))``,
+  the EvINR paper's protocol, after SSL-E2VID), each on the image quantised to uint8 as
+  ``round(255 * x)`` and mapped back to [0, 1] as ``/ 255``.
+
+Every result carries its protocol text (:data:`PROTOCOLS`, :func:`protocol_description`).
+"""
+from __future__ import annotations
+
+import numpy as np
+from skimage.metrics import structural_similarity
+
+from ..core.frames import to_uint8
+
+__all__ = ["mse", "ssim", "equalize", "score_frames", "protocol_description", "PROTOCOLS",
+           "METRIC_PROTOCOL", "SSIM_PROTOCOL", "EQUALIZATIONS", "CLAHE_CLIP_LIMIT", "CLAHE_TILES"]
+
+EQUALIZATIONS = ("none", "global", "clahe")
+CLAHE_CLIP_LIMIT = 2.0
+CLAHE_TILES = (8, 8)
+
+SSIM_PROTOCOL = ("SSIM: gaussian window sigma 1.5 (truncate 3.5, 11x11; 5 px borders excluded), K1 0.01, "
+                 "K2 0.03, population covariance, data_range 1.0")
+METRIC_PROTOCOL = ("prediction clipped to [0, 1], ground truth in [0, 1] (uint8 / 255); MSE on [0, 1]; " + SSIM_PROTOCOL
+                   + "; LPIPS: AlexNet trunk, linear heads v0.1, grey copied to 3 channels, [0, 1] -> [-1, 1]")
+PROTOCOLS = {
+    "none": "no histogram equalisation; " + METRIC_PROTOCOL,
+    "global": ("global histogram equalisation of both images (cv2.equalizeHist on uint8 round(255 x), "
+               "back to [0, 1] as / 255); " + METRIC_PROTOCOL),
+    "clahe": (f"CLAHE on both images (cv2.createCLAHE(clipLimit={CLAHE_CLIP_LIMIT}, tileGridSize={CLAHE_TILES}) "
+              "on uint8 round(255 x), back to [0, 1] as / 255; the EvINR paper's protocol); " + METRIC_PROTOCOL),
+}
+
+
+def protocol_description(equalization: str = "none") -> str:
+    """The full scoring protocol (equalisation and metric parameters) as one line of text."""
+    if equalization not in PROTOCOLS:
+        raise ValueError(f"equalization must be one of {EQUALIZATIONS}, got {equalization!r}")
+    return PROTOCOLS[equalization]
+
+
+def _pair(pred, gt):
+    pred = np.clip(np.asarray(pred, dtype=np.float64), 0.0, 1.0)
+    gt = np.asarray(gt, dtype=np.float64)
+    if pred.shape != gt.shape:
+        raise ValueError(f"prediction {pred.shape} and ground truth {gt.shape} differ in shape")
+    return pred, gt
+
+
+def mse(pred, gt) -> float:
+    """Mean squared error of images in [0, 1] (prediction clipped first). Shapes [H, W]."""
+    pred, gt = _pair(pred, gt)
+    return float(np.mean((pred - gt) ** 2))
+
+
+def ssim(pred, gt) -> float:
+    """SSIM of two grey images [H, W] in [0, 1] (prediction clipped first); see the module docstring."""
+    pred, gt = _pair(pred, gt)
+    if min(pred.shape) < 11:
+        raise ValueError(f"SSIM needs images of at least 11 x 11 pixels (its gaussian window), got {pred.shape}")
+    return float(structural_similarity(pred, gt, gaussian_weights=True, sigma=1.5,
+                                       use_sample_covariance=False, data_range=1.0))
+
+
+def equalize(img, method: str = "none") -> np.ndarray:
+    """Histogram equalisation of a grey image [H, W] in [0, 1] (or uint8).
+
+    Args:
+        method: "none" (clip to [0, 1] only), "global" (``cv2.equalizeHist``) or "clahe"
+            (``cv2.createCLAHE(clipLimit=2.0, tileGridSize=(8, 8))``), both on ``to_uint8(img)``.
+
+    Returns:
+        float64 [H, W] in [0, 1].
+    """
+    if method not in EQUALIZATIONS:
+        raise ValueError(f"equalization must be one of {EQUALIZATIONS}, got {method!r}")
+    img = np.asarray(img)
+    if img.ndim != 2:
+        raise ValueError(f"equalize takes one grey image [H, W], got shape {img.shape}")
+    if method == "none":
+        if img.dtype == np.uint8:
+            return img.astype(np.float64) / 255.0
+        return np.clip(img.astype(np.float64), 0.0, 1.0)
+    import cv2
+
+    u = to_uint8(img)
+    if method == "global":
+        out = cv2.equalizeHist(u)
+    else:
+        out = cv2.createCLAHE(clipLimit=CLAHE_CLIP_LIMIT, tileGridSize=CLAHE_TILES).apply(u)
+    return out.astype(np.float64) / 255.0
+
+
+def score_frames(pred, gt, equalization: str = "none") -> dict:
+    """Mean MSE and SSIM over frames [F, H, W] (both in [0, 1]) after the same equalisation of both.
+
+    Frames are taken as already matched (for matching by timestamp and LPIPS see
+    :func:`evinr_lite.evaluation.scoring.score_sequence`).
+
+    Returns:
+        {"mse": float, "ssim": float, "n_frames": int, "protocol": str}.
+    """
+    pred, gt = np.asarray(pred), np.asarray(gt)
+    if pred.shape != gt.shape or pred.ndim != 3:
+        raise ValueError(f"expected two [F, H, W] stacks of the same shape, got {pred.shape} and {gt.shape}")
+    p = [equalize(a, equalization) for a in pred]
+    g = [equalize(b, equalization) for b in gt]
+    return {"mse": float(np.mean([mse(a, b) for a, b in zip(p, g)])),
+            "ssim": float(np.mean([ssim(a, b) for a, b in zip(p, g)])),
+            "n_frames": len(p), "protocol": f"equalization={equalization}: " + protocol_description(equalization)}

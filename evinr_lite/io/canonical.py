@@ -1,0 +1,469 @@
+"""The canonical HDF5 file of one converted sequence: its layout, its reader and its writer.
+
+Every dataset that ``data_fetch`` converts (IJRR, HQF, CED, MVSEC, and AED once its converter
+exists) ends up in this one layout, so the rest of the kit has a single real-data format::
+
+    /                      attrs: format = "evinr-lite canonical", format_version = 1,
+                           sensor_size = (H, W), t_origin (s, absolute time of t = 0),
+                           dataset, sequence, source, source_url, raw_file, C (contrast
+                           threshold to use), eval_window (s, on this file's clock; NaN, NaN
+                           = whole sequence), eval_window_published (as published, seconds
+                           after t_zero), t_zero (s, the zero of the published windows:
+                           earliest event or frame), n_events, n_frames, t_first, t_last,
+                           converter, meta_json (a JSON object: calibration, notes, ...)
+    /events/t              float64 [N], seconds since t_origin, non-decreasing
+    /events/x, /events/y   uint16 [N], column and row
+    /events/p              int8 [N], polarity -1 / +1
+    /events/t_index        float64 [ceil(N / stride)], t[::stride] (attr "stride"): a coarse
+                           index so that a time window is found by reading one chunk
+    /frames/images         uint8 [F, H, W], ground-truth frames (grey), one chunk per frame
+    /frames/t              float64 [F], seconds since t_origin, non-decreasing
+
+Event datasets are chunked and compressed; readers never load more than the requested
+window (or one chunk at a time with :func:`iter_canonical_events`), so a sequence of 10^8
+events does not need 10^8 x 4 x 8 bytes of memory.
+
+:class:`CanonicalWriter` (used by ``data_fetch``'s converters) takes events and frames in pieces
+(a converter streams a raw file chunk by chunk or message by message), checks them, writes full
+compressed chunks, builds the coarse time index on the way, and at the end sets the attributes.
+The file is written under a temporary name and renamed into place only when complete, so an
+interrupted conversion never leaves a file that looks finished.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..core.events import EventDataError, Events
+from ..core.frames import Frames
+
+__all__ = [
+    "CanonicalWriter",
+    "repair_frame_times",
+    "CHUNK_EVENTS",
+    "COMPRESSION",
+    "FORMAT_NAME",
+    "FORMAT_VERSION",
+    "is_canonical",
+    "canonical_info",
+    "read_canonical",
+    "iter_canonical_events",
+    "find_time_index",
+]
+
+FORMAT_NAME = "evinr-lite canonical"
+FORMAT_VERSION = 1
+CHUNK_EVENTS = 1 << 16          # events per HDF5 chunk, and the stride of events/t_index
+COMPRESSION = dict(compression="gzip", compression_opts=4, shuffle=True)
+DTYPES = {"t": np.float64, "x": np.uint16, "y": np.uint16, "p": np.int8}
+log = logging.getLogger("evinr_lite")
+EVENT_FIELDS = ("t", "x", "y", "p")
+
+
+def is_canonical(path) -> bool:
+    """True when ``path`` is an HDF5 file in the canonical layout (any version)."""
+    import h5py
+
+    path = Path(path)
+    if not path.is_file():
+        return False
+    try:
+        with h5py.File(path, "r") as f:
+            return f.attrs.get("format") == FORMAT_NAME
+    except OSError:
+        return False
+
+
+def _open(path):
+    import h5py
+
+    path = Path(path)
+    if not path.exists():
+        raise EventDataError(f"no such file: {path}; check the path (data_fetch.get(...) returns it)")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as err:
+        raise EventDataError(f"{path}: not a readable HDF5 file ({err}); the file is damaged or incomplete: "
+                             "delete it and convert again (python -m data_fetch get/convert ...)") from None
+    if f.attrs.get("format") != FORMAT_NAME:
+        f.close()
+        raise EventDataError(f"{path}: not an evinr-lite canonical file (root attribute format is "
+                             f"{f.attrs.get('format')!r}); convert the raw recording with "
+                             "`python -m data_fetch convert <raw path>`, or read an HQF-style h5 "
+                             "with evinr_lite.io.readers.read_h5")
+    version = int(f.attrs.get("format_version", 0))
+    if version > FORMAT_VERSION:
+        f.close()
+        raise EventDataError(f"{path}: canonical format version {version} is newer than this evinr-lite "
+                             f"reads ({FORMAT_VERSION}); update evinr-lite")
+    missing = [f"events/{k}" for k in EVENT_FIELDS if f"events/{k}" not in f]
+    if missing:
+        f.close()
+        raise EventDataError(f"{path}: missing datasets {missing}; the file is incomplete: convert it again")
+    return f
+
+
+def _attr(value):
+    """h5py attribute -> plain Python value (str, float, int, tuple)."""
+    if isinstance(value, bytes):
+        return value.decode()
+    if isinstance(value, np.ndarray):
+        return tuple(v.item() for v in value.ravel())
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _info_from(f, path) -> dict:
+    info = {k: _attr(v) for k, v in f.attrs.items() if k != "meta_json"}
+    info["meta"] = json.loads(f.attrs["meta_json"]) if "meta_json" in f.attrs else {}
+    info["sensor_size"] = tuple(int(v) for v in f.attrs["sensor_size"])
+    for key in ("eval_window", "eval_window_published"):   # NaN, NaN on disk = the whole sequence
+        window = info.get(key)
+        if window is not None and not all(math.isfinite(v) for v in window):
+            window = None
+        info[key] = window
+    info["path"] = str(path)
+    return info
+
+
+def canonical_info(path) -> dict:
+    """The file's attributes as a dict (``meta`` decoded from JSON; ``eval_window`` None = whole)."""
+    with _open(path) as f:
+        return _info_from(f, path)
+
+
+def find_time_index(f, value: float, side: str = "left") -> int:
+    """First event index i with t[i] >= value (side 'left') or t[i] > value ('right').
+
+    Uses ``events/t_index`` (one float per chunk) and then reads a single chunk of ``events/t``;
+    files without the index fall back to a binary search reading one element at a time.
+    """
+    ts = f["events/t"]
+    n = ts.shape[0]
+    if "events/t_index" in f:
+        index = f["events/t_index"][()]
+        stride = int(f["events/t_index"].attrs["stride"])
+        k = int(np.searchsorted(index, value, side=side))
+        if k == 0:
+            return 0
+        lo, hi = (k - 1) * stride, min(k * stride, n)
+        return lo + int(np.searchsorted(ts[lo:hi], value, side=side))
+    lo, hi = 0, n
+    while lo < hi:
+        mid = (lo + hi) // 2
+        t_mid = float(ts[mid])
+        if t_mid < value or (side == "right" and t_mid == value):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+def _window(f, path, t_start, t_end) -> tuple[int, int]:
+    n = f["events/t"].shape[0]
+    if t_start is not None and t_end is not None and t_end <= t_start:
+        raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
+    lo = 0 if t_start is None else find_time_index(f, t_start)
+    hi = n if t_end is None else find_time_index(f, t_end)
+    return lo, max(lo, hi)
+
+
+def _events(f, lo: int, hi: int, sensor_size, origin: float, source) -> Events:
+    t = f["events/t"][lo:hi].astype(np.float64, copy=False)
+    x, y, p = (f[f"events/{k}"][lo:hi] for k in "xyp")
+    try:
+        return Events(t, x, y, p, sensor_size, t_origin=origin, polarity_encoding="pm1")
+    except EventDataError as err:
+        raise EventDataError(f"{source}: {err}") from None
+
+
+def read_canonical(path, t_start: float | None = None, t_end: float | None = None, *,
+                   frames: bool = True):
+    """A canonical sequence file as a :class:`~evinr_lite.core.recording.Recording`.
+
+    Args:
+        path: the ``.h5`` file that ``data_fetch.get`` / ``convert`` wrote.
+        t_start, t_end: seconds on the file's clock (``t`` relative to ``t_origin``); only the
+            events with ``t_start <= t < t_end`` are read from disk (found through the stored
+            time index), and only the frames in that window. None: from the start / to the end.
+            ``recording.meta["eval_window"]`` is the sequence's evaluation window on this clock.
+        frames: False skips the ground-truth frames.
+
+    Returns:
+        Recording(events, frames or None, meta) with meta holding dataset, sequence, source, C,
+        eval_window (None = whole sequence), t_zero, event_slice (lo, hi) and the stored meta.
+    """
+    from ..core.recording import Recording
+
+    with _open(path) as f:
+        info = _info_from(f, path)
+        sensor_size, origin = info["sensor_size"], float(info["t_origin"])
+        lo, hi = _window(f, path, t_start, t_end)
+        if hi <= lo and (t_start is not None or t_end is not None):
+            first, last = info.get("t_first"), info.get("t_last")
+            span = f"[{first:.6f}, {last:.6f}] s" if info.get("n_events") else "nothing (no events)"
+            raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
+                                 f"{span} (relative to t_origin = {origin}); choose a window inside that range")
+        events = _events(f, lo, hi, sensor_size, origin, path)
+        gt = None
+        if frames and "frames/t" in f and f["frames/t"].shape[0]:
+            ft = f["frames/t"][()]
+            a = 0 if t_start is None else int(np.searchsorted(ft, t_start, side="left"))
+            b = len(ft) if t_end is None else int(np.searchsorted(ft, t_end, side="left"))
+            if b > a:
+                gt = Frames(f["frames/images"][a:b], ft[a:b], origin)
+    meta = {"format": "canonical", **{k: v for k, v in info.items() if k not in ("format", "meta")},
+            **info["meta"], "event_slice": (lo, hi)}
+    meta["path"] = str(path)
+    return Recording(events, gt, meta)
+
+
+def iter_canonical_events(path, t_start: float | None = None, t_end: float | None = None, *,
+                          chunk_events: int = 1 << 20):
+    """Yield the events of a canonical file as consecutive :class:`Events` of at most ``chunk_events``.
+
+    Memory stays at one chunk whatever the sequence length (e.g. for event rates or binning of a
+    10^8-event recording). The window is ``t_start <= t < t_end`` as in :func:`read_canonical`.
+    """
+    if chunk_events < 1:
+        raise EventDataError(f"chunk_events must be a positive number of events, got {chunk_events}")
+    with _open(path) as f:
+        info = _info_from(f, path)
+        lo, hi = _window(f, path, t_start, t_end)
+        for start in range(lo, hi, chunk_events):
+            yield _events(f, start, min(start + chunk_events, hi), info["sensor_size"],
+                          float(info["t_origin"]), path)
+
+
+# ---- writing ----------------------------------------------------------------------------
+
+def repair_frame_times(t: np.ndarray) -> tuple[np.ndarray, list[int]]:
+    """Repair isolated wrong frame timestamps (a stamp out of order between two good ones).
+
+    A decreasing step t[i] > t[i+1] is blamed on the one stamp whose neighbours are in order
+    (t[i-1] <= t[i+1]: t[i] is too late; else t[i] <= t[i+2]: t[i+1] is too early); that stamp is
+    replaced by the midpoint of its neighbours. Returns (repaired copy, indices repaired). Steps
+    that cannot be blamed on one interior stamp are left (the caller then sorts the frames).
+    """
+    t = np.array(t, dtype=np.float64)
+    fixed = []
+    for i in np.flatnonzero(np.diff(t) < 0):
+        if t[i] <= t[i + 1]:
+            continue  # already repaired through its neighbour
+        if 0 < i and t[i - 1] <= t[i + 1]:
+            t[i] = 0.5 * (t[i - 1] + t[i + 1])
+            fixed.append(int(i))
+        elif i + 2 < len(t) and t[i] <= t[i + 2]:
+            t[i + 1] = 0.5 * (t[i] + t[i + 2])
+            fixed.append(int(i + 1))
+    return t, fixed
+
+
+class CanonicalWriter:
+    """Stream events and frames into a canonical ``.h5`` file.
+
+    Args:
+        out: final path of the file (written as ``.<name>.partial`` and renamed when done).
+        sensor_size: (H, W) of the events.
+        t_origin: seconds; absolute time of t = 0 (the times given to :meth:`add_events` and
+            :meth:`add_frame` are relative to it).
+        dataset, sequence, source, source_url, raw_file, converter: provenance attributes.
+        C: contrast threshold to use with this sequence.
+        eval_window: (start, end) seconds after the sequence's zero (earliest event or frame), as
+            published; None = the whole sequence.
+        meta: JSON-serialisable extras (calibration, notes).
+
+    Use as a context manager; leaving the block with an exception deletes the partial file.
+    Problems raise :attr:`error` (``EventDataError``; ``data_fetch`` sets its ``ConversionError``).
+    """
+
+    error = EventDataError
+
+    def __init__(self, out, *, sensor_size, t_origin: float = 0.0, dataset: str = "", sequence: str = "",
+                 source: str = "", source_url: str = "", raw_file: str = "", C: float = 1.0,
+                 eval_window=None, converter: str = "", meta: dict | None = None):
+        import h5py
+
+        self.out = Path(out)
+        self.out.parent.mkdir(parents=True, exist_ok=True)
+        self.tmp = self.out.with_name(f".{self.out.name}.partial")
+        self.H, self.W = (int(v) for v in sensor_size)
+        self.t_origin = float(t_origin)
+        self.attrs = dict(dataset=dataset, sequence=sequence, source=source, source_url=source_url,
+                          raw_file=raw_file, C=float(C), converter=converter)
+        self.eval_window = None if eval_window is None else tuple(float(v) for v in eval_window)
+        self.meta = dict(meta or {})
+        self.f = h5py.File(self.tmp, "w")
+        ev = self.f.create_group("events")
+        self.ds = {k: ev.create_dataset(k, shape=(0,), maxshape=(None,), dtype=dt, chunks=(CHUNK_EVENTS,),
+                                        **COMPRESSION) for k, dt in DTYPES.items()}
+        self.buf = {k: [] for k in DTYPES}
+        self.buffered = 0
+        self.n = 0
+        self.t_last = -math.inf
+        self.t_first = None
+        self.index: list[np.ndarray] = []
+        self.frame_t: list[float] = []
+        self.frames = None
+        self.closed = False
+
+    # ---- events -----------------------------------------------------------------------------
+    def add_events(self, t, x, y, p, *, where: str = "") -> None:
+        """Append events (t float64 s since t_origin, non-decreasing; p in -1/+1).
+
+        ``where`` names the position in the raw file for error messages (e.g. "line 1200").
+        """
+        t = np.asarray(t, dtype=np.float64)
+        if t.size == 0:
+            return
+        x, y, p = np.asarray(x), np.asarray(y), np.asarray(p)
+        at = f" ({where})" if where else ""
+        if not (t.shape == x.shape == y.shape == p.shape) or t.ndim != 1:
+            raise self.error(f"t, x, y, p of a block differ in shape{at}: {t.shape}, {x.shape}, {y.shape}, {p.shape}")
+        if not np.all(np.isfinite(t)):
+            raise self.error(f"non-finite timestamp{at}; the raw file is damaged")
+        steps = np.diff(t, prepend=self.t_last)
+        if np.any(steps < 0):
+            i = int(np.flatnonzero(steps < 0)[0])
+            prev = self.t_last if i == 0 else t[i - 1]
+            raise self.error(f"timestamps go back in time{at}: {t[i]!r} s after {prev!r} s (event "
+                                  f"{self.n + self.buffered + i}); the raw events are not sorted by time")
+        for name, v, size in (("x", x, self.W), ("y", y, self.H)):
+            if v.min() < 0 or v.max() >= size:
+                raise self.error(
+                    f"{name} coordinates span [{v.min()}, {v.max()}] but the sensor is (H, W) = "
+                    f"{(self.H, self.W)}{at}; the sensor size is wrong for this recording (pass the camera's "
+                    "real size) or the raw file is damaged")
+        if not np.all((p == 1) | (p == -1)):
+            raise self.error(f"polarities must be -1/+1 when written{at}; got {np.unique(p)[:6]}")
+        if self.t_first is None:
+            self.t_first = float(t[0])
+        self.t_last = float(t[-1])
+        for k, v in zip("txyp", (t, x, y, p)):
+            self.buf[k].append(v.astype(DTYPES[k], copy=False))
+        self.buffered += t.size
+        if self.buffered >= 16 * CHUNK_EVENTS:
+            self._flush(full_chunks_only=True)
+
+    def _flush(self, full_chunks_only: bool) -> None:
+        if not self.buffered:
+            return
+        cols = {k: np.concatenate(v) if len(v) > 1 else v[0] for k, v in self.buf.items()}
+        count = self.buffered
+        if full_chunks_only:
+            count = (count // CHUNK_EVENTS) * CHUNK_EVENTS
+            if count == 0:
+                return
+        start, end = self.n, self.n + count
+        for k, ds in self.ds.items():
+            ds.resize((end,))
+            ds[start:end] = cols[k][:count]
+        first = (-start) % CHUNK_EVENTS
+        self.index.append(cols["t"][first:count:CHUNK_EVENTS].copy())
+        self.buf = {k: [v[count:]] if count < self.buffered else [] for k, v in cols.items()}
+        self.buffered -= count
+        self.n = end
+
+    # ---- frames -----------------------------------------------------------------------------
+    def add_frame(self, image, t: float) -> None:
+        """Append one grey uint8 frame [H, W] taken at ``t`` (s since t_origin)."""
+        image = np.asarray(image)
+        if image.dtype != np.uint8 or image.ndim != 2:
+            raise self.error(f"frames must be grey uint8 [H, W]; got {image.dtype} {image.shape}")
+        if not math.isfinite(t):
+            raise self.error(f"frame {len(self.frame_t)} has a non-finite timestamp")
+        if self.frames is None:
+            h, w = image.shape
+            self.frames = self.f.create_dataset("frames/images", shape=(0, h, w), maxshape=(None, h, w),
+                                                dtype=np.uint8, chunks=(1, h, w), **COMPRESSION)
+        if image.shape != self.frames.shape[1:]:
+            raise self.error(f"frame {len(self.frame_t)} is {image.shape} but the first frame is "
+                                  f"{self.frames.shape[1:]}; all frames of a sequence must share one size")
+        k = len(self.frame_t)
+        self.frames.resize((k + 1, *self.frames.shape[1:]))
+        self.frames[k] = image
+        self.frame_t.append(float(t))
+
+    # ---- finishing --------------------------------------------------------------------------
+    def _finish_frames(self) -> list[int]:
+        ft = np.array(self.frame_t, dtype=np.float64)
+        repaired: list[int] = []
+        if ft.size > 1 and np.any(np.diff(ft) < 0):
+            ft, repaired = repair_frame_times(ft)
+            if repaired:
+                log.warning("frame timestamps out of order at %s; repaired as the midpoint of their "
+                            "neighbours", repaired)
+                self.meta["frame_times_repaired"] = repaired
+            if np.any(np.diff(ft) < 0):
+                order = np.argsort(ft, kind="stable")
+                log.warning("frames are not in time order; sorting them")
+                images = self.frames[()]
+                self.frames[...] = images[order]
+                ft = ft[order]
+                self.meta["frames_sorted"] = True
+        self.f.create_dataset("frames/t", data=ft, dtype=np.float64)
+        if self.frames is None:
+            self.f.create_dataset("frames/images", shape=(0, self.H, self.W), dtype=np.uint8)
+        return repaired
+
+    def close(self) -> Path:
+        """Write the remaining events, the index and the attributes; rename into place."""
+        if self.closed:
+            return self.out
+        self._flush(full_chunks_only=False)
+        if self.n == 0:
+            self.abort()
+            raise self.error(f"no events were found for {self.out.name}; the raw file holds no events "
+                                  "(wrong topic or an empty/damaged file)")
+        idx = np.concatenate(self.index) if self.index else np.zeros(0)
+        dset = self.f.create_dataset("events/t_index", data=idx, dtype=np.float64)
+        dset.attrs["stride"] = CHUNK_EVENTS
+        self._finish_frames()
+        ft = self.f["frames/t"][()]
+        t_zero = min(self.t_first, float(ft[0])) if ft.size else self.t_first
+        window = (math.nan, math.nan) if self.eval_window is None else (t_zero + self.eval_window[0],
+                                                                        t_zero + self.eval_window[1])
+        a = self.f.attrs
+        a["format"] = FORMAT_NAME
+        a["format_version"] = FORMAT_VERSION
+        a["sensor_size"] = np.array([self.H, self.W], dtype=np.int64)
+        a["t_origin"] = self.t_origin
+        for k, v in self.attrs.items():
+            a[k] = v
+        a["eval_window"] = np.array(window, dtype=np.float64)
+        a["eval_window_published"] = np.array(self.eval_window or (math.nan, math.nan), dtype=np.float64)
+        a["t_zero"] = float(t_zero)
+        a["n_events"] = int(self.n)
+        a["n_frames"] = int(ft.size)
+        a["t_first"] = float(self.t_first)
+        a["t_last"] = float(self.t_last)
+        a["meta_json"] = json.dumps(self.meta, sort_keys=True)
+        self.f.close()
+        os.replace(self.tmp, self.out)
+        self.closed = True
+        return self.out
+
+    def abort(self) -> None:
+        """Drop the partial file."""
+        if not self.closed:
+            try:
+                self.f.close()
+            finally:
+                self.tmp.unlink(missing_ok=True)
+                self.closed = True
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+        return False

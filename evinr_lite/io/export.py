@@ -1,0 +1,94 @@
+"""Writing reconstructed frames: numbered PNGs, an animated GIF (Pillow), an MP4 (OpenCV).
+
+Frames are grey float arrays [F, H, W] in [0, 1] (or uint8). These functions write into a folder
+they are given; the reconstruct job hands them the temporary folder of
+:func:`evinr_lite.io.output.atomic_output_dir`, so an interrupted export never looks complete.
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from ..core.frames import to_uint8 as metrics_to_uint8
+from .output import save_png
+
+__all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv"]
+
+
+def to_uint8(frames) -> np.ndarray:
+    """[F, H, W] floats in [0, 1] (clipped) or uint8 -> uint8 [F, H, W]."""
+    frames = np.asarray(frames)
+    if frames.ndim != 3:
+        raise ValueError(f"frames must have shape [F, H, W] (grey), got {frames.shape}")
+    return metrics_to_uint8(frames)
+
+
+def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
+    """Write frames [F, H, W] as ``folder/<prefix>00000.png``, ... (8-bit grey). Returns the paths."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for i, img in enumerate(to_uint8(frames)):
+        paths.append(folder / f"{prefix}{i:05d}.png")
+        save_png(paths[-1], img)
+    return paths
+
+
+def save_gif(path, frames, fps: float) -> Path:
+    """An animated grey GIF of frames [F, H, W] at ``fps`` frames per second (to the GIF's 10 ms
+    resolution, at most 50 per second), looping."""
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps}")
+    images = [Image.fromarray(img) for img in to_uint8(frames)]
+    delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
+    images[0].save(path, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
+    return Path(path)
+
+
+def save_mp4(path, frames, fps: float) -> Path:
+    """An MP4 video (MPEG-4 part 2, 'mp4v') of frames [F, H, W] at ``fps`` frames per second.
+
+    Odd widths or heights are padded by one black row / column (most players need even sizes).
+    Raises RuntimeError when OpenCV cannot open a writer (an OpenCV build without video support).
+    """
+    import cv2
+
+    if not fps > 0:
+        raise ValueError(f"fps must be positive, got {fps}")
+    frames = to_uint8(frames)
+    F, H, W = frames.shape
+    frames = np.pad(frames, ((0, 0), (0, H % 2), (0, W % 2)))
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
+                             (frames.shape[2], frames.shape[1]), isColor=False)
+    if not writer.isOpened():
+        raise RuntimeError(f"OpenCV could not open an MP4 writer for {path}; the GIF and PNGs are still written")
+    try:
+        for img in frames:
+            writer.write(img)
+    finally:
+        writer.release()
+    return Path(path)
+
+
+def save_timestamps(path, times, t_origin: float = 0.0) -> Path:
+    """One line per frame: `index t_seconds` (relative to t_origin), with a header comment."""
+    times = np.asarray(times, np.float64)
+    with open(path, "w") as f:
+        f.write(f"# frame index, time in seconds relative to t_origin = {t_origin!r} s\n")
+        for i, t in enumerate(times):
+            f.write(f"{i} {t:.9f}\n")
+    return Path(path)
+
+
+def save_csv(path, rows: list[dict]) -> Path:
+    """A CSV file with one row per dict (columns: the keys of the first row)."""
+    if not rows:
+        raise ValueError("no rows to write")
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    return Path(path)

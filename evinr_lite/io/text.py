@@ -1,0 +1,353 @@
+"""The vectorised parser of `t x y p` event text (IJRR events.txt, rpg_e2vid .txt) and IJRR images.txt.
+
+Used by :func:`evinr_lite.io.readers.read_events_txt` (whole files) and by ``data_fetch``'s IJRR
+converter (blocks of a multi-GB file inside a zip), so both check the same things with the same
+messages: column count, numbers, finite timestamps, whole-number coordinates.
+
+Absolute clocks (IJRR: about 1.47e9 s written with 9 decimals) do not fit float64 at nanosecond
+resolution (the spacing of float64 near 1.5e9 is 2.4e-7 s). Timestamps are therefore split into
+whole seconds and nanoseconds as integers, and a whole-second origin is subtracted exactly before
+any float is formed.
+
+Public functions: :func:`parse_event_block` (one block of whole lines), :func:`parse_event_text`
+(a whole file, block by block), :func:`parse_frame_list` (images.txt), :func:`line_blocks`,
+:func:`origin_to_ns`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+
+from ..core.events import LARGE_T, EventDataError, auto_origin
+
+__all__ = ["EventBlock", "parse_event_block", "parse_event_text", "parse_frame_list", "line_blocks",
+           "origin_to_ns", "NS", "CHUNK_BYTES", "EVENT_COLUMNS"]
+
+NS = 10**9              # nanoseconds per second
+CHUNK_BYTES = 1 << 20   # the text parser works on 1 MiB of whole lines at a time (cache-friendly)
+EVENT_COLUMNS = "`t x y p` (time in seconds, x = column, y = row, polarity)"
+FRAME_COLUMNS = "`t images/frame_%08d.png`"
+
+
+def origin_to_ns(t_origin) -> int:
+    """Seconds (float or int) -> exact integer nanoseconds of that float value."""
+    if not math.isfinite(t_origin):
+        raise EventDataError(f"t_origin must be a finite number of seconds, got {t_origin!r}")
+    return round(Fraction(t_origin) * NS)
+
+
+# ---- vectorised text parsing --------------------------------------------------------------
+# A chunk of text (about 1 MiB of whole lines) is a uint8 array. Tokens are runs of non-whitespace
+# bytes, found by comparing each byte with its neighbour; a column of tokens is given by two
+# arrays of byte offsets (starts, ends). Integers and the two halves of a timestamp are parsed
+# digit position by digit position over all tokens at once; anything else (exponents, nan) goes
+# through numpy's float parser on a zero-padded char matrix [N, L].
+
+_IS_WORD = np.ones(256, dtype=bool)
+_IS_WORD[[9, 10, 13, 32]] = False  # tab, newline, carriage return, space
+
+
+class _BadToken(Exception):
+    """Token `row` of a column does not parse."""
+
+    def __init__(self, row: int):
+        self.row = row
+
+
+def _tokenize(buf: np.ndarray):
+    """Whitespace-separated tokens of whole lines of text.
+
+    Args:
+        buf: uint8 [B], the bytes of one or more whole lines.
+    Returns:
+        starts, ends: int64 [K], byte span [start, end) of each token.
+        counts: int64 [n_lines], tokens on each line.
+        newlines: int64, byte positions of the newlines in buf.
+    """
+    word = np.concatenate(([False], _IS_WORD[buf], [False]))
+    starts = np.flatnonzero(word[1:] & ~word[:-1])
+    ends = np.flatnonzero(word[:-1] & ~word[1:])
+    newlines = np.flatnonzero(buf == 10)
+    line_ends = newlines if len(buf) == 0 or buf[-1] == 10 else np.append(newlines, len(buf))
+    counts = np.diff(np.searchsorted(starts, line_ends), prepend=0)
+    return starts, ends, counts, newlines
+
+
+def _char_matrix(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Byte spans [N] -> uint8 [N, L] of their characters, left-aligned and zero-padded."""
+    lengths = ends - starts
+    cols = np.arange(max(int(lengths.max()) if len(lengths) else 1, 1))
+    chars = buf.take(starts[:, None] + cols, mode="clip")
+    chars[cols >= lengths[:, None]] = 0
+    return chars
+
+
+def _parse_float(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Tokens given by byte spans [N] -> float64 [N] (numpy's parser); raises _BadToken."""
+    chars = _char_matrix(buf, starts, ends)
+    strings = chars.view(f"S{chars.shape[1]}").ravel()
+    try:
+        return strings.astype(np.float64)
+    except ValueError:
+        for row, s in enumerate(strings):  # error path only: find the first bad token
+            try:
+                float(s)
+            except ValueError:
+                raise _BadToken(row) from None
+        raise
+
+
+def _parse_digits(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray | None:
+    """Tokens of decimal digits only -> int64 [N]; None if a token has another character.
+
+    Empty spans give 0. One vectorised step per character position (Horner's scheme).
+    """
+    lengths = ends - starts
+    width = int(lengths.max()) if len(lengths) else 0
+    if width > 18:  # would overflow int64
+        return None
+    value = np.zeros(len(starts), dtype=np.int64)
+    for k in range(width):
+        inside = lengths > k
+        digit = buf.take(starts + k, mode="clip").astype(np.int64) - 48
+        if np.any(inside & ((digit < 0) | (digit > 9))):
+            return None
+        value = np.where(inside, value * 10 + digit, value)
+    return value
+
+
+def _parse_decimal(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray):
+    """Exact parse of plain decimal tokens ``[-+]digits[.digits]`` as integers.
+
+    Args:
+        buf: uint8 text; starts, ends: int64 [N], byte spans of the tokens.
+    Returns:
+        (sign, whole, nanos), int64 [N] each: value = sign * (whole + nanos / 1e9), digits
+        beyond nanoseconds dropped; or None when some token is not a plain decimal (exponent,
+        nan, inf, no whole part, more than 18 whole digits).
+    """
+    first = buf[starts]
+    sign = np.where(first == 45, -1, 1)               # '-'
+    whole_start = starts + ((first == 45) | (first == 43))
+    dots = np.flatnonzero(buf == 46)                  # '.'
+    point = ends
+    if len(dots):
+        next_dot = dots[np.minimum(np.searchsorted(dots, whole_start), len(dots) - 1)]
+        point = np.where((next_dot >= whole_start) & (next_dot < ends), next_dot, ends)
+    frac_start = np.minimum(point + 1, ends)
+    frac_end = np.minimum(frac_start + 9, ends)
+    whole = _parse_digits(buf, whole_start, point)
+    nanos = _parse_digits(buf, frac_start, frac_end)
+    beyond_ns = _parse_digits(buf, frac_end, ends)  # only checked to be digits
+    if whole is None or nanos is None or beyond_ns is None or np.any(point == whole_start):
+        return None
+    return sign, whole, nanos * 10 ** (9 - (frac_end - frac_start))
+
+
+def _parse_number(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray:
+    """Tokens -> int64 [N] when all are plain integers, else float64 [N]; raises _BadToken."""
+    first = buf[starts]
+    signed = (first == 45) | (first == 43)
+    value = _parse_digits(buf, starts + signed, ends)
+    if value is None or np.any(ends - starts - signed < 1):
+        return _parse_float(buf, starts, ends)
+    return np.where(first == 45, -value, value)
+
+
+def _parse_time(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, origin_ns: int) -> np.ndarray:
+    """Timestamp tokens (seconds) -> float64 [N] seconds relative to ``origin_ns`` nanoseconds.
+
+    With a non-zero origin the tokens are parsed as integers (whole seconds and nanoseconds) and
+    the origin is subtracted exactly, so relative times keep nanosecond resolution. With origin 0
+    (small timestamps) this is a plain float64 parse. Raises _BadToken.
+    """
+    parsed = _parse_decimal(buf, starts, ends) if origin_ns != 0 else None
+    if parsed is None:  # small times, or exponents / nan / inf: plain float64 parse
+        return _parse_float(buf, starts, ends) - origin_ns / NS
+    sign, whole, nanos = parsed
+    rel_ns = (sign * whole - origin_ns // NS) * NS + sign * nanos - origin_ns % NS
+    return rel_ns / NS
+
+
+def _first_time_origin(buf: np.ndarray, start: int, end: int) -> int:
+    """The automatic origin (integer ns) from the first timestamp token: its whole seconds if large."""
+    starts, ends = np.array([start]), np.array([end])
+    parsed = _parse_decimal(buf, starts, ends)
+    if parsed is not None:
+        sign, whole, nanos = (int(a[0]) for a in parsed)
+        value_ns = sign * (whole * NS + nanos)
+        return (value_ns // NS) * NS if abs(value_ns) >= LARGE_T * NS else 0
+    try:
+        return int(auto_origin(float(_parse_float(buf, starts, ends)[0]))) * NS
+    except _BadToken:
+        return 0  # reported with its line number by the caller
+
+
+def _line_text(buf: np.ndarray, newlines: np.ndarray, line: int) -> str:
+    """Line `line` (0-based) of buf, for error messages."""
+    lo = int(newlines[line - 1]) + 1 if line > 0 else 0
+    hi = int(newlines[line]) if line < len(newlines) else len(buf)
+    text = bytes(buf[lo:hi]).decode("utf-8", "replace").strip()
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def line_blocks(data: bytes, size: int = None):
+    """(start, end) byte ranges of about ``size`` bytes (default :data:`CHUNK_BYTES`) that end at a
+    newline (or at the end of ``data``): whole lines, so each range parses on its own."""
+    size = CHUNK_BYTES if size is None else size
+    start = 0
+    while start < len(data):
+        end = len(data)
+        if start + size < len(data):
+            cut = data.rfind(b"\n", start, start + size)
+            if cut < 0:  # one very long line
+                cut = data.find(b"\n", start + size)
+            end = cut + 1 if cut >= 0 else len(data)
+        yield start, end
+        start = end
+
+
+@dataclass
+class EventBlock:
+    """The columns of a block of `t x y p` lines."""
+
+    t: np.ndarray                    # float64 [N], seconds relative to origin_ns
+    x: np.ndarray                    # int64 [N], column
+    y: np.ndarray                    # int64 [N], row
+    p: np.ndarray                    # [N] as written: int8 when all in {-1, 0, 1}, else int64/float64
+    header: tuple[int, int] | None   # (H, W) from a `W H` header line (first block only)
+    origin_ns: int | None            # t_origin in integer nanoseconds (None: the block had no events)
+    n_lines: int                     # lines in the block
+
+
+def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0, first: bool = False,
+                      t_last: float | None = None) -> EventBlock:
+    """Parse one block of whole `t x y p` lines, all vectorised.
+
+    Args:
+        buf: uint8 [B] (or bytes), whole lines.
+        origin_ns: integer nanoseconds subtracted from every timestamp; None: picked from the first
+            timestamp (its whole seconds when it is >= 1e5 s, an absolute clock; else 0).
+        source: what to name in error messages (e.g. the file).
+        line_base: lines before this block (for the line numbers in messages).
+        first: the block opens the file, so an rpg_e2vid header `W H` may be its first line.
+        t_last: the last timestamp of the previous block; when given, timestamps must not decrease.
+    Raises:
+        EventDataError naming ``source``, the line number and the line's text.
+    """
+    buf = np.frombuffer(buf, dtype=np.uint8) if isinstance(buf, (bytes, bytearray, memoryview)) else buf
+    starts, ends, counts, newlines = _tokenize(buf)
+    n_lines = len(newlines) + (0 if len(buf) == 0 or buf[-1] == 10 else 1)
+
+    def fail(line, problem):  # line: 0-based within this block
+        raise EventDataError(f"{source}, line {line_base + line + 1}: {problem} "
+                             f"(line reads {_line_text(buf, newlines, line)!r})")
+
+    def row_line(row):  # 0-based line (in this block) of event row `row`
+        return int(np.searchsorted(newlines, starts[row, 0]))
+
+    header = None
+    if first and counts.any():  # an rpg_e2vid header `W H` may open the file
+        line = int(np.flatnonzero(counts)[0])
+        words = [bytes(buf[s:e]) for s, e in zip(starts[:2], ends[:2])]
+        if counts[line] == 2 and all(w.isdigit() for w in words):
+            header = (int(words[1]), int(words[0]))  # (H, W)
+            counts[line], starts, ends = 0, starts[2:], ends[2:]
+    bad = np.flatnonzero((counts != 0) & (counts != 4))
+    if bad.size:
+        i = int(bad[0])
+        hint = " (a `W H` header is allowed only as the first line)" if counts[i] == 2 else ""
+        fail(i, f"found {counts[i]} columns, expected 4: {EVENT_COLUMNS}{hint}")
+    empty = np.zeros(0, dtype=np.int64)
+    if len(starts) == 0:
+        return EventBlock(np.zeros(0), empty, empty, empty.astype(np.int8), header, origin_ns, n_lines)
+    starts, ends = starts.reshape(-1, 4), ends.reshape(-1, 4)
+
+    if origin_ns is None:
+        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0])
+    try:
+        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
+    except _BadToken as err:
+        fail(row_line(err.row), f"the timestamp is not a number; expected {EVENT_COLUMNS}")
+    xyp = []
+    for c, name in ((1, "x"), (2, "y"), (3, "p")):
+        try:
+            xyp.append(_parse_number(buf, starts[:, c], ends[:, c]))
+        except _BadToken as err:
+            fail(row_line(err.row), f"{name} is not a number; expected {EVENT_COLUMNS}")
+    x, y, p = xyp
+
+    nonfinite = np.flatnonzero(~np.isfinite(t))
+    if nonfinite.size:
+        fail(row_line(nonfinite[0]), "the timestamp is not finite; drop or repair that line")
+    if t_last is not None:
+        back = np.flatnonzero(np.diff(t, prepend=t_last) < 0)
+        if back.size:
+            fail(row_line(back[0]), "the timestamp is earlier than the one before: the events are not "
+                 "sorted by time; sort the file (e.g. `sort -g -k1,1 events.txt`) or load the columns "
+                 "with numpy and use Events.from_arrays(..., sort=True)")
+    for name, v in (("x", x), ("y", y)):
+        if v.dtype.kind == "f":
+            not_whole = np.flatnonzero(~np.isfinite(v) | (v != np.round(v)))
+            if not_whole.size:
+                fail(row_line(not_whole[0]), f"{name} must be a whole pixel index")
+    if np.all(np.isin(p, (-1, 0, 1))):
+        p = p.astype(np.int8)
+    return EventBlock(t, x.astype(np.int64), y.astype(np.int64), p, header, origin_ns, n_lines)
+
+
+def parse_event_text(path, origin_ns: int | None = None) -> EventBlock:
+    """A whole `t x y p` text file (optionally after a `W H` header), block by block.
+
+    Timestamps must be finite and non-decreasing. ``origin_ns`` None picks the origin from the
+    first timestamp. Raises EventDataError naming the file and line.
+    """
+    path = Path(path)
+    data = path.read_bytes()
+    everything = np.frombuffer(data, dtype=np.uint8)
+    parts, header, line_base, t_last = [], None, 0, -np.inf
+    for lo, hi in line_blocks(data, CHUNK_BYTES):
+        block = parse_event_block(everything[lo:hi], origin_ns, source=path, line_base=line_base,
+                                  first=lo == 0, t_last=t_last)
+        header = block.header if lo == 0 else header
+        origin_ns = block.origin_ns
+        line_base += block.n_lines
+        if len(block.t):
+            parts.append((block.t, block.x, block.y, block.p))
+            t_last = block.t[-1]
+    if not parts:
+        raise EventDataError(f"{path}: no events found; expected lines {EVENT_COLUMNS}")
+    t, x, y, p = (np.concatenate(c) for c in zip(*parts))
+    return EventBlock(t, x, y, p, header, origin_ns, line_base)
+
+
+def parse_frame_list(buf, origin_ns: int | None, *, source) -> tuple[np.ndarray, list[str], int]:
+    """IJRR images.txt (`t images/frame_%08d.png` per line) -> (t float64 [F] s, names, origin_ns).
+
+    ``origin_ns`` None picks it from the first timestamp, as for the events. Raises EventDataError
+    naming ``source`` and the line; a listing with no lines gives ([], [], origin_ns).
+    """
+    buf = np.frombuffer(buf, dtype=np.uint8) if isinstance(buf, (bytes, bytearray, memoryview)) else buf
+    starts, ends, counts, newlines = _tokenize(buf)
+    bad = np.flatnonzero((counts != 0) & (counts != 2))
+    if bad.size:
+        i = int(bad[0])
+        raise EventDataError(f"{source}, line {i + 1}: found {counts[i]} columns, expected 2: {FRAME_COLUMNS} "
+                             f"(file names without spaces; line reads {_line_text(buf, newlines, i)!r})")
+    if len(starts) == 0:
+        return np.zeros(0), [], origin_ns
+    starts, ends = starts.reshape(-1, 2), ends.reshape(-1, 2)
+    if origin_ns is None:
+        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0])
+    try:
+        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
+    except _BadToken as err:
+        i = int(np.searchsorted(newlines, starts[err.row, 0]))
+        raise EventDataError(f"{source}, line {i + 1}: the timestamp is not a number "
+                             f"(line reads {_line_text(buf, newlines, i)!r})") from None
+    names = [bytes(buf[s:e]).decode("utf-8", "replace") for s, e in zip(starts[:, 1], ends[:, 1])]
+    return t, names, origin_ns

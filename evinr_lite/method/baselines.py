@@ -1,0 +1,298 @@
+"""Baselines without learning: direct, leaky and high-pass-filtered event integration.
+
+All three solve the per-pixel equation dL/dt = E(t) - rate * (L - L_rest), where
+E(t) = sum_i C p_i delta(t - t_i) is the event stream of that pixel:
+
+- ``integration``: rate = 0, L(t) = L0 + C sum p (Eq. 2; :func:`evinr_lite.method.integration.integrate_events`).
+- ``leaky``: every event's contribution fades as exp(-leak_hz * age): L(t) = L0 + sum C p exp(-leak (t - t_i)).
+  The start image L0 does not fade (L_rest = L0): a leak only forgets accumulated noise.
+- ``hf``: the high-pass filter of Scheerlinck et al. (ACCV 2018, "Continuous-time intensity
+  estimation using event cameras", without frames), the 'HF' row of the EvINR paper's Table 1.
+  Its state, L0 included, decays towards 0 at alpha = 2 pi cutoff_hz rad/s (L_rest = 0), and each
+  event adds C p. Per pixel, at each event:  L <- exp(-alpha (t - t_last)) L + C p;  t_last <- t.
+  Low temporal frequencies (static scene content, drift, and the unknown L0) are filtered out.
+
+Both decays are computed exactly (no time step): between query times every pixel's state is
+multiplied by exp(-rate dt) and the events in between are added with their own decay factors, so the
+vectorised form costs O(N + Q H W) and agrees with the per-event loop to rounding.
+
+:func:`reconstruct_baseline` turns any of them into frames exactly like the EvINR solver does
+(brightness anchor, then Reinhard tone mapping), so baselines and EvINR are scored by one path
+(:mod:`evinr_lite.evaluation.scoring`).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.events import EventDataError, Events
+from .integration import integrate_events
+from .tonemap import anchor_level, tonemap_reinhard
+
+__all__ = ["leaky_integration", "highpass_filter", "highpass_per_event", "reconstruct_baseline",
+           "BaselineReconstruction", "BASELINES", "DEFAULT_CUTOFF_HZ"]
+
+BASELINES = ("integration", "leaky", "hf")
+DEFAULT_CUTOFF_HZ = 1.0   # alpha = 2 pi rad/s; a tunable choice (Scheerlinck et al. expose it as a parameter)
+
+
+# ---- argument checks -------------------------------------------------------------------------
+
+def _thresholds(C) -> tuple[float, float]:
+    C_pos, C_neg = (C, C) if np.isscalar(C) else tuple(C)
+    if not all(np.isscalar(c) and np.isfinite(c) and c > 0 for c in (C_pos, C_neg)):
+        raise EventDataError(f"C must be a positive number or a pair (C_pos, C_neg) of positive numbers, got {C!r}")
+    return float(C_pos), float(C_neg)
+
+
+def _rate(value, name: str) -> float:
+    if not (np.isscalar(value) and np.isfinite(value) and value >= 0):
+        raise EventDataError(f"{name} must be a finite number >= 0 (per second), got {value!r}")
+    return float(value)
+
+
+def _query(t_query) -> np.ndarray:
+    tq = np.asarray(t_query, dtype=np.float64)
+    if tq.ndim > 1 or tq.size == 0 or not np.all(np.isfinite(tq)):
+        raise EventDataError(f"query times must be a finite scalar or a non-empty 1-D array of seconds, got shape {tq.shape}")
+    return tq
+
+
+def _initial(L0, sensor_size) -> np.ndarray | float:
+    if L0 is None:
+        return 0.0
+    L0 = np.asarray(L0, dtype=np.float64)
+    if np.ndim(L0) not in (0, 2) or (np.ndim(L0) == 2 and L0.shape != tuple(sensor_size)):
+        raise EventDataError(f"L0 must be a scalar or an [H, W] = {tuple(sensor_size)} array, got shape {np.shape(L0)}")
+    return L0
+
+
+def _start_time(events: Events, tq: np.ndarray, t_start) -> float:
+    first = events.t[0] if len(events) else tq.min()
+    t0 = min(first, tq.min()) if t_start is None else float(t_start)
+    if tq.min() < t0:
+        raise EventDataError(f"query time {tq.min()} s is before t_start = {t0} s; query at or after the start")
+    return t0
+
+
+# ---- the shared core --------------------------------------------------------------------------
+
+def _decayed_sums(events: Events, t_sorted: np.ndarray, C_pos: float, C_neg: float, rate: float,
+                  t_start: float) -> np.ndarray:
+    """float64 [Q, H, W]: sum over events with t_start <= t_i <= t_q of C p_i exp(-rate (t_q - t_i)).
+
+    ``t_sorted`` must be increasing. One pass over the queries; the events between two queries are
+    added with np.bincount (no Python loop over events).
+    """
+    H, W = events.sensor_size
+    t = events.t
+    pix = events.y.astype(np.int64) * W + events.x
+    weight = np.where(events.p > 0, C_pos, -C_neg)
+    state = np.zeros(H * W)
+    out = np.empty((len(t_sorted), H, W))
+    lo = int(np.searchsorted(t, t_start, side="left"))
+    ends = np.searchsorted(t, t_sorted, side="right")
+    t_prev = t_start
+    for q, (tq, hi) in enumerate(zip(t_sorted, ends)):
+        if rate > 0:
+            state *= math.exp(-rate * (tq - t_prev))
+        if hi > lo:
+            w = weight[lo:hi] if rate == 0 else weight[lo:hi] * np.exp(-rate * (tq - t[lo:hi]))
+            state += np.bincount(pix[lo:hi], weights=w, minlength=H * W)
+        out[q] = state.reshape(H, W)
+        t_prev, lo = tq, max(lo, int(hi))
+    return out
+
+
+def _per_query(fn, tq: np.ndarray) -> np.ndarray:
+    """Evaluate fn(sorted unique times) -> [U, H, W] and return it in the order of tq (scalar -> [H, W])."""
+    uniq, inverse = np.unique(np.atleast_1d(tq), return_inverse=True)
+    L = fn(uniq)[inverse.ravel()]
+    return L[0] if tq.ndim == 0 else L
+
+
+# ---- the baselines ----------------------------------------------------------------------------
+
+def leaky_integration(events: Events, query_times, C=0.2, leak_hz: float = 0.0, L0=None, *,
+                      t_start: float | None = None) -> np.ndarray:
+    """Leaky event integration: L(t) = L0 + sum over events t_i <= t of C p_i exp(-leak_hz (t - t_i)).
+
+    Args:
+        events: the events (same clock as the query times).
+        query_times: seconds, a scalar or [Q] (any order, repeats allowed).
+        C: contrast threshold (log units), or (C_pos, C_neg).
+        leak_hz: decay rate in 1/s (an event's contribution falls to 1/e after 1/leak_hz s);
+            0 gives plain integration (== :func:`evinr_lite.method.integration.integrate_events`).
+        L0: log intensity at the start (scalar or [H, W]); default 0. It does not leak.
+        t_start: events before it are ignored; default: the first event (or query).
+
+    Returns:
+        float64 [Q, H, W] log intensity ([H, W] for a scalar query).
+    """
+    tq = _query(query_times)
+    C_pos, C_neg = _thresholds(C)
+    leak = _rate(leak_hz, "leak_hz")
+    L0 = _initial(L0, events.sensor_size)
+    t0 = _start_time(events, tq, t_start)
+    return _per_query(lambda u: L0 + _decayed_sums(events, u, C_pos, C_neg, leak, t0), tq)
+
+
+def highpass_filter(events: Events, query_times, C=0.2, cutoff_hz: float = DEFAULT_CUTOFF_HZ, L0=None,
+                    method: str = "vectorised", *, t_start: float | None = None) -> np.ndarray:
+    """The high-pass filter of Scheerlinck et al. (ACCV 2018): log intensity from events alone.
+
+    Per pixel, dL/dt = E(t) - alpha L with alpha = 2 pi cutoff_hz (rad/s) and L(t_start) = L0:
+    L(t) = L0 exp(-alpha (t - t_start)) + sum over t_i <= t of C p_i exp(-alpha (t - t_i)).
+
+    Args:
+        events, query_times, C, t_start: as in :func:`leaky_integration`.
+        cutoff_hz: cut-off frequency in Hz (>= 0); 0 gives plain integration.
+        L0: state at t_start (scalar or [H, W]); default 0. It decays like everything else.
+        method: "vectorised" (default) or "per_event" (a plain Python loop over events, the
+            filter's published per-event update; slow, a reference for tests and teaching).
+
+    Returns:
+        float64 [Q, H, W] ([H, W] for a scalar query).
+    """
+    tq = _query(query_times)
+    C_pos, C_neg = _thresholds(C)
+    alpha = 2 * math.pi * _rate(cutoff_hz, "cutoff_hz")
+    L0 = _initial(L0, events.sensor_size)
+    t0 = _start_time(events, tq, t_start)
+    if method == "vectorised":
+        def fn(u):
+            return np.exp(-alpha * (u - t0))[:, None, None] * L0 + _decayed_sums(events, u, C_pos, C_neg, alpha, t0)
+    elif method == "per_event":
+        def fn(u):
+            return _highpass_loop(events, u, C_pos, C_neg, alpha, t0, L0)
+    else:
+        raise ValueError(f"method must be 'vectorised' or 'per_event', got {method!r}")
+    return _per_query(fn, tq)
+
+
+def _highpass_loop(events: Events, t_sorted, C_pos, C_neg, alpha, t_start, L0) -> np.ndarray:
+    """The per-event update in a plain loop; snapshots at the (sorted) query times. [Q, H, W]."""
+    H, W = events.sensor_size
+    state = np.zeros((H, W)) + L0
+    t_last = np.full((H, W), t_start)
+    out = np.empty((len(t_sorted), H, W))
+    q = 0
+    for t, x, y, p in zip(events.t, events.x, events.y, events.p):
+        if t < t_start:
+            continue
+        while q < len(t_sorted) and t_sorted[q] < t:        # snapshot: every pixel decayed to the query time
+            out[q] = state * np.exp(-alpha * (t_sorted[q] - t_last))
+            q += 1
+        state[y, x] = math.exp(-alpha * (t - t_last[y, x])) * state[y, x] + (C_pos if p > 0 else -C_neg)
+        t_last[y, x] = t
+    for k in range(q, len(t_sorted)):
+        out[k] = state * np.exp(-alpha * (t_sorted[k] - t_last))
+    return out
+
+
+def highpass_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """The high-pass filter, one event at a time (exercise reference).
+
+    Every pixel starts at 0 at ``t_start``. For each event in time order, at pixel (y, x):
+    decay its state by exp(-alpha * (t - t_last)), where t_last is the time of that pixel's
+    previous event (or t_start), then add C * p, then set t_last = t. At the end every pixel
+    is decayed to ``t_end``.
+
+    Args:
+        t: float64 [N] seconds, sorted. x, y: int [N] column and row. p: int [N] in {-1, +1}.
+        sensor_size: (H, W). C: contrast threshold. alpha: cut-off in rad/s. t_end: seconds.
+
+    Returns:
+        float64 [H, W], the log intensity at t_end.
+    """
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_last = np.full((H, W), float(t_start))
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * state[yi, xi] + C * pi
+        t_last[yi, xi] = ti
+    return state * np.exp(-alpha * (t_end - t_last))
+
+
+# ---- frames, as the EvINR solver makes them ----------------------------------------------------
+
+@dataclass(eq=False)
+class BaselineReconstruction:
+    """A baseline's predictions, interchangeable with :class:`evinr_lite.method.solver.Reconstruction`.
+
+    Attributes:
+        times: float64 [Q] query times (s). log_intensity: float64 [Q, H, W], anchored.
+        frames: float32 [Q, H, W] tone-mapped, in [0, 1]. method: "integration", "leaky" or "hf".
+        params: the method's parameters (C, gamma, leak_hz / cutoff_hz, ...).
+        offset: the constant added by the brightness anchor. history: {"train_time_s": 0.0, "time_s": ...}.
+    """
+
+    times: np.ndarray
+    log_intensity: np.ndarray
+    frames: np.ndarray
+    method: str
+    params: dict
+    offset: float
+    history: dict = field(repr=False, default_factory=dict)
+    _fn: object = field(repr=False, default=None)       # times [Q] -> log intensity before the anchor
+
+    def at(self, times) -> np.ndarray:
+        """Anchored log intensity at other times: float64 [Q, H, W] (recomputed from the events)."""
+        return self._fn(np.atleast_1d(np.asarray(times, np.float64))) + self.offset
+
+    def frames_at(self, times) -> np.ndarray:
+        return tonemap_reinhard(self.at(times), self.params["gamma"]).astype(np.float32)
+
+
+def reconstruct_baseline(events: Events, query_times, method: str = "integration", C=0.2, gamma: float = 0.6,
+                         display_mean: float = 0.5, *, t_start: float | None = None, t_end: float | None = None,
+                         **params) -> BaselineReconstruction:
+    """Frames from a baseline, made like the EvINR solver's: anchor, then Reinhard tone mapping.
+
+    The brightness anchor is the solver's: one constant is added so that the mean log intensity
+    over 64 times spread over [t_start, t_end] tone-maps to ``display_mean``.
+
+    Args:
+        events: the events. query_times: [Q] seconds.
+        method: "integration", "leaky" (params: leak_hz, L0) or "hf" (params: cutoff_hz, L0).
+        C: contrast threshold (or (C_pos, C_neg)). gamma: tone-mapping exponent.
+        t_start, t_end: span of the anchor (default: first/last event, widened to the queries).
+
+    Returns:
+        BaselineReconstruction with ``.frames`` [Q, H, W] in [0, 1].
+    """
+    allowed = {"integration": ("L0",), "leaky": ("leak_hz", "L0"), "hf": ("cutoff_hz", "L0")}
+    if method not in allowed:
+        raise ValueError(f"method must be one of {BASELINES}, got {method!r}")
+    extra = set(params) - set(allowed[method])
+    if extra:
+        raise TypeError(f"baseline {method!r} takes parameters {allowed[method]}, not {sorted(extra)}")
+    q = _query(query_times)
+    q = np.atleast_1d(q)
+    first, last = (events.t[0], events.t[-1]) if len(events) else (q.min(), q.max())
+    lo = min(first, q.min()) if t_start is None else float(t_start)
+    hi = max(last, q.max()) if t_end is None else float(t_end)
+    if method == "integration":
+        def fn(t):
+            return integrate_events(events, t, C=C, L0=params.get("L0"))
+    elif method == "leaky":
+        def fn(t):
+            return leaky_integration(events, t, C, params.get("leak_hz", 0.0), params.get("L0"), t_start=lo)
+    else:
+        def fn(t):
+            return highpass_filter(events, t, C, params.get("cutoff_hz", DEFAULT_CUTOFF_HZ), params.get("L0"),
+                                   t_start=lo)
+    t0 = time.perf_counter()
+    grid = np.linspace(lo, hi, 64)
+    L_all = fn(np.concatenate([grid, q]))
+    offset = anchor_level(gamma, display_mean) - float(L_all[:len(grid)].mean())
+    L = L_all[len(grid):] + offset
+    frames = tonemap_reinhard(L, gamma).astype(np.float32)
+    seconds = time.perf_counter() - t0
+    rec = BaselineReconstruction(q, L, frames, method, {"C": C, "gamma": gamma, "display_mean": display_mean,
+                                                        **{k: v for k, v in params.items() if k != "L0"}},
+                                 offset, {"train_time_s": 0.0, "time_s": seconds}, fn)
+    return rec

@@ -1,0 +1,134 @@
+"""The frame-based INR (Eq. 11): F(t) -> all H x W log intensities, for N networks at once.
+
+``FrameINR`` holds N independent SIRENs with stacked weights, so an ensemble of N sub-sequence
+networks (Sec. 3.3, "network ensembling") trains in one batched computation (``torch.baddbmm``),
+never a Python loop over networks. N = 1 is the plain frame-based model.
+
+Each network maps a time t (seconds) in its own window [t_lo, t_hi] to [-1, 1] and then:
+
+    h_0 = sin(first_omega_0 * (W_0 tau + b_0))            width `hidden_features`
+    h_k = sin(omega_0 * (W_k h_{k-1} + b_k))                `hidden_layers` times
+    F   = W_out h_L + b_out                                 H * W log intensities
+
+The time derivative dF/dt (Eq. 5) is propagated alongside the values (forward mode): with
+z_k the pre-activation, dh_k/dt = cos(z_k) * omega * W_k dh_{k-1}/dt, and dF/dt = W_out dh_L/dt.
+This is exactly what double back-propagation computes, at the cost of one extra pass; the
+tests check it against autograd.
+"""
+from __future__ import annotations
+
+import math
+
+import torch
+from torch import nn
+
+from ..core.events import check_sensor_size
+
+__all__ = ["FrameINR"]
+
+
+def _uniform(shape, bound, generator):
+    return (torch.rand(shape, generator=generator) * 2 - 1) * bound
+
+
+class FrameINR(nn.Module):
+    """N frame-based SIRENs F_n(t) -> [H, W] with stacked weights.
+
+    Args:
+        sensor_size: (H, W).
+        windows: [N, 2] seconds, the time window [t_lo, t_hi] of each network (mapped to [-1, 1]).
+        hidden_features: width (paper: 512).
+        hidden_layers: hidden-to-hidden sine layers (paper: 3).
+        omega_0: frequency factor of the hidden layers (SIREN: 30; the reference code uses 10).
+        first_omega_0: frequency factor of the first layer (None: omega_0).
+        seed: seeds the initialisation (SIREN's, per network).
+
+    Shapes: ``forward(t)`` with t [N, T] seconds -> F [N, T, H, W].
+    """
+
+    def __init__(self, sensor_size, windows, hidden_features: int = 512, hidden_layers: int = 3,
+                 omega_0: float = 30.0, first_omega_0: float | None = None, seed: int = 0):
+        super().__init__()
+        H, W = check_sensor_size(sensor_size)
+        windows = torch.as_tensor(windows, dtype=torch.float64).reshape(-1, 2)
+        if torch.any(windows[:, 1] <= windows[:, 0]):
+            raise ValueError("every network window [t_lo, t_hi] needs t_hi > t_lo (seconds)")
+        self.sensor_size = (H, W)
+        self.n_models = N = windows.shape[0]
+        self.omega_0 = float(omega_0)
+        self.first_omega_0 = float(omega_0 if first_omega_0 is None else first_omega_0)
+        self.register_buffer("windows", windows)
+        g = torch.Generator().manual_seed(int(seed))
+        d = int(hidden_features)
+
+        def bias(n_in, n_out):  # PyTorch's default Linear bias
+            return nn.Parameter(_uniform((N, 1, n_out), 1 / math.sqrt(n_in), g))
+
+        self.weights = nn.ParameterList([nn.Parameter(_uniform((N, 1, d), 1.0, g))])  # first layer: U(-1/in, 1/in), in = 1
+        self.biases = nn.ParameterList([bias(1, d)])
+        hidden_bound = math.sqrt(6 / d) / self.omega_0
+        for _ in range(int(hidden_layers)):
+            self.weights.append(nn.Parameter(_uniform((N, d, d), hidden_bound, g)))
+            self.biases.append(bias(d, d))
+        self.head_weight = nn.Parameter(_uniform((N, d, H * W), hidden_bound, g))
+        self.head_bias = nn.Parameter(_uniform((N, 1, H * W), 1 / math.sqrt(d), g))
+
+    # ---- time mapping -------------------------------------------------------------------
+    def normalize_time(self, t: torch.Tensor) -> torch.Tensor:
+        """Seconds [N, T] -> [-1, 1] within each network's window (float32)."""
+        lo, hi = self.windows[:, :1], self.windows[:, 1:]
+        return (2 * (t.double() - lo) / (hi - lo) - 1).to(self.head_weight.dtype)
+
+    def _time_scale(self) -> torch.Tensor:
+        """d tau / d t per network, [N, 1, 1] (1/seconds)."""
+        return (2 / (self.windows[:, 1] - self.windows[:, 0])).to(self.head_weight.dtype)[:, None, None]
+
+    # ---- forward ------------------------------------------------------------------------
+    def features(self, t: torch.Tensor, with_derivative: bool = False):
+        """Last hidden layer h [N, T, d] (and dh/dt [N, T, d] per second if asked)."""
+        tau = self.normalize_time(t)[..., None]                                  # [N, T, 1]
+        z = self.first_omega_0 * (tau * self.weights[0] + self.biases[0])        # [N, T, d]
+        h = torch.sin(z)
+        dh = torch.cos(z) * (self.first_omega_0 * self.weights[0] * self._time_scale()) if with_derivative else None
+        for w, b in zip(self.weights[1:], self.biases[1:]):
+            z = self.omega_0 * torch.baddbmm(b, h, w)
+            h = torch.sin(z)
+            if with_derivative:
+                dh = torch.cos(z) * (self.omega_0 * torch.bmm(dh, w))
+        return h, dh
+
+    def forward(self, t: torch.Tensor, out: torch.Tensor | None = None) -> torch.Tensor:
+        """Log intensity F at times t [N, T] (seconds) -> [N, T, H, W].
+
+        ``out``: optional float32 tensor [N, T, H, W] to write into (no gradient), so that a long
+        query fills one preallocated result instead of allocating and copying every batch.
+        """
+        h, _ = self.features(t)
+        if out is not None:
+            torch.baddbmm(self.head_bias, h, self.head_weight, out=out.view(*out.shape[:2], -1))
+            return out
+        F = torch.baddbmm(self.head_bias, h, self.head_weight)
+        return F.reshape(*F.shape[:2], *self.sensor_size)
+
+    def forward_with_derivative(self, t: torch.Tensor):
+        """(F, dF/dt) at times t [N, T] (seconds): two tensors [N, T, H, W], dF/dt per second."""
+        h, dh = self.features(t, with_derivative=True)
+        T = h.shape[1]
+        out = torch.bmm(torch.cat([h, dh], dim=1), self.head_weight)             # one matmul for both
+        F = (out[:, :T] + self.head_bias).reshape(-1, T, *self.sensor_size)
+        dF = out[:, T:].reshape(-1, T, *self.sensor_size)
+        return F, dF
+
+    def network(self, k: int) -> "FrameINR":
+        """A one-network FrameINR holding a copy of network k's weights (same device and window)."""
+        if not -self.n_models <= k < self.n_models:
+            raise IndexError(f"network {k} does not exist; this FrameINR holds {self.n_models}")
+        k = k % self.n_models
+        d = self.weights[0].shape[-1]
+        single = FrameINR(self.sensor_size, self.windows[k:k + 1].cpu(), d, len(self.weights) - 1,
+                          self.omega_0, self.first_omega_0)
+        single.load_state_dict({name: v[k:k + 1].clone() for name, v in self.state_dict().items()})
+        return single.to(self.head_weight.device)
+
+    def num_parameters(self) -> int:
+        return sum(p.numel() for p in self.parameters())

@@ -1,0 +1,455 @@
+"""EvINR's solver: train frame-based INRs on events and query them at any time.
+
+    rec = reconstruct(events, query_times, EvINRConfig(C=0.2))
+    rec.frames          # [Q, H, W] tone-mapped, in [0, 1]
+    rec.log_intensity   # [Q, H, W] log intensity
+    rec.at(t)           # log intensity at other times
+
+The recipe (paper Sec. 3-4; defaults in :class:`EvINRConfig`):
+
+1. Cut [t_start, t_end] into N overlapping windows of at most ``tau`` seconds (ensembling), one
+   network each, all trained together in one batched computation (:class:`~evinr_lite.method.models.FrameINR`).
+2. Stack each window's events into event frames. With coarse-to-fine, training starts with bins
+   4x longer than ``bin_duration`` and bisects every bin into halves of equal event count at
+   iterations 100 and 200, ending at ``bin_duration`` on average (with "fixed" binning the final
+   bins are equal-count halves, so their lengths vary with the event rate); without it, training
+   uses fixed bins of ``bin_duration`` throughout (the paper's Base).
+3. Minimise temporal loss + lambda * spatial regularizer with Adam (lr 1e-4, x0.95 every 10 steps).
+4. Align the networks: each network's per-pixel offset is matched to its predecessor's over their
+   overlap, and predictions are cross-faded linearly across the overlap, so no seam shows.
+5. Anchor the brightness. Events only constrain changes of log intensity: adding any constant to
+   F leaves every loss unchanged, and a per-pixel constant is only set by the regularizer. The
+   global level is therefore a choice, not a measurement: by default F is shifted so that its mean
+   over the sequence tone-maps to ``display_mean`` (0.5, mid-grey). Metrics with histogram
+   equalisation (CLAHE) are insensitive to it; others should say how the level was set.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+import torch
+
+from .binning import bisect_boundaries, equal_count_boundaries, events_to_frames
+from ..core.runtime import default_device
+from ..core.events import EventDataError, Events
+from .fused import head_losses
+from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
+from .models import FrameINR
+from .tonemap import anchor_level, tonemap_reinhard
+
+__all__ = ["EvINRConfig", "Reconstruction", "reconstruct", "split_windows", "train_frame_inr",
+           "predict_networks", "blend_weights", "blend_networks", "alignment_offsets"]
+
+
+@dataclass
+class EvINRConfig:
+    """Every setting of the frame-based solver. Defaults are the paper's unless noted.
+
+    Events and bins:
+        C: contrast threshold (log units per event; paper: 1 for IJRR/HQF, 0.25 for AED).
+        bin_duration: final event-frame length in seconds (paper: 1/32 s).
+        binning: "fixed" (paper: fixed-duration bins) or "equal_count" (the reference code).
+        events_per_bin: final events per bin for "equal_count". The reference code fixes the number
+            of bins instead (50, then 100 after one bisection at n_iters / 2, over the whole window):
+            emulate it with events_per_bin = n_events // 100 and c2f_iters = (n_iters // 2,)
+            (``ablation.recipe_variants`` does).
+    Losses:
+        temporal_loss: "derivative" (paper, Eq. 5-6: dF/dt at bin mid-points times bin length) or
+            "difference" (F(b_{i+1}) - F(b_i) at bin boundaries: exact integral form).
+        regularizer: "tikhonov" (paper, Eq. 9), "tv" (reference code) or "none".
+        lam: weight lambda of the regularizer (paper: 0.05; finite differences in pixel units).
+    Network (SIREN):
+        hidden_features, hidden_layers: width and depth (paper: 512, 3).
+        omega_0: frequency factor of the hidden layers (SIREN's default 30).
+        first_omega_0: frequency factor of the first layer, which sets how fast F can vary in time
+            (not in the paper; the reference code uses 10 everywhere). With 30, the network fits
+            dF/dt at the bin mid-points while wandering between them, so integrated changes are
+            wrong (notebook 01 shows the same in 1-D); 10 keeps F smooth at the scale of a bin.
+            Each network maps its own window to [-1, 1], so shorter ensemble windows allow faster
+            wiggles per second: with short windows prefer temporal_loss="difference" (notebook 06).
+    Optimisation:
+        n_iters: iterations (paper: 300). lr, lr_decay, lr_decay_every: Adam with lr x lr_decay
+            every lr_decay_every iterations (paper: 1e-4, 0.95, 10).
+        head_lr_scale: learning-rate factor for the H*W output layer. Not in the paper: the public
+            reference code multiplies the head's output by omega_0, which under Adam makes the head
+            learn omega_0 times faster. We keep SIREN's small initial output and scale the head's
+            learning rate instead (default 30 = omega_0); with 1, 300 iterations at lr 1e-4 leave
+            the frames far from converged (see benchmarks/solver_quality.py).
+        coarse_to_fine: bisect the bins at ``c2f_iters`` (paper: 3 stages, at 100 and 200).
+    Ensembling:
+        tau: longest window per network in seconds (paper: 5); None for one network.
+        overlap: seconds shared by neighbouring windows (used to align and cross-fade them).
+    Output:
+        gamma: tone-mapping exponent (paper: 0.6). display_mean: the tone-mapped value that the
+            mean log intensity is anchored to (see the module docstring).
+    Runtime:
+        seed: seeds the initialisation. device: "cpu", "cuda" or None (GPU when present).
+        progress: show a progress bar (terminal or notebook).
+    """
+
+    C: float = 1.0
+    bin_duration: float = 1 / 32
+    binning: str = "fixed"
+    events_per_bin: int = 100
+    temporal_loss: str = "derivative"
+    regularizer: str = "tikhonov"
+    lam: float = 0.05
+    hidden_features: int = 512
+    hidden_layers: int = 3
+    omega_0: float = 30.0
+    first_omega_0: float | None = 10.0
+    n_iters: int = 300
+    lr: float = 1e-4
+    lr_decay: float = 0.95
+    lr_decay_every: int = 10
+    head_lr_scale: float = 30.0
+    coarse_to_fine: bool = True
+    c2f_iters: tuple = (100, 200)
+    tau: float | None = 5.0
+    overlap: float = 0.5
+    gamma: float = 0.6
+    display_mean: float = 0.5
+    seed: int = 0
+    device: str | None = None
+    progress: bool = True
+
+    def __post_init__(self):
+        choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
+                   "regularizer": ("tikhonov", "tv", "none")}
+        for name, allowed in choices.items():
+            if getattr(self, name) not in allowed:
+                raise ValueError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+        for name in ("C", "bin_duration", "lr", "gamma"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
+        if not 0 < self.display_mean < 1:
+            raise ValueError(f"display_mean must be in (0, 1), got {self.display_mean}")
+        if self.tau is not None and not self.tau > self.overlap >= 0:
+            raise ValueError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
+        self.c2f_iters = tuple(int(i) for i in self.c2f_iters)
+
+    @classmethod
+    def base(cls, **overrides) -> "EvINRConfig":
+        """The paper's ablation 'Base': no spatial regularization, no coarse-to-fine."""
+        return cls(**{"regularizer": "none", "coarse_to_fine": False, **overrides})
+
+    @classmethod
+    def reference_code(cls, **overrides) -> "EvINRConfig":
+        """The public reference code's choices where they differ from the paper (as far as this
+        solver expresses them): anisotropic TV, equal-count bins, a boundary-difference temporal
+        term (evaluated at the boundaries, without the code's half-bin shift), omega_0 = 10.
+
+        Its bin count depends on the data (the code uses 100 bins over the window, 50 before one
+        bisection at n_iters / 2): pass ``events_per_bin=n_events // 100, c2f_iters=(n_iters // 2,)``.
+        Not expressible here: AdamW at a fixed lr 3e-4 for 1000 steps, the extra regularizer terms,
+        the sigmoid tone mapping."""
+        return cls(**{"regularizer": "tv", "binning": "equal_count", "temporal_loss": "difference",
+                      "omega_0": 10.0, "head_lr_scale": 10.0, **overrides})
+
+    @property
+    def n_bisections(self) -> int:
+        """How many times the bins are halved during training."""
+        return len(self.c2f_iters) if self.coarse_to_fine else 0
+
+
+def split_windows(t_start: float, t_end: float, tau: float | None, overlap: float) -> np.ndarray:
+    """N equal windows covering [t_start, t_end], each at most ``tau`` s, neighbours sharing ``overlap`` s.
+
+    Returns float64 [N, 2] (seconds). N = 1 when tau is None or the span fits in one window.
+    """
+    span = t_end - t_start
+    if not span > 0:
+        raise EventDataError(f"time span [{t_start}, {t_end}] is empty; t_end must exceed t_start")
+    if tau is None or span <= tau:
+        return np.array([[t_start, t_end]], dtype=np.float64)
+    n = math.ceil((span - overlap) / (tau - overlap))
+    length = (span + (n - 1) * overlap) / n
+    if length < 2 * overlap:  # then three windows would share some instants
+        raise EventDataError(f"windows of {length:.3g} s with overlap {overlap:g} s would overlap three at a "
+                             "time; use tau of at least twice the overlap")
+    starts = t_start + np.arange(n) * (length - overlap)
+    windows = np.stack([starts, starts + length], axis=1)
+    windows[-1, 1] = t_end
+    return windows
+
+
+def _initial_boundaries(events: Events, windows: np.ndarray, cfg: EvINRConfig) -> list[np.ndarray]:
+    """Bin edges per window at the coarsest stage: 2^n_bisections times coarser than the final bins."""
+    factor = 2 ** cfg.n_bisections
+    out = []
+    if cfg.binning == "fixed":
+        n_final = max(factor, int(round((windows[0, 1] - windows[0, 0]) / cfg.bin_duration)))
+        n0 = max(1, int(round(n_final / factor)))
+        for lo, hi in windows:
+            out.append(np.linspace(lo, hi, n0 + 1))
+        return out
+    for lo, hi in windows:
+        ev = events.slice_time(lo, hi, allow_empty=True)
+        n0 = max(1, int(round(len(ev) / (cfg.events_per_bin * factor))))
+        if len(ev) < 2 * n0:
+            raise EventDataError(f"window [{lo:.3f}, {hi:.3f}] s holds {len(ev)} events, too few for equal-count "
+                                 "bins; use binning='fixed' or a longer window")
+        b = equal_count_boundaries(ev, n_bins=n0)
+        b[0], b[-1] = lo, hi
+        out.append(b)
+    n = {len(b) for b in out}
+    if len(n) > 1:  # equal-count bins must agree in number across networks to batch them
+        n0 = min(n) - 1
+        out = [np.interp(np.linspace(0, len(b) - 1, n0 + 1), np.arange(len(b)), b) for b in out]
+    return out
+
+
+@dataclass
+class _Bins:
+    """Event frames of all windows, stacked for batched training (tensors on the device)."""
+
+    boundaries: torch.Tensor   # float64 [N, B + 1] seconds
+    centers: torch.Tensor      # float64 [N, B]
+    durations: torch.Tensor    # float32 [N, B]
+    frames: torch.Tensor       # float32 [N, B, H, W], C * sum of p per bin
+
+    @classmethod
+    def build(cls, events: Events, boundaries: list[np.ndarray], C: float, device) -> "_Bins":
+        b = np.stack(boundaries)
+        frames = np.stack([events_to_frames(events, bb, C).frames for bb in boundaries])
+        return cls(
+            boundaries=torch.as_tensor(b, device=device),
+            centers=torch.as_tensor(0.5 * (b[:, 1:] + b[:, :-1]), device=device),
+            durations=torch.as_tensor(np.diff(b, axis=1), dtype=torch.float32, device=device),
+            frames=torch.as_tensor(frames, device=device),
+        )
+
+
+def make_adam(param_groups, lr: float) -> torch.optim.Optimizer:
+    """Adam, fused into one kernel per step where this torch build has it (CPU and CUDA float32).
+
+    The same update as the default implementation up to float rounding; on a 240x180 head
+    (22 M weights) the fused step reads and writes each state tensor once instead of about ten
+    times (see benchmarks/train_step.py).
+    """
+    try:
+        return torch.optim.Adam(param_groups, lr=lr, fused=True)
+    except (RuntimeError, TypeError, ValueError):   # no fused kernel for this device / dtype
+        return torch.optim.Adam(param_groups, lr=lr)
+
+
+def step_losses(model: FrameINR, bins: "_Bins", temporal_loss: str, regularizer: str, fused: bool = True,
+                buffers: dict | None = None):
+    """(temporal loss, regularizer) of one training step, scalars averaged over networks, bins and pixels.
+
+    ``fused=False`` is the readable path (``model.forward_with_derivative`` or ``model(...)``, then
+    the functions of :mod:`evinr_lite.method.losses`); ``fused=True`` computes the same numbers with the
+    output layer and the losses in one autograd node (:func:`~evinr_lite.method.fused.head_losses`),
+    which touches the [N, B, H, W] tensors far fewer times. ``buffers``: a dict kept across the steps
+    of one training loop, in which the fused path reuses its large work arrays.
+    """
+    times = bins.centers if temporal_loss == "derivative" else bins.boundaries
+    if fused:
+        h, dh = model.features(times, with_derivative=temporal_loss == "derivative")
+        return head_losses(h, dh, model.head_weight, model.head_bias, bins.frames,
+                           bins.durations if dh is not None else None, regularizer, buffers)
+    if temporal_loss == "derivative":
+        F, dF = model.forward_with_derivative(times)
+        temporal = temporal_loss_derivative(dF, bins.frames, bins.durations)
+    else:
+        F = model(times)
+        temporal = temporal_loss_difference(F, bins.frames)
+    regularize = {"tikhonov": tikhonov, "tv": total_variation, "none": None}[regularizer]
+    reg = regularize(F) if regularize is not None else torch.zeros((), device=F.device)
+    return temporal, reg
+
+
+def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=None, *,
+                    model: FrameINR | None = None, fast: bool = True):
+    """Train one FrameINR per window, all in one batched computation.
+
+    Args:
+        events, windows ([N, 2] seconds), cfg: what to train on and how.
+        model: a FrameINR with N networks to start from (trained in place, on its own device);
+            None builds one from ``cfg`` (seeded by ``cfg.seed``).
+        fast: True uses the fused Adam kernel and the fused output layer + losses
+            (:func:`step_losses`); False the readable reference path. Same results up to float
+            rounding (tests/test_perf_equivalence.py).
+
+    Returns:
+        (model, history) with history = {"loss", "temporal", "regularizer": per-iteration floats,
+        "n_bins": bins per network at each iteration, "train_time_s": float}.
+    """
+    if model is None:
+        device = default_device(cfg.device)
+        model = FrameINR(events.sensor_size, windows, cfg.hidden_features, cfg.hidden_layers,
+                         cfg.omega_0, cfg.first_omega_0, seed=cfg.seed).to(device)
+    device = model.head_weight.device
+    if model.n_models != len(windows):
+        raise ValueError(f"model holds {model.n_models} networks but {len(windows)} windows were given")
+    head = [model.head_weight, model.head_bias]
+    trunk = [p for n, p in model.named_parameters() if not n.startswith("head_")]
+    groups = [{"params": trunk}, {"params": head, "lr": cfg.lr * cfg.head_lr_scale}]
+    opt = make_adam(groups, lr=cfg.lr) if fast else torch.optim.Adam(groups, lr=cfg.lr)
+    sched = torch.optim.lr_scheduler.StepLR(opt, step_size=cfg.lr_decay_every, gamma=cfg.lr_decay)
+    boundaries = _initial_boundaries(events, windows, cfg)
+    bins = _Bins.build(events, boundaries, cfg.C, device)
+    regularizer = cfg.regularizer if cfg.lam > 0 else "none"
+    history = {"loss": [], "temporal": [], "regularizer": [], "n_bins": []}
+    bisect_at = set(cfg.c2f_iters) if cfg.coarse_to_fine else set()
+    buffers = {}   # the fused path's work arrays, reused from step to step
+
+    from tqdm.auto import tqdm
+
+    t0 = time.perf_counter()
+    bar = tqdm(range(cfg.n_iters), desc="EvINR", disable=not cfg.progress, leave=False)
+    for it in bar:
+        if it in bisect_at:
+            boundaries = [bisect_boundaries(events, b) for b in boundaries]
+            bins = _Bins.build(events, boundaries, cfg.C, device)
+        temporal, reg = step_losses(model, bins, cfg.temporal_loss, regularizer, fused=fast, buffers=buffers)
+        # per-network means summed over networks: each network gets its own gradient, whatever N
+        loss = model.n_models * (temporal + cfg.lam * reg)
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        opt.step()
+        sched.step()
+        history["loss"].append(loss.item() / model.n_models)
+        history["temporal"].append(temporal.item())
+        history["regularizer"].append(reg.item())
+        history["n_bins"].append(int(bins.frames.shape[1]))
+        if it % 10 == 0:
+            bar.set_postfix(loss=f"{history['loss'][-1]:.4g}", bins=history["n_bins"][-1])
+    bar.close()
+    if device.type == "cuda":
+        torch.cuda.synchronize(device)
+    history["train_time_s"] = time.perf_counter() - t0
+    return model, history
+
+
+@dataclass(eq=False)
+class Reconstruction:
+    """A trained EvINR and its predictions.
+
+    Attributes:
+        times: float64 [Q] query times (seconds, the events' clock).
+        log_intensity: float32 [Q, H, W] anchored log intensity at ``times``.
+        frames: float32 [Q, H, W] tone-mapped frames in [0, 1].
+        model: the trained FrameINR (N networks). windows: [N, 2] their time windows (s).
+        offsets: float32 [N, H, W] per-network offsets added by the alignment and the anchor.
+        config: the EvINRConfig used. history: training curves and time (see train_frame_inr).
+    """
+
+    times: np.ndarray
+    log_intensity: np.ndarray
+    frames: np.ndarray
+    model: FrameINR
+    windows: np.ndarray
+    offsets: np.ndarray
+    config: EvINRConfig
+    history: dict = field(repr=False)
+
+    def at(self, times, chunk: int = 256) -> np.ndarray:
+        """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W]."""
+        return blend_networks(self.model, self.windows, np.atleast_1d(np.asarray(times, np.float64)), self.offsets, chunk)
+
+    def frames_at(self, times) -> np.ndarray:
+        """Tone-mapped frames in [0, 1] at any times: float32 [Q, H, W]."""
+        return tonemap_reinhard(self.at(times), self.config.gamma).astype(np.float32)
+
+
+@torch.no_grad()
+def predict_networks(model: FrameINR, times: np.ndarray, chunk: int = 256) -> np.ndarray:
+    """Every network at every time: float32 [N, Q, H, W] (no offsets)."""
+    device = model.head_weight.device
+    times = np.asarray(times, dtype=np.float64)
+    # torch's allocation (64-byte aligned) keeps the matmul's rounding the same from run to run
+    out = torch.empty((model.n_models, len(times), *model.sensor_size), dtype=torch.float32)
+    in_place = device.type == "cpu" and model.n_models == 1 and model.head_weight.dtype == torch.float32
+    for i in range(0, len(times), chunk):
+        t = torch.as_tensor(times[i:i + chunk], device=device).expand(model.n_models, -1)
+        if in_place:
+            model(t, out=out[:, i:i + chunk])                            # written in place: no copy
+        else:
+            out[:, i:i + chunk] = model(t).float().cpu()
+    return out.numpy()
+
+
+def blend_weights(windows: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """[N, Q] weights: linear ramps across overlaps, zero outside a window, summing to 1."""
+    lo, hi = windows[:, :1], windows[:, 1:]
+    inside = (times >= lo - 1e-9) & (times <= hi + 1e-9)
+    if not np.all(inside.any(axis=0)):
+        bad = times[~inside.any(axis=0)][0]
+        raise EventDataError(f"query time {bad} s is outside the reconstructed span "
+                             f"[{windows[0, 0]}, {windows[-1, 1]}] s")
+    if len(windows) == 1:
+        return inside.astype(np.float64)
+    overlap = max(windows[0, 1] - windows[1, 0], 1e-9)
+    ramp = np.clip(np.minimum(times - lo, hi - times) / overlap, 1e-6, 1.0)
+    ramp[0] = np.where(times < windows[1, 0], 1.0, ramp[0])      # no fade-in at the sequence start
+    ramp[-1] = np.where(times > windows[-2, 1], 1.0, ramp[-1])   # nor fade-out at its end
+    w = np.where(inside, ramp, 0.0)
+    return w / w.sum(axis=0, keepdims=True)
+
+
+def blend_networks(model, windows, times, offsets, chunk=256) -> np.ndarray:
+    """The ensemble's log intensity at times [Q]: each network plus its offset [N, H, W], blended
+    with :func:`blend_weights`. Returns float32 [Q, H, W]."""
+    F = predict_networks(model, times, chunk) + offsets[:, None]
+    w = blend_weights(windows, times)
+    return np.einsum("nq,nqhw->qhw", w, F).astype(np.float32)
+
+
+def alignment_offsets(model: FrameINR, windows: np.ndarray, n_samples: int = 8) -> np.ndarray:
+    """Per-network, per-pixel offsets [N, H, W] chaining each network onto its predecessor.
+
+    Over the overlap of windows k-1 and k, offset_k = offset_{k-1} + mean_t (F_{k-1}(t) - F_k(t)).
+    """
+    H, W = model.sensor_size
+    offsets = np.zeros((len(windows), H, W), np.float32)
+    for k in range(1, len(windows)):
+        ts = np.linspace(windows[k, 0], windows[k - 1, 1], n_samples)
+        F = predict_networks(model, ts)
+        offsets[k] = offsets[k - 1] + (F[k - 1] - F[k]).mean(axis=0)
+    return offsets
+
+
+def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, *,
+                t_start: float | None = None, t_end: float | None = None) -> Reconstruction:
+    """Reconstruct log intensity and tone-mapped frames at ``query_times`` from events alone.
+
+    Args:
+        events: the events (their sensor_size gives H, W).
+        query_times: [Q] seconds on the events' clock, inside [t_start, t_end].
+        config: EvINRConfig (paper defaults when None).
+        t_start, t_end: span to reconstruct (seconds); default: from the first to the last event,
+            widened to include the query times.
+
+    Returns:
+        Reconstruction with frames [Q, H, W] in [0, 1] and log intensities [Q, H, W].
+    """
+    cfg = config or EvINRConfig()
+    q = np.atleast_1d(np.asarray(query_times, dtype=np.float64))
+    if len(events) < 2:
+        raise EventDataError(f"need at least 2 events to reconstruct, got {len(events)}; choose a longer window")
+    if q.size == 0 or not np.all(np.isfinite(q)):
+        raise EventDataError("query_times must be a non-empty array of finite seconds")
+    t_start = min(events.t[0], q.min()) if t_start is None else float(t_start)
+    t_end = max(events.t[-1], q.max()) if t_end is None else float(t_end)
+    if q.min() < t_start or q.max() > t_end:
+        raise EventDataError(f"query times span [{q.min()}, {q.max()}] s, outside [t_start, t_end] = "
+                             f"[{t_start}, {t_end}] s; widen the span or drop those times")
+    events = events.slice_time(t_start, np.nextafter(t_end, np.inf), allow_empty=True)
+    if len(events) < 2:
+        raise EventDataError(f"fewer than 2 events in [{t_start}, {t_end}] s; choose a window with events")
+    windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
+    model, history = train_frame_inr(events, windows, cfg)
+    model.eval()
+    offsets = alignment_offsets(model, windows)
+    # anchor: mean log intensity over the sequence tone-maps to display_mean
+    grid = np.linspace(t_start, t_end, min(64, 8 * len(windows)))
+    mean_L = float(blend_networks(model, windows, grid, offsets).mean())
+    offsets += np.float32(anchor_level(cfg.gamma, cfg.display_mean) - mean_L)
+    L = blend_networks(model, windows, q, offsets)
+    frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)
+    history["config"] = asdict(cfg)
+    return Reconstruction(q, L, frames, model, windows, offsets, cfg, history)

@@ -1,0 +1,428 @@
+"""An ESIM-style event simulator: log-intensity samples in, `Events` out (Sec. 3.1 of the paper).
+
+The model (one pixel; every pixel is independent):
+
+- The pixel remembers a reference level ``L_ref``, at first ``L(t[0])``.
+- An ON event (p = +1) fires when ``L`` rises to ``L_ref + C_pos``; an OFF event (p = -1)
+  when it falls to ``L_ref - C_neg``. The reference then moves by exactly that step, so a
+  pixel fires one event per level crossed, possibly several between two samples.
+- Between samples ``L`` is taken to be linear, so the crossing time of a level is found by
+  linear interpolation. When ``L`` is a Python function (1-D simulator), each crossing is
+  refined by bisection on ``L`` itself, so timestamps are exact to float64 resolution.
+
+What this guarantees (Eq. 2 of the paper): without noise and refractory period, at every
+pixel and sample time ``t[k]``,
+``L(t[k]) - L(t[0]) - (C_pos * #ON - C_neg * #OFF with t_event <= t[k])`` lies in
+``[0, C_pos)`` after a rise and ``(-C_neg, 0]`` after a fall, so always within one threshold.
+:func:`evinr_lite.method.integration.integrate_events` computes the event sum.
+
+Non-idealities (all optional, all seeded):
+
+- ``threshold_sigma``: per-pixel threshold mismatch, *relative*: a pixel's ON threshold is
+  drawn once from N(C_pos, (threshold_sigma * C_pos)^2) and its OFF threshold independently
+  from N(C_neg, (threshold_sigma * C_neg)^2), each clipped below at
+  ``MIN_THRESHOLD_FRACTION`` (0.1) times its nominal value. See :func:`sample_thresholds`.
+- ``refractory`` (s): an event that comes less than ``refractory`` after the previous
+  *emitted* event at its pixel is dropped. ESIM convention: the reference level still moves
+  for a dropped event (the change is consumed, not reported), so the integrated events fall
+  short of ``L`` by the dropped steps. (v2e instead holds the reference and reports the change
+  late.) Noise events are emitted events too: they start a refractory period.
+- ``noise_rate`` (Hz per pixel): background events, an independent Poisson process per pixel
+  with uniform times in ``[t[0], t[-1]]`` and polarity +1 or -1 with probability 1/2.
+  They do not move the reference level.
+
+Randomness: ``seed`` is an int or a ``np.random.Generator``. From it the simulator draws, in
+this order, the thresholds (only when ``threshold_sigma > 0``, via :func:`sample_thresholds`)
+and then the noise (only when ``noise_rate > 0``). The same seed gives identical events.
+
+All three simulators share one core, :func:`_simulate_samples`, which loops over sample
+intervals (a Python loop over time) and is vectorised over pixels and events.
+"""
+from __future__ import annotations
+
+from typing import Callable, Iterable, Iterator
+
+import numpy as np
+
+from ..core.events import EventDataError, Events
+
+__all__ = ["simulate_events_1d", "pixel_events", "simulate_video", "simulate_scene", "sample_thresholds",
+           "MIN_THRESHOLD_FRACTION", "MAX_PX_PER_SAMPLE"]
+
+MIN_THRESHOLD_FRACTION = 0.1   # mismatched thresholds are clipped below at this x nominal
+MAX_PX_PER_SAMPLE = 0.5        # simulate_scene's default sampling: at most this motion per sample
+N_BISECTION = 50               # halvings when refining a crossing of a callable L
+_REFINE_CHUNK = 1 << 22        # values of L evaluated per call during refinement (bounds memory)
+_SCENE_CHUNK = 1 << 21         # pixels x samples rendered per scene.log_intensity call
+
+
+# ---- argument checks ---------------------------------------------------------------------
+
+def _as_rng(seed) -> np.random.Generator:
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
+        raise EventDataError(f"seed must be an int or a np.random.Generator, got {seed!r}")
+    return np.random.default_rng(int(seed))
+
+
+def _check_times(t) -> np.ndarray:
+    t = np.asarray(t, dtype=np.float64)
+    if t.ndim != 1 or t.size < 2:
+        raise EventDataError(f"sample times t must be a 1-D array of at least 2 times (seconds), got shape {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise EventDataError("sample times t contain NaN or inf; pass finite seconds")
+    if np.any(np.diff(t) <= 0):
+        raise EventDataError("sample times t must be strictly increasing (seconds); sort them and drop duplicates")
+    return t
+
+
+def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
+    C_pos = C if C_pos is None else C_pos
+    C_neg = C if C_neg is None else C_neg
+    for name, value in (("C_pos", C_pos), ("C_neg", C_neg)):
+        if not (np.isscalar(value) and np.isreal(value) and np.isfinite(value) and value > 0):
+            raise EventDataError(f"contrast threshold {name} (or C) must be a positive number in log units, got {value!r}")
+    return float(C_pos), float(C_neg)
+
+
+def _check_nonnegative(**values) -> None:
+    for name, value in values.items():
+        if not (np.isscalar(value) and np.isreal(value) and np.isfinite(value) and value >= 0):
+            raise EventDataError(f"{name} must be a finite number >= 0, got {value!r}")
+
+
+def sample_thresholds(n_pixels: int, C_pos: float, C_neg: float, threshold_sigma: float = 0.0,
+                      rng: np.random.Generator | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Per-pixel ON and OFF contrast thresholds.
+
+    With ``threshold_sigma = s > 0``: ON thresholds ~ N(C_pos, (s * C_pos)^2), then OFF
+    thresholds ~ N(C_neg, (s * C_neg)^2) (relative mismatch, drawn in that order from ``rng``),
+    each clipped below at ``MIN_THRESHOLD_FRACTION`` times its nominal value. With ``s = 0``
+    nothing is drawn and every pixel gets the nominal values.
+
+    Returns:
+        (C_pos_pix, C_neg_pix): float64 [n_pixels] each, log units.
+    """
+    C_pos_pix = np.full(n_pixels, C_pos, dtype=np.float64)
+    C_neg_pix = np.full(n_pixels, C_neg, dtype=np.float64)
+    if threshold_sigma > 0:
+        if rng is None:
+            raise EventDataError("threshold_sigma > 0 needs a generator: pass rng=np.random.default_rng(seed)")
+        C_pos_pix *= 1.0 + threshold_sigma * rng.standard_normal(n_pixels)
+        C_neg_pix *= 1.0 + threshold_sigma * rng.standard_normal(n_pixels)
+        np.maximum(C_pos_pix, MIN_THRESHOLD_FRACTION * C_pos, out=C_pos_pix)
+        np.maximum(C_neg_pix, MIN_THRESHOLD_FRACTION * C_neg, out=C_neg_pix)
+    return C_pos_pix, C_neg_pix
+
+
+# ---- the core: threshold crossings between samples ---------------------------------------
+
+def _expand(pixels: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Repeat pixel i counts[i] times; also return j = 1..counts[i] within each repeat."""
+    rep = np.repeat(pixels, counts)
+    starts = np.cumsum(counts) - counts
+    j = np.arange(rep.size) - np.repeat(starts, counts) + 1
+    return rep, j
+
+
+def _crossings(t: np.ndarray, frames: Iterable[np.ndarray], C_pos: np.ndarray, C_neg: np.ndarray):
+    """All threshold crossings of per-pixel signals sampled at times ``t``.
+
+    Args:
+        t: float64 [T] sample times (s), strictly increasing.
+        frames: T arrays [P] of log intensity, one per sample time (consumed one at a time,
+            so a long video never needs to be in memory at once).
+        C_pos, C_neg: float64 [P] thresholds.
+
+    Returns:
+        t_ev float64 [N] (linear interpolation), pix int64 [N], p int8 [N],
+        level float64 [N] (the level crossed), k int64 [N] (index of the sample that ends the
+        interval holding the crossing). Sorted by time (stable).
+    """
+    it = iter(frames)
+    L_prev = np.asarray(next(it), dtype=np.float64).ravel()
+    L_init = L_prev.copy()
+    n_on = np.zeros(L_init.size, np.int64)     # ON events so far, per pixel
+    n_off = np.zeros(L_init.size, np.int64)    # OFF events so far, per pixel
+    ref = L_init.copy()                        # = L_init + n_on * C_pos - n_off * C_neg (no drift)
+    out = []
+    for k in range(1, t.size):
+        L_next = np.asarray(next(it), dtype=np.float64).ravel()
+        if L_next.shape != L_init.shape:
+            raise EventDataError(f"sample {k} has {L_next.size} pixels but sample 0 has {L_init.size}")
+        d = L_next - ref
+        up = np.floor(d / C_pos)
+        down = np.floor(-d / C_neg)
+        parts = []
+        for sign, steps, C in ((1, up, C_pos), (-1, down, C_neg)):
+            pixels = np.flatnonzero(steps > 0)
+            if pixels.size == 0:
+                continue
+            counts = steps[pixels].astype(np.int64)
+            rep, j = _expand(pixels, counts)
+            if sign > 0:
+                level = L_init[rep] + (n_on[rep] + j) * C_pos[rep] - n_off[rep] * C_neg[rep]
+                n_on[pixels] += counts
+            else:
+                level = L_init[rep] + n_on[rep] * C_pos[rep] - (n_off[rep] + j) * C_neg[rep]
+                n_off[pixels] += counts
+            ref[pixels] = L_init[pixels] + n_on[pixels] * C_pos[pixels] - n_off[pixels] * C_neg[pixels]
+            a, b = L_prev[rep], L_next[rep]
+            frac = np.clip((level - a) / (b - a), 0.0, 1.0)
+            t_ev = t[k - 1] + frac * (t[k] - t[k - 1])
+            parts.append((t_ev, rep, np.full(rep.size, sign, np.int8), level))
+        if parts:
+            t_ev, rep, p, level = (np.concatenate(c) for c in zip(*parts))
+            order = np.argsort(t_ev, kind="stable")
+            out.append((t_ev[order], rep[order], p[order], level[order], np.full(rep.size, k, np.int64)))
+        L_prev = L_next
+    if not out:
+        e = np.zeros(0)
+        return e, e.astype(np.int64), e.astype(np.int8), e, e.astype(np.int64)
+    return tuple(np.concatenate(c) for c in zip(*out))
+
+
+def _refine(L: Callable, n_pixels: int, t: np.ndarray, pix, p, level, k) -> np.ndarray:
+    """Bisection on a callable ``L`` for each crossing inside its sample interval [t[k-1], t[k]].
+
+    g(s) = p * (L(s) - level) is < 0 at t[k-1] and >= 0 at t[k] (the simulator's invariant), so
+    halving keeps a bracket of the crossing. Cost: N_BISECTION calls of L on all N event times,
+    each returning [N, P] (in chunks, to bound memory). Returns float64 [N] refined times.
+    """
+    lo, hi = t[k - 1], t[k]
+    for _ in range(N_BISECTION):
+        mid = 0.5 * (lo + hi)
+        below = p * (_eval_at(L, mid, pix, n_pixels) - level) < 0
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    return hi
+
+
+def _eval_at(L: Callable, s: np.ndarray, pix: np.ndarray, n_pixels: int) -> np.ndarray:
+    """L at times s [N], reading pixel pix[i] at time s[i] -> float64 [N]."""
+    out = np.empty(s.size)
+    chunk = max(1, _REFINE_CHUNK // n_pixels)
+    for i in range(0, s.size, chunk):
+        si = s[i:i + chunk]
+        v = np.asarray(L(si), dtype=np.float64).reshape(si.size, n_pixels)
+        out[i:i + chunk] = v[np.arange(si.size), pix[i:i + chunk]]
+    return out
+
+
+def _noise(n_pixels: int, t0: float, t1: float, rate: float, rng: np.random.Generator):
+    """Poisson background events: per-pixel counts ~ Poisson(rate * (t1 - t0)), uniform times."""
+    counts = rng.poisson(rate * (t1 - t0), size=n_pixels)
+    pix = np.repeat(np.arange(n_pixels, dtype=np.int64), counts)
+    t_ev = t0 + (t1 - t0) * rng.random(pix.size)
+    p = np.where(rng.random(pix.size) < 0.5, -1, 1).astype(np.int8)
+    return t_ev, pix, p
+
+
+def _refractory_keep(t_ev: np.ndarray, pix: np.ndarray, refractory: float) -> np.ndarray:
+    """Mask [N] of events kept by a per-pixel refractory period (greedy in time).
+
+    An event is kept if it comes at least ``refractory`` seconds after the previous *kept* event
+    of its pixel. Vectorised over pixels: each pass of the loop jumps every pixel to its next
+    kept event, so the loop runs (max kept events per pixel) times. The jump is an exact
+    integer search on the key (pixel, rank of the time among all times).
+    """
+    n = t_ev.size
+    order = np.lexsort((t_ev, pix))
+    ts, ps = t_ev[order], pix[order].astype(np.int64)
+    t_all = np.sort(t_ev)
+    key = ps * (n + 1) + np.searchsorted(t_all, ts, side="left")
+    cur = np.flatnonzero(np.r_[True, ps[1:] != ps[:-1]])     # first event of every pixel
+    keep_sorted = np.zeros(n, bool)
+    while cur.size:
+        keep_sorted[cur] = True
+        target = ps[cur] * (n + 1) + np.searchsorted(t_all, ts[cur] + refractory, side="left")
+        nxt = np.maximum(np.searchsorted(key, target, side="left"), cur + 1)
+        ok = nxt < n
+        cur, nxt = cur[ok], nxt[ok]
+        cur = nxt[ps[nxt] == ps[cur]]
+    keep = np.empty(n, bool)
+    keep[order] = keep_sorted
+    return keep
+
+
+def _simulate_samples(t, frames, n_pixels, C_pos, C_neg, threshold_sigma, refractory, noise_rate, rng,
+                      L_callable=None):
+    """Shared core of the 1-D and 2-D simulators.
+
+    Args:
+        t: float64 [T] sample times (s). frames: T arrays [P] (log intensity at t[k]).
+        n_pixels: P. C_pos, C_neg: nominal thresholds. threshold_sigma, refractory (s),
+        noise_rate (Hz per pixel): see the module docstring. rng: np.random.Generator.
+        L_callable: if given, crossings are refined by bisection on it (see :func:`_refine`).
+
+    Returns:
+        t_ev float64 [N] sorted, pix int64 [N] (flat pixel index), p int8 [N].
+    """
+    C_pos_pix, C_neg_pix = sample_thresholds(n_pixels, C_pos, C_neg, threshold_sigma, rng)
+    t_ev, pix, p, level, k = _crossings(t, frames, C_pos_pix, C_neg_pix)
+    if L_callable is not None and t_ev.size:
+        t_ev = _refine(L_callable, n_pixels, t, pix, p, level, k)
+    if noise_rate > 0:
+        tn, pn, poln = _noise(n_pixels, t[0], t[-1], noise_rate, rng)
+        t_ev, pix, p = np.concatenate([t_ev, tn]), np.concatenate([pix, pn]), np.concatenate([p, poln])
+    order = np.argsort(t_ev, kind="stable")          # nearly sorted already: cheap
+    t_ev, pix, p = t_ev[order], pix[order], p[order]
+    if refractory > 0 and t_ev.size:
+        keep = _refractory_keep(t_ev, pix, refractory)
+        t_ev, pix, p = t_ev[keep], pix[keep], p[keep]
+    return t_ev, pix, p
+
+
+# ---- public simulators --------------------------------------------------------------------
+
+def simulate_events_1d(L, t, C=0.2, *, C_pos=None, C_neg=None, threshold_sigma=0.0, refractory=0.0,
+                       noise_rate=0.0, seed=0, refine=True) -> Events:
+    """Events of P independent pixels whose log intensities are 1-D signals of time.
+
+    Args:
+        L: either a function ``L(s)`` taking an array of times [M] (s) and returning log
+            intensities [M] (one pixel) or [M, P]; or the samples themselves, an array [T] or
+            [T, P] at the times ``t``.
+        t: float64 [T] sample times in seconds, strictly increasing. Crossings are found
+            between consecutive samples, so sample finely enough that L is monotone between
+            samples (each crossing of the sampled signal is one event).
+        C: contrast threshold (log units), used for both polarities unless ``C_pos`` /
+            ``C_neg`` are given.
+        threshold_sigma: relative per-pixel threshold mismatch (see :func:`sample_thresholds`).
+        refractory: seconds; events closer than this to the previous emitted event of their
+            pixel are dropped (the reference still moves: ESIM convention).
+        noise_rate: background events per pixel per second (Poisson, random polarity).
+        seed: int or np.random.Generator.
+        refine: when L is a function, refine each crossing by bisection on L (exact time
+            to ~1e-15 s relative; costs 50 calls of L on all event times). Ignored for samples.
+
+    Returns:
+        Events on a sensor of size (1, P): y = 0, x = pixel index, sorted by time, all
+        times in [t[0], t[-1]]. The reference level starts at L(t[0]) per pixel.
+    """
+    t = _check_times(t)
+    samples = np.asarray(L(t) if callable(L) else L, dtype=np.float64)
+    if samples.ndim == 1:
+        samples = samples[:, None]
+    if samples.ndim != 2 or samples.shape[0] != t.size:
+        what = "L(t)" if callable(L) else "L"
+        raise EventDataError(
+            f"{what} has shape {samples.shape} but t has {t.size} samples; L must give [T] (one pixel) "
+            "or [T, P] values (P pixels), one row per sample time")
+    if not np.all(np.isfinite(samples)):
+        raise EventDataError("L contains NaN or inf; log intensities must be finite (clip intensities above 0 before the log)")
+    C_pos, C_neg = _check_thresholds(C, C_pos, C_neg)
+    _check_nonnegative(threshold_sigma=threshold_sigma, refractory=refractory, noise_rate=noise_rate)
+    P = samples.shape[1]
+    t_ev, pix, p = _simulate_samples(
+        t, iter(samples), P, C_pos, C_neg, threshold_sigma, refractory, noise_rate, _as_rng(seed),
+        L_callable=L if (callable(L) and refine) else None)
+    return Events(t_ev, pix.astype(np.int32), np.zeros(pix.size, np.int32), p, (1, P))
+
+
+def pixel_events(events, pixel: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """(t, p) of one pixel: from an ``Events`` with sensor_size (1, P) (x = pixel index), or a
+    ``(t, p)`` pair of arrays passed through."""
+    if isinstance(events, Events):
+        H, W = events.sensor_size
+        if H != 1:
+            raise EventDataError(f"1-D helpers expect events with sensor_size (1, P), got {(H, W)}")
+        if not 0 <= pixel < W:
+            raise EventDataError(f"pixel {pixel} is outside the {W} pixels of these events")
+        keep = events.x == pixel
+        return events.t[keep], events.p[keep].astype(np.float64)
+    try:
+        t, p = events
+    except (TypeError, ValueError):
+        raise TypeError("events must be an Events or a (t, p) pair of arrays") from None
+    return np.asarray(t, dtype=np.float64), np.asarray(p, dtype=np.float64)
+
+
+def _check_video(log_frames, t) -> tuple[np.ndarray, np.ndarray]:
+    t = _check_times(t)
+    log_frames = np.asarray(log_frames)
+    if log_frames.ndim != 3 or log_frames.shape[0] != t.size:
+        raise EventDataError(
+            f"log_frames must have shape [T, H, W] with T = len(t) = {t.size}, got {log_frames.shape}")
+    if log_frames.dtype.kind not in "fiu":
+        raise EventDataError(f"log_frames must be numbers (log intensity), got dtype {log_frames.dtype}")
+    if not np.all(np.isfinite(log_frames)):
+        raise EventDataError("log_frames contain NaN or inf; take the log of intensities clipped above 0")
+    return log_frames, t
+
+
+def _video_events(t, frames: Iterable[np.ndarray], sensor_size, C, C_pos, C_neg, threshold_sigma,
+                  refractory, noise_rate, seed) -> Events:
+    C_pos, C_neg = _check_thresholds(C, C_pos, C_neg)
+    _check_nonnegative(threshold_sigma=threshold_sigma, refractory=refractory, noise_rate=noise_rate)
+    H, W = sensor_size
+    t_ev, pix, p = _simulate_samples(t, frames, H * W, C_pos, C_neg, threshold_sigma, refractory,
+                                     noise_rate, _as_rng(seed))
+    y, x = np.divmod(pix, W)
+    return Events(t_ev, x.astype(np.int32), y.astype(np.int32), p, (H, W))
+
+
+def simulate_video(log_frames, t, C=0.2, *, C_pos=None, C_neg=None, threshold_sigma=0.0, refractory=0.0,
+                   noise_rate=0.0, seed=0) -> Events:
+    """Events of a video given as log-intensity frames (ESIM-style).
+
+    Args:
+        log_frames: [T, H, W] log intensities at the times ``t`` (any float dtype; computed in
+            float64 one frame at a time). Between frames, each pixel's L is linear, so a pixel can
+            fire several events per frame interval, with linearly interpolated timestamps.
+        t: float64 [T] sample times (s), strictly increasing.
+        C, C_pos, C_neg, threshold_sigma, refractory, noise_rate, seed: as in
+            :func:`simulate_events_1d`.
+
+    Returns:
+        Events on a sensor of size (H, W), sorted by time, within [t[0], t[-1]].
+    """
+    log_frames, t = _check_video(log_frames, t)
+    H, W = log_frames.shape[1:]
+    frames = (f.reshape(-1) for f in log_frames)
+    return _video_events(t, frames, (H, W), C, C_pos, C_neg, threshold_sigma, refractory, noise_rate, seed)
+
+
+def _scene_frames(scene, t: np.ndarray) -> Iterator[np.ndarray]:
+    """scene.log_intensity at times t, rendered in chunks and yielded one flat frame [H*W] at a time."""
+    H, W = scene.sensor_size
+    chunk = max(1, _SCENE_CHUNK // (H * W))
+    for i in range(0, t.size, chunk):
+        block = np.asarray(scene.log_intensity(t[i:i + chunk]), dtype=np.float64)
+        if not np.all(np.isfinite(block)):
+            raise EventDataError(f"scene.log_intensity returned NaN or inf near t = {t[i]:.6f} s")
+        yield from block.reshape(block.shape[0], H * W)
+
+
+def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, **kwargs) -> Events:
+    """Events of a synthetic scene (see :mod:`evinr_lite.sim.scenes`) between t_start and t_end.
+
+    Args:
+        scene: a Scene (``sensor_size``, ``duration``, ``log_intensity(t)``, ``max_speed``).
+        t_start, t_end: seconds; ``t_end`` defaults to ``scene.duration``.
+        sample_rate: samples per second of ``scene.log_intensity``. Default:
+            ``scene.max_speed / MAX_PX_PER_SAMPLE`` so the image moves at most 0.5 px between
+            samples (at least 100 Hz), which keeps the linear interpolation between samples accurate.
+        C: contrast threshold; ``**kwargs`` go on to :func:`simulate_video` (C_pos, C_neg,
+            threshold_sigma, refractory, noise_rate, seed).
+
+    Returns:
+        Events on ``scene.sensor_size``. Frames are rendered in chunks, never all at once.
+    """
+    t_end = scene.duration if t_end is None else t_end
+    if not (np.isfinite(t_start) and np.isfinite(t_end) and t_end > t_start):
+        raise EventDataError(f"time range [{t_start}, {t_end}] s is empty or reversed; t_end must exceed t_start")
+    if sample_rate is None:
+        sample_rate = max(100.0, float(scene.max_speed) / MAX_PX_PER_SAMPLE)
+    if not (np.isfinite(sample_rate) and sample_rate > 0):
+        raise EventDataError(f"sample_rate must be a positive number of samples per second, got {sample_rate!r}")
+    n = max(2, int(np.ceil((t_end - t_start) * sample_rate - 1e-9)) + 1)
+    t = np.linspace(t_start, t_end, n)
+    unknown = set(kwargs) - {"C_pos", "C_neg", "threshold_sigma", "refractory", "noise_rate", "seed"}
+    if unknown:
+        raise TypeError(f"simulate_scene got unexpected arguments {sorted(unknown)}; "
+                        "it accepts C_pos, C_neg, threshold_sigma, refractory, noise_rate, seed")
+    opts = dict(C_pos=None, C_neg=None, threshold_sigma=0.0, refractory=0.0, noise_rate=0.0, seed=0)
+    opts.update(kwargs)
+    return _video_events(t, _scene_frames(scene, t), tuple(scene.sensor_size), C, **opts)

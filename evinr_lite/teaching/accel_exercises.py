@@ -1,0 +1,393 @@
+"""Making EvINR fast (paper Sec. 3.3, Tables 2-3): the pieces of notebook 06 and its exercises.
+
+The reference solutions of the notebook's exercises live here and are registered with
+:mod:`evinr_lite.teaching.exercises` at import:
+
+- :func:`bisect_equal_count`: coarse-to-fine's step, every bin cut into two halves holding equal
+  numbers of events (the same rule as :func:`evinr_lite.method.binning.bisect_boundaries`, on bare
+  timestamps).
+- :func:`crossfade_weights`: how an ensemble's predictions are mixed, linear ramps across each
+  overlap (the same weights as the solver's ``blend_weights``).
+
+Helpers for the experiments:
+
+- :class:`VaryingSpeedScene`: a scene played at a speed that swings up and down, so that the event
+  rate varies in time (equal-count bins then differ from equal-duration bins).
+- :func:`ensemble_predictions`: an ensemble's log intensity with or without the offset alignment
+  and with or without the cross-fade (a hard switch at the middle of each overlap).
+- :func:`frame_change`: how fast the predicted frames change, per second, to see seams.
+- Batched versus sequential training of N networks with identical initial weights:
+  :func:`window_bins`, :func:`per_network_loss`, :func:`train_networks`, :func:`single_copies` and
+  :func:`batched_vs_sequential` (used by ``benchmarks/ensemble_batching.py``).
+
+Times are float64 seconds; windows are float64 [N, 2] (see :func:`evinr_lite.method.solver.split_windows`).
+"""
+from __future__ import annotations
+
+import copy
+import time
+
+import numpy as np
+import torch
+
+from . import exercises
+from ..method.binning import events_to_frames
+from ..core.runtime import default_device
+from ..core.events import EventDataError, Events
+from ..method.losses import spatial_differences
+from ..method.models import FrameINR
+from ..sim.scenes import Scene
+from ..method.solver import blend_networks, predict_networks
+
+__all__ = [
+    "bisect_equal_count", "crossfade_weights", "VaryingSpeedScene", "ensemble_predictions", "frame_change",
+    "overlap_mask", "window_bins", "per_network_loss", "train_networks", "single_copies",
+    "batched_vs_sequential",
+]
+
+
+# ---- exercise 1: coarse-to-fine bisection -------------------------------------------------
+
+def bisect_equal_count(t_events, boundaries) -> np.ndarray:
+    """Cut every bin (b_i, b_{i+1}] into two halves holding equal numbers of events.
+
+    A bin with n >= 2 events is cut half-way between its events n//2 - 1 and n//2 (0-based, in time
+    order), so each half holds n//2 or n - n//2 of them. A bin with fewer than 2 events, or whose
+    cut would land on one of its edges (events at equal times), is cut at its time mid-point.
+    Bin 0 also holds events at exactly b_0 (the convention of :mod:`evinr_lite.method.binning`).
+
+    Args:
+        t_events: float [M] sorted event times (s).
+        boundaries: float [B + 1] increasing bin edges (s).
+
+    Returns:
+        float64 [2B + 1]: the old edges at even positions, the cuts at odd positions.
+    """
+    t = np.asarray(t_events, dtype=np.float64)
+    b = np.asarray(boundaries, dtype=np.float64)
+    cuts = []
+    for i, (lo, hi) in enumerate(zip(b[:-1], b[1:])):
+        in_bin = t[((t > lo) | ((i == 0) & (t == lo))) & (t <= hi)]
+        n = len(in_bin)
+        cut = 0.5 * (lo + hi)                                   # too few events: the time mid-point
+        if n >= 2:
+            median = 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2])
+            if lo < median < hi:
+                cut = median
+        cuts.append(cut)
+    out = np.empty(2 * len(b) - 1)
+    out[0::2] = b
+    out[1::2] = cuts
+    return out
+
+
+def _inputs_bisect(rng):
+    cases = []
+    # a busy start and a quiet end; one bin with no event and one with a single event
+    t = np.sort(np.concatenate([rng.uniform(0.0, 0.3, 40), rng.uniform(0.3, 1.0, 12)]))
+    cases.append(dict(t_events=t, boundaries=np.linspace(0.0, 1.0, 5)))
+    t = np.sort(np.concatenate([rng.uniform(0.0, 0.5, 9), [0.8]]))
+    cases.append(dict(t_events=t, boundaries=np.array([0.0, 0.25, 0.5, 0.75, 1.0])))
+    t = np.sort(rng.uniform(0.0, 2.0, 101))
+    b = np.concatenate([[0.0], np.sort(rng.uniform(0.1, 1.9, 6)), [2.0]])
+    cases.append(dict(t_events=t, boundaries=b))
+    return cases
+
+
+def _midpoints(t_events, boundaries):
+    b = np.asarray(boundaries, dtype=np.float64)
+    out = np.empty(2 * len(b) - 1)
+    out[0::2] = b
+    out[1::2] = 0.5 * (b[:-1] + b[1:])
+    return out
+
+
+def _cut_at_mean(t_events, boundaries):
+    t = np.asarray(t_events, dtype=np.float64)
+    out = _midpoints(t, boundaries)
+    for i, (lo, hi) in enumerate(zip(out[0:-1:2], out[2::2])):
+        in_bin = t[(t > lo) & (t <= hi)]
+        if len(in_bin) >= 2:
+            out[2 * i + 1] = in_bin.mean()
+    return out
+
+
+def _cut_at_event(t_events, boundaries):
+    t = np.asarray(t_events, dtype=np.float64)
+    out = _midpoints(t, boundaries)
+    for i, (lo, hi) in enumerate(zip(out[0:-1:2], out[2::2])):
+        in_bin = t[(t > lo) & (t <= hi)]
+        if len(in_bin) >= 2:
+            out[2 * i + 1] = in_bin[len(in_bin) // 2]
+    return out
+
+
+exercises.register(
+    "bisect_equal_count", bisect_equal_count, _inputs_bisect,
+    hints={
+        "you cut every bin at its time mid-point: that halves the duration, not the number of events; "
+        "cut between the two middle events instead": _midpoints,
+        "you cut at the mean event time; equal counts need the median (half-way between events "
+        "n//2 - 1 and n//2)": _cut_at_mean,
+        "you cut exactly at event n//2; cut half-way between events n//2 - 1 and n//2, so that no event "
+        "sits on an edge": _cut_at_event,
+    })
+
+
+# ---- exercise 2: cross-fade weights ---------------------------------------------------------
+
+def crossfade_weights(windows, times) -> np.ndarray:
+    """Blend weights [N, Q] of N overlapping windows at the query times.
+
+    Over the overlap of windows k-1 and k, window k's weight rises linearly from 0 at its start
+    (windows[k, 0]) to 1 at the end of window k-1 (windows[k-1, 1]), and window k-1's weight falls
+    from 1 to 0; elsewhere the one window that covers t has weight 1, and a window that does not
+    cover t has weight 0. The first window does not fade in, nor the last fade out. Columns sum to 1.
+
+    Args:
+        windows: float [N, 2] seconds, equal overlaps between neighbours (as split_windows makes them).
+        times: float [Q] seconds inside [windows[0, 0], windows[-1, 1]].
+
+    Returns:
+        float64 [N, Q].
+    """
+    windows = np.asarray(windows, dtype=np.float64)
+    t = np.asarray(times, dtype=np.float64)
+    if len(windows) == 1:
+        return np.ones((1, len(t)))
+    lo, hi = windows[:, :1], windows[:, 1:]
+    overlap = windows[0, 1] - windows[1, 0]
+    fade_in = np.clip((t - lo) / overlap, 0.0, 1.0)
+    fade_out = np.clip((hi - t) / overlap, 0.0, 1.0)
+    fade_in[0] = 1.0                      # the sequence starts inside window 0
+    fade_out[-1] = 1.0                    # and ends inside the last window
+    w = np.minimum(fade_in, fade_out)
+    return w / w.sum(axis=0, keepdims=True)
+
+
+def _inputs_crossfade(rng):
+    from ..method.solver import split_windows
+
+    cases = []
+    for span, tau, overlap in ((3.0, 1.2, 0.3), (6.0, 2.2, 0.5), (2.0, 1.1, 0.1)):
+        w = split_windows(0.0, span, tau, overlap)
+        edges = np.concatenate([w.ravel(), 0.5 * (w[1:, 0] + w[:-1, 1])])
+        t = np.sort(np.concatenate([edges, rng.uniform(0.0, span, 9)]))
+        cases.append(dict(windows=w, times=t))
+    cases.append(dict(windows=np.array([[0.0, 1.0]]), times=np.array([0.0, 0.3, 1.0])))
+    return cases
+
+
+def _hard_switch_weights(windows, times):
+    windows = np.asarray(windows, dtype=np.float64)
+    t = np.asarray(times, dtype=np.float64)
+    centres = 0.5 * (windows[1:, 0] + windows[:-1, 1])
+    k = np.searchsorted(centres, t)
+    w = np.zeros((len(windows), len(t)))
+    w[k, np.arange(len(t))] = 1.0
+    return w
+
+
+def _fades_at_both_ends(windows, times):
+    windows = np.asarray(windows, dtype=np.float64)
+    t = np.asarray(times, dtype=np.float64)
+    if len(windows) == 1:
+        return np.ones((1, len(t)))
+    overlap = windows[0, 1] - windows[1, 0]
+    w = np.minimum(np.clip((t - windows[:, :1]) / overlap, 0, 1), np.clip((windows[:, 1:] - t) / overlap, 0, 1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return w / w.sum(axis=0, keepdims=True)
+
+
+def _not_normalised(windows, times):
+    windows = np.asarray(windows, dtype=np.float64)
+    t = np.asarray(times, dtype=np.float64)
+    return ((t >= windows[:, :1]) & (t <= windows[:, 1:])).astype(np.float64)
+
+
+exercises.register(
+    "crossfade_weights", crossfade_weights, _inputs_crossfade, atol=1e-5,
+    hints={
+        "these are hard switches (0 or 1); ramp the weights linearly across each overlap": _hard_switch_weights,
+        "the first window must not fade in at the start of the sequence, nor the last fade out at its end "
+        "(there is no neighbour to hand over to)": _fades_at_both_ends,
+        "every window covering t has weight 1: the weights of each time must sum to 1": _not_normalised,
+    })
+
+
+# ---- a scene whose event rate varies --------------------------------------------------------
+
+class VaryingSpeedScene(Scene):
+    """``base`` played at a varying speed: L(t) = base.L(s(t)), s(t) = t + depth sin(w t) / w, w = 2 pi / period.
+
+    The playback speed s'(t) = 1 + depth cos(2 pi t / period) swings between 1 - depth and 1 + depth,
+    so the event rate rises and falls with it (0 <= depth < 1).
+    """
+
+    def __init__(self, base: Scene, depth: float = 0.8, period: float = 2.0):
+        super().__init__(base.sensor_size, base.duration)
+        if not 0 <= depth < 1:
+            raise EventDataError(f"depth must be in [0, 1) so that time keeps running forward, got {depth}")
+        if not period > 0:
+            raise EventDataError(f"period must be positive seconds, got {period}")
+        self.base, self.depth, self.period = base, float(depth), float(period)
+
+    def warp(self, t) -> np.ndarray:
+        """s(t): the base scene's time shown at time t (seconds)."""
+        w = 2 * np.pi / self.period
+        return np.asarray(t, dtype=np.float64) + self.depth * np.sin(w * np.asarray(t, dtype=np.float64)) / w
+
+    def speed(self, t) -> np.ndarray:
+        """s'(t): playback speed relative to the base scene."""
+        return 1 + self.depth * np.cos(2 * np.pi * np.asarray(t, dtype=np.float64) / self.period)
+
+    @property
+    def max_speed(self) -> float:
+        return float(self.base.max_speed) * (1 + self.depth)
+
+    def _log_intensity(self, t: np.ndarray) -> np.ndarray:
+        return self.base.log_intensity(self.warp(t))
+
+
+# ---- seams ----------------------------------------------------------------------------------
+
+def ensemble_predictions(rec, times, *, align: bool = True, crossfade: bool = True) -> np.ndarray:
+    """Log intensity [Q, H, W] of a Reconstruction's networks, mixed four ways.
+
+    align: add the alignment offsets (``rec.offsets``); otherwise every network gets network 0's
+        offset (the global brightness anchor only), i.e. the raw networks.
+    crossfade: linear ramps across the overlaps (what ``reconstruct`` does); otherwise a hard switch
+        from network k-1 to k at the middle of their overlap.
+    """
+    times = np.atleast_1d(np.asarray(times, dtype=np.float64))
+    offsets = rec.offsets if align else np.broadcast_to(rec.offsets[:1], rec.offsets.shape).copy()
+    if crossfade:
+        return blend_networks(rec.model, rec.windows, times, offsets)
+    centres = 0.5 * (rec.windows[1:, 0] + rec.windows[:-1, 1])
+    k = np.searchsorted(centres, times)
+    F = predict_networks(rec.model, times)                                   # [N, Q, H, W]
+    return (F[k, np.arange(len(times))] + offsets[k]).astype(np.float32)
+
+
+def frame_change(L, times) -> np.ndarray:
+    """Mean |dL/dt| between consecutive frames, [Q - 1] (log units per second), at the mid-times."""
+    L = np.asarray(L, dtype=np.float64)
+    return np.abs(np.diff(L, axis=0)).mean(axis=(1, 2)) / np.diff(np.asarray(times, dtype=np.float64))
+
+
+def overlap_mask(windows, times) -> np.ndarray:
+    """bool [Q]: the times that lie inside an overlap of two neighbouring windows."""
+    windows = np.asarray(windows, dtype=np.float64)
+    t = np.asarray(times, dtype=np.float64)
+    mask = np.zeros(t.shape, bool)
+    for k in range(1, len(windows)):
+        mask |= (t > windows[k, 0]) & (t < windows[k - 1, 1])
+    return mask
+
+
+# ---- batched versus sequential training -----------------------------------------------------
+
+def window_bins(events: Events, windows, bin_duration: float, C: float, device=None) -> dict:
+    """Equal-duration bins of about ``bin_duration`` s in every window, the same number per window.
+
+    Returns a dict of tensors on ``device``: "centers" float64 [N, B] (s), "durations" float32 [N, B]
+    (s) and "frames" float32 [N, B, H, W] (C times the summed polarities per pixel and bin).
+    """
+    windows = np.asarray(windows, dtype=np.float64)
+    n_bins = max(1, int(round((windows[0, 1] - windows[0, 0]) / bin_duration)))
+    edges = [np.linspace(lo, hi, n_bins + 1) for lo, hi in windows]
+    frames = np.stack([events_to_frames(events, e, C).frames for e in edges])
+    b = np.stack(edges)
+    device = default_device(None) if device is None else torch.device(device)
+    return {"centers": torch.as_tensor(0.5 * (b[:, 1:] + b[:, :-1]), device=device),
+            "durations": torch.as_tensor(np.diff(b, axis=1), dtype=torch.float32, device=device),
+            "frames": torch.as_tensor(frames, device=device)}
+
+
+def _take(bins: dict, k: int) -> dict:
+    return {name: v[k:k + 1] for name, v in bins.items()}
+
+
+def per_network_loss(model: FrameINR, bins: dict, lam: float = 0.05) -> torch.Tensor:
+    """Each network's loss, [N]: temporal (Eq. 5-6, derivative form) + lam * Tikhonov (Eq. 9).
+
+    Averaged within a network and never across networks, so that network k's gradient is the same
+    whether it is trained alone or inside a batch (the sum of these is what the batch minimises).
+    """
+    F, dF = model.forward_with_derivative(bins["centers"])
+    temporal = ((bins["frames"] - dF * bins["durations"][..., None, None]) ** 2).mean(dim=(1, 2, 3))
+    dx, dy = spatial_differences(F)
+    return temporal + lam * ((dx ** 2).mean(dim=(1, 2, 3)) + (dy ** 2).mean(dim=(1, 2, 3)))
+
+
+def train_networks(model: FrameINR, bins: dict, n_iters: int, *, lr: float = 1e-4, head_lr_scale: float = 30.0,
+                   lam: float = 0.05) -> float:
+    """Train ``model`` (all its networks at once) for n_iters Adam steps in place; returns seconds.
+
+    The optimiser is the solver's (Adam, head learning rate x head_lr_scale), without the schedule.
+    """
+    head = [model.head_weight, model.head_bias]
+    trunk = [p for name, p in model.named_parameters() if not name.startswith("head_")]
+    opt = torch.optim.Adam([{"params": trunk}, {"params": head, "lr": lr * head_lr_scale}], lr=lr)
+    t0 = time.perf_counter()
+    for _ in range(n_iters):
+        loss = per_network_loss(model, bins, lam).sum()
+        opt.zero_grad(set_to_none=True)
+        loss.backward()
+        opt.step()
+    if bins["frames"].is_cuda:
+        torch.cuda.synchronize()
+    return time.perf_counter() - t0
+
+
+def single_copies(model: FrameINR) -> list[FrameINR]:
+    """N one-network FrameINRs holding exactly the weights of ``model``'s N networks (copies)."""
+    d = model.weights[0].shape[-1]
+    out = []
+    for k in range(model.n_models):
+        single = FrameINR(model.sensor_size, model.windows[k:k + 1].cpu().numpy(), d, len(model.weights) - 1,
+                          model.omega_0, model.first_omega_0)
+        single.load_state_dict({name: v[k:k + 1].clone() for name, v in model.state_dict().items()})
+        out.append(single.to(model.head_weight.device))
+    return out
+
+
+def batched_vs_sequential(events: Events, windows, *, hidden_features: int = 64, hidden_layers: int = 2,
+                          n_iters: int = 30, bin_duration: float = 1 / 32, C: float = 0.2, lam: float = 0.05,
+                          repeats: int = 2, seed: int = 0, device=None) -> dict:
+    """Train N networks (one per window) in one batched pass, and the same N one after another.
+
+    Both start from identical weights (the sequential networks are :func:`single_copies` of the
+    batched model's initial weights) and do the same work: N networks x n_iters steps on the same
+    bins. The two timings alternate ``repeats`` times after a short warm-up (which one goes first
+    alternates too); the fastest of each is kept, so both see the same machine load as far as possible.
+
+    Returns:
+        dict with "n_models", "batched_s", "sequential_s", "ratio" (sequential / batched),
+        "max_abs_diff" (largest difference of the trained predictions at the bin centres, log
+        units), "pred_scale" (their standard deviation) and "n_parameters" (all N networks).
+    """
+    device = default_device(None) if device is None else torch.device(device)
+    windows = np.asarray(windows, dtype=np.float64)
+    bins = window_bins(events, windows, bin_duration, C, device)
+    init = FrameINR(events.sensor_size, windows, hidden_features, hidden_layers, 30.0, 10.0, seed=seed).to(device)
+    # warm-up: the first steps allocate memory and pick kernels
+    train_networks(copy.deepcopy(init), bins, 2, lam=lam)
+    train_networks(single_copies(init)[0], _take(bins, 0), 2, lam=lam)
+    batched_s, sequential_s = [], []
+    for r in range(max(1, repeats)):
+        batched, singles = copy.deepcopy(init), single_copies(init)
+        order = ("batched", "sequential") if r % 2 == 0 else ("sequential", "batched")   # which goes first alternates
+        for which in order:
+            if which == "batched":
+                batched_s.append(train_networks(batched, bins, n_iters, lam=lam))
+            else:
+                sequential_s.append(sum(train_networks(m, _take(bins, k), n_iters, lam=lam)
+                                        for k, m in enumerate(singles)))
+    with torch.no_grad():
+        F_batched = batched(bins["centers"])
+        F_single = torch.cat([m(bins["centers"][k:k + 1]) for k, m in enumerate(singles)])
+    return {"n_models": len(windows), "batched_s": min(batched_s), "sequential_s": min(sequential_s),
+            "ratio": min(sequential_s) / min(batched_s),
+            "max_abs_diff": float((F_batched - F_single).abs().max()),
+            "pred_scale": float(F_batched.std()), "n_parameters": init.num_parameters()}

@@ -1,0 +1,66 @@
+"""Notebook 03 (the coordinate network): exercise registrations.
+
+- ``split_index``: a flat index over (bin, row, column) back to (bin, y, x);
+- ``tikhonov_autograd``: Eq. 9 on autograd derivatives.
+
+The references are the library's :func:`evinr_lite.method.coordinate.split_index` and
+:func:`~evinr_lite.method.coordinate.tikhonov_autograd`; each hint is a deliberately wrong version.
+"""
+from __future__ import annotations
+
+import torch
+
+from ..method.coordinate import split_index, tikhonov_autograd
+from . import exercises
+
+__all__: list[str] = []
+
+
+def _inputs_split(rng):
+    cases = []
+    for H, W, B in ((2, 3, 4), (5, 7, 3), (16, 20, 32)):
+        index = torch.as_tensor(rng.integers(0, B * H * W, 12), dtype=torch.int64)
+        cases.append(dict(index=index, sensor_size=(H, W)))
+    return cases
+
+
+def _inputs_tikhonov(rng):
+    cases = []
+    for M in (5, 64):
+        gx = torch.as_tensor(rng.normal(0, 0.3, M), dtype=torch.float32)
+        gy = torch.as_tensor(rng.normal(0, 0.5, M), dtype=torch.float32)
+        cases.append(dict(dF_dx=gx, dF_dy=gy))
+    return cases
+
+
+def _split_swapped(index, sensor_size):
+    H, W = sensor_size
+    return index // (H * W), index % W, (index // W) % H
+
+
+def _split_by_height(index, sensor_size):
+    H, W = sensor_size
+    return index // (H * W), index % H, (index // H) % W
+
+
+exercises.register(
+    "split_index", split_index, _inputs_split,
+    hints={
+        "x and y are swapped: y is the row (index // W) % H, x the column index % W":
+            _split_swapped,
+        "rows are W pixels long: the column is index % W (not % H), the row (index // W) % H":
+            _split_by_height,
+    })
+
+exercises.register(
+    "tikhonov_autograd", tikhonov_autograd, _inputs_tikhonov, rtol=1e-5, atol=1e-7,
+    hints={
+        "use the mean over the minibatch, not the sum":
+            lambda dF_dx, dF_dy: torch.sum(dF_dx ** 2 + dF_dy ** 2),
+        "Eq. 9 squares the gradients (|dF/dx| + |dF/dy| is total variation, another regularizer)":
+            lambda dF_dx, dF_dy: torch.mean(dF_dx.abs() + dF_dy.abs()),
+        "Eq. 9 uses both directions: (dF/dx)^2 + (dF/dy)^2":
+            lambda dF_dx, dF_dy: torch.mean(dF_dx ** 2),
+        "square each gradient, not their sum: (dF/dx)^2 + (dF/dy)^2":
+            lambda dF_dx, dF_dy: torch.mean((dF_dx + dF_dy) ** 2),
+    })

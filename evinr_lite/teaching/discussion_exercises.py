@@ -1,0 +1,110 @@
+"""Notebook 08 (discussion experiments): exercise registrations.
+
+- ``highpass_per_event``: the high-pass filter of Scheerlinck et al. event by event; the reference
+  is the library's :func:`evinr_lite.method.baselines.highpass_per_event`, which the tests pin to
+  the vectorised :func:`~evinr_lite.method.baselines.highpass_filter`;
+- ``render_event_counts``: events re-rendered from a model's log intensity at bin boundaries; the
+  reference is :func:`evinr_lite.evaluation.enhance.render_event_counts`.
+
+Each hint is a deliberately wrong version (same signature) that makes one common mistake.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..evaluation.enhance import render_counts, render_event_counts
+from ..method.baselines import highpass_per_event
+from . import exercises
+
+__all__: list[str] = []
+
+
+def _inputs_highpass(rng):
+    cases = []
+    for n, (H, W), alpha in ((12, (2, 3), 2 * math.pi), (40, (3, 4), 5.0), (25, (1, 5), 0.0)):
+        t = np.sort(rng.uniform(0.0, 1.0, n))
+        cases.append(dict(t=t, x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=rng.choice([-1, 1], n),
+                          sensor_size=(H, W), C=0.2, alpha=alpha, t_end=1.2))
+    return cases
+
+
+def _no_final_decay(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_last = np.full((H, W), float(t_start))
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * state[yi, xi] + C * pi
+        t_last[yi, xi] = ti
+    return state
+
+
+def _global_last_time(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_prev = float(t_start)
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        state[yi, xi] = np.exp(-alpha * (ti - t_prev)) * state[yi, xi] + C * pi
+        t_prev = ti
+    return state * np.exp(-alpha * (t_end - t_prev))
+
+
+def _decay_after_adding(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_last = np.full((H, W), float(t_start))
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * (state[yi, xi] + C * pi)
+        t_last[yi, xi] = ti
+    return state * np.exp(-alpha * (t_end - t_last))
+
+
+exercises.register(
+    "highpass_per_event", highpass_per_event, _inputs_highpass, rtol=1e-7, atol=1e-10,
+    hints={
+        "after the last event, decay every pixel to t_end (exp(-alpha (t_end - t_last)))": _no_final_decay,
+        "each pixel decays since its own last event: keep one t_last per pixel, not one for the stream":
+            _global_last_time,
+        "decay the old state first, then add C * p (the new event has not decayed yet)": _decay_after_adding,
+    })
+
+
+def _inputs_render(rng):
+    cases = []
+    for B, shape, C in ((4, (2, 3), 0.2), (6, (3, 4), 0.25), (5, (1, 6), 0.5)):
+        steps = rng.normal(0.0, 2.5 * C, (B,) + shape)
+        L = np.concatenate([rng.normal(0.0, 1.0, (1,) + shape), steps]).cumsum(axis=0)
+        cases.append(dict(L_boundaries=L, C=C))
+    return cases
+
+
+def _no_carry(L_boundaries, C):
+    L = np.asarray(L_boundaries, dtype=np.float64)
+    return np.trunc(np.diff(L, axis=0) / C).astype(np.int64)
+
+
+def _round_nearest(L_boundaries, C):
+    return render_counts(L_boundaries, C, np.round)
+
+
+def _reference_to_level(L_boundaries, C):
+    L = np.asarray(L_boundaries, dtype=np.float64)
+    ref = L[0].copy()
+    out = np.empty((L.shape[0] - 1,) + L.shape[1:], dtype=np.int64)
+    for k in range(1, L.shape[0]):
+        n = np.trunc((L[k] - ref) / C)
+        ref = np.where(n != 0, L[k], ref)
+        out[k - 1] = n
+    return out
+
+
+exercises.register(
+    "render_event_counts", render_event_counts, _inputs_render,
+    hints={
+        "carry the remainder: compare with a reference level that moves by whole steps n * C, "
+        "not with the previous boundary": _no_carry,
+        "a camera fires only once the change reaches C: round toward zero (np.trunc), not to the nearest": _round_nearest,
+        "move the reference by n * C, not to the current level (the part below C must carry over)":
+            _reference_to_level,
+    })

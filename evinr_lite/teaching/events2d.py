@@ -1,0 +1,201 @@
+"""Many pixels: events from a moving picture, and event frames (Eq. 2). Notebook 02.
+
+The reference solutions of notebook 02's exercises live here and are registered with
+:mod:`evinr_lite.teaching.exercises` at import:
+
+- :func:`esim_interval`: one pixel, one frame interval of the ESIM-style simulator: every
+  level crossed between two samples is one event, with a linearly interpolated timestamp.
+  :func:`evinr_lite.sim.simulate.simulate_video` does exactly this for all pixels at once.
+- :func:`events_to_frames_fixed`: Eq. 2 per pixel and bin, C times the sum of polarities of
+  the events in (b_i, b_{i+1}], written with ``np.add.at``.
+  :func:`evinr_lite.method.binning.events_to_frames` is the package's version (with ``np.bincount``).
+
+Small helpers for the notebook: :func:`pixel_trace` (one pixel's events) and
+:func:`busiest_pixel`.
+
+Times are float64 seconds; polarities are +-1; C is the contrast threshold (log units).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import exercises
+from ..core.events import Events
+
+__all__ = ["esim_interval", "events_to_frames_fixed", "pixel_trace", "busiest_pixel"]
+
+
+# ---- exercise 1: the simulator for one pixel and one frame interval ------------------------
+
+def esim_interval(L_a, L_b, t_a, t_b, ref, C):
+    """Events of one pixel between two samples of its log intensity (ESIM-style).
+
+    Between the samples (t_a, L_a) and (t_b, L_b), L is taken to be linear. The pixel fires an
+    ON event at each level ``ref + k*C`` (k = 1, 2, ...) that L reaches on the way up, or an OFF
+    event at each level ``ref - k*C`` on the way down; the time of an event is where the
+    straight line from L_a to L_b crosses its level.
+
+    Args:
+        L_a, L_b: log intensity at the two samples (floats).
+        t_a, t_b: the sample times (s), t_a < t_b.
+        ref: the pixel's reference level (log intensity of its last event, or L at the start).
+        C: contrast threshold (log units), the same for ON and OFF.
+
+    Returns:
+        (times float64 [n], polarities int8 [n], new reference level float): n >= 0 events in
+        time order, and the reference moved by exactly n steps of C (not set to L_b).
+    """
+    d = L_b - ref
+    p = 1 if d > 0 else -1
+    n = int(np.floor(abs(d) / C))                        # levels crossed
+    levels = ref + p * C * np.arange(1, n + 1)
+    times = t_a + (levels - L_a) / (L_b - L_a) * (t_b - t_a) if n else np.zeros(0)
+    return times.astype(np.float64), np.full(n, p, dtype=np.int8), float(ref + p * n * C)
+
+
+def _inputs_esim(rng):
+    cases = []
+    for L_a, L_b, ref in ((0.0, 0.55, 0.0),            # rise through 2 levels of 0.25
+                          (0.1, -0.62, 0.08),          # fall through 3 levels
+                          (0.3, 0.35, 0.2),            # small change: no event
+                          (-1.0, -1.0, -1.1)):         # no change at all
+        cases.append(dict(L_a=L_a, L_b=L_b, t_a=0.5, t_b=0.52, ref=ref, C=0.25))
+    for _ in range(3):                                 # random slopes, several crossings
+        ref = rng.normal()
+        L_a = ref + rng.uniform(-0.19, 0.19)
+        cases.append(dict(L_a=L_a, L_b=L_a + rng.normal(0, 0.8), t_a=1.0, t_b=1.0 + rng.uniform(0.001, 0.02),
+                          ref=ref, C=0.2))
+    return cases
+
+
+def _esim_at_sample_times(L_a, L_b, t_a, t_b, ref, C):
+    times, p, new_ref = esim_interval(L_a, L_b, t_a, t_b, ref, C)
+    return np.full(times.size, float(t_b)), p, new_ref
+
+
+def _esim_ref_to_L(L_a, L_b, t_a, t_b, ref, C):
+    times, p, _ = esim_interval(L_a, L_b, t_a, t_b, ref, C)
+    return times, p, float(L_b) if times.size else float(ref)
+
+
+def _esim_from_sample(L_a, L_b, t_a, t_b, ref, C):
+    return esim_interval(L_a, L_b, t_a, t_b, L_a, C)
+
+
+exercises.register(
+    "esim_interval", esim_interval, _inputs_esim,
+    hints={
+        "the timestamps should be interpolated inside the interval, not put at the sample time t_b":
+            _esim_at_sample_times,
+        "move the reference by n * C (to the last level crossed), not to L_b: the remainder L_b - level "
+        "counts towards the next event":
+            _esim_ref_to_L,
+        "measure the change from the reference level `ref`, not from the previous sample L_a":
+            _esim_from_sample,
+    })
+
+
+# ---- exercise 2: event frames over bins (Eq. 2) --------------------------------------------
+
+def events_to_frames_fixed(events: Events, boundaries, C):
+    """Event frames: ``frames[i, y, x] = C * sum of p`` over the events at (x, y) with
+    ``b_i < t <= b_{i+1}`` (bin 0 also takes an event at exactly b_0; events outside
+    [b_0, b_B] are dropped).
+
+    Args:
+        events: an :class:`Events` (t sorted, x column, y row, p +-1, sensor_size (H, W)).
+        boundaries: float [B + 1] increasing bin edges (s).
+        C: contrast threshold.
+
+    Returns:
+        float32 [B, H, W].
+    """
+    b = np.asarray(boundaries, dtype=np.float64)
+    H, W = events.sensor_size
+    B = b.size - 1
+    i = np.searchsorted(b, events.t, side="left") - 1   # b[i] < t <= b[i+1]
+    i[events.t == b[0]] = 0                              # bin 0 is closed on the left
+    keep = (i >= 0) & (i < B)
+    frames = np.zeros((B, H, W), dtype=np.float64)
+    np.add.at(frames, (i[keep], events.y[keep], events.x[keep]), events.p[keep])
+    return (C * frames).astype(np.float32)
+
+
+def _random_events(rng, n, sensor_size, t0=0.0, t1=1.0) -> Events:
+    H, W = sensor_size
+    t = np.sort(rng.uniform(t0, t1, n))
+    return Events(t, rng.integers(0, W, n), rng.integers(0, H, n), rng.choice(np.array([-1, 1]), n), (H, W))
+
+
+def _inputs_frames(rng):
+    cases = []
+    ev = _random_events(rng, 40, (4, 4))
+    cases.append(dict(events=ev, boundaries=np.array([0.0, 0.25, 0.5, 0.75, 1.0]), C=0.2))
+    # events exactly on the edges, at the first edge and outside the range
+    t = np.array([0.0, 0.1, 0.25, 0.25, 0.3, 0.5, 0.6, 0.9])
+    ev = Events(t, np.array([0, 1, 1, 2, 0, 2, 1, 0]), np.array([0, 0, 1, 1, 1, 0, 0, 1]),
+                np.array([1, -1, 1, 1, -1, 1, 1, -1]), (2, 3))
+    cases.append(dict(events=ev, boundaries=np.array([0.0, 0.25, 0.5]), C=0.5))
+    ev = _random_events(rng, 300, (5, 7))
+    cases.append(dict(events=ev, boundaries=np.array([0.1, 0.2, 0.45, 0.5, 0.8, 0.95]), C=0.15))
+    return cases
+
+
+def _frames_right(events, boundaries, C):
+    b = np.asarray(boundaries, dtype=np.float64)
+    H, W = events.sensor_size
+    i = np.searchsorted(b, events.t, side="right") - 1
+    keep = (i >= 0) & (i < b.size - 1)
+    frames = np.zeros((b.size - 1, H, W))
+    np.add.at(frames, (i[keep], events.y[keep], events.x[keep]), events.p[keep])
+    return (C * frames).astype(np.float32)
+
+
+def _frames_abs(events, boundaries, C):
+    ones = Events(events.t, events.x, events.y, np.ones(len(events), np.int8), events.sensor_size)
+    return events_to_frames_fixed(ones, boundaries, C)
+
+
+def _frames_xy_swapped(events, boundaries, C):
+    H, W = events.sensor_size
+    if H != W:
+        raise ValueError("only a square sensor can be indexed both ways")   # the check skips this hint
+    return events_to_frames_fixed(events, boundaries, C).transpose(0, 2, 1)
+
+
+def _frames_no_first_edge(events, boundaries, C):
+    b = np.asarray(boundaries, dtype=np.float64)
+    return events_to_frames_fixed(events.take(events.t != b[0]), b, C)
+
+
+exercises.register(
+    "events_to_frames_fixed", events_to_frames_fixed, _inputs_frames,
+    hints={
+        "an event exactly on an edge b_{i+1} belongs to bin i, (b_i, b_{i+1}]: use "
+        "np.searchsorted(boundaries, t, side='left') - 1":
+            _frames_right,
+        "did you forget the sign of the polarity? ON events add C, OFF events subtract C":
+            _frames_abs,
+        "did you forget to multiply by the contrast threshold C?":
+            lambda events, boundaries, C: events_to_frames_fixed(events, boundaries, 1.0),
+        "an event at exactly t = b_0 belongs to bin 0 (the first bin is closed on the left)":
+            _frames_no_first_edge,
+        "images are indexed [y, x] (row, column)":
+            _frames_xy_swapped,
+    })
+
+
+# ---- helpers --------------------------------------------------------------------------------
+
+def pixel_trace(events: Events, x: int, y: int) -> tuple[np.ndarray, np.ndarray]:
+    """(t float64 [n], p int8 [n]) of the events of the pixel at column ``x``, row ``y``."""
+    keep = (events.x == x) & (events.y == y)
+    return events.t[keep], events.p[keep]
+
+
+def busiest_pixel(events: Events) -> tuple[int, int]:
+    """(x, y) of the pixel with the most events (the first in row-major order on a tie)."""
+    H, W = events.sensor_size
+    counts = np.bincount(events.y.astype(np.int64) * W + events.x, minlength=H * W)
+    y, x = divmod(int(np.argmax(counts)), W)
+    return x, y

@@ -1,0 +1,389 @@
+"""Exercises that keep a notebook runnable, finished or not.
+
+An exercise has three parts:
+
+- a **stub** in the notebook: the function's signature and docstring. The instructor copy
+  holds the solution between ``### BEGIN SOLUTION`` and ``### END SOLUTION`` lines; the
+  student copy (generated from it) has ``raise NotImplementedError`` instead;
+- a **reference solution** in the package, registered here under the exercise's name;
+- a **check** that runs the learner's function and the reference on small seeded inputs
+  and says what is wrong: not done yet, an exception, a wrong type, shape or dtype, or
+  wrong values (where, by how much, and a hint when the mistake is a known one).
+
+Typical notebook cells::
+
+    from evinr_lite.teaching import exercises
+
+    def integrate_events_1d(t_events, p_events, C, t_query):
+        ### BEGIN SOLUTION
+        ...
+        ### END SOLUTION
+
+    exercises.check("integrate_events_1d", integrate_events_1d)      # prints a report
+
+    # later cells: the learner's version if it passes, otherwise the reference + a warning
+    integrate = exercises.use("integrate_events_1d", integrate_events_1d)
+
+Registering an exercise (done in a module of :mod:`evinr_lite.teaching`, at import; the reference
+may be a library function or a teaching version pinned to one by a test)::
+
+    exercises.register("integrate_events_1d", reference, make_inputs,
+                       hints={"did you forget the sign of the polarity?": wrong_version})
+
+``make_inputs(rng)`` gets a seeded ``numpy.random.Generator`` and returns a list of cases;
+a case is a dict of keyword arguments (preferred: the names appear in the report) or a
+tuple of positional arguments. A hint maps a message to a *wrong version* of the
+reference (same signature) that makes the mistake: when the learner's output matches the
+wrong version's output, the message is shown.
+"""
+from __future__ import annotations
+
+import copy
+import importlib
+import inspect
+import traceback
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+__all__ = [
+    "Exercise", "ExerciseWarning", "register", "exercise", "get", "names", "reference",
+    "check", "use", "solution_or_reference", "show_reference",
+]
+
+# Modules that register reference solutions at import; imported on the first lookup of an
+# unknown name, so ``check`` works without the notebook importing them first.
+REFERENCE_MODULES = ["evinr_lite.teaching." + name for name in (
+    "pde1d", "events2d", "coordinate_exercises", "frame_exercises", "accel_exercises", "ablation_exercises",
+    "discussion_exercises", "realdata_exercises", "aed_exercises", "recording_exercises")]
+
+SEED = 0
+
+
+class ExerciseWarning(UserWarning):
+    """An exercise is unfinished or wrong, and the reference solution is used instead."""
+
+
+@dataclass
+class Exercise:
+    """One registered exercise (see the module docstring)."""
+
+    name: str
+    reference: Callable
+    make_inputs: Callable[[np.random.Generator], list]
+    hints: dict[str, Callable] = field(default_factory=dict)
+    rtol: float = 1e-5
+    atol: float = 1e-8
+    compare: Callable[[Any, Any], str | None] | None = None
+
+    def cases(self) -> list[tuple[tuple, dict]]:
+        """The seeded inputs as (args, kwargs) pairs."""
+        out = []
+        for case in self.make_inputs(np.random.default_rng(SEED)):
+            if isinstance(case, dict):
+                out.append(((), dict(case)))
+            elif isinstance(case, tuple):
+                out.append((case, {}))
+            else:
+                raise TypeError(f"exercise {self.name!r}: make_inputs must return dicts or tuples, got {type(case)}")
+        return out
+
+
+_REGISTRY: dict[str, Exercise] = {}
+
+
+def register(name: str, reference: Callable, make_inputs: Callable, *, hints: dict | None = None,
+             rtol: float = 1e-5, atol: float = 1e-8,
+             compare: Callable[[Any, Any], str | None] | None = None) -> Exercise:
+    """Register (or replace) an exercise.
+
+    Args:
+        name: the exercise's name, used in ``check(name, fn)``.
+        reference: the reference solution.
+        make_inputs: ``make_inputs(rng) -> list of cases`` (dicts of keyword arguments or
+            tuples of positional arguments); keep them small.
+        hints: ``{message: wrong_version}``; the message is shown when the learner's output
+            matches ``wrong_version``'s output on the failing input.
+        rtol, atol: tolerances for comparing numbers (``numpy.isclose``).
+        compare: optional ``compare(got, expected) -> message or None`` replacing the
+            built-in comparison.
+    """
+    if not callable(reference) or not callable(make_inputs):
+        raise TypeError("register needs a callable reference and a callable make_inputs(rng)")
+    ex = Exercise(name, reference, make_inputs, dict(hints or {}), rtol, atol, compare)
+    _REGISTRY[name] = ex
+    return ex
+
+
+def exercise(name: str, make_inputs: Callable, **kwargs) -> Callable:
+    """Decorator form of :func:`register`: ``@exercise("name", make_inputs)`` above the reference."""
+    def wrap(reference):
+        register(name, reference, make_inputs, **kwargs)
+        return reference
+    return wrap
+
+
+def get(name: str) -> Exercise:
+    """The registered exercise ``name`` (KeyError listing the known names otherwise)."""
+    if name not in _REGISTRY:
+        for module in REFERENCE_MODULES:
+            try:
+                importlib.import_module(module)
+            except ImportError:  # pragma: no cover - a broken optional module must not hide the KeyError
+                pass
+    if name not in _REGISTRY:
+        raise KeyError(f"no exercise named {name!r}; known exercises: {', '.join(names()) or 'none'}")
+    return _REGISTRY[name]
+
+
+def names() -> list[str]:
+    return sorted(_REGISTRY)
+
+
+def reference(name: str) -> Callable:
+    """The reference solution of exercise ``name``."""
+    return get(name).reference
+
+
+def show_reference(name: str) -> None:
+    """Print the reference solution's source (to compare after trying)."""
+    print(inspect.getsource(get(name).reference))
+
+
+# ---- comparing outputs ------------------------------------------------------------
+
+def _is_tensor(x) -> bool:
+    return type(x).__module__.startswith("torch") and hasattr(x, "detach")
+
+
+def _to_numpy(x):
+    if _is_tensor(x):
+        return x.detach().cpu().numpy()
+    return np.asarray(x)
+
+
+def _fmt(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        return f"{float(v):.4g}"
+    return str(v)
+
+
+def _describe_value(v) -> str:
+    if _is_tensor(v):
+        return f"tensor {str(v.dtype).replace('torch.', '')}{list(v.shape)}"
+    if isinstance(v, np.ndarray):
+        return f"{v.dtype}{list(v.shape)}" if v.size > 4 else np.array2string(v, precision=3)
+    if isinstance(v, (list, tuple)) and len(v) > 4:
+        return f"{type(v).__name__} of {len(v)}"
+    return _fmt(v) if isinstance(v, (int, float, np.number)) else repr(v)
+
+
+def _describe_case(args: tuple, kwargs: dict) -> str:
+    parts = [_describe_value(a) for a in args] + [f"{k}={_describe_value(v)}" for k, v in kwargs.items()]
+    return ", ".join(parts)
+
+
+def _kind(a: np.ndarray) -> str:
+    return {"b": "bool", "i": "integer", "u": "integer", "f": "float", "c": "complex"}.get(a.dtype.kind, str(a.dtype))
+
+
+@dataclass
+class _Problem:
+    message: str
+    values: bool = False  # True when shapes/types agree and only the numbers differ
+
+
+def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Problem | None:
+    at = f" in output {where}" if where else ""
+    if got is None and expected is not None:
+        return _Problem(f"returned None{at}; did you forget the `return` statement?")
+    if isinstance(expected, (tuple, list)):
+        if not isinstance(got, (tuple, list)):
+            return _Problem(f"returned a {type(got).__name__}{at}, expected a {type(expected).__name__} of {len(expected)} items")
+        if len(got) != len(expected):
+            return _Problem(f"returned {len(got)} items{at}, expected {len(expected)}")
+        for k, (g, e) in enumerate(zip(got, expected)):
+            p = _compare(g, e, rtol, atol, f"{where}[{k}]")
+            if p is not None:
+                return p
+        return None
+    if isinstance(expected, dict):
+        if not isinstance(got, dict) or set(got) != set(expected):
+            return _Problem(f"returned {type(got).__name__}{at}, expected a dict with keys {sorted(expected)}")
+        for k in expected:
+            p = _compare(got[k], expected[k], rtol, atol, f"{where}[{k!r}]")
+            if p is not None:
+                return p
+        return None
+    if _is_tensor(expected) and not _is_tensor(got):
+        return _Problem(f"returned a {type(got).__name__}{at}, expected a torch.Tensor: keep the computation "
+                        "in torch so that it can be back-propagated")
+    if isinstance(expected, (np.ndarray, np.generic, int, float, bool)) or _is_tensor(expected):
+        try:
+            g = _to_numpy(got)
+        except Exception:
+            return _Problem(f"returned a {type(got).__name__}{at}, expected numbers")
+        e = _to_numpy(expected)
+        if g.dtype == object or g.dtype.kind not in "biufc":
+            return _Problem(f"returned {type(got).__name__} of dtype {g.dtype}{at}, expected numbers")
+        if g.shape != e.shape:
+            return _Problem(f"wrong shape{at}: got {g.shape}, expected {e.shape}")
+        if _kind(g) != _kind(e):
+            return _Problem(f"wrong dtype{at}: got {_kind(g)} ({g.dtype}), expected {_kind(e)} ({e.dtype})")
+        close = np.isclose(g, e, rtol=rtol, atol=atol, equal_nan=True)
+        if np.all(close):
+            return None
+        bad = np.flatnonzero(~close.ravel())
+        diff = np.abs(g.astype(np.float64) - e.astype(np.float64)).ravel()
+        diff = np.where(np.isnan(diff), np.inf, diff)
+        worst = int(bad[np.argmax(diff[bad])])
+        if e.ndim == 0:
+            return _Problem(f"wrong value{at}: got {_fmt(g.item())}, expected {_fmt(e.item())}", values=True)
+        idx = np.unravel_index(worst, e.shape)
+        idx_s = str(idx[0]) if len(idx) == 1 else str(tuple(int(i) for i in idx))
+        return _Problem(
+            f"wrong values{at}: {bad.size} of {e.size} differ; at index {idx_s}: got {_fmt(g.ravel()[worst])}, "
+            f"expected {_fmt(e.ravel()[worst])}", values=True)
+    # anything else: plain equality
+    if got != expected:
+        return _Problem(f"got {got!r}{at}, expected {expected!r}", values=True)
+    return None
+
+
+def _generic_hint(got, expected) -> str | None:
+    """Recognise a few common patterns between a wrong and a right numeric output."""
+    try:
+        g = _to_numpy(got).astype(np.float64).ravel()
+        e = _to_numpy(expected).astype(np.float64).ravel()
+    except Exception:
+        return None
+    if g.shape != e.shape or g.size == 0 or not (np.all(np.isfinite(g)) and np.all(np.isfinite(e))):
+        return None
+    scale = max(np.abs(e).max(), 1e-12)
+    tol = 1e-6 * scale
+    if np.all(np.abs(g + e) <= tol) and np.any(np.abs(e) > tol):
+        return "the sign is flipped everywhere"
+    nz = np.abs(e) > tol
+    if nz.any() and np.all(np.abs(g[~nz]) <= tol):
+        ratios = g[nz] / e[nz]
+        if np.ptp(ratios) <= 1e-6 * max(1.0, abs(ratios[0])) and abs(ratios[0] - 1) > 1e-6:
+            return f"off by a constant factor: got {ratios[0]:.4g} x the expected values"
+    if g.size > 1:
+        d = g - e
+        if np.ptp(d) <= tol and abs(d[0]) > tol:
+            return f"off by a constant offset of {d[0]:.4g}"
+        if np.allclose(g[1:], e[:-1], atol=tol) or np.allclose(g[:-1], e[1:], atol=tol):
+            return "the values are shifted by one position; check the window/boundary indexing (< versus <=)"
+    return None
+
+
+def _where_raised(err: BaseException) -> list[str]:
+    """The line of the learner's code that raised (the last frame outside this module)."""
+    frames = [f for f in traceback.extract_tb(err.__traceback__) if f.filename != __file__]
+    if not frames:
+        return []
+    f = frames[-1]
+    code = f": `{f.line.strip()}`" if f.line else ""
+    return [f"raised in {f.name}, line {f.lineno}{code}"]
+
+
+def _run(fn, args, kwargs):
+    return fn(*copy.deepcopy(args), **copy.deepcopy(kwargs))
+
+
+def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
+    """(passed, headline, detail lines) without printing."""
+    if not callable(fn):
+        return False, f"expected a function, got {type(fn).__name__}", []
+    try:
+        cases = ex.cases()
+    except Exception as err:  # a bug in the exercise itself, not the learner's
+        return False, f"could not build the test inputs ({type(err).__name__}: {err})", []
+    n = len(cases)
+    for k, (args, kwargs) in enumerate(cases):
+        where = f"input #{k + 1} of {n} ({_describe_case(args, kwargs)})"
+        try:
+            got = _run(fn, args, kwargs)
+        except NotImplementedError:
+            return False, "not done yet: the function raises NotImplementedError", [
+                "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
+        except Exception as err:
+            return False, f"raised {type(err).__name__} on {where}", [f"{type(err).__name__}: {err}"] + _where_raised(err)
+        expected = _run(ex.reference, args, kwargs)
+        if ex.compare is not None:
+            msg = ex.compare(got, expected)
+            problem = None if msg is None else _Problem(msg, values=True)
+        else:
+            problem = _compare(got, expected, ex.rtol, ex.atol)
+        if problem is None:
+            continue
+        details = [problem.message]
+        hint = None
+        if problem.values:
+            for message, wrong in ex.hints.items():
+                try:
+                    w = _run(wrong, args, kwargs)
+                    if _compare(got, w, ex.rtol, ex.atol) is None:
+                        hint = message
+                        break
+                except Exception:
+                    continue
+            if hint is None:
+                hint = _generic_hint(got, expected)
+        if hint:
+            details.append(f"hint: {hint}")
+        return False, f"does not match the reference on {where}", details
+    return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
+
+
+def check(name: str, fn: Callable, *, verbose: bool = True) -> bool:
+    """Run ``fn`` against exercise ``name``'s reference and print a ✓/✗ report. Never raises.
+
+    Returns:
+        True when ``fn`` matches the reference on every seeded input.
+    """
+    try:
+        ex = get(name)
+    except KeyError as err:
+        if verbose:
+            print(f"✗ {err.args[0]}")
+        return False
+    try:
+        ok, headline, details = _evaluate(ex, fn)
+    except Exception as err:  # never raise from a check
+        ok, headline, details = False, f"the check itself failed ({type(err).__name__}: {err})", []
+    if verbose:
+        print(f"{'✓' if ok else '✗'} {name}: {headline}")
+        for line in details:
+            print(f"    {line}")
+    return ok
+
+
+def use(name: str, fn: Callable, *, verbose: bool = True) -> Callable:
+    """``fn`` when it passes exercise ``name``'s check, otherwise the reference solution.
+
+    When the reference is used, a warning (:class:`ExerciseWarning`) and a printed banner
+    say so, so that the cells below still run and the reader knows whose code they run.
+    """
+    ex = get(name)  # an unknown name is a mistake in the notebook itself: raise
+    try:
+        ok, headline, _ = _evaluate(ex, fn)
+    except Exception as err:
+        ok, headline = False, f"the check itself failed ({type(err).__name__}: {err})"
+    if ok:
+        if verbose:
+            print(f"✓ Using your {name}.")
+        return fn
+    banner = f"⚠ Exercise '{name}' is not finished: the cells below use the reference solution."
+    if verbose:
+        rule = "=" * 88
+        print(f"{rule}\n{banner}\n  Why: {headline}.\n"
+              f"  Run exercises.check({name!r}, your_function) for details.\n{rule}")
+    warnings.warn(f"Exercise '{name}' is not finished ({headline}); the cells below use the reference solution.",
+                  ExerciseWarning, stacklevel=2)
+    return ex.reference
+
+
+solution_or_reference = use

@@ -1,0 +1,253 @@
+"""Frame-based EvINR in the notebooks: exercise references (04, 05) and small teaching helpers.
+
+Exercises (reference solutions, registered with :mod:`evinr_lite.teaching.exercises` at import):
+
+- notebook 04, ``sine_layer_derivative``: one sine layer with its forward-mode time derivative,
+  the step that :meth:`evinr_lite.method.models.FrameINR.forward_with_derivative` repeats layer by layer;
+- notebook 04, ``temporal_loss_boundary``: the boundary-difference temporal loss
+  (F(b_{i+1}) - F(b_i) against the events of bin i);
+- notebook 05, ``reinhard_tonemap``: Eq. 12, (e^L / (e^L + 1))^gamma;
+- notebook 05, ``total_variation``: anisotropic total variation by finite differences.
+
+Helpers used by both notebooks:
+
+- :func:`best_offsets`: with *exact* changes of L, the only freedom left is a per-pixel offset
+  g(x, y); this finds the g that a regularizer prefers (closed form for Tikhonov, Adam for TV);
+- :func:`static_residual`, :func:`ghost_strength`: measure how much of the temporal-mean
+  image a reconstruction subtracts (the Tikhonov "ghost").
+"""
+from __future__ import annotations
+
+
+import numpy as np
+import torch
+
+from . import exercises
+from ..method.losses import spatial_differences
+
+__all__ = ["sine_layer_derivative", "temporal_loss_boundary", "reinhard_tonemap", "total_variation",
+           "best_offsets", "static_residual", "ghost_strength"]
+
+
+# ---- notebook 04 ---------------------------------------------------------------------------
+
+def sine_layer_derivative(h, dh_dt, weight, bias, omega):
+    """One sine layer and its time derivative (forward mode, the chain rule by hand).
+
+    z = omega * (h @ weight + bias), h_out = sin(z), dh_out/dt = cos(z) * omega * (dh_dt @ weight).
+
+    Args:
+        h: torch [T, d_in], the layer's input at T times.
+        dh_dt: torch [T, d_in], its derivative with respect to time.
+        weight: torch [d_in, d_out]. bias: torch [d_out]. omega: float frequency factor.
+
+    Returns:
+        (h_out, dh_out_dt): two torch tensors [T, d_out].
+    """
+    z = omega * (h @ weight + bias)
+    return torch.sin(z), torch.cos(z) * (omega * (dh_dt @ weight))
+
+
+def temporal_loss_boundary(F_boundaries, event_frames):
+    """The boundary-difference temporal loss: mean of (E_i - (F(b_{i+1}) - F(b_i)))^2.
+
+    Args:
+        F_boundaries: torch [B + 1, H, W], the model at the bin boundaries b_0 .. b_B.
+        event_frames: torch [B, H, W], E_i = C * (sum of p over the events in (b_i, b_{i+1}]).
+
+    Returns:
+        torch scalar (mean over bins and pixels).
+    """
+    predicted = F_boundaries[1:] - F_boundaries[:-1]
+    return torch.mean((event_frames - predicted) ** 2)
+
+
+def _inputs_sine(rng):
+    g = torch.Generator().manual_seed(0)
+    cases = []
+    for T, d_in, d_out, omega in ((3, 1, 4, 10.0), (5, 6, 3, 30.0), (4, 8, 8, 1.0)):
+        cases.append(dict(h=torch.rand(T, d_in, generator=g) * 2 - 1, dh_dt=torch.randn(T, d_in, generator=g),
+                          weight=(torch.rand(d_in, d_out, generator=g) * 2 - 1) / d_in,
+                          bias=torch.rand(d_out, generator=g) - 0.5, omega=omega))
+    return cases
+
+
+def _inputs_boundary(rng):
+    g = torch.Generator().manual_seed(1)
+    cases = []
+    for B, H, W in ((3, 2, 2), (6, 4, 5)):
+        F = torch.randn(B + 1, H, W, generator=g)
+        E = torch.randint(-3, 4, (B, H, W), generator=g).float() * 0.2
+        cases.append(dict(F_boundaries=F, event_frames=E))
+    return cases
+
+
+exercises.register(
+    "sine_layer_derivative", sine_layer_derivative, _inputs_sine, rtol=1e-4, atol=1e-6,
+    hints={
+        "the derivative of sin(z) is cos(z) times dz/dt: multiply by cos(z)":
+            lambda h, dh_dt, weight, bias, omega: (torch.sin(omega * (h @ weight + bias)), omega * (dh_dt @ weight)),
+        "dz/dt = omega * (dh/dt @ W): keep the factor omega (the bias has no derivative)":
+            lambda h, dh_dt, weight, bias, omega: (torch.sin(omega * (h @ weight + bias)),
+                                                   torch.cos(omega * (h @ weight + bias)) * (dh_dt @ weight)),
+        "the derivative of sin(z) is cos(z), not sin(z)":
+            lambda h, dh_dt, weight, bias, omega: (torch.sin(omega * (h @ weight + bias)),
+                                                   torch.sin(omega * (h @ weight + bias)) * omega * (dh_dt @ weight)),
+        "omega multiplies the bias too: z = omega * (h @ W + b)":
+            lambda h, dh_dt, weight, bias, omega: (torch.sin(omega * (h @ weight) + bias),
+                                                   torch.cos(omega * (h @ weight) + bias) * omega * (dh_dt @ weight)),
+    })
+
+exercises.register(
+    "temporal_loss_boundary", temporal_loss_boundary, _inputs_boundary,
+    hints={
+        "use the mean over bins and pixels, not the sum":
+            lambda F_boundaries, event_frames: torch.sum((event_frames - (F_boundaries[1:] - F_boundaries[:-1])) ** 2),
+        "the change over bin i is F(b_{i+1}) - F(b_i), later minus earlier":
+            lambda F_boundaries, event_frames: torch.mean((event_frames - (F_boundaries[:-1] - F_boundaries[1:])) ** 2),
+        "square the difference (an absolute value gives another loss)":
+            lambda F_boundaries, event_frames: torch.mean(torch.abs(event_frames - (F_boundaries[1:] - F_boundaries[:-1]))),
+    })
+
+
+# ---- notebook 05 ---------------------------------------------------------------------------
+
+def reinhard_tonemap(L, gamma):
+    """Eq. 12 on log intensities: I = exp(L), Gamma = (I / (I + 1))^gamma.
+
+    Args:
+        L: numpy float array, any shape (log intensity). gamma: positive float.
+
+    Returns:
+        numpy float64 array of the same shape, values in (0, 1).
+    """
+    I = np.exp(np.asarray(L, dtype=np.float64))
+    return (I / (I + 1.0)) ** gamma
+
+
+def total_variation(F):
+    """Anisotropic total variation by forward differences: mean |dF/dx| + mean |dF/dy|.
+
+    Args:
+        F: torch [..., H, W] (any leading dimensions, e.g. [T, H, W]).
+
+    Returns:
+        torch scalar: the mean of |F[..., :, 1:] - F[..., :, :-1]| plus the mean of
+        |F[..., 1:, :] - F[..., :-1, :]| (each averaged over its own differences).
+    """
+    dx = F[..., :, 1:] - F[..., :, :-1]
+    dy = F[..., 1:, :] - F[..., :-1, :]
+    return dx.abs().mean() + dy.abs().mean()
+
+
+def _inputs_tonemap(rng):
+    return [dict(L=rng.uniform(-4.0, 2.0, 7), gamma=0.6), dict(L=rng.normal(-1.0, 1.0, (3, 4)), gamma=1.0),
+            dict(L=rng.normal(0.0, 2.0, (2, 5)), gamma=2.2)]
+
+
+def _tonemap_without_exp(L, gamma):
+    L = np.asarray(L, dtype=np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (L / (L + 1.0)) ** gamma
+
+
+def _inputs_tv(rng):
+    g = torch.Generator().manual_seed(2)
+    return [dict(F=torch.randn(3, 4, generator=g)), dict(F=torch.randn(2, 5, 3, generator=g)),
+            dict(F=torch.randn(1, 6, 9, generator=g))]
+
+
+def _tv_pooled(F):
+    dx, dy = spatial_differences(F)
+    return torch.cat([dx.abs().flatten(), dy.abs().flatten()]).mean()
+
+
+exercises.register(
+    "reinhard_tonemap", reinhard_tonemap, _inputs_tonemap,
+    hints={
+        "the exponent is gamma, not 1 / gamma (1 / gamma is the public reference code's convention)":
+            lambda L, gamma: reinhard_tonemap(L, 1.0 / gamma),
+        "L is a log intensity: take I = exp(L) first":
+            _tonemap_without_exp,
+        "do not forget the exponent gamma":
+            lambda L, gamma: reinhard_tonemap(L, 1.0),
+    })
+
+exercises.register(
+    "total_variation", total_variation, _inputs_tv, rtol=1e-5, atol=1e-7,
+    hints={
+        "total variation takes absolute values; squares give Tikhonov (Eq. 9)":
+            lambda F: torch.mean((F[..., :, 1:] - F[..., :, :-1]) ** 2) + torch.mean((F[..., 1:, :] - F[..., :-1, :]) ** 2),
+        "use means, not sums":
+            lambda F: (F[..., :, 1:] - F[..., :, :-1]).abs().sum() + (F[..., 1:, :] - F[..., :-1, :]).abs().sum(),
+        "use both directions: |dF/dx| (along a row) and |dF/dy| (along a column)":
+            lambda F: (F[..., :, 1:] - F[..., :, :-1]).abs().mean(),
+        "average each direction over its own differences and add the two means":
+            _tv_pooled,
+    })
+
+
+# ---- helpers for notebooks 04 and 05 -------------------------------------------------------
+
+def best_offsets(L, regularizer: str = "tikhonov", n_iters: int = 400, lr: float = 0.05, seed: int = 0):
+    """The per-pixel offset g [H, W] a regularizer picks when the temporal loss is exact.
+
+    With exact changes, every F(t) = L(t) + g(x, y) has zero temporal loss, so the total loss is
+    lam * mean_t R(L(t) + g) and the optimum is the g minimising mean_t R(L(t) + g), whatever lam.
+
+    - "tikhonov": setting the gradient to zero gives D^T D (g + mean_t L) = 0, so
+      g = -mean_t L(t) + const (closed form; D are the finite differences).
+    - "tv": no closed form; minimised by Adam on the subgradient (lr decaying to 1 % over
+      ``n_iters``), starting from g = 0, in numpy.
+
+    Args:
+        L: float [T, H, W] true log intensities. Returns float64 [H, W] with zero mean.
+    """
+    L = np.asarray(L, dtype=np.float64)
+    if regularizer == "tikhonov":
+        g = -L.mean(axis=0)
+        return g - g.mean()
+    if regularizer != "tv":
+        raise ValueError(f"regularizer must be 'tikhonov' or 'tv', got {regularizer!r}")
+    # Adam on mean_t TV(L(t) + g) in numpy (subgradient sign(.) of |.|); cheap and thread-free
+    T, H, W = L.shape
+    Lx, Ly = np.diff(L, axis=2), np.diff(L, axis=1)
+    g = np.zeros((H, W))
+    m = np.zeros_like(g)
+    v = np.zeros_like(g)
+    beta1, beta2, eps = 0.9, 0.999, 1e-8
+    for k in range(1, int(n_iters) + 1):
+        sx = np.sign(Lx + np.diff(g, axis=1)).sum(axis=0) / (T * H * (W - 1))   # d mean|dx| / d(dg_x)
+        sy = np.sign(Ly + np.diff(g, axis=0)).sum(axis=0) / (T * (H - 1) * W)
+        grad = np.zeros_like(g)
+        grad[:, 1:] += sx
+        grad[:, :-1] -= sx
+        grad[1:, :] += sy
+        grad[:-1, :] -= sy
+        m = beta1 * m + (1 - beta1) * grad
+        v = beta2 * v + (1 - beta2) * grad ** 2
+        step = lr * 0.01 ** ((k - 1) / max(n_iters, 1))
+        g -= step * (m / (1 - beta1 ** k)) / (np.sqrt(v / (1 - beta2 ** k)) + eps)
+    return g - g.mean()
+
+
+def static_residual(L_rec, L_true) -> np.ndarray:
+    """The part of the error that is the same in every frame: mean_t of (L_rec - L_true), each frame
+    mean-subtracted first (the global offset is not an error here). float64 [H, W]."""
+    r = np.asarray(L_rec, np.float64) - np.asarray(L_true, np.float64)
+    r = r - r.mean(axis=(1, 2), keepdims=True)
+    return r.mean(axis=0)
+
+
+def ghost_strength(L_rec, L_true) -> float:
+    """How much of the temporal-mean image is missing from every frame of a reconstruction.
+
+    The least-squares coefficient a in ``static_residual(L_rec, L_true) ~ -a * (mean_t L_true - its
+    mean)``: 1 for Tikhonov's exact optimum L(t) - mean_t L(t) (and for frames that lost all their
+    static content, e.g. flat ones), 0 when the static error has no component along the mean image
+    (e.g. the truth itself, or the truth plus a constant).
+    """
+    r = static_residual(L_rec, L_true).ravel()
+    m = np.asarray(L_true, np.float64).mean(axis=0).ravel()
+    b = -(m - m.mean())
+    return float((r - r.mean()) @ b / max(b @ b, 1e-300))

@@ -1,0 +1,381 @@
+"""One pixel, one dimension: the event generation equation (Eq. 1-6) in its smallest form.
+
+Notebook 01 teaches with these pieces; the reference solutions of its exercises live here
+and are registered with :mod:`evinr_lite.teaching.exercises` at import.
+
+- :func:`integrate_events_1d`: Eq. 2, the log-intensity change since t0 from the events.
+- :func:`event_rate_derivative`: Eq. 4's right-hand side, the event rate per window.
+- :func:`temporal_loss`: Eq. 5-6, (Delta L - dF/dt * (t2 - t1))^2 averaged over windows.
+- :func:`taylor_error`, :func:`eq4_error_vs_window`: how good Eq. 3's mid-point derivative is.
+- :func:`fit_siren_1d`: solve Eq. 4 for one pixel with a small SIREN F(t).
+
+Times are float64 seconds; polarities are +-1; C is the contrast threshold (log units).
+"""
+from __future__ import annotations
+
+import copy
+import time
+from typing import Callable
+
+import numpy as np
+import torch
+from torch import nn
+
+from ..core.runtime import default_device
+from ..method.siren import Siren, input_gradient
+from ..sim.simulate import pixel_events
+from . import exercises
+
+__all__ = [
+    "integrate_events_1d", "event_rate_derivative", "window_sums", "temporal_loss",
+    "taylor_error", "eq4_error_vs_window", "TimeSiren1D", "time_derivative",
+    "fit_siren_1d", "evaluate_temporal_loss",
+]
+
+
+# ---- Eq. 2 and Eq. 4 from events ----------------------------------------------------
+
+def integrate_events_1d(t_events, p_events, C, t_query):
+    """Eq. 2: L(t_q) - L(t0) estimated as C times the sum of the polarities of the events
+    with ``t_event <= t_q``.
+
+    Args:
+        t_events: float [N] sorted event times (s).
+        p_events: [N] polarities (+-1).
+        C: contrast threshold.
+        t_query: float [Q] query times (s).
+
+    Returns:
+        float64 [Q].
+    """
+    t_events = np.asarray(t_events, dtype=np.float64)
+    csum = np.concatenate([[0.0], np.cumsum(np.asarray(p_events, dtype=np.float64))])
+    n_before = np.searchsorted(t_events, np.asarray(t_query, dtype=np.float64), side="right")
+    return C * csum[n_before]
+
+
+def _window_index(t_events: np.ndarray, boundaries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Window index of every event inside [b0, b_end] (b_i < t <= b_{i+1}; t == b0 joins window 0)."""
+    inside = (t_events >= boundaries[0]) & (t_events <= boundaries[-1])
+    idx = np.searchsorted(boundaries, t_events[inside], side="left") - 1
+    return np.maximum(idx, 0), inside
+
+
+def window_sums(t_events, p_events, C, boundaries) -> np.ndarray:
+    """Delta L per window (Eq. 2): C times the summed polarities in each window. float64 [B]."""
+    b = np.asarray(boundaries, dtype=np.float64)
+    t = np.asarray(t_events, dtype=np.float64)
+    idx, inside = _window_index(t, b)
+    return C * np.bincount(idx, weights=np.asarray(p_events, dtype=np.float64)[inside], minlength=b.size - 1)
+
+
+def event_rate_derivative(t_events, p_events, C, boundaries):
+    """Eq. 4's right-hand side: (1 / (t2 - t1)) * C * (sum of polarities in (t1, t2]) per window.
+
+    It estimates dL/dt at the window mid-points ``(b[i] + b[i+1]) / 2``.
+
+    Args:
+        t_events: float [N] sorted event times (s).
+        p_events: [N] polarities (+-1).
+        C: contrast threshold.
+        boundaries: float [B + 1] increasing window edges (s).
+
+    Returns:
+        float64 [B], in log units per second.
+    """
+    b = np.asarray(boundaries, dtype=np.float64)
+    return window_sums(t_events, p_events, C, b) / np.diff(b)
+
+
+def temporal_loss(dF_dt, delta_L, durations):
+    """Eq. 5-6 averaged over windows: mean((delta_L - dF_dt * durations)^2).
+
+    Args:
+        dF_dt: torch [B], the model's time derivative at the window mid-points.
+        delta_L: torch [B], summed events per window (Eq. 2).
+        durations: torch [B], window lengths t2 - t1.
+
+    Returns:
+        torch scalar (shape ()), differentiable.
+    """
+    return torch.mean((delta_L - dF_dt * durations) ** 2)
+
+
+# ---- exercises (reference solutions above) --------------------------------------------
+
+def _sorted_events(rng, n, t0=0.0, t1=1.0):
+    t = np.sort(rng.uniform(t0, t1, n))
+    p = rng.choice(np.array([-1, 1], dtype=np.int8), n)
+    return t, p
+
+
+def _inputs_integrate(rng):
+    cases = []
+    for n, q, C in ((5, 6, 0.2), (12, 7, 0.5), (40, 9, 0.25)):
+        t, p = _sorted_events(rng, n)
+        tq = np.sort(np.concatenate([[-0.1, 1.1], rng.uniform(0, 1, q - 2)]))
+        cases.append(dict(t_events=t, p_events=p, C=C, t_query=tq))
+    return cases
+
+
+def _inputs_rate(rng):
+    cases = []
+    for n, B, C in ((6, 3, 0.2), (30, 5, 0.5), (80, 8, 0.25)):
+        t, p = _sorted_events(rng, n)
+        inner = np.sort(rng.uniform(0.05, 0.95, B - 1))
+        cases.append(dict(t_events=t, p_events=p, C=C, boundaries=np.concatenate([[0.0], inner, [1.0]])))
+    return cases
+
+
+def _inputs_loss(rng):
+    g = torch.Generator().manual_seed(0)
+    cases = []
+    for B in (4, 9):
+        dF = torch.randn(B, generator=g) * 5
+        dur = torch.rand(B, generator=g) * 0.05 + 0.01
+        dL = torch.randint(-3, 4, (B,), generator=g).float() * 0.2
+        cases.append(dict(dF_dt=dF, delta_L=dL, durations=dur))
+    return cases
+
+
+exercises.register(
+    "integrate_events_1d", integrate_events_1d, _inputs_integrate,
+    hints={
+        "did you forget the sign of the polarity? ON events add C, OFF events subtract C":
+            lambda t_events, p_events, C, t_query: integrate_events_1d(t_events, np.abs(p_events), C, t_query),
+        "did you forget to multiply by the contrast threshold C?":
+            lambda t_events, p_events, C, t_query: integrate_events_1d(t_events, p_events, 1.0, t_query),
+    })
+
+exercises.register(
+    "event_rate_derivative", event_rate_derivative, _inputs_rate,
+    hints={
+        "did you forget to divide by the window length t2 - t1 (Eq. 4)?":
+            lambda t_events, p_events, C, boundaries: window_sums(t_events, p_events, C, boundaries),
+        "did you forget the sign of the polarity? (count ON minus OFF, not all events)":
+            lambda t_events, p_events, C, boundaries: event_rate_derivative(t_events, np.abs(p_events), C, boundaries),
+        "did you forget to multiply by the contrast threshold C?":
+            lambda t_events, p_events, C, boundaries: event_rate_derivative(t_events, p_events, 1.0, boundaries),
+    })
+
+exercises.register(
+    "temporal_loss", temporal_loss, _inputs_loss,
+    hints={
+        "use the mean over windows, not the sum":
+            lambda dF_dt, delta_L, durations: torch.sum((delta_L - dF_dt * durations) ** 2),
+        "multiply dF/dt by the window length t2 - t1 before comparing with delta_L (Eq. 5)":
+            lambda dF_dt, delta_L, durations: torch.mean((delta_L - dF_dt) ** 2),
+        "Eq. 6 squares the difference; an absolute value gives a different loss":
+            lambda dF_dt, delta_L, durations: torch.mean(torch.abs(delta_L - dF_dt * durations)),
+    })
+
+
+# ---- how good is the mid-point derivative (Eq. 3)? -------------------------------------
+
+def _derivative(L: Callable, t: np.ndarray, dLdt: Callable | None, h: float = 1e-6) -> np.ndarray:
+    if dLdt is not None:
+        return np.asarray(dLdt(t), dtype=np.float64)
+    return (np.asarray(L(t + h)) - np.asarray(L(t - h))) / (2 * h)
+
+
+def taylor_error(L: Callable, t_mid, window: float, dLdt: Callable | None = None) -> np.ndarray:
+    """|Delta L / (t2 - t1) - dL/dt(mid)| for windows of length ``window`` centred at ``t_mid``:
+    the error of Eq. 3 alone (exact Delta L, no events).
+
+    Args:
+        L: callable, float [T] seconds -> float [T] log intensity.
+        t_mid: float [M] window mid-points (s).
+        window: window length t2 - t1 (s).
+        dLdt: the exact derivative of L if known (else a central difference is used).
+
+    Returns:
+        float64 [M], log units per second.
+    """
+    t_mid = np.asarray(t_mid, dtype=np.float64)
+    slope = (np.asarray(L(t_mid + window / 2)) - np.asarray(L(t_mid - window / 2))) / window
+    return np.abs(slope - _derivative(L, t_mid, dLdt))
+
+
+def eq4_error_vs_window(L: Callable, windows, t_range, *, t_events=None, p_events=None, C=None,
+                        dLdt: Callable | None = None) -> dict:
+    """Mean absolute error of dL/dt estimates at window mid-points, for each window length.
+
+    Windows of each length tile ``t_range`` (whole windows only). Two estimates are compared
+    with the true derivative:
+
+    - ``"taylor"``: Eq. 3 with the exact Delta L (error grows like window^2);
+    - ``"events"``: Eq. 4 with events (adds the quantisation of Delta L into steps of C,
+      an error up to about C / window), when ``t_events``, ``p_events`` and ``C`` are given.
+
+    Returns:
+        dict with float64 arrays [K]: ``"window"``, ``"taylor"`` and (with events) ``"events"``.
+    """
+    t0, t1 = (float(v) for v in t_range)
+    windows = np.asarray(windows, dtype=np.float64)
+    out = {"window": windows, "taylor": np.empty_like(windows)}
+    with_events = t_events is not None
+    if with_events:
+        if p_events is None or C is None:
+            raise ValueError("the event estimate needs t_events, p_events and C together")
+        out["events"] = np.empty_like(windows)
+    for k, w in enumerate(windows):
+        n = int(np.floor((t1 - t0) / w + 1e-9))
+        if n < 1:
+            raise ValueError(f"window {w} s is longer than t_range {t_range}")
+        b = t0 + w * np.arange(n + 1)
+        mid = 0.5 * (b[1:] + b[:-1])
+        true = _derivative(L, mid, dLdt)
+        out["taylor"][k] = np.mean(np.abs((np.asarray(L(b[1:])) - np.asarray(L(b[:-1]))) / w - true))
+        if with_events:
+            out["events"][k] = np.mean(np.abs(event_rate_derivative(t_events, p_events, C, b) - true))
+    return out
+
+
+# ---- a SIREN for one pixel ----------------------------------------------------------------
+
+class TimeSiren1D(nn.Module):
+    """F(t): one pixel's log intensity as a SIREN of time.
+
+    Times in seconds are mapped linearly from ``t_range`` to [-1, 1] inside ``forward``, so
+    autograd's derivative with respect to the input is dF/dt in log units per second.
+    ``offset`` is a constant added to the output (see :meth:`shifted`).
+
+    The defaults (64 wide, 2 hidden layers, omega_0 = 10 as in the public code, first layer
+    omega 5) suit a signal with a few oscillations per ``t_range``: a higher first-layer
+    frequency lets F match every mid-point derivative exactly while jumping in between.
+
+    Shapes: forward(t [N] seconds) -> [N].
+    """
+
+    def __init__(self, t_range, hidden_features: int = 64, hidden_layers: int = 2,
+                 omega_0: float = 10.0, first_omega_0: float | None = 5.0):
+        super().__init__()
+        t0, t1 = (float(v) for v in t_range)
+        if not t1 > t0:
+            raise ValueError(f"t_range must be increasing, got {t_range}")
+        self.t_range = (t0, t1)
+        self.siren = Siren(1, 1, hidden_features, hidden_layers, omega_0, first_omega_0)
+        self.register_buffer("offset", torch.zeros(()))
+
+    def forward(self, t: torch.Tensor) -> torch.Tensor:
+        t0, t1 = self.t_range
+        s = (t - 0.5 * (t0 + t1)) * (2.0 / (t1 - t0))
+        return self.siren(s[:, None])[:, 0] + self.offset
+
+    def predict(self, t) -> np.ndarray:
+        """F at times ``t`` (numpy, seconds) as float64 numpy [N]."""
+        p = next(self.parameters())
+        with torch.no_grad():
+            return self(torch.as_tensor(np.asarray(t), dtype=p.dtype, device=p.device)).double().cpu().numpy()
+
+    def derivative(self, t) -> np.ndarray:
+        """dF/dt at times ``t`` (numpy, seconds) as float64 numpy [N]."""
+        p = next(self.parameters())
+        tt = torch.as_tensor(np.asarray(t), dtype=p.dtype, device=p.device).requires_grad_(True)
+        return time_derivative(self, tt, create_graph=False).detach().double().cpu().numpy()
+
+    def shifted(self, c: float) -> "TimeSiren1D":
+        """A copy computing F(t) + c: the same derivative everywhere, so the same temporal loss."""
+        new = copy.deepcopy(self)
+        with torch.no_grad():
+            new.offset += c
+        return new
+
+
+def time_derivative(model: nn.Module, t: torch.Tensor, create_graph: bool = True) -> torch.Tensor:
+    """dF/dt at times ``t`` [N] (requires_grad) by autograd; ``create_graph=True`` lets a loss
+    on it be back-propagated into the weights (double back-propagation, Eq. 5). -> [N]."""
+    return input_gradient(model(t), t, create_graph=create_graph)
+
+
+def _prepare_windows(events, t_range, C, window, pixel):
+    t_e, p_e = pixel_events(events, pixel)
+    t0, t1 = (float(v) for v in t_range)
+    n = max(1, int(round((t1 - t0) / window)))
+    b = np.linspace(t0, t1, n + 1)
+    return b, window_sums(t_e, p_e, C, b)
+
+
+def evaluate_temporal_loss(model: TimeSiren1D, events, C: float, window: float, t_range=None,
+                           pixel: int = 0, form: str = "derivative") -> float:
+    """The temporal loss (Eq. 6, mean over windows) of a fitted model, as a float."""
+    t_range = model.t_range if t_range is None else t_range
+    b, dL = _prepare_windows(events, t_range, C, window, pixel)
+    p = next(model.parameters())
+    kw = dict(dtype=p.dtype, device=p.device)
+    pred = _predicted_change(model, torch.as_tensor(b, **kw), form, create_graph=False)
+    return float(torch.mean((torch.as_tensor(dL, **kw) - pred.detach()) ** 2))
+
+
+def _predicted_change(model, b: torch.Tensor, form: str, create_graph: bool) -> torch.Tensor:
+    if form == "derivative":  # Eq. 5: dF/dt at the mid-point times the window length
+        mid = (0.5 * (b[1:] + b[:-1])).detach().requires_grad_(True)
+        return time_derivative(model, mid, create_graph=create_graph) * (b[1:] - b[:-1])
+    if form == "difference":  # Eq. 2 directly: F(t2) - F(t1)
+        F = model(b)
+        return F[1:] - F[:-1]
+    raise ValueError(f"form must be 'derivative' (Eq. 5) or 'difference' (F(t2) - F(t1)), got {form!r}")
+
+
+def fit_siren_1d(events, t_range, C: float, n_iters: int = 300, window: float = 0.025, seed: int = 0, *,
+                 anchor: tuple[float, float] | None = None, prior_mean: float | None = None,
+                 anchor_weight: float = 1.0, form: str = "derivative", lr: float = 3e-3,
+                 lr_decay: float = 0.98, hidden_features: int = 64, hidden_layers: int = 2, omega_0: float = 10.0,
+                 first_omega_0: float | None = 5.0, pixel: int = 0, device=None,
+                 ) -> tuple[TimeSiren1D, dict]:
+    """Solve Eq. 4 for one pixel: fit F(t) so that dF/dt(mid) * (t2 - t1) matches the summed
+    events of every window (Eq. 5-6), by Adam with double back-propagation.
+
+    Args:
+        events: ``Events`` with sensor_size (1, P) (``pixel`` picks one), or a (t, p) pair.
+        t_range: (t0, t1) seconds covered by the windows.
+        C: contrast threshold used to turn events into Delta L.
+        n_iters: Adam steps (full batch: every window at every step).
+        window: window length (s); the range is cut into round((t1 - t0) / window) equal windows.
+        seed: seeds the network's initialisation (the fit is deterministic on CPU).
+        anchor: ``(t_a, L_a)``: also penalise ``anchor_weight * (F(t_a) - L_a)^2`` (a known frame).
+        prior_mean: also penalise ``anchor_weight * (mean of F over the windows - prior_mean)^2``
+            (a prior on the overall brightness instead of a known frame).
+        form: ``"derivative"`` (Eq. 5, the paper) or ``"difference"`` (F(t2) - F(t1)).
+        lr: Adam learning rate, multiplied by ``lr_decay`` every 10 steps (the paper's schedule).
+        hidden_features, hidden_layers, omega_0, first_omega_0: the SIREN (see :class:`Siren`).
+        device: torch device (default: :func:`evinr_lite.core.runtime.default_device`).
+
+    Without ``anchor`` or ``prior_mean`` nothing fixes F's constant offset: any F + c fits the
+    events equally well, and the offset is whatever the initialisation gives.
+
+    Returns:
+        (model, history): the fitted :class:`TimeSiren1D` (on CPU) and a dict of per-step lists
+        ``"loss"`` (total), ``"temporal"``, ``"anchor"`` and the float ``"seconds"`` spent.
+    """
+    device = default_device() if device is None else torch.device(device)
+    if n_iters < 0 or window <= 0:
+        raise ValueError(f"need n_iters >= 0 and window > 0, got {n_iters}, {window}")
+    b, dL = _prepare_windows(events, t_range, C, window, pixel)
+    torch.manual_seed(seed)
+    model = TimeSiren1D(t_range, hidden_features, hidden_layers, omega_0, first_omega_0).to(device)
+    kw = dict(dtype=torch.float32, device=device)
+    b_t, dL_t = torch.as_tensor(b, **kw), torch.as_tensor(dL, **kw)
+    mid = 0.5 * (b_t[1:] + b_t[:-1])
+    opt = torch.optim.Adam(model.parameters(), lr=lr)
+    sched = torch.optim.lr_scheduler.StepLR(opt, step_size=10, gamma=lr_decay)
+    hist = {"loss": [], "temporal": [], "anchor": []}
+    start = time.perf_counter()
+    for _ in range(int(n_iters)):
+        opt.zero_grad(set_to_none=True)
+        temporal = torch.mean((dL_t - _predicted_change(model, b_t, form, create_graph=True)) ** 2)
+        extra = torch.zeros((), **kw)
+        if anchor is not None:
+            t_a, L_a = anchor
+            extra = extra + anchor_weight * (model(torch.tensor([float(t_a)], **kw))[0] - float(L_a)) ** 2
+        if prior_mean is not None:
+            extra = extra + anchor_weight * (model(mid).mean() - float(prior_mean)) ** 2
+        loss = temporal + extra
+        loss.backward()
+        opt.step()
+        sched.step()
+        hist["loss"].append(loss.item())
+        hist["temporal"].append(temporal.item())
+        hist["anchor"].append(extra.item())
+    hist["seconds"] = time.perf_counter() - start
+    return model.cpu().eval(), hist

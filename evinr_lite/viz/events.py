@@ -1,0 +1,285 @@
+"""Looking at events: x-y-t scatter, polarity images, rates, animations and event frames.
+
+Plotting helpers for event data on a sensor (notebook 02 and later); the method modules never
+import matplotlib. Conventions:
+
+- ``plot_*`` functions draw into ``ax`` (a new figure's axes when None) and return the axes;
+  ``show_event_frames`` and ``animate_events`` make their own figure.
+- Colours: ON events red, OFF events blue (:data:`ON_COLOR`, :data:`OFF_COLOR`, the same as
+  :mod:`evinr_lite.viz.signals`); event frames use a diverging map, red positive, blue negative,
+  white zero.
+- Time windows follow the binning convention of :mod:`evinr_lite.method.binning`: a window
+  ``(t0, t1]`` holds the events with ``t0 < t <= t1``.
+- Subsampling for scatter plots is deterministic (seeded), so a figure is the same every run.
+
+Numbers behind the figures (:func:`count_map`, :func:`polarity_image`,
+:func:`subsample_index`) are plain functions returning arrays, tested by their values.
+"""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.animation import FuncAnimation
+from matplotlib.colors import to_rgb
+from matplotlib.transforms import blended_transform_factory
+
+from ..core.events import EventDataError, Events
+from ..method.binning import EventFrames, event_rate
+from .signals import OFF_COLOR, ON_COLOR
+
+__all__ = ["ON_COLOR", "OFF_COLOR", "ON_RGB", "OFF_RGB", "subsample_index", "subsample", "count_map",
+           "polarity_image", "plot_xyt", "plot_count_map", "plot_polarity", "plot_event_rate",
+           "plot_boundaries", "show_event_frames", "animate_events"]
+
+ON_RGB = to_rgb(ON_COLOR)     # (r, g, b) floats in [0, 1]
+OFF_RGB = to_rgb(OFF_COLOR)
+EVENT_FRAME_CMAP = "RdBu_r"   # red > 0 (more ON), blue < 0 (more OFF)
+
+
+def _axes(ax, figsize=(6, 4)):
+    if ax is None:
+        _, ax = plt.subplots(figsize=figsize)
+    return ax
+
+
+# ---- numbers ------------------------------------------------------------------------------
+
+def subsample_index(n: int, max_points: int, seed: int = 0) -> np.ndarray:
+    """Indices of at most ``max_points`` of ``n`` items, drawn without replacement, sorted.
+
+    All of ``range(n)`` when ``n <= max_points``. The same (n, max_points, seed) always gives
+    the same indices. Returns int64 [min(n, max_points)].
+    """
+    if max_points < 1:
+        raise EventDataError(f"max_points must be at least 1, got {max_points}")
+    if n <= max_points:
+        return np.arange(n, dtype=np.int64)
+    idx = np.random.default_rng(seed).choice(n, size=max_points, replace=False)
+    return np.sort(idx).astype(np.int64)
+
+
+def subsample(events: Events, max_points: int, seed: int = 0) -> Events:
+    """At most ``max_points`` events, chosen uniformly at random (seeded), still in time order."""
+    return events.take(subsample_index(len(events), max_points, seed))
+
+
+def _window(events: Events, t0, t1) -> Events:
+    """Events with t0 < t <= t1; None means from the first / to the last event."""
+    lo = 0 if t0 is None else int(np.searchsorted(events.t, t0, side="right"))
+    hi = len(events) if t1 is None else int(np.searchsorted(events.t, t1, side="right"))
+    if t0 is not None and t1 is not None and not t1 > t0:
+        raise EventDataError(f"time window ({t0}, {t1}] is empty or reversed; t1 must exceed t0")
+    return events.take(slice(lo, max(lo, hi)))
+
+
+def count_map(events: Events, polarity: int | None = None) -> np.ndarray:
+    """Events per pixel: int64 [H, W]. ``polarity`` +1 or -1 counts only ON or only OFF events."""
+    if polarity not in (None, 1, -1):
+        raise EventDataError(f"polarity must be None (all), +1 (ON) or -1 (OFF), got {polarity!r}")
+    H, W = events.sensor_size
+    keep = slice(None) if polarity is None else events.p == polarity
+    flat = events.y[keep].astype(np.int64) * W + events.x[keep]
+    return np.bincount(flat, minlength=H * W).reshape(H, W)
+
+
+def polarity_image(events: Events, t0: float | None = None, t1: float | None = None,
+                   background=(1.0, 1.0, 1.0)) -> np.ndarray:
+    """The events of a time window as a colour image: float64 [H, W, 3] in [0, 1].
+
+    A pixel is :data:`ON_RGB` (red) when the sum of the polarities of its events with
+    ``t0 < t <= t1`` is positive, :data:`OFF_RGB` (blue) when it is negative, and
+    ``background`` when it had no events (or as many ON as OFF). ``t0 = None`` starts at the
+    first event (included), ``t1 = None`` ends at the last.
+    """
+    win = _window(events, t0, t1)
+    net = count_map(win, 1) - count_map(win, -1)
+    img = np.empty(net.shape + (3,))
+    img[:] = np.asarray(background, dtype=np.float64)
+    img[net > 0] = ON_RGB
+    img[net < 0] = OFF_RGB
+    return img
+
+
+def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, size: float = 1.0,
+             title: str | None = None, view=(55, -110)):
+    """The events as points in (t, x, y) space: ON red, OFF blue.
+
+    At most ``max_points`` events are drawn, a seeded random subset (see :func:`subsample`).
+    Time runs along the long horizontal axis, x (column) along the other, and y (row) is
+    vertical, pointing down as in an image. ``ax`` must be a 3-D axes (``projection='3d'``)
+    if given; ``view`` is the (elevation, azimuth) in degrees.
+    """
+    if ax is None:
+        ax = plt.figure(figsize=(7, 5)).add_subplot(projection="3d")
+    sub = subsample(events, max_points, seed)
+    for sign, color, name in ((1, ON_COLOR, "ON"), (-1, OFF_COLOR, "OFF")):
+        sel = sub.p == sign
+        ax.scatter(sub.t[sel], sub.x[sel], sub.y[sel], s=size, c=color, depthshade=False,
+                   label=f"{name} ({int(sel.sum())} shown)")
+    H, W = events.sensor_size
+    ax.set(xlabel="t (s)", ylabel="x (column)", zlabel="y (row)", ylim=(0, W - 1), zlim=(H - 1, 0))
+    ax.set_box_aspect((1.6, 1.0, 0.8))
+    ax.view_init(*view)
+    ax.set_title(title or f"{len(sub)} of {len(events)} events")
+    ax.legend(loc="upper left", fontsize=8, markerscale=4)
+    return ax
+
+
+def plot_count_map(events: Events, ax=None, polarity: int | None = None, title: str | None = None):
+    """Events per pixel as an image (with a colour bar)."""
+    ax = _axes(ax)
+    counts = count_map(events, polarity)
+    im = ax.imshow(counts, cmap="magma", interpolation="nearest")
+    ax.figure.colorbar(im, ax=ax, fraction=0.046, pad=0.04, label="events")
+    which = {None: "", 1: "ON ", -1: "OFF "}[polarity]
+    ax.set_title(title or f"{which}events per pixel (max {counts.max()})")
+    ax.set_xticks([]), ax.set_yticks([])
+    return ax
+
+
+def plot_polarity(events: Events, t0: float | None = None, t1: float | None = None, ax=None,
+                  title: str | None = None):
+    """:func:`polarity_image` of the window ``(t0, t1]``, titled with the window and its event count."""
+    ax = _axes(ax, (4, 3))
+    ax.imshow(polarity_image(events, t0, t1), interpolation="nearest")
+    if title is None:
+        n = len(_window(events, t0, t1))
+        a = events.t[0] if t0 is None else t0
+        b = events.t[-1] if t1 is None else t1
+        title = f"({a:.3f}, {b:.3f}] s: {n} events"
+    ax.set_title(title, fontsize=9)
+    ax.set_xticks([]), ax.set_yticks([])
+    return ax
+
+
+def plot_event_rate(events: Events, bin_s: float, ax=None, t_range=None):
+    """ON and OFF event rates (events/s, whole sensor) over time, as steps; see :func:`event_rate`."""
+    ax = _axes(ax, (8, 3))
+    edges, on, off = event_rate(events, bin_s, t_range)
+    ax.stairs(on, edges, color=ON_COLOR, label="ON")
+    ax.stairs(off, edges, color=OFF_COLOR, label="OFF")
+    ax.set(xlabel="time t (s)", ylabel="events / s", title=f"event rate in bins of {bin_s * 1e3:.3g} ms")
+    ax.legend(fontsize=8)
+    return ax
+
+
+def plot_boundaries(events: Events, boundaries: dict, ax=None, max_points: int = 4000):
+    """Cumulative event count over time, with sets of bin boundaries as vertical lines.
+
+    Args:
+        events: the events.
+        boundaries: ``{label: edges [B + 1]}``; set k is drawn in the k-th horizontal band of
+            the axes, so several sets can be compared on one figure.
+        max_points: points of the cumulative curve drawn (evenly spaced in event index).
+
+    Between two boundaries of an equal-count set the curve rises by the same amount; between
+    two boundaries of a fixed-duration set the lines are evenly spaced.
+    """
+    ax = _axes(ax, (9, 3.5))
+    n = len(events)
+    k = np.unique(np.linspace(0, n - 1, min(n, max_points)).round().astype(np.int64))
+    ax.plot(events.t[k], k + 1, color="black", lw=1.2, label="events so far")
+    trans = blended_transform_factory(ax.transData, ax.transAxes)
+    m = max(len(boundaries), 1)
+    for j, (label, b) in enumerate(boundaries.items()):
+        b = np.asarray(b)
+        ax.vlines(b, j / m, (j + 1) / m, transform=trans, colors=f"C{j}", lw=1.0,
+                  label=f"{label}: {b.size - 1} bins")
+    ax.set(xlabel="time t (s)", ylabel="cumulative number of events")
+    ax.legend(fontsize=8, loc="upper left")
+    return ax
+
+
+def show_event_frames(frames: EventFrames, indices=None, max_frames: int = 8, ncols: int = 4,
+                      vmax: float | None = None, title: str | None = None, panel_size: float = 2.2):
+    """A grid of event frames (Eq. 2), red positive, blue negative, on one shared symmetric scale.
+
+    Args:
+        frames: :class:`~evinr_lite.method.binning.EventFrames`.
+        indices: which bins to show; default ``max_frames`` bins evenly spread over all of them.
+        ncols: panels per row.
+        vmax: colour scale limit (log units); default the largest |value| shown.
+        title: figure title.
+
+    Returns:
+        The figure; each panel's title gives the bin's interval in ms and its event count.
+    """
+    B = len(frames)
+    if indices is None:
+        indices = np.unique(np.linspace(0, B - 1, min(B, max_frames)).round().astype(int))
+    indices = [int(i) for i in indices]
+    if not indices:
+        raise EventDataError("no event frames to show")
+    shown = frames.frames[indices]
+    if vmax is None:
+        vmax = float(np.abs(shown).max()) or 1.0
+    ncols = min(ncols, len(indices))
+    nrows = -(-len(indices) // ncols)
+    H, W = frames.frames.shape[1:]
+    fig, axes = plt.subplots(nrows, ncols, figsize=(panel_size * ncols * max(W / H, 0.5) + 0.8,
+                                                    panel_size * nrows + 0.4), squeeze=False)
+    b = frames.boundaries
+    for ax, i in zip(axes.flat, indices):
+        im = ax.imshow(frames.frames[i], cmap=EVENT_FRAME_CMAP, vmin=-vmax, vmax=vmax, interpolation="nearest")
+        ax.set_title(f"bin {i}: ({b[i] * 1e3:.1f}, {b[i + 1] * 1e3:.1f}] ms\n{frames.counts[i]} events", fontsize=8)
+    for ax in axes.flat:
+        ax.set_xticks([]), ax.set_yticks([])
+    for ax in axes.flat[len(indices):]:
+        ax.axis("off")
+    fig.colorbar(im, ax=axes, fraction=0.03, pad=0.02, label="C x (sum of p)")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def animate_events(events: Events, n_frames: int = 20, window_s: float | None = None, t_range=None,
+                   figsize=(4, 3), dpi: int = 72, interval: int = 100) -> FuncAnimation:
+    """An animation of polarity images sliding through time.
+
+    Frame k shows :func:`polarity_image` of the window ``(t_k - window_s, t_k]``, with the end
+    times ``t_k`` evenly spaced so that the last frame ends at ``t_range[1]``.
+
+    Args:
+        events: the events.
+        n_frames: number of frames (each is one PNG in the HTML: keep it small).
+        window_s: window length (s); default ``(t1 - t0) / n_frames`` (consecutive windows).
+        t_range: (t0, t1) seconds; default the first and last event times.
+        figsize, dpi: size of each frame. interval: milliseconds between frames when played.
+
+    Returns:
+        A ``FuncAnimation``; show it in a notebook with
+        ``IPython.display.HTML(anim.to_jshtml())``. Its figure is already closed, so inline
+        back ends show no extra static copy. ``anim.windows`` is float64 [n_frames, 2] (the
+        windows) and ``anim.draw_frame(k)`` draws frame k.
+    """
+    if n_frames < 1:
+        raise EventDataError(f"n_frames must be at least 1, got {n_frames}")
+    if t_range is None:
+        if len(events) < 2:
+            raise EventDataError("animate_events needs t_range when there are fewer than 2 events")
+        t_range = (events.t[0], events.t[-1])
+    t0, t1 = float(t_range[0]), float(t_range[1])
+    window = (t1 - t0) / n_frames if window_s is None else float(window_s)
+    if not window > 0:
+        raise EventDataError(f"window_s must be positive seconds, got {window_s}")
+    ends = t0 + window + (t1 - t0 - window) * np.linspace(0, 1, n_frames) if n_frames > 1 else np.array([t1])
+    windows = np.stack([ends - window, ends], axis=1)
+
+    fig, ax = plt.subplots(figsize=figsize, dpi=dpi)
+    plt.close(fig)
+    image = ax.imshow(polarity_image(events, *windows[0]), interpolation="nearest")
+    ax.set_xticks([]), ax.set_yticks([])
+    title = ax.set_title("", fontsize=9)
+
+    def draw_frame(k):
+        a, b = windows[k]
+        image.set_data(polarity_image(events, a, b))
+        title.set_text(f"events in ({a:.3f}, {b:.3f}] s")
+        return image, title
+
+    draw_frame(0)
+    fig.tight_layout()
+    anim = FuncAnimation(fig, draw_frame, frames=n_frames, interval=interval, blit=False)
+    anim.windows = windows
+    anim.draw_frame = draw_frame
+    return anim

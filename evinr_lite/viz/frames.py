@@ -1,0 +1,107 @@
+"""Figures of whole frames for notebooks 04-05 (grids of reconstructions, image rows, loss curves).
+
+Every function draws into ``fig`` (a new figure when None) and returns the figure, so it also
+works inside :func:`evinr_lite.viz.widgets.interact`, which hands its draw function one figure to
+redraw. The method modules never import this one.
+"""
+from __future__ import annotations
+
+import numpy as np
+import matplotlib.pyplot as plt
+
+__all__ = ["show_frames", "show_images", "plot_histories"]
+
+
+def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: float = 0.0, vmax: float = 1.0,
+                cell_size: float = 1.6, row_titles: dict | None = None):
+    """A grid of frames: one row per entry of ``rows``, one column per frame.
+
+    Args:
+        rows: ``{label: frames [Q, H, W]}``; every entry must have the same Q.
+        times: float [Q] seconds, written above the columns of the first row.
+        fig: a figure to draw into (cleared first); a new one of the right size when None.
+        cmap, vmin, vmax: how values map to grey (tone-mapped frames lie in [0, 1]).
+        cell_size: inches per image (width), for a new figure.
+        row_titles: optional ``{label: extra text}`` appended to the row's label (e.g. a score).
+
+    Returns:
+        The figure.
+    """
+    if not rows:
+        raise ValueError("rows is empty: pass {label: frames [Q, H, W]}")
+    stacks = {k: np.asarray(v) for k, v in rows.items()}
+    shapes = {v.shape[0] for v in stacks.values()}
+    if len(shapes) != 1 or any(v.ndim != 3 for v in stacks.values()):
+        raise ValueError(f"every entry of rows must be [Q, H, W] with the same Q, got "
+                         f"{[v.shape for v in stacks.values()]}")
+    Q = shapes.pop()
+    H, W = next(iter(stacks.values())).shape[1:]
+    n = len(stacks)
+    if fig is None:
+        fig = plt.figure(figsize=(cell_size * Q, cell_size * H / W * n + 0.4 * n))
+    else:
+        fig.clf()
+    axes = np.atleast_2d(fig.subplots(n, Q, squeeze=False))
+    for r, (label, frames) in enumerate(stacks.items()):
+        for q in range(Q):
+            ax = axes[r, q]
+            ax.imshow(frames[q], cmap=cmap, vmin=vmin, vmax=vmax, interpolation="nearest")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if r == 0 and times is not None:
+                ax.set_title(f"t = {float(np.asarray(times)[q]):.2f} s", fontsize=8)
+        extra = (row_titles or {}).get(label)
+        axes[r, 0].set_ylabel(label if extra is None else f"{label}\n{extra}", fontsize=8)
+    fig.subplots_adjust(wspace=0.03, hspace=0.12)
+    return fig
+
+
+def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=None, symmetric: bool = False,
+                colorbar: bool = False, cell_size: float = 2.6):
+    """Single images side by side, each titled by its key.
+
+    Args:
+        images: ``{title: image [H, W]}``.
+        vmin, vmax: shared limits (None: each image's own range, unless ``symmetric``).
+        symmetric: limits +-max|value| over all images (for signed maps such as errors; use a
+            diverging ``cmap``).
+        colorbar: one colour bar per image.
+
+    Returns:
+        The figure.
+    """
+    if not images:
+        raise ValueError("images is empty: pass {title: image [H, W]}")
+    arrays = {k: np.asarray(v, dtype=np.float64) for k, v in images.items()}
+    if symmetric:
+        m = max(float(np.abs(a).max()) for a in arrays.values()) or 1.0
+        vmin, vmax = -m, m
+    n = len(arrays)
+    H, W = next(iter(arrays.values())).shape
+    if fig is None:
+        fig = plt.figure(figsize=(cell_size * n, cell_size * H / W + 0.5))
+    else:
+        fig.clf()
+    axes = fig.subplots(1, n, squeeze=False)[0]
+    for ax, (title, img) in zip(axes, arrays.items()):
+        im = ax.imshow(img, cmap=cmap, vmin=vmin, vmax=vmax, interpolation="nearest")
+        ax.set_title(title, fontsize=8)
+        ax.set_xticks([])
+        ax.set_yticks([])
+        if colorbar:
+            fig.colorbar(im, ax=ax, fraction=0.035, pad=0.02)
+    return fig
+
+
+def plot_histories(histories: dict, key: str = "loss", *, ax=None, xlabel: str = "iteration"):
+    """Training curves (log scale): ``{label: history dict or sequence of floats}``; ``key`` picks
+    the curve inside a history dict. Returns the axes."""
+    if ax is None:
+        _, ax = plt.subplots(figsize=(5, 3))
+    for label, h in histories.items():
+        values = np.asarray(h[key] if isinstance(h, dict) else h, dtype=np.float64)
+        ax.semilogy(np.maximum(values, 1e-16), label=label)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(key)
+    ax.legend(fontsize=8)
+    return ax

@@ -1,0 +1,121 @@
+"""Figures of scores: results bar charts, ablation panels, the time/quality trade-off."""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ..evaluation.ablation import COLUMN_LABELS, pareto_front
+
+__all__ = ["plot_results", "plot_ablation", "plot_tradeoff"]
+
+
+def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
+    """Bar charts, one panel per metric: methods along x, one bar per equalisation. Returns the figure."""
+    rows = list(rows)
+    metrics = [m for m in metrics if any(r.get(m) is not None for r in rows)]
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    eqs = list(dict.fromkeys(r.get("equalization", "") for r in rows))
+    fig = fig or plt.figure(figsize=(3.6 * len(metrics), 3.0))
+    axes = fig.subplots(1, len(metrics), squeeze=False)[0]
+    width = 0.8 / len(eqs)
+    better = {"mse": "lower is better", "ssim": "higher is better", "lpips": "lower is better"}
+    for ax, metric in zip(axes, metrics):
+        for k, eq in enumerate(eqs):
+            vals = []
+            for m in methods:
+                hit = [r.get(metric) for r in rows if r["method"] == m and r.get("equalization", "") == eq]
+                vals.append(np.nan if not hit or hit[0] is None else hit[0])
+            ax.bar(np.arange(len(methods)) + (k - (len(eqs) - 1) / 2) * width, vals, width, label=eq)
+        ax.set_xticks(np.arange(len(methods)), methods)
+        ax.set_title(f"{metric.upper()} ({better.get(metric, '')})")
+    axes[0].legend(title="equalisation", fontsize=8)
+    fig.tight_layout()
+    return fig
+
+
+def plot_ablation(rows: list[dict], metrics=("ssim_none", "ssim_clahe"), *, x=None, xlabel: str | None = None,
+                  xscale: str = "linear", title: str | None = None, fig=None):
+    """Quality (left) and training time (right) of each variant.
+
+    Args:
+        rows: from :func:`evinr_lite.evaluation.ablation.run_variants`.
+        metrics: quality keys drawn on the left panel (one bar or line each).
+        x: None for bars, one group per variant; or numbers [len(rows)] (e.g. the lambdas of a sweep)
+            for lines against x.
+        xlabel, xscale: the x axis when ``x`` is given ("linear", "log", "symlog").
+        title: figure title. fig: a figure to draw into (cleared); a new one when None.
+
+    Returns:
+        The matplotlib figure.
+    """
+    if not rows:
+        raise ValueError("no rows to plot")
+    names = [r["name"] for r in rows]
+    if fig is None:
+        fig = plt.figure(figsize=(max(9.0, 1.3 * len(rows) + 4), 3.4))
+    else:
+        fig.clf()
+    ax_q, ax_t = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
+    times = [r["train_time_s"] for r in rows]
+    if x is None:
+        pos = np.arange(len(rows))
+        width = 0.8 / len(metrics)
+        for k, m in enumerate(metrics):
+            ax_q.bar(pos + (k - (len(metrics) - 1) / 2) * width, [r[m] for r in rows], width,
+                     label=COLUMN_LABELS.get(m, (m,))[0])
+        ax_t.bar(pos, times, 0.6, color="0.5")
+        for ax in (ax_q, ax_t):
+            ax.set_xticks(pos, names, rotation=30, ha="right", fontsize=8)
+    else:
+        x = np.asarray(x, dtype=np.float64)
+        if x.shape != (len(rows),):
+            raise ValueError(f"x must hold one number per row ({len(rows)}), got shape {x.shape}")
+        for m in metrics:
+            ax_q.plot(x, [r[m] for r in rows], "o-", label=COLUMN_LABELS.get(m, (m,))[0])
+        ax_t.plot(x, times, "o-", color="0.4")
+        for ax in (ax_q, ax_t):
+            ax.set_xscale(xscale)
+            ax.set_xticks(x, [f"{v:g}" for v in x])
+            ax.minorticks_off()
+            ax.set_xlabel(xlabel or "")
+    ax_q.set(ylabel="score", title="quality (higher SSIM, lower MSE is better)")
+    ax_q.legend(fontsize=8)
+    ax_t.set(ylabel="training time (s)", title="time on this machine")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = "train_time_s", front=None,
+                  labels: str = "front", ax=None, title: str | None = None):
+    """Scatter of cost (x) against quality (y), one labelled point per row, the Pareto front joined.
+
+    Args:
+        rows: from :func:`evinr_lite.evaluation.ablation.run_variants` (all of them, from several tables).
+        quality, cost: row keys (higher quality and lower cost are better).
+        front: bool [len(rows)] marking the front (default: :func:`pareto_front`).
+        labels: "front" names the points on the front only (readable with many rows), "all" every point.
+        ax: axes to draw into (a new figure when None). title: axes title.
+
+    Returns:
+        The axes.
+    """
+    if ax is None:
+        _, ax = plt.subplots(figsize=(8, 4.5))
+    c = np.array([r[cost] for r in rows], dtype=np.float64)
+    q = np.array([r[quality] for r in rows], dtype=np.float64)
+    front = pareto_front(c, q) if front is None else np.asarray(front, bool)
+    ax.scatter(c[~front], q[~front], color="0.6", s=18, label="dominated")
+    ax.scatter(c[front], q[front], color="tab:red", s=30, label="Pareto front")
+    order = np.flatnonzero(front)[np.argsort(c[front])]
+    ax.step(c[order], q[order], where="post", color="tab:red", lw=1)
+    if labels not in ("front", "all"):
+        raise ValueError(f"labels must be 'front' or 'all', got {labels!r}")
+    for r, ci, qi, on in zip(rows, c, q, front):
+        if on or labels == "all":
+            ax.annotate(r["name"], (ci, qi), fontsize=7, xytext=(4, -3), textcoords="offset points")
+    ax.set(xlabel=COLUMN_LABELS.get(cost, (cost,))[0], ylabel=COLUMN_LABELS.get(quality, (quality,))[0],
+           title=title or "time against quality")
+    ax.legend(fontsize=8)
+    return ax

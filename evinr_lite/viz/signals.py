@@ -1,0 +1,109 @@
+"""Small matplotlib helpers for the notebooks (method modules never import matplotlib).
+
+Every function draws into ``ax`` (a new figure's axes when ``ax`` is None) and returns the axes.
+Colours: ON events red, OFF events blue. No named styles (they change between versions).
+"""
+from __future__ import annotations
+
+import numpy as np
+import matplotlib.pyplot as plt
+from matplotlib.transforms import blended_transform_factory
+
+from ..sim.simulate import pixel_events
+
+__all__ = ["ON_COLOR", "OFF_COLOR", "plot_event_ticks", "plot_signal_and_events", "plot_reconstruction_1d",
+           "plot_window_errors"]
+
+ON_COLOR = "tab:red"
+OFF_COLOR = "tab:blue"
+
+
+def _axes(ax, figsize=(8, 3.5)):
+    if ax is None:
+        _, ax = plt.subplots(figsize=figsize)
+    return ax
+
+
+def plot_event_ticks(ax, t_events, p_events, height: float = 0.08, legend: bool = True):
+    """Short vertical ticks at the bottom of ``ax`` (axes fraction ``height``), one per event,
+    red for ON and blue for OFF."""
+    t_events = np.asarray(t_events)
+    p_events = np.asarray(p_events)
+    trans = blended_transform_factory(ax.transData, ax.transAxes)
+    for sign, color, name in ((1, ON_COLOR, "ON event"), (-1, OFF_COLOR, "OFF event")):
+        sel = t_events[p_events * sign > 0]
+        ax.vlines(sel, 0.0, height, colors=color, lw=1.0, transform=trans,
+                  label=f"{name}s ({sel.size})" if legend else None)
+    return ax
+
+
+def plot_signal_and_events(t, L, events, C: float | None = None, *, ax=None, pixel: int = 0, L0=None,
+                           show_levels: bool = True, show_crossings: bool = True, label: str = "L(t) = log I(t)"):
+    """A 1-D log-intensity signal, its threshold levels and its events (Eq. 1).
+
+    Args:
+        t: float [T] sample times (s).
+        L: float [T] log intensity at ``t``, or a callable of t.
+        events: ``Events`` with sensor_size (1, P) (``pixel`` picks one) or a (t, p) pair.
+        C: contrast threshold; draws the levels L0 + k*C and the level each event reached.
+        L0: the reference level at the start (default ``L[0]``).
+    """
+    ax = _axes(ax)
+    t = np.asarray(t, dtype=np.float64)
+    L = np.asarray(L(t) if callable(L) else L, dtype=np.float64)
+    te, pe = pixel_events(events, pixel)
+    L0 = L[0] if L0 is None else float(L0)
+    ax.plot(t, L, color="black", lw=1.5, label=label)
+    if C is not None and show_levels:
+        k = np.arange(np.floor((L.min() - L0) / C), np.ceil((L.max() - L0) / C) + 1)
+        for level in L0 + C * k:
+            ax.axhline(level, color="0.85", lw=0.7, zorder=0)
+    if C is not None and show_crossings and te.size:
+        level = L0 + C * np.cumsum(pe)
+        ax.plot(te[pe > 0], level[pe > 0], "^", color=ON_COLOR, ms=4, ls="none")
+        ax.plot(te[pe < 0], level[pe < 0], "v", color=OFF_COLOR, ms=4, ls="none")
+    plot_event_ticks(ax, te, pe)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("log intensity")
+    ax.legend(loc="upper right", fontsize=8)
+    return ax
+
+
+def plot_reconstruction_1d(t, curves: dict, truth=None, *, events=None, ax=None, pixel: int = 0, title=None):
+    """Reconstructions of one pixel against the true signal.
+
+    Args:
+        t: float [T] times (s).
+        curves: ``{label: values [T]}``; drawn in order.
+        truth: float [T] true log intensity (thick black), optional.
+        events: optional events drawn as ticks at the bottom.
+    """
+    ax = _axes(ax)
+    t = np.asarray(t)
+    if truth is not None:
+        ax.plot(t, truth, color="black", lw=2.5, alpha=0.35, label="true L(t)")
+    for label, values in curves.items():
+        ax.plot(t, values, lw=1.3, label=label)
+    if events is not None:
+        plot_event_ticks(ax, *pixel_events(events, pixel), legend=False)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("log intensity")
+    if title:
+        ax.set_title(title)
+    ax.legend(loc="best", fontsize=8)
+    return ax
+
+
+def plot_window_errors(result: dict, *, ax=None, C: float | None = None):
+    """Error of the dL/dt estimate versus window length (from :func:`evinr_lite.teaching.pde1d.eq4_error_vs_window`)."""
+    ax = _axes(ax, (5, 3.5))
+    w = np.asarray(result["window"])
+    ax.loglog(w, result["taylor"], "o-", label="Eq. 3 with the exact ΔL (Taylor error)")
+    if "events" in result:
+        ax.loglog(w, result["events"], "s-", label="Eq. 4 with events")
+    if C is not None:
+        ax.loglog(w, C / w, ":", color="0.5", label="C / window: the rate of one event")
+    ax.set_xlabel("window length t2 - t1 (s)")
+    ax.set_ylabel("mean |error of dL/dt| (1/s)")
+    ax.legend(fontsize=8)
+    return ax
