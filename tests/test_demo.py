@@ -3,6 +3,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 
 from evinr_lite.apps.demo import run_demo
 from evinr_lite.method.solver import EvINRConfig
@@ -25,6 +27,8 @@ def test_demo_writes_frames_and_scores(tmp_path):
     # handing the integrator the first frame must beat not knowing it
     assert oracle["mse_none"] < blind["mse_none"] and oracle["ssim_none"] > blind["ssim_none"]
     assert "data_range 1" in saved["protocol"] and saved["evinr_config"]["n_iters"] == 60
+    assert saved["overview"]["rows"] == ["ground truth", "EvINR", "integration", "oracle (true L0)"]
+    assert saved["overview"]["columns"] == [f"t = {t:.2f} s" for t in saved["query_times_s"]]
 
 
 def test_demo_command_refuses_existing_output(tmp_path):
@@ -40,3 +44,18 @@ def test_demo_command_rejects_bad_size():
     r = subprocess.run([sys.executable, "-m", "evinr_lite", "demo", "--size", "120by160"],
                        capture_output=True, text=True)
     assert r.returncode == 2 and "HxW" in r.stderr
+
+
+def test_overview_labels_rows_and_columns():
+    import numpy as np
+    from evinr_lite.apps.demo import labelled_grid
+
+    rows = [np.full((3, 20, 30), v) for v in (0.2, 0.5, 0.8)]
+    img = labelled_grid(rows, ["ground truth", "EvINR", "integration"], ["t = 0.10 s", "t = 0.20 s", "t = 0.30 s"])
+    left = img.shape[1] - 3 * 32          # the label column left of the frames
+    top = img.shape[0] - 3 * 22           # the time labels above them
+    assert left > 20 and top > 5
+    assert (img[top:, :left] < 128).any() and (img[:top, left:] < 128).any()   # text was drawn in both strips
+    np.testing.assert_array_equal(img[top:top + 20, left:left + 30], round(0.2 * 255))  # frames pasted unscaled
+    with pytest.raises(ValueError, match="one label per row"):
+        labelled_grid(rows, ["only one"], ["a", "b", "c"])
