@@ -117,19 +117,50 @@ class EvINRConfig:
     progress: bool = True
 
     def __post_init__(self):
+        # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
                    "regularizer": ("tikhonov", "tv", "none")}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
-                raise ValueError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
-        for name in ("C", "bin_duration", "lr", "gamma"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)}")
-        if not 0 < self.display_mean < 1:
-            raise ValueError(f"display_mean must be in (0, 1), got {self.display_mean}")
-        if self.tau is not None and not self.tau > self.overlap >= 0:
-            raise ValueError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
-        self.c2f_iters = tuple(int(i) for i in self.c2f_iters)
+                raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+
+        def number(name, value, *, integer=False):
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or (
+                    integer and not float(value).is_integer()) or not math.isfinite(value):
+                raise EventDataError(f"{name} must be a finite {'whole ' if integer else ''}number, got {value!r}")
+            return int(value) if integer else float(value)
+
+        for name in ("C", "bin_duration", "lr", "gamma", "omega_0", "head_lr_scale"):
+            if not number(name, getattr(self, name)) > 0:
+                raise EventDataError(f"{name} must be positive, got {getattr(self, name)}")
+        if self.first_omega_0 is not None and not number("first_omega_0", self.first_omega_0) > 0:
+            raise EventDataError(f"first_omega_0 must be positive (or None), got {self.first_omega_0}")
+        for name, low in (("n_iters", 1), ("hidden_features", 1), ("hidden_layers", 0), ("lr_decay_every", 1),
+                          ("events_per_bin", 1)):
+            if number(name, getattr(self, name), integer=True) < low:
+                raise EventDataError(f"{name} must be at least {low}, got {getattr(self, name)}")
+            setattr(self, name, int(getattr(self, name)))
+        if not number("lam", self.lam) >= 0:
+            raise EventDataError(f"lam must be zero or positive, got {self.lam}")
+        if not 0 < number("lr_decay", self.lr_decay) <= 1:
+            raise EventDataError(f"lr_decay must be in (0, 1], got {self.lr_decay}")
+        if not 0 < number("display_mean", self.display_mean) < 1:
+            raise EventDataError(f"display_mean must be in (0, 1), got {self.display_mean}")
+        if self.tau is not None and not number("tau", self.tau) > number("overlap", self.overlap) >= 0:
+            raise EventDataError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
+        self.c2f_iters = tuple(number("c2f_iters", i, integer=True) for i in self.c2f_iters)
+        if self.coarse_to_fine:
+            if any(i < 1 for i in self.c2f_iters) or list(self.c2f_iters) != sorted(set(self.c2f_iters)):
+                raise EventDataError(f"c2f_iters must be increasing iterations >= 1, got {self.c2f_iters}")
+            late = [i for i in self.c2f_iters if i >= self.n_iters]
+            if late:   # a warning, not an error: fast-mode notebooks shorten n_iters under the default stages
+                import warnings
+
+                fix = (f"c2f_iters=({self.n_iters // 3}, {2 * self.n_iters // 3})" if self.n_iters >= 3
+                       else "coarse_to_fine=False")
+                warnings.warn(f"c2f_iters {late} are not inside the run of n_iters={self.n_iters} iterations: those "
+                              f"bisections never happen, so the final bins are coarser than bin_duration; pass {fix}",
+                              stacklevel=3)
 
     @classmethod
     def base(cls, **overrides) -> "EvINRConfig":
