@@ -1,0 +1,183 @@
+"""evinr-lite batch on Dask, on loopback: a 2-worker LocalCluster gives the sequential run's scores,
+a worker killed in the middle of a task loses nothing, a bad recording is reported and does not stop
+the others, a rerun resumes."""
+import json
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import cloudpickle
+import pytest
+
+from evinr_lite.apps.batch import estimate_task_memory_mb, resolve_inputs, run_batch
+from evinr_lite.core.events import EventDataError
+from evinr_lite.sim.recordings import write_example_recording
+
+distributed = pytest.importorskip("distributed")
+
+SCENES = ("camera", "astronaut", "coffee", "moon")   # 4 small recordings that differ
+ITERS = 30
+GOOD = {f"rec_{scene}" for scene in SCENES}
+
+
+def _quiet(*args, **kwargs):
+    pass
+
+
+@pytest.fixture(scope="module")
+def recordings(tmp_path_factory):
+    """A folder of 4 small synthetic IJRR-style recordings and one bad file."""
+    folder = tmp_path_factory.mktemp("batch") / "synth"
+    folder.mkdir()
+    for i, scene in enumerate(SCENES):
+        write_example_recording(folder / f"rec_{scene}", scene=scene, sensor_size=(30, 40), duration=0.4,
+                                frame_rate=10.0, seed=i)
+    (folder / "broken.npy").write_bytes(b"this is not an event file")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def sequential(recordings, tmp_path_factory):
+    out = tmp_path_factory.mktemp("seq") / "out"
+    return run_batch([recordings], out, sequential=True, n_iters=ITERS, progress=False, log=_quiet)
+
+
+def _scores(summary):
+    return {r["name"]: r.get("scores") for r in summary["recordings"]}
+
+
+def _assert_same_results(summary, reference):
+    assert summary["pooled"] == reference["pooled"]
+    assert _scores(summary) == _scores(reference)
+    assert [f["name"] for f in summary["failed"]] == [f["name"] for f in reference["failed"]] == ["broken"]
+
+
+def test_sequential_reference_scores_everything_but_the_bad_file(sequential, recordings):
+    by_name = {r["name"]: r for r in sequential["recordings"]}
+    assert set(by_name) == GOOD | {"broken"}
+    assert all(by_name[n]["status"] == "done" for n in GOOD)
+    broken = by_name["broken"]
+    assert broken["status"] == "failed" and "broken.npy" in broken["error"] and "supported formats" in broken["error"]
+    # the recordings differ, so equal summaries below are not a coincidence
+    assert len({by_name[n]["scores"]["none"]["mse"] for n in GOOD}) == len(GOOD)
+    pooled = {p["equalization"]: p for p in sequential["pooled"]}
+    assert set(pooled) == {"none", "clahe"} and all(p["dataset"] == "synth" for p in pooled.values())
+    n = [by_name[k]["scores"]["none"]["n_frames"] for k in sorted(GOOD)]
+    mse = [by_name[k]["scores"]["none"]["mse"] for k in sorted(GOOD)]
+    assert pooled["none"]["n_frames"] == sum(n) and pooled["none"]["n_sequences"] == len(GOOD)
+    assert pooled["none"]["mse"] == pytest.approx(sum(a * b for a, b in zip(n, mse)) / sum(n))  # frame-weighted
+    assert "CLAHE" in pooled["clahe"]["protocol"] and pooled["none"]["protocol"] != pooled["clahe"]["protocol"]
+
+
+def test_two_workers_give_the_sequential_scores_and_a_rerun_resumes(recordings, sequential, tmp_path):
+    out = tmp_path / "out"
+    summary = run_batch([recordings], out, workers=2, n_iters=ITERS, progress=False, log=_quiet)
+    _assert_same_results(summary, sequential)
+    for name in GOOD:
+        run = json.loads((out / name / "run.json").read_text())
+        assert run["scores"]["none"]["mse"] == _scores(summary)[name]["none"]["mse"]
+    saved = json.loads((out / "summary.json").read_text())
+    assert saved["pooled"] == summary["pooled"] and "frame-weighted" in saved["pooling"]
+    csv_lines = (out / "summary.csv").read_text().splitlines()
+    assert csv_lines[0].startswith("dataset,equalization,n_sequences,n_frames,mse,ssim") and len(csv_lines) == 3
+    md = (out / "summary.md").read_text()
+    assert "Protocol (clahe)" in md and "broken" in md and "## Failed" in md
+    assert not list(out.glob(".*.partial-*"))
+
+    # a rerun schedules only what is not finished: here the bad file, and one deleted result
+    import shutil
+    shutil.rmtree(out / "rec_moon")
+    again = run_batch([recordings], out, sequential=True, n_iters=ITERS, progress=False, log=_quiet)
+    status = {r["name"]: r["status"] for r in again["recordings"]}
+    assert status == {**{n: "skipped" for n in GOOD - {"rec_moon"}}, "rec_moon": "done", "broken": "failed"}
+    _assert_same_results(again, sequential)
+
+    with pytest.raises(EventDataError, match="other settings.*n_iters"):
+        run_batch([recordings], out, sequential=True, n_iters=ITERS + 1, progress=False, log=_quiet)
+
+
+class KillOnceMidTask(distributed.WorkerPlugin):
+    """Logs every batch task's start; the first task to write its frames has its worker SIGKILLed
+    (like the OOM killer) right after the frames are written into its temporary output folder:
+    after training and scoring, before the result is renamed into place."""
+
+    def __init__(self, folder):
+        self.folder = str(folder)
+
+    def setup(self, worker):
+        import evinr_lite.io.export as export
+        from distributed.worker import thread_state
+
+        write_frames, folder = export.save_frames_png, self.folder
+
+        def write_then_die(*args, **kwargs):
+            result = write_frames(*args, **kwargs)
+            try:
+                fd = os.open(os.path.join(folder, "killed"), os.O_CREAT | os.O_EXCL | os.O_WRONLY)
+            except FileExistsError:
+                return result
+            os.write(fd, str(thread_state.key).encode())
+            os.close(fd)
+            os.kill(os.getpid(), signal.SIGKILL)
+
+        export.save_frames_png = write_then_die
+
+    def transition(self, key, start, finish, **kwargs):
+        if finish == "executing" and str(key).startswith("evinr-batch-"):
+            with open(os.path.join(self.folder, "starts.log"), "a") as f:
+                f.write(f"{key}\n")
+
+
+def test_worker_killed_mid_task_loses_nothing(recordings, sequential, tmp_path):
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])   # workers cannot import this test module
+    marks = tmp_path / "marks"
+    marks.mkdir()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        client.register_plugin(KillOnceMidTask(marks))
+        summary = run_batch([recordings], tmp_path / "out", client=client, n_iters=ITERS, progress=False, log=_quiet)
+    killed = (marks / "killed").read_text()
+    starts = (marks / "starts.log").read_text().splitlines()
+    assert starts.count(killed) == 2, starts          # the killed task ran again, on a live worker
+    assert len(set(starts)) == len(GOOD) + 1          # every task started once (the bad file's too)
+    _assert_same_results(summary, sequential)
+    assert not list((tmp_path / "out").glob(".*.partial-*"))   # the killed attempt's temporary folder is gone
+
+
+def test_inputs_from_paths_folders_and_the_data_fetch_cache(tmp_path, recordings):
+    cache = tmp_path / "cache"
+    (cache / "ijrr").mkdir(parents=True)
+    for name in ("slider_depth", "boxes_6dof"):
+        (cache / "ijrr" / f"{name}.h5").write_bytes(b"")
+    items = resolve_inputs(["ijrr", "ijrr:slider_depth", recordings / "rec_camera"], cache=cache, log=_quiet)
+    assert [(i["dataset"], i["name"]) for i in items] == [("ijrr", "boxes_6dof"), ("ijrr", "slider_depth"),
+                                                          ("synth", "rec_camera")]   # the same file once
+    with pytest.raises(EventDataError, match="python -m data_fetch get hqf all"):
+        resolve_inputs(["hqf:all"], cache=cache)
+    with pytest.raises(EventDataError, match="python -m data_fetch get ijrr office_zigzag"):
+        resolve_inputs(["ijrr:office_zigzag"], cache=cache)
+    with pytest.raises(EventDataError, match="no such recording"):
+        resolve_inputs([str(tmp_path / "missing" / "x.aedat4")], cache=cache)
+    # two recordings with one name: each is prefixed with its dataset
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "rec_camera.npy").write_bytes(b"")
+    names = [i["name"] for i in resolve_inputs([recordings / "rec_camera", other], cache=cache, log=_quiet)]
+    assert names == ["synth-rec_camera", "other-rec_camera"]
+
+
+def test_memory_estimate_grows_with_sensor_events_and_duration():
+    base = estimate_task_memory_mb((180, 240), 15.0, 10_000_000)
+    assert estimate_task_memory_mb((260, 346), 15.0, 10_000_000) > base
+    assert estimate_task_memory_mb((180, 240), 15.0, 50_000_000) > base
+    assert estimate_task_memory_mb((180, 240), 60.0, 10_000_000) > base
+
+
+def test_command_reports_missing_inputs(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "evinr_lite", "batch", "mvsec:indoor_flying1", "--out",
+                        str(tmp_path / "out"), "--workers", "2"], capture_output=True, text=True,
+                       env={**os.environ, "EVINR_DATA": str(tmp_path / "cache")}, timeout=120)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert "python -m data_fetch get mvsec indoor_flying1" in r.stderr
