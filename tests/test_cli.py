@@ -138,14 +138,14 @@ def test_bad_input_errors(capsys, ijrr_folder, tmp_path):
     junk.write_bytes(bytes(range(256)))
     assert_error(capsys, ["reconstruct", junk, *out], r"unknown format '.xyz'.*supported formats: .*AEDAT4")
     assert_error(capsys, ["reconstruct", ijrr_folder, "--sensor", "10x10", *out],
-                 r"sensor is \(H, W\) = \(24, 32\).*\(10, 10\) was given")
+                 r"sensor is \(H, W\) = \(24, 32\).*--sensor 10x10 was given.*pass --sensor 24x32")
     assert_error(capsys, ["reconstruct", ijrr_folder, "--start", "5", "--end", "6", *out],
                  r"no events in the window \[5\.0, 6\.0\).*choose a window inside")
     assert_error(capsys, ["reconstruct", ijrr_folder, "--start", "0.2", "--end", "0.1", *out], r"empty or reversed")
     assert_error(capsys, ["reconstruct", ijrr_folder, "--at", "0.1,7", *out], r"7\.0 s is outside the reconstructed window")
     assert_error(capsys, ["reconstruct", ijrr_folder, "--at", "soon", *out], r"could not read times")
-    assert_error(capsys, ["reconstruct", ijrr_folder, "--fps", "-3", *out], r"--fps must be a positive")
-    assert_error(capsys, ["reconstruct", ijrr_folder, "--C", "0", *out], r"C must be positive")
+    assert_error(capsys, ["reconstruct", ijrr_folder, "--fps", "-3", *out], r"argument --fps: must be positive")
+    assert_error(capsys, ["reconstruct", ijrr_folder, "--C", "0", *out], r"argument --C: must be positive")
     assert not (tmp_path / "never").exists()
 
 

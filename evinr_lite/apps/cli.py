@@ -7,21 +7,63 @@
     evinr-lite batch INPUTS... --out DIR [--scheduler ADDRESS | --workers N]
                                               every recording of INPUTS on Dask; a pooled table at the end
 
-Bad input (missing file, unknown format, wrong sensor size, empty window, existing output folder)
-prints ``evinr-lite: error: ...`` and exits with status 2; Ctrl-C exits with 130 and leaves no
-output folder behind.
+Exit status: 0 done; 2 bad input (``evinr-lite: error: ...``: missing or damaged file, unknown
+format, wrong sensor size, empty window, a bad option, an output folder that exists or cannot be
+written, not enough memory); 1 an internal error (a bug: rerun with ``--debug`` for the traceback);
+128 + n after signal n: 130 Ctrl-C (SIGINT), 143 SIGTERM, 129 SIGHUP. An interrupted run leaves no
+partial output and an existing output folder as it was.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import re
 import sys
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "build_parser", "EXIT_ERROR", "EXIT_INTERNAL", "EXIT_INTERRUPTED"]
 
-EXIT_ERROR = 2
-EXIT_INTERRUPTED = 130
+EXIT_ERROR = 2          # bad input
+EXIT_INTERNAL = 1       # a bug: "internal error", --debug shows the traceback
+EXIT_INTERRUPTED = 130  # 128 + SIGINT; SIGTERM gives 143, SIGHUP 129
+TIME_UNIT_CHOICES = ("s", "ms", "us", "ns")
+
+
+def _finite(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def _positive(text: str) -> float:
+    value = _finite(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text!r}")
+    return value
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {text!r}")
+    return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"must be in [0, 2**63), got {text!r}")
+    return value
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -31,54 +73,72 @@ def _size(text: str) -> tuple[int, int]:
         raise argparse.ArgumentTypeError(f"size must be HxW (rows x columns), e.g. 120x160; got {text!r}") from None
     if h <= 0 or w <= 0:
         raise argparse.ArgumentTypeError(f"size must be positive, got {text!r}")
+    if h > 1 << 16 or w > 1 << 16:
+        raise argparse.ArgumentTypeError(f"size {text!r} is larger than any event camera (at most 65536 per side)")
     return h, w
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with errors in the command's one style: ``evinr-lite: error: ...`` (status 2)."""
+
+    def error(self, message):
+        self.exit(EXIT_ERROR, f"evinr-lite: error: {message} (see `{self.prog} --help`)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
     from ..io.readers import SUPPORTED_FORMATS
 
-    parser = argparse.ArgumentParser(prog="evinr-lite", description=__doc__,
+    parser = _Parser(prog="evinr-lite", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--debug", action="store_true", help="show the traceback of an internal error")
+    common = _Parser(add_help=False)
+    common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
+                        help="show the traceback of an internal error")
     sub = parser.add_subparsers(dest="command", required=True)
+    unit_help = ("unit of the timestamps for .npy, text, IJRR, EVREAL and HQF h5 recordings (default: integers "
+                 "are microseconds, with a note; decimals seconds)")
 
     info = sub.add_parser("info", help="what a recording holds: format, sensor size, events, frames",
-                          description=f"Supported formats: {SUPPORTED_FORMATS}.")
+                          description=f"Supported formats: {SUPPORTED_FORMATS}.", parents=[common])
     info.add_argument("recording", help="file or folder (format detected from content and name)")
     info.add_argument("--sensor", type=_size, help="sensor size HxW, for files that do not record it (.npy, "
                                                    "text without a header, some Prophesee .raw)")
     info.add_argument("--json", action="store_true", help="print the description as JSON")
+    info.add_argument("--time-unit", choices=TIME_UNIT_CHOICES, help=unit_help)
 
     rec = sub.add_parser("reconstruct", help="reconstruct frames from a recording with EvINR",
                          description="Reconstruct frames with EvINR and write PNGs, an MP4 and a GIF; when the "
                                      "recording has frames, score against them (metrics.json / metrics.csv). "
-                                     f"Supported formats: {SUPPORTED_FORMATS}.")
+                                     f"Supported formats: {SUPPORTED_FORMATS}.", parents=[common])
     rec.add_argument("recording", help="file or folder (format detected from content and name)")
     rec.add_argument("--out", required=True, help="output folder (refused if it exists, unless --overwrite)")
     rec.add_argument("--sensor", type=_size, help="sensor size HxW (rows x columns), for files that do not "
                                                   "record it; checked against the file's otherwise")
-    rec.add_argument("--C", type=float, help="contrast threshold (default: the file's, else 1 as in the paper)")
+    rec.add_argument("--C", type=_positive, help="contrast threshold (default: the file's, else 1 as in the paper)")
+    rec.add_argument("--time-unit", choices=TIME_UNIT_CHOICES, help=unit_help)
     when = rec.add_mutually_exclusive_group()
-    when.add_argument("--fps", type=float, help="reconstruct this many frames per second over the window")
+    when.add_argument("--fps", type=_positive, help="reconstruct this many frames per second over the window")
     when.add_argument("--at", help="reconstruct at these times (seconds, comma-separated, or a file with "
                                    "one per line); default: the ground-truth frame times, else 30 per second")
-    rec.add_argument("--start", type=float, help="window start, seconds on the recording's clock (see `info`)")
-    rec.add_argument("--end", type=float, help="window end, seconds on the recording's clock (see `info`)")
+    rec.add_argument("--start", type=_finite, help="window start, seconds on the recording's clock (see `info`)")
+    rec.add_argument("--end", type=_finite, help="window end, seconds on the recording's clock (see `info`)")
     rec.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
-    rec.add_argument("--iters", type=int, default=300, help="training iterations (default: 300, the paper's)")
-    rec.add_argument("--seed", type=int, default=0)
+    rec.add_argument("--iters", type=_count, default=300, help="training iterations (default: 300, the paper's)")
+    rec.add_argument("--seed", type=_seed, default=0)
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--quiet", action="store_true", help="no progress bar")
 
-    demo = sub.add_parser("demo", help="reconstruct a built-in synthetic scene and score it (no download)")
+    demo = sub.add_parser("demo", help="reconstruct a built-in synthetic scene and score it (no download)",
+                          parents=[common])
     demo.add_argument("--out", default="evinr_demo", help="output folder (default: evinr_demo)")
     demo.add_argument("--scene", default="camera", help="built-in scene: camera, astronaut, bar, ... (default: camera)")
     demo.add_argument("--size", type=_size, default=(120, 160), help="sensor size HxW (default: 120x160)")
-    demo.add_argument("--duration", type=float, default=2.0, help="seconds of events (default: 2)")
-    demo.add_argument("--C", type=float, default=0.2, help="contrast threshold (default: 0.2)")
-    demo.add_argument("--frames", type=int, default=8, help="number of frames to reconstruct (default: 8)")
-    demo.add_argument("--iters", type=int, default=300, help="EvINR training iterations (default: 300, the paper's)")
-    demo.add_argument("--seed", type=int, default=0)
+    demo.add_argument("--duration", type=_positive, default=2.0, help="seconds of events (default: 2)")
+    demo.add_argument("--C", type=_positive, default=0.2, help="contrast threshold (default: 0.2)")
+    demo.add_argument("--frames", type=_count, default=8, help="number of frames to reconstruct (default: 8)")
+    demo.add_argument("--iters", type=_count, default=300, help="EvINR training iterations (default: 300, the paper's)")
+    demo.add_argument("--seed", type=_seed, default=0)
     demo.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
 
     batch = sub.add_parser("batch", help="reconstruct and score many recordings on Dask (one task each)",
@@ -111,7 +171,7 @@ def build_parser() -> argparse.ArgumentParser:
 def _info(args) -> None:
     from .recon_job import describe_recording, format_info, read_any
 
-    rec = read_any(args.recording, sensor_size=args.sensor)
+    rec = read_any(args.recording, sensor_size=args.sensor, time_unit=args.time_unit)
     info = describe_recording(rec)
     print(json.dumps(info, indent=2) if args.json else format_info(info))
 
@@ -121,19 +181,18 @@ def _reconstruct(args) -> None:
 
     run_reconstruct(args.recording, args.out, sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
                     t_start=args.start, t_end=args.end, device=args.device, n_iters=args.iters, seed=args.seed,
-                    overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet)
+                    overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet,
+                    time_unit=args.time_unit, command=" ".join(["evinr-lite", *sys.argv[1:]]))
 
 
 def _demo(args) -> None:
-    from pathlib import Path
-
     from .demo import run_demo
+    from ..io.output import check_output_path
     from ..method.solver import EvINRConfig
 
-    if Path(args.out).exists() and not args.overwrite:  # say so before training, not after
-        raise FileExistsError(f"output folder {args.out} already exists; choose another --out or pass --overwrite")
-    config = EvINRConfig(C=args.C, n_iters=args.iters, seed=args.seed,
-                         c2f_iters=(args.iters // 3, 2 * args.iters // 3))
+    check_output_path(args.out, overwrite=args.overwrite)   # say so before training, not after
+    c2f = (args.iters // 3, 2 * args.iters // 3) if args.iters >= 3 else ()
+    config = EvINRConfig(C=args.C, n_iters=args.iters, seed=args.seed, c2f_iters=c2f, coarse_to_fine=bool(c2f))
     run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
              n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)
 
@@ -158,42 +217,93 @@ def _batch(args) -> None:
 FLAG_FOR = [
     (re.compile(r"sensor_size=\((\d+), (\d+)\)"), r"--sensor \1x\2"),
     (re.compile(r"sensor_size=\(H, W\)"), "--sensor HxW"),
+    (re.compile(r"\bsensor_size="), "--sensor "),
     (re.compile(r"\bt_start=/t_end="), "--start/--end"),
-    (re.compile(r"\bt_start="), "--start "),
-    (re.compile(r"\bt_end="), "--end "),
-    (re.compile(r"\bn_iters="), "--iters"),
-    (re.compile(r"\bout_dir="), "--out"),
     (re.compile(r"\boverwrite=True"), "--overwrite"),
     (re.compile(r"\bdevice='(\w+)'"), r"--device \1"),
-    (re.compile(r"\bfps="), "--fps"),
-    (re.compile(r"\bat="), "--at "),
-    (re.compile(r"\bC="), "--C "),
+    (re.compile(r"\btime_unit='(\w+)'"), r"--time-unit \1"),
+    (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)=(?=[\w'\"(.+-])"),
+     lambda m: FLAGS[m.group(1)] + " "),
+    (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)="), lambda m: FLAGS[m.group(1)]),
 ]
+FLAGS = {"t_start": "--start", "t_end": "--end", "n_iters": "--iters", "out_dir": "--out", "fps": "--fps",
+         "at": "--at", "C": "--C", "time_unit": "--time-unit"}
 
 
 def _message(exc: BaseException) -> str:
     """The error's text with each parameter named as its command-line flag."""
     text = str(exc) or type(exc).__name__
+    if isinstance(exc, OSError) and exc.strerror and exc.filename:
+        text = f"{exc.filename}: {exc.strerror}"
     for pattern, flag in FLAG_FOR:
         text = pattern.sub(flag, text)
     return re.sub(r" {2,}", " ", text)
 
 
+def _show_note(message, category, filename, lineno, file=None, line=None):
+    print(f"evinr-lite: note: {_message(Warning(str(message)))}", file=sys.stderr)
+
+
+def _out_of_memory(exc: BaseException) -> bool:
+    if isinstance(exc, MemoryError):
+        return True
+    torch = sys.modules.get("torch")
+    oom = getattr(torch, "OutOfMemoryError", None) if torch is not None else None
+    return (oom is not None and isinstance(exc, oom)) or (isinstance(exc, RuntimeError) and
+                                                          "out of memory" in str(exc).lower())
+
+
 def main(argv=None) -> int:
-    """Run the command; returns the exit status (0 ok, 2 bad input, 130 interrupted)."""
-    args = build_parser().parse_args(argv)
-    from ..core.events import EventDataError
+    """Run the command; returns the exit status (0 ok, 2 bad input, 1 internal error, 128 + n after signal n).
+
+    One guard around every command: a known input problem prints ``evinr-lite: error: ...``
+    (status 2); anything else prints ``evinr-lite: internal error: ...`` with the command to rerun
+    with ``--debug``, which shows the traceback (status 1). SIGTERM and SIGHUP are handled as
+    Ctrl-C: the run stops, cleans up and says what happened to the output folder.
+    """
+    import signal
+    import traceback
+    import warnings
+    from pathlib import Path
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        args = build_parser().parse_args([str(a) for a in argv])
+    except SystemExit as exc:   # --help (0) or a bad option (2, already printed)
+        return exc.code if isinstance(exc.code, int) else EXIT_ERROR
+    from ..core.events import InputError
+    from ..io.output import Interrupted, termination_signals
 
     commands = {"info": _info, "reconstruct": _reconstruct, "demo": _demo, "batch": _batch}
+    out = getattr(args, "out", None)
+    existed = out is not None and Path(out).exists()
     try:
-        commands[args.command](args)
-    except (EventDataError, FileExistsError, FileNotFoundError, PermissionError, IsADirectoryError,
-            NotADirectoryError, ValueError) as exc:
+        with termination_signals(), warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.showwarning = _show_note
+            commands[args.command](args)
+    except KeyboardInterrupt as exc:
+        signum = exc.signum if isinstance(exc, Interrupted) else signal.SIGINT
+        note = getattr(exc, "output_note", None)
+        if note is None and out is not None:
+            note = f"the existing {out} was left as it was" if existed else f"{out} was not written"
+        where = f"; {note}" if note else ""
+        print(f"\nevinr-lite: interrupted by {signal.Signals(signum).name}{where} (partial results are deleted)",
+              file=sys.stderr)
+        return 128 + int(signum)
+    except (InputError, OSError) as exc:
         print(f"evinr-lite: error: {_message(exc)}", file=sys.stderr)
         return EXIT_ERROR
-    except KeyboardInterrupt:
-        out = getattr(args, "out", None)
-        where = f"; {out} was not written or changed" if out else ""
-        print(f"\nevinr-lite: interrupted{where} (partial results are deleted)", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except Exception as exc:
+        if _out_of_memory(exc):
+            print("evinr-lite: error: ran out of memory (the estimate made before training was too low); shorten "
+                  "the window with --start/--end or ask for fewer frames with --fps/--at", file=sys.stderr)
+            return EXIT_ERROR
+        if getattr(args, "debug", False):
+            traceback.print_exc()
+        else:
+            print(f"evinr-lite: internal error: {type(exc).__name__}: {exc}\n"
+                  f"  This is a bug in evinr-lite, not a problem with your input. Rerun with --debug to see the "
+                  f"traceback and include it in a report:\n  evinr-lite --debug {' '.join(argv)}", file=sys.stderr)
+        return EXIT_INTERNAL
     return 0

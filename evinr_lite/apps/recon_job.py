@@ -16,12 +16,13 @@ first event on an absolute clock, else 0), as ``describe_recording`` prints them
 from __future__ import annotations
 
 import math
+import os
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ..core.events import EventDataError
+from ..core.events import TIME_UNITS, EventDataError
 from ..core.frames import Frames
 from ..core.recording import Recording
 from ..io.readers import detect_format, read_recording
@@ -30,7 +31,7 @@ from ..method.solver import EvINRConfig, Reconstruction, reconstruct
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
-           "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS"]
+           "check_run_options", "estimate_memory", "check_memory", "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 DEFAULT_C = 1.0         # the paper's contrast threshold for DAVIS recordings (IJRR, HQF)
@@ -41,23 +42,41 @@ READER_WINDOW_FORMATS = ("canonical", "h5", "aedat4", "prophesee_raw", "prophese
 
 # ---- load ------------------------------------------------------------------------------------
 
-def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None) -> Recording:
+SENSOR_ARG_FORMATS = SIZE_FREE_FORMATS + ("ijrr", "aedat4", "prophesee_raw", "prophesee_dat")  # take sensor_size=
+TIME_UNIT_FORMATS = ("txt", "npy", "ijrr", "evreal", "h5")   # formats whose time unit may differ from seconds
+FIXED_UNITS = {"aedat4": "us", "prophesee_raw": "us", "prophesee_dat": "us", "canonical": "s"}
+
+
+def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None,
+             time_unit: str | None = None) -> Recording:
     """Read a recording of any supported format, the sensor size checked or supplied.
 
     Args:
         path: file or folder; the format is detected (:func:`evinr_lite.io.readers.detect_format`).
         sensor_size: (H, W). Needed for formats that do not record it (.npy, text without a
-            `W H` header, some Prophesee .raw); for the others it must match the file's.
+            `W H` header, an IJRR folder without images.txt, some Prophesee .raw); for the others
+            it must match the file's.
         t_start, t_end: passed to readers that read only a window from disk (the others read all).
+        time_unit: unit of the timestamps for formats that do not fix it (.npy, text, IJRR, EVREAL,
+            HQF h5): 's', 'ms', 'us', 'ns'; None: the reader's detection (integers are taken as
+            microseconds, with a warning). For AEDAT4 / Prophesee (microseconds) and canonical files
+            (seconds) a different unit is refused.
     Raises:
-        EventDataError: missing file, unknown format, wrong or missing sensor size.
+        EventDataError: missing file, unknown format, wrong or missing sensor size, a time unit the
+            format does not allow.
     """
     kind = detect_format(path)
     kwargs = {}
-    if kind in SIZE_FREE_FORMATS + ("aedat4", "prophesee_raw", "prophesee_dat") and sensor_size is not None:
+    if kind in SENSOR_ARG_FORMATS and sensor_size is not None:
         kwargs["sensor_size"] = sensor_size
     if kind in READER_WINDOW_FORMATS:
         kwargs.update(t_start=t_start, t_end=t_end)
+    if time_unit is not None:
+        if kind in TIME_UNIT_FORMATS:
+            kwargs["time_unit"] = time_unit
+        elif FIXED_UNITS.get(kind) != time_unit:
+            raise EventDataError(f"{path}: a {kind} file stores its timestamps in {FIXED_UNITS.get(kind, 's')} "
+                                 f"by its format, so time_unit={time_unit!r} cannot apply; leave time_unit= out")
     rec = read_recording(path, **kwargs)
     if sensor_size is not None and tuple(int(v) for v in sensor_size) != rec.events.sensor_size:
         H, W = rec.events.sensor_size
@@ -66,11 +85,12 @@ def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: flo
     return Recording(rec.events, rec.frames, {**rec.meta, "format": rec.meta.get("format", kind)})
 
 
-def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None) -> Recording:
+def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None,
+                   time_unit: str | None = None) -> Recording:
     """Read a recording (any supported format) restricted to the window [t_start, t_end).
 
     Args:
-        path, sensor_size: see :func:`read_any`.
+        path, sensor_size, time_unit: see :func:`read_any`.
         t_start, t_end: seconds on the recording's clock; None: from the first / to the last event.
     Returns:
         Recording whose events lie in the window and whose frames lie in [start, end], the span
@@ -79,7 +99,10 @@ def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_en
         EventDataError: missing file, unknown format, wrong sensor size, empty window (each
             message says what to do).
     """
-    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end)
+    for name, value in (("t_start", t_start), ("t_end", t_end)):
+        if value is not None and not math.isfinite(value):
+            raise EventDataError(f"{name}= must be a finite number of seconds, got {value}")
+    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
     events, frames = rec.events, rec.frames
     if rec.meta["format"] not in READER_WINDOW_FORMATS:
         events = events.slice_time(t_start, t_end)
@@ -268,15 +291,32 @@ def export_reconstruction(out_dir, rec: Recording, result: Reconstruction, score
     window) with ``metrics.json`` and ``metrics.csv`` (per frame, both protocols) when scored, and
     ``run.json`` (input, format, window, settings, EvINR config, timings).
 
+    ``out_dir`` may also be an :class:`~evinr_lite.io.output.OutputDir` opened (checked and locked)
+    before the long work, as :func:`run_reconstruct` does; it is committed here.
+
     Returns:
         The contents of run.json.
     Raises:
-        FileExistsError: ``out_dir`` exists and ``overwrite`` is False.
+        OutputError (FileExistsError): ``out_dir`` exists and ``overwrite`` is False, or it cannot be
+            written (see :func:`evinr_lite.io.output.check_output_path`).
     """
-    from ..io.export import save_csv, save_frames_png, save_gif, save_mp4, save_timestamps
-    from ..io.output import atomic_output_dir, save_json
+    from ..io.output import OutputDir
 
-    out_dir = Path(out_dir)
+    if isinstance(out_dir, OutputDir):
+        run = _write_reconstruction(out_dir.staging, rec, result, scores, settings=settings, video=video, log=log)
+        out_dir.commit()
+        return run
+    with OutputDir(out_dir, overwrite=overwrite, inputs=[rec.meta.get("path")], log=log) as target:
+        run = _write_reconstruction(target.staging, rec, result, scores, settings=settings, video=video, log=log)
+        target.commit()
+    return run
+
+
+def _write_reconstruction(tmp: Path, rec: Recording, result: Reconstruction, scores: dict | None, *,
+                          settings: dict | None, video: bool, log) -> dict:
+    from ..io.export import save_csv, save_frames_png, save_gif, save_mp4, save_timestamps
+    from ..io.output import save_json
+
     written = ["frames/", "timestamps.txt"]
     run = {"input": rec.meta.get("path"), "format": rec.meta.get("format"),
            "sensor_size": list(rec.events.sensor_size), "t_origin": rec.events.t_origin,
@@ -284,41 +324,41 @@ def export_reconstruction(out_dir, rec: Recording, result: Reconstruction, score
            "n_frames_written": len(result.times), "times_s": result.times.tolist(),
            **(settings or {}), "evinr_config": result.history.get("config"),
            "train_time_s": result.history.get("train_time_s")}
-    with atomic_output_dir(out_dir, overwrite=overwrite) as tmp:
-        save_frames_png(tmp / "frames", result.frames)
-        save_timestamps(tmp / "timestamps.txt", result.times, rec.events.t_origin)
-        if video:
-            fps = _video_fps(result.times)
-            save_gif(tmp / "reconstruction.gif", result.frames, fps)
-            written.append("reconstruction.gif")
-            try:
-                save_mp4(tmp / "reconstruction.mp4", result.frames, fps)
-                written.append("reconstruction.mp4")
-            except RuntimeError as err:
-                log(f"warning: {err}")
-            run["video_fps"] = fps
-        if scores is not None:
-            gt = rec.frames
-            save_frames_png(tmp / "gt", gt.images)
-            save_timestamps(tmp / "gt" / "timestamps.txt", gt.t, gt.t_origin)
-            summary = {eq: {k: v for k, v in s.items() if not k.startswith("per_frame")} for eq, s in scores.items()}
-            save_json(tmp / "metrics.json", {"scored_at": "the ground-truth frame times in the window",
-                                             "protocols": summary,
-                                             "per_frame": {eq: {k: v for k, v in s.items() if k.startswith("per_frame")}
-                                                           for eq, s in scores.items()}})
-            first = next(iter(scores.values()))
-            rows = []
-            for k, gi in enumerate(first["per_frame_index"]):
-                row = {"gt_index": gi, "t_s": f"{first['per_frame_t_s'][k]:.9f}"}
-                for eq, s in scores.items():
-                    row[f"mse_{eq}"] = f"{s['per_frame_mse'][k]:.6f}"
-                    row[f"ssim_{eq}"] = f"{s['per_frame_ssim'][k]:.6f}"
-                rows.append(row)
-            save_csv(tmp / "metrics.csv", rows)
-            written += ["gt/", "metrics.json", "metrics.csv"]
-            run["scores"] = summary
-        run["files"] = written + ["run.json"]
-        save_json(tmp / "run.json", _jsonable(run))
+    # into the staging folder; the caller renames it into place
+    save_frames_png(tmp / "frames", result.frames)
+    save_timestamps(tmp / "timestamps.txt", result.times, rec.events.t_origin)
+    if video:
+        fps = _video_fps(result.times)
+        save_gif(tmp / "reconstruction.gif", result.frames, fps)
+        written.append("reconstruction.gif")
+        try:
+            save_mp4(tmp / "reconstruction.mp4", result.frames, fps)
+            written.append("reconstruction.mp4")
+        except RuntimeError as err:
+            log(f"warning: {err}")
+        run["video_fps"] = fps
+    if scores is not None:
+        gt = rec.frames
+        save_frames_png(tmp / "gt", gt.images)
+        save_timestamps(tmp / "gt" / "timestamps.txt", gt.t, gt.t_origin)
+        summary = {eq: {k: v for k, v in s.items() if not k.startswith("per_frame")} for eq, s in scores.items()}
+        save_json(tmp / "metrics.json", {"scored_at": "the ground-truth frame times in the window",
+                                         "protocols": summary,
+                                         "per_frame": {eq: {k: v for k, v in s.items() if k.startswith("per_frame")}
+                                                       for eq, s in scores.items()}})
+        first = next(iter(scores.values()))
+        rows = []
+        for k, gi in enumerate(first["per_frame_index"]):
+            row = {"gt_index": gi, "t_s": f"{first['per_frame_t_s'][k]:.9f}"}
+            for eq, s in scores.items():
+                row[f"mse_{eq}"] = f"{s['per_frame_mse'][k]:.6f}"
+                row[f"ssim_{eq}"] = f"{s['per_frame_ssim'][k]:.6f}"
+            rows.append(row)
+        save_csv(tmp / "metrics.csv", rows)
+        written += ["gt/", "metrics.json", "metrics.csv"]
+        run["scores"] = summary
+    run["files"] = written + ["run.json"]
+    save_json(tmp / "run.json", _jsonable(run))
     return run
 
 
@@ -337,48 +377,152 @@ def _jsonable(obj):
 
 # ---- the whole job ---------------------------------------------------------------------------
 
+def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: int = 300, seed: int = 0,
+                      time_unit=None) -> None:
+    """Every option of :func:`run_reconstruct` checked before any file is read (EventDataError naming it)."""
+    def finite(name, value):
+        if value is None:
+            return None
+        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
+            raise EventDataError(f"{name} must be a finite number, got {value!r}")
+        return float(value)
+
+    if finite("C=", C) is not None and not C > 0:
+        raise EventDataError(f"C= must be positive (a contrast threshold in log units), got {C}")
+    if finite("fps=", fps) is not None and not fps > 0:
+        raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
+    finite("t_start=", t_start)
+    finite("t_end=", t_end)
+    if t_start is not None and t_end is not None and not t_end > t_start:
+        raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end= must exceed t_start=")
+    if isinstance(n_iters, bool) or not isinstance(n_iters, (int, np.integer)) or n_iters < 1:
+        raise EventDataError(f"n_iters= must be a whole number of at least 1, got {n_iters!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**63:
+        raise EventDataError(f"seed must be a whole number in [0, 2**63), got {seed!r}")
+    if time_unit is not None and time_unit not in TIME_UNITS:
+        raise EventDataError(f"time_unit= must be one of {', '.join(TIME_UNITS)}, got {time_unit!r}")
+
+
+def _available_bytes(device: str) -> int:
+    """Memory free for the run: the GPU's free memory on cuda, else the system's available memory."""
+    if device.startswith("cuda"):
+        import torch
+
+        return int(torch.cuda.mem_get_info()[0])
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return 1 << 62
+
+
+def estimate_memory(rec: Recording, times, config: EvINRConfig) -> dict:
+    """Bytes a reconstruction will need, by part, before anything is allocated.
+
+    Parts: ``networks`` (each window's SIREN with its H*W head: weights, gradients and Adam's two
+    moments, float32), ``bins`` (the event frames and the loss terms over them), ``frames`` (the
+    queried log intensities and tone-mapped frames). An estimate (within a factor of about 2).
+    """
+    lo, hi = rec.meta["window"]
+    span = max(float(hi) - float(lo), 0.0)
+    H, W = rec.events.sensor_size
+    pixels = float(H) * float(W)
+    if config.tau is None or span <= config.tau:
+        n_windows = 1
+    else:
+        n_windows = math.ceil((span - config.overlap) / (config.tau - config.overlap))
+    hidden = config.hidden_features
+    params = 2 * hidden + config.hidden_layers * (hidden * hidden + hidden) + (hidden + 1) * pixels
+    if config.binning == "fixed":
+        n_bins = math.ceil(span / config.bin_duration)
+    else:
+        n_bins = math.ceil(len(rec.events) / config.events_per_bin)
+    n_bins = max(n_bins, 1)
+    parts = {"networks": 16.0 * params * n_windows, "bins": 3 * 4.0 * n_bins * pixels,
+             "frames": 2 * 16.0 * len(np.atleast_1d(times)) * pixels}
+    return {"total": sum(parts.values()), "parts": parts, "n_windows": n_windows, "n_bins": n_bins,
+            "n_frames": len(np.atleast_1d(times)), "span_s": span}
+
+
+def check_memory(rec: Recording, times, config: EvINRConfig, device: str = "cpu", *, fraction: float = 0.8) -> dict:
+    """Refuse (EventDataError) a reconstruction whose :func:`estimate_memory` exceeds ``fraction`` of
+    the free memory, naming the estimate and the parameter to change. Returns the estimate."""
+    est = estimate_memory(rec, times, config)
+    free = _available_bytes(device)
+    if est["total"] <= fraction * free:
+        return est
+    gib = lambda b: f"{b / 2**30:,.1f} GiB"  # noqa: E731
+    H, W = rec.events.sensor_size
+    lo, hi = rec.meta["window"]
+    worst = max(est["parts"], key=est["parts"].get)
+    ev_lo, ev_hi = (float(rec.events.t[0]), float(rec.events.t[-1])) if len(rec.events) else (lo, hi)
+    fix = {
+        "networks": (f"{est['n_windows']:,} network(s) with a head of {H}x{W} pixels (windows of tau = {config.tau} s "
+                     f"over {est['span_s']:.6g} s); shorten the window with t_start=/t_end= (the events cover "
+                     f"[{ev_lo:.6f}, {ev_hi:.6f}] s) or check the sensor size (sensor_size=(H, W))"),
+        "bins": (f"{est['n_bins']:,} event bins of {H}x{W} pixels ({est['span_s']:.6g} s in bins of "
+                 f"{config.bin_duration:g} s); shorten the window with t_start=/t_end= (the events cover "
+                 f"[{ev_lo:.6f}, {ev_hi:.6f}] s) or use a longer bin_duration"),
+        "frames": (f"{est['n_frames']:,} output frames of {H}x{W} pixels; ask for fewer frames with fps= or at=, "
+                   "or shorten the window with t_start=/t_end="),
+    }[worst]
+    raise EventDataError(f"this reconstruction needs about {gib(est['total'])} of memory but about {gib(free)} is "
+                         f"free on {device}: most of it for {fix}")
+
+
+# ---- the whole job ---------------------------------------------------------------------------
+
 def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, fps: float | None = None, at=None,
                     t_start: float | None = None, t_end: float | None = None, device: str | None = None,
                     n_iters: int = 300, seed: int = 0, overwrite: bool = False, video: bool = True,
-                    progress: bool = True, log=print) -> dict:
+                    progress: bool = True, time_unit: str | None = None, log=print, command: str = "") -> dict:
     """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
 
-    Every check that can fail (output folder, device, file, format, sensor size, window, times)
-    runs before training. C: the contrast threshold; None takes the file's (canonical files
-    store it), else DEFAULT_C = 1 (the paper's for DAVIS data).
+    Every check that can fail runs before training: the options, the output folder (checked,
+    locked for the whole run against a second run, a staging folder created beside it), the
+    device, the file, its format, the sensor size, the window, the times and the memory needed.
+    C: the contrast threshold; None takes the file's (canonical files store it), else DEFAULT_C = 1
+    (the paper's for DAVIS data). time_unit: the unit of integer or text timestamps ('s', 'ms',
+    'us', 'ns'; None: the reader's detection). ``command`` is recorded in the lock so a second run
+    can name this one.
     Returns the contents of run.json (with "scores" when the recording has frames).
     """
     from ..core.runtime import default_device
+    from ..io.output import OutputDir
 
     t0 = time.perf_counter()
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not overwrite:
-        raise FileExistsError(f"output folder {out_dir} already exists; choose another out_dir= or pass overwrite=True")
-    try:
-        device_name = str(default_device(device))
-    except RuntimeError as err:
-        raise EventDataError(str(err)) from None
-    if n_iters < 1:
-        raise EventDataError(f"n_iters= must be at least 1, got {n_iters}")
-    rec = load_recording(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end)
-    times, source = choose_times(rec, fps=fps, at=at)
-    C_source = "given" if C is not None else ("from the file" if rec.meta.get("C") else "default (pass C=)")
-    C = float(C if C is not None else rec.meta.get("C") or DEFAULT_C)
-    lo, hi = rec.meta["window"]
-    H, W = rec.events.sensor_size
-    log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
-        + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
-        + f" in {time.perf_counter() - t0:.1f} s")
-    log(f"reconstructing {source} with EvINR (C = {C:g} {C_source}, {n_iters} iterations, {device_name})")
-    c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
-    config = EvINRConfig(C=C, n_iters=n_iters, c2f_iters=c2f, coarse_to_fine=bool(c2f), seed=seed,
-                         device=device, progress=progress)
-    result = reconstruct_recording(rec, times, config)
-    scores = score_recording(result, rec.frames)
-    settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
-    run = export_reconstruction(out_dir, rec, result, scores, settings=settings, overwrite=overwrite,
-                                video=video, log=log)
+    check_run_options(C=C, fps=fps, t_start=t_start, t_end=t_end, n_iters=n_iters, seed=seed, time_unit=time_unit)
+    with OutputDir(out_dir, overwrite=overwrite, inputs=[path], log=log, command=command) as target:
+        try:
+            device_name = str(default_device(device))
+        except RuntimeError as err:
+            raise EventDataError(str(err)) from None
+        rec = load_recording(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
+        times, source = choose_times(rec, fps=fps, at=at)
+        C_source = "given" if C is not None else ("from the file" if rec.meta.get("C") else "default (pass C=)")
+        C = float(C if C is not None else rec.meta.get("C") or DEFAULT_C)
+        c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
+        config = EvINRConfig(C=C, n_iters=n_iters, c2f_iters=c2f, coarse_to_fine=bool(c2f), seed=seed,
+                             device=device, progress=progress)
+        check_memory(rec, times, config, device_name)
+        lo, hi = rec.meta["window"]
+        H, W = rec.events.sensor_size
+        log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
+            + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
+            + f" in {time.perf_counter() - t0:.1f} s")
+        log(f"reconstructing {source} with EvINR (C = {C:g} {C_source}, {n_iters} iterations, {device_name})")
+        result = reconstruct_recording(rec, times, config)
+        scores = score_recording(result, rec.frames)
+        settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
+        run = export_reconstruction(target, rec, result, scores, settings=settings, video=video, log=log)
     seconds = time.perf_counter() - t0
+    out_dir = target.given
     line = (f"wrote {len(times)} frames to {out_dir}/ in {seconds:.1f} s "
             f"(training {result.history['train_time_s']:.1f} s)")
     if scores:

@@ -1,42 +1,394 @@
-"""Writing results so that nothing is ever half-written: everything goes to a temporary folder
-that is renamed into place only when complete."""
+"""Writing results so that nothing is ever lost or half-written.
+
+An output folder is reserved for the whole run by :class:`OutputDir`, before any long work:
+
+1. **checks** (:func:`check_output_path`): the path is not a symbolic link, not an existing file, not
+   the input recording, does not contain it and does not lie inside it, is not the current folder
+   when it would be replaced; its parent can be created and written; its name leaves room for the
+   temporary names on this file system; an existing folder is refused unless ``overwrite``.
+2. **lock**: ``.<name>.lock`` beside the folder (a ``filelock`` lock, released by the kernel when a
+   process dies): a second run into the same folder is refused at once, naming the first.
+3. **recovery**: hidden ``.<name>.partial-<pid>-*`` folders of dead runs are named and removed; an
+   old result renamed aside (``.<name>.old-*``) by a run killed mid-replacement is put back.
+4. **staging**: results are written into ``.<name>.partial-<pid>-<random>`` beside the folder
+   (created at once, so an unwritable place is found before training).
+5. **commit**: with SIGINT, SIGTERM and SIGHUP held back, the old folder is renamed aside, the new
+   one renamed in, and only then is the old one deleted: at every instant the old or the new
+   result is complete under its name (or, after a hard kill between the two renames, complete
+   under ``.<name>.old-*``, and put back by the next run).
+
+On an exception or an interruption the staging folder, the lock file and any parent folders the
+run created are removed; an existing folder is left as it was.
+"""
 from __future__ import annotations
 
 import json
 import os
+import secrets
 import shutil
-import tempfile
+import signal
+import socket
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
-__all__ = ["atomic_output_dir", "save_png", "save_json"]
+from ..core.events import InputError
+
+__all__ = ["atomic_output_dir", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
+           "termination_signals", "signals_deferred", "save_png", "save_json", "TERMINATION_SIGNALS"]
+
+TERMINATION_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
+_TEMP_ROOM = len(".partial-4194304-") + 16 + 1   # bytes a temporary name adds to the folder's name
+
+
+class OutputError(InputError):
+    """The output path cannot be used as given; the message names the problem and the fix."""
+
+
+class OutputExistsError(OutputError, FileExistsError):
+    """The output folder exists and ``overwrite`` is False."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT, SIGTERM or SIGHUP arrived; ``signum`` says which (the exit status is 128 + signum)."""
+
+    def __init__(self, signum: int = signal.SIGINT):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = int(signum)
+
+
+def _raise_interrupted(signum, frame):
+    raise Interrupted(signum)
 
 
 @contextmanager
-def atomic_output_dir(out_dir, overwrite: bool = False):
-    """Yield a temporary folder beside ``out_dir``; on success it replaces ``out_dir``.
+def termination_signals():
+    """Inside the block SIGTERM and SIGHUP raise :class:`Interrupted` like Ctrl-C (SIGINT) does, so
+    cleanup runs for all three. SIGINT is left alone when it is ignored (a background job)."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {}
+    for sig in TERMINATION_SIGNALS:
+        current = signal.getsignal(sig)
+        if sig == signal.SIGINT and current in (signal.SIG_IGN, None):
+            continue
+        previous[sig] = current
+        signal.signal(sig, _raise_interrupted)
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+@contextmanager
+def signals_deferred():
+    """Hold back SIGINT, SIGTERM and SIGHUP inside the block; one that arrives is acted on when the
+    block ends (its handler runs then, or its default action). Only the main thread can do this
+    (Python runs signal handlers there); elsewhere the block runs unprotected."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    pending, previous = [], {}
+    for sig in TERMINATION_SIGNALS:
+        handler = signal.getsignal(sig)
+        if handler in (signal.SIG_IGN, None):
+            continue
+        previous[sig] = handler
+        signal.signal(sig, lambda signum, frame: pending.append(signum))
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if pending:
+            handler = previous[pending[0]]
+            if callable(handler):
+                handler(pending[0], None)        # e.g. raises KeyboardInterrupt / Interrupted
+            elif handler == signal.SIG_DFL:
+                os.kill(os.getpid(), pending[0])  # the default action, now that the block is done
+
+
+def _first_existing(path: Path) -> Path:
+    while not os.path.lexists(path) and path != path.parent:
+        path = path.parent
+    return path
+
+
+def _inside(a: Path, b: Path) -> bool:
+    """True when a is b or lies inside b (both resolved)."""
+    return a == b or b in a.parents
+
+
+def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:
+    """Every check of an output folder that can be made before any work; returns its absolute path.
+
+    Args:
+        out_dir: the folder to write.
+        overwrite: an existing folder may be replaced.
+        inputs: paths the run reads (the recording): the output may not be, contain, or lie inside one.
+    Raises:
+        OutputError naming the problem and the fix.
+    """
+    given = Path(out_dir).expanduser()
+    out = Path(os.path.abspath(given))
+    if out == out.parent or not out.name:
+        raise OutputError(f"out_dir={str(given)!r} is the root of the file system; choose a folder to create, e.g. out_dir=rec")
+    real = out.parent.resolve() / out.name
+    for source in inputs:
+        if source is None:
+            continue
+        source = Path(source).expanduser().resolve()
+        if _inside(source, real.resolve() if out.is_symlink() else real):
+            what = "is the input recording" if source == real else f"contains the input recording {source}"
+            raise OutputError(f"the output folder {given} {what}; writing there would replace the input; "
+                              "choose another out_dir=")
+        if source.is_dir() and _inside(real, source):
+            raise OutputError(f"the output folder {given} lies inside the input folder {source}; write the result "
+                              "elsewhere (choose another out_dir=)")
+    if out.is_symlink():
+        raise OutputError(f"the output {given} is a symbolic link (to {os.readlink(out)}); pass the folder it points "
+                          "to, or another name, as out_dir=")
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"the output {given} exists and is a file, not a folder; it is left as it is: choose "
+                          "another out_dir= (or delete the file yourself)")
+    if out.exists() and not overwrite:
+        raise OutputExistsError(f"output folder {given} already exists; choose another out_dir= or pass overwrite=True")
+    if out.exists() and _inside(Path.cwd().resolve(), real):
+        raise OutputError(f"the output folder {given} is the current folder (or contains it); replacing it would "
+                          "delete the folder you are working in: choose a new folder, e.g. out_dir=rec")
+    anchor = _first_existing(out.parent)
+    if not anchor.is_dir():
+        raise OutputError(f"cannot create the output folder {given}: {anchor} is a file, not a folder; choose "
+                          "another out_dir=")
+    if not os.access(anchor, os.W_OK | os.X_OK):
+        raise OutputError(f"cannot write the output folder {given}: no permission to write in {anchor}; choose an "
+                          "out_dir= in a folder you can write")
+    try:
+        name_max = os.pathconf(anchor, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        name_max = 255
+    longest = max(len(part.encode()) for part in out.relative_to(anchor).parts)
+    if longest + _TEMP_ROOM > name_max:
+        raise OutputError(f"the output folder name in {given} is {longest} bytes long; this file system allows "
+                          f"{name_max} per name and {_TEMP_ROOM} are needed for a temporary name beside it: choose "
+                          f"a name of at most {name_max - _TEMP_ROOM} bytes as out_dir=")
+    return out
+
+
+class OutputDir:
+    """An output folder reserved for one run: checked, locked, written beside, renamed into place.
+
+    Use as a context manager around the whole run (before training)::
+
+        with OutputDir("rec", overwrite=True, inputs=[recording]) as out:
+            ... long work ...
+            write files into out.staging
+            out.commit()
+
+    Leaving the block without :meth:`commit` (an error, Ctrl-C, SIGTERM, SIGHUP) removes
+    everything the run created and leaves an existing folder as it was. ``note`` says afterwards,
+    in words, what happened to the folder (for messages).
+    """
+
+    def __init__(self, out_dir, *, overwrite: bool = False, inputs=(), log=None, command: str = ""):
+        self.given = Path(out_dir).expanduser()
+        self.overwrite = overwrite
+        self.inputs = tuple(inputs)
+        self.log = log or (lambda message: None)
+        self.command = command
+        self.path = Path(os.path.abspath(self.given))
+        self.staging: Path | None = None
+        self.state = "new"           # new -> staged -> committed | aborted
+        self.existed = os.path.lexists(self.path)
+        self._lock = None
+        self._lock_path = self.path.parent / f".{self.path.name}.lock"
+        self._created: list[Path] = []
+
+    # ---- opening -------------------------------------------------------------------------------
+    def open(self) -> "OutputDir":
+        from filelock import FileLock, Timeout
+
+        check_output_path(self.given, overwrite=self.overwrite, inputs=self.inputs)
+        with signals_deferred():
+            self._make_parents()
+            info = json.dumps({"pid": os.getpid(), "host": socket.gethostname(), "command": self.command,
+                               "started": time.strftime("%Y-%m-%d %H:%M:%S")}).encode()
+
+            def write_holder(fd):
+                os.ftruncate(fd, 0)
+                os.write(fd, info)
+
+            try:
+                lock = FileLock(self._lock_path, timeout=0, on_acquired=write_holder)
+                lock.acquire()
+            except Timeout:
+                self._remove_created_parents()
+                raise OutputError(f"the output folder {self.given} is being written by another run "
+                                  f"({self._holder()}); wait for it to finish or choose another out_dir=") from None
+            except OSError as err:
+                self._remove_created_parents()
+                raise OutputError(f"cannot lock the output folder {self.given} ({err.strerror}: {self._lock_path}); "
+                                  "choose an out_dir= in a folder you can write") from None
+            self._lock = lock
+        try:
+            self._recover()
+            self.existed = os.path.lexists(self.path)
+            check_output_path(self.given, overwrite=self.overwrite, inputs=self.inputs)  # again, under the lock
+            with signals_deferred():
+                tmp = self.path.parent / f".{self.path.name}.partial-{os.getpid()}-{secrets.token_hex(8)}"
+                try:
+                    tmp.mkdir()
+                except OSError as err:
+                    raise OutputError(f"cannot write the output folder {self.given} ({err.strerror}); choose an "
+                                      "out_dir= in a folder you can write") from None
+                self.staging = tmp
+                self.state = "staged"
+        except BaseException:
+            self._cleanup()
+            raise
+        return self
+
+    def _make_parents(self):
+        missing = []
+        p = self.path.parent
+        while not os.path.lexists(p):
+            missing.append(p)
+            p = p.parent
+        for p in reversed(missing):
+            try:
+                p.mkdir()
+            except FileExistsError:
+                continue
+            except OSError as err:
+                self._remove_created_parents()
+                raise OutputError(f"cannot create {p} for the output folder {self.given} ({err.strerror}); choose "
+                                  "another out_dir=") from None
+            self._created.append(p)
+
+    def _remove_created_parents(self):
+        for p in reversed(self._created):
+            try:
+                p.rmdir()
+            except OSError:
+                break
+        self._created = []
+
+    def _holder(self) -> str:
+        try:
+            holder = json.loads(self._lock_path.read_text() or "{}")
+        except (OSError, ValueError):
+            return "its lock file could not be read"
+        parts = [f"process {holder.get('pid', '?')} on {holder.get('host', '?')}",
+                 f"started {holder.get('started', '?')}"]
+        if holder.get("command"):
+            parts.append(f"`{holder['command']}`")
+        return ", ".join(parts)
+
+    def _recover(self):
+        """Under the lock: put back an old result left aside, remove partial folders of dead runs."""
+        parent, name = self.path.parent, self.path.name
+        for old in sorted(parent.glob(f".{name}.old-*")):
+            if not os.path.lexists(self.path):
+                os.rename(old, self.path)
+                self.log(f"note: put back {self.path} from {old.name}, left aside by a replacement that was killed")
+            else:
+                shutil.rmtree(old, ignore_errors=True)
+                self.log(f"note: removed {old.name}, an old result left aside by a replacement that was killed")
+        for stale in sorted(parent.glob(f".{name}.partial-*")):
+            pid = stale.name.rsplit(".partial-", 1)[1].split("-")[0]   # the lock proves that run has ended
+            shutil.rmtree(stale, ignore_errors=True)
+            self.log(f"note: removed {stale.name}, an unfinished result of an earlier run "
+                     f"(process {pid}) that was killed")
+
+    # ---- closing -------------------------------------------------------------------------------
+    def commit(self) -> Path:
+        """Put the staging folder in place (renames only; the old result is deleted last)."""
+        if self.state != "staged":
+            raise RuntimeError(f"commit() on an output folder in state {self.state!r}")
+        with signals_deferred():
+            aside = None
+            if os.path.lexists(self.path):
+                if not (self.overwrite and self.path.is_dir() and not self.path.is_symlink()):
+                    raise OutputError(f"{self.given} appeared while this run was working; the result was not "
+                                      "written: choose another out_dir=")
+                aside = self.path.parent / f".{self.path.name}.old-{os.getpid()}-{secrets.token_hex(8)}"
+                os.rename(self.path, aside)
+            os.rename(self.staging, self.path)
+            self.state = "committed"
+            self.staging = None
+            if aside is not None:
+                shutil.rmtree(aside, ignore_errors=True)
+                if os.path.lexists(aside):
+                    self.log(f"warning: could not delete the old result, now {aside}; delete it by hand")
+            self._release()
+        return self.path
+
+    def abort(self) -> None:
+        with signals_deferred():
+            if self.state == "staged":
+                self.state = "aborted"
+            self._cleanup()
+
+    def _cleanup(self):
+        if self.staging is not None:
+            shutil.rmtree(self.staging, ignore_errors=True)
+            self.staging = None
+        self._release()
+        self._remove_created_parents()
+
+    def _release(self):
+        if self._lock is not None:
+            try:
+                self._lock_path.unlink(missing_ok=True)   # while held: waiters see an unlinked inode and retry
+            finally:
+                self._lock.release()
+                self._lock = None
+
+    @property
+    def note(self) -> str:
+        """What happened to the folder, in words."""
+        if self.state == "committed":
+            return f"{self.given} was complete before that and is in place"
+        if self.existed:
+            return f"the existing {self.given} was left as it was"
+        return f"{self.given} was not written"
+
+    def __enter__(self) -> "OutputDir":
+        return self.open()
+
+    def __exit__(self, exc_type, exc, tb):
+        if self.state != "committed":
+            self.abort()
+        if exc is not None:
+            try:
+                exc.output_note = self.note
+            except AttributeError:
+                pass
+        return False
+
+
+@contextmanager
+def atomic_output_dir(out_dir, overwrite: bool = False, *, inputs=(), log=None):
+    """Yield a temporary folder beside ``out_dir``; on success it replaces ``out_dir`` (see :class:`OutputDir`).
 
     On an exception (or Ctrl-C) the temporary folder is removed and ``out_dir`` is untouched.
 
     Raises:
-        FileExistsError: ``out_dir`` exists and ``overwrite`` is False.
+        OutputError: ``out_dir`` exists and ``overwrite`` is False, or cannot be written (see
+            :func:`check_output_path`).
     """
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not overwrite:
-        raise FileExistsError(f"output folder {out_dir} already exists; choose another out_dir= or pass overwrite=True")
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.partial-", dir=out_dir.parent))
-    try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if out_dir.exists():
-        shutil.rmtree(out_dir)
-    os.replace(tmp, out_dir)
+    with OutputDir(out_dir, overwrite=overwrite, inputs=inputs, log=log) as target:
+        yield target.staging
+        target.commit()
 
 
 def save_png(path, image) -> None:
