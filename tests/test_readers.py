@@ -123,7 +123,7 @@ def test_txt_bad_input(tmp_path, lines, message):
 def test_txt_empty(tmp_path):
     path = tmp_path / "events.txt"
     path.write_text("\n")
-    with pytest.raises(EventDataError, match="no events found"):
+    with pytest.raises(EventDataError, match="is empty"):
         read_events_txt(path, (3, 5))
 
 

@@ -21,14 +21,21 @@ import numpy as np
 
 import math
 
-__all__ = ["Events", "EventDataError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T"]
+__all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
+           "TimeUnitWarning", "resolve_time_unit", "check_time_span", "MAX_SPAN_S"]
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 LARGE_T = 1e5  # seconds; clocks whose first timestamp is at least this large get a whole-second t_origin
 
 
-class EventDataError(ValueError):
+class InputError(ValueError):
+    """A bad input the user can fix (a file, a path, a setting); the message names the problem and the fix.
+
+    The command line prints it as ``evinr-lite: error: ...`` and exits with status 2."""
+
+
+class EventDataError(InputError):
     """Event data that cannot be used as given. The message names the problem and the fix."""
 
 
@@ -80,6 +87,55 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
             )
         return np.where(p > 0, 1, -1).astype(np.int8)
     raise EventDataError(f"unknown polarity encoding {encoding!r}; use 'auto', 'pm1', '01' or 'bool'")
+
+
+class TimeUnitWarning(UserWarning):
+    """The unit of the timestamps was not given and was assumed (the message says which, and how to set it)."""
+
+
+MAX_SPAN_S = 1e5        # seconds; a recording longer than about 28 hours is taken as a wrong time unit
+MIN_RATE_PER_S = 10.0   # events per second; thousands of events at a lower mean rate also mean a wrong unit
+
+
+def resolve_time_unit(t, time_unit: str | None, source, *, flag: str = "time_unit") -> str:
+    """The unit of timestamps ``t``: ``time_unit`` when given, else detected.
+
+    Detection ('auto' or None): integer timestamps are microseconds (Prophesee, AEDAT4 exports, DSEC,
+    Tonic), with a :class:`TimeUnitWarning` that says so and how to choose another unit
+    (nanoseconds: ESIM); floating-point timestamps are seconds.
+    """
+    if time_unit not in (None, "auto"):
+        if time_unit not in TIME_UNITS:
+            raise EventDataError(f"unknown {flag}={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
+        return time_unit
+    kind = np.asarray(t).dtype.kind if not isinstance(t, str) else t
+    if kind in "iu":
+        import warnings
+
+        warnings.warn(f"{source}: the timestamps are integers; read them as microseconds (as Prophesee, AEDAT4 "
+                      f"exports and DSEC write them); if they are nanoseconds (ESIM) or another unit, pass "
+                      f"{flag}='ns' (or 's', 'ms', 'us')", TimeUnitWarning, stacklevel=3)
+        return "us"
+    return "s"
+
+
+def check_time_span(t, source, time_unit: str, *, flag: str = "time_unit") -> None:
+    """Refuse timestamps (seconds, sorted or not) whose span is implausible for an event recording:
+    longer than :data:`MAX_SPAN_S`, or at least 1000 events at under :data:`MIN_RATE_PER_S` per second;
+    both mean the unit is wrong. The message names the unit used and the option to change it."""
+    t = np.asarray(t)
+    if t.size < 2:
+        return
+    finite = t[np.isfinite(t)]
+    if finite.size < 2:
+        return
+    span = float(finite.max() - finite.min())
+    if span > MAX_SPAN_S or (t.size >= 1000 and span > 0 and t.size / span < MIN_RATE_PER_S):
+        others = [u for u in ("ms", "us", "ns") if u != time_unit]
+        raise EventDataError(
+            f"{source}: read in {time_unit!r}, the timestamps span {span:,.6g} s ({span / 3600:,.3g} hours) with "
+            f"{t.size:,} events ({t.size / span:,.3g} per second); that is implausible for an event recording, so "
+            f"the time unit is probably wrong: pass {flag}={others[0]!r} (or {', '.join(repr(u) for u in others[1:])})")
 
 
 def auto_origin(t_first: float) -> float:

@@ -15,14 +15,17 @@ Use :func:`read_recording` (format detected from content and name) or the per-fo
 from __future__ import annotations
 
 import json
+import math
+import os
 from pathlib import Path
 
 import numpy as np
 
-from ..core.events import EventDataError, Events, auto_origin, relative_seconds
+from ..core.events import (TIME_UNITS, EventDataError, Events, auto_origin, check_time_span, relative_seconds,
+                           resolve_time_unit)
 from ..core.frames import Frames, to_grey_uint8
 from ..core.recording import Recording
-from .text import NS, origin_to_ns, parse_event_text, parse_frame_list
+from .text import NS, origin_to_ns, parse_event_text, parse_frame_list, read_text_bytes
 
 __all__ = [
     "read_events_npy",
@@ -51,10 +54,41 @@ SUPPORTED_FORMATS = (
 # ---- small helpers ------------------------------------------------------------------------
 
 def _existing(path, kind: str = "file") -> Path:
+    import stat
+
     path = Path(path)
     if not path.exists():
         raise EventDataError(f"no such {kind}: {path}; check the path")
+    mode = path.stat().st_mode
+    if kind == "folder" and not stat.S_ISDIR(mode):
+        raise EventDataError(f"{path} is not a folder; pass the recording's folder")
+    if kind == "file" and stat.S_ISDIR(mode):
+        raise EventDataError(f"{path} is a folder, not a file; pass the file")
+    if kind == "file" and not stat.S_ISREG(mode):
+        raise EventDataError(f"{path} is not a regular file (a FIFO, pipe or device); save the data to a file first")
+    if kind == "file" and path.stat().st_size == 0:
+        raise EventDataError(f"{path} is empty")
     return path
+
+
+def _load_npy(path: Path):
+    """np.load of one plain array, every failure an EventDataError naming the file."""
+    import zipfile
+
+    try:
+        return np.load(path, allow_pickle=False)
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile, TypeError) as err:
+        raise EventDataError(f"{path}: not a readable numeric .npy array ({type(err).__name__}: {err}); the file is "
+                             "damaged or incomplete, or not saved with np.save(path, array)") from None
+
+
+def _seconds(source, t, time_unit):
+    """Timestamps in their unit (detected when time_unit is 'auto'/None) -> (seconds relative to origin,
+    origin, unit), the span checked for plausibility."""
+    unit = resolve_time_unit(t, time_unit, source)
+    t, origin = relative_seconds(t, unit)
+    check_time_span(t, source, unit)
+    return t, origin, unit
 
 
 def _build_events(source, t, x, y, p, sensor_size, *, polarity, t_origin=0.0, sort=False) -> Events:
@@ -88,7 +122,7 @@ def _sensor_from_header(path, header, sensor_size):
 
 # ---- readers ------------------------------------------------------------------------------
 
-def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", time_unit="s",
+def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", time_unit="auto",
                     sort=False) -> Events:
     """Events from an .npy array [N, 4].
 
@@ -97,15 +131,12 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
         sensor_size: (H, W); required (an .npy array does not record it).
         columns: order of the columns, a permutation of 'txyp' (e.g. 'xytp' for MVSEC).
         polarity: encoding of p, see :func:`~evinr_lite.core.events.normalize_polarity`.
-        time_unit: unit of t: 's', 'ms', 'us' or 'ns'.
+        time_unit: unit of t: 's', 'ms', 'us' or 'ns'; 'auto': an integer array is microseconds
+            (with a TimeUnitWarning), a floating-point one seconds. Implausible spans are refused.
         sort: sort the events by time instead of raising on unsorted input.
     """
     path = _existing(path)
-    try:
-        a = np.load(path, allow_pickle=False)
-    except ValueError as err:
-        raise EventDataError(f"{path}: not a plain numeric .npy array ({err}); "
-                             "save it with np.save(path, array)") from None
+    a = _load_npy(path)
     if sorted(columns) != sorted("txyp"):
         raise EventDataError(f"columns must be a permutation of 'txyp' (e.g. 'txyp' or 'xytp'), got {columns!r}")
     if a.ndim != 2 or a.shape[1] != 4 or a.dtype.kind not in "iuf":
@@ -120,12 +151,12 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
             f"{path}: an .npy array does not record the sensor size; pass sensor_size=(H, W) (rows, columns)"
             + _size_hint(col["x"], col["y"])
         )
-    t, origin = relative_seconds(col["t"], time_unit)
+    t, origin, _ = _seconds(path, col["t"], time_unit)
     return _build_events(path, t, col["x"], col["y"], col["p"], sensor_size,
                          polarity=polarity, t_origin=origin, sort=sort)
 
 
-def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None) -> Events:
+def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, time_unit="auto") -> Events:
     """Events from a text file of `t x y p` lines (IJRR events.txt, rpg_e2vid .txt).
 
     Args:
@@ -135,9 +166,12 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None) -
         polarity: encoding of p ('auto', '01', 'pm1').
         t_origin: seconds subtracted from every timestamp (exactly). None: the whole seconds of the
             first timestamp when it is >= 1e5 s (an absolute clock), else 0.
+        time_unit: unit of t, 's', 'ms', 'us', 'ns'; 'auto': integer timestamps are microseconds
+            (with a TimeUnitWarning), decimals seconds. Implausible spans are refused.
     """
-    path = _existing(path)
-    raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin))
+    path = Path(path)
+    raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
+    check_time_span(raw.t, path, raw.time_unit)
     sensor_size = _sensor_from_header(path, raw.header, sensor_size)
     if sensor_size is None:
         raise EventDataError(
@@ -148,13 +182,14 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None) -
                          polarity=polarity, t_origin=raw.origin_ns / NS)
 
 
-def read_frames_ijrr(folder, t_origin=0.0) -> Frames:
+def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s") -> Frames:
     """Frames listed in ``folder/images.txt`` (`t images/frame_%08d.png` per line), in time order.
 
     Args:
         folder: the IJRR sequence folder.
         t_origin: seconds subtracted exactly from the timestamps (pass the events' ``t_origin``);
             None: automatic, as for the events.
+        time_unit: unit of the timestamps (the events' unit), 's' by default.
     Returns:
         Frames with grey uint8 images [F, H, W] (RGB is converted to grey).
     """
@@ -164,16 +199,28 @@ def read_frames_ijrr(folder, t_origin=0.0) -> Frames:
     listing = folder / "images.txt"
     if not listing.exists():
         raise EventDataError(f"{folder}: no images.txt, so no frames; expected lines `t images/frame_%08d.png`")
-    t, names, origin_ns = parse_frame_list(listing.read_bytes(), None if t_origin is None else origin_to_ns(t_origin),
-                                           source=listing)
+    try:
+        data = read_text_bytes(listing, "frame list")
+    except EventDataError as err:
+        if "is empty" not in str(err):
+            raise
+        data = b""
+    t, names, origin_ns = parse_frame_list(data, None if t_origin is None else origin_to_ns(t_origin),
+                                           source=listing, time_unit=time_unit)
     if not names:
-        raise EventDataError(f"{listing} lists no frames; expected lines `t images/frame_%08d.png`")
+        raise EventDataError(f"{listing} lists no frames; expected lines `t images/frame_%08d.png` "
+                             "(or remove images.txt and give the sensor size)")
     images = []
     for name in names:
         image_path = folder / name
-        if not image_path.exists():
-            raise EventDataError(f"{listing} lists {image_path.name}, but {image_path} does not exist")
-        images.append(to_grey_uint8(imread(image_path), image_path))
+        if not image_path.is_file():
+            raise EventDataError(f"{listing} lists {image_path.name}, but {image_path} does not exist (or is not a file)")
+        try:
+            image = imread(image_path)
+        except Exception as err:   # Pillow / imageio raise many types on a damaged image
+            raise EventDataError(f"{image_path}: not a readable image ({type(err).__name__}: {err}); the file is "
+                                 "damaged: replace it or remove its line from images.txt") from None
+        images.append(to_grey_uint8(image, image_path))
     shapes = {im.shape for im in images}
     if len(shapes) > 1:
         raise EventDataError(f"{listing}: the frames have different sizes {sorted(shapes)}; all must share one (H, W)")
@@ -189,7 +236,7 @@ def _read_calib(path: Path) -> dict | list:
     return dict(zip(names, values)) if len(values) == len(names) else values
 
 
-def read_ijrr_folder(folder, *, t_origin=None) -> Recording:
+def read_ijrr_folder(folder, *, t_origin=None, sensor_size=None, time_unit="auto") -> Recording:
     """An IJRR / Event Camera Dataset sequence folder (the unzipped text release).
 
     Reads events.txt (p in {0, 1}), the frames of images.txt on the events' clock, and calib.txt
@@ -199,34 +246,78 @@ def read_ijrr_folder(folder, *, t_origin=None) -> Recording:
     Args:
         t_origin: seconds subtracted from all timestamps; None: whole seconds of the first event
             when the clock is absolute (>= 1e5 s), else 0.
+        sensor_size: (H, W); needed only when there are no frames and no `W H` header (then the
+            events' size is unknown); checked against the frames / header otherwise.
+        time_unit: unit of the timestamps of events.txt and images.txt ('auto': see
+            :func:`read_events_txt`).
     """
     folder = _existing(folder, "folder")
     events_path = folder / "events.txt"
     if not events_path.exists():
         raise EventDataError(f"{folder}: no events.txt; an IJRR folder holds events.txt, "
                              "images.txt, images/, calib.txt")
-    raw = parse_event_text(events_path, None if t_origin is None else origin_to_ns(t_origin))
-    frames = read_frames_ijrr(folder, t_origin=raw.origin_ns / NS) if (folder / "images.txt").exists() else None
-    sensor_size = _sensor_from_header(events_path, raw.header, frames.size if frames is not None else None)
+    raw = parse_event_text(events_path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
+    check_time_span(raw.t, events_path, raw.time_unit)
+    frames = (read_frames_ijrr(folder, t_origin=raw.origin_ns / NS, time_unit=raw.time_unit)
+              if (folder / "images.txt").exists() else None)
+    known = _sensor_from_header(events_path, raw.header, frames.size if frames is not None else None)
+    if known is not None and sensor_size is not None and tuple(int(v) for v in sensor_size) != tuple(known):
+        H, W = known
+        raise EventDataError(f"{folder}: the frames (or header) say the sensor is (H, W) = {tuple(known)} ({H}x{W}) "
+                             f"but sensor_size={tuple(int(v) for v in sensor_size)} was given; leave it out or pass "
+                             f"sensor_size=({H}, {W})")
+    sensor_size = known if known is not None else sensor_size
     if sensor_size is None:
         raise EventDataError(
             f"{folder}: no images.txt and no `W H` header in events.txt, so the sensor size is unknown; "
-            f"read the events with read_events_txt(path, sensor_size=(H, W)){_size_hint(raw.x, raw.y)}"
+            f"pass sensor_size=(H, W){_size_hint(raw.x, raw.y)}"
         )
     events = _build_events(events_path, raw.t, raw.x, raw.y, raw.p, sensor_size,
-                           polarity="01", t_origin=raw.origin_ns / NS)
-    meta = {"format": "ijrr", "path": str(folder)}
-    if (folder / "calib.txt").exists():
-        meta["calib"] = _read_calib(folder / "calib.txt")
+                           polarity="auto", t_origin=raw.origin_ns / NS)
+    meta = {"format": "ijrr", "path": str(folder), "time_unit": raw.time_unit}
+    if (folder / "calib.txt").is_file():
+        try:
+            meta["calib"] = _read_calib(folder / "calib.txt")
+        except (ValueError, OSError) as err:
+            raise EventDataError(f"{folder / 'calib.txt'}: not a list of numbers ({err}); repair or remove it") from None
     return Recording(events, frames, meta)
 
 
-def read_evreal_folder(folder) -> Recording:
+def _json_file(path: Path) -> dict:
+    try:
+        data = json.loads(read_text_bytes(path, "JSON file").decode("utf-8"))
+    except UnicodeDecodeError as err:
+        raise EventDataError(f"{path}: not UTF-8 text ({err}); save it as UTF-8 JSON") from None
+    except json.JSONDecodeError as err:
+        raise EventDataError(f"{path}: not valid JSON ({err}); expected e.g. {{\"sensor_resolution\": [H, W]}}") from None
+    if not isinstance(data, dict):
+        raise EventDataError(f"{path}: expected a JSON object such as {{\"sensor_resolution\": [H, W]}}, "
+                             f"got {type(data).__name__}")
+    return data
+
+
+def _size_value(source, value, name) -> tuple[int, int]:
+    """A stored (H, W) -> two positive ints, or an EventDataError naming where it came from."""
+    try:
+        a = np.asarray(value).ravel()
+        if a.size != 2 or a.dtype.kind not in "iuf" or not np.all(np.isfinite(a)) or np.any(a != np.round(a)) \
+                or np.any(a <= 0) or np.any(a > 1 << 20):
+            raise ValueError
+        return int(a[0]), int(a[1])
+    except (ValueError, TypeError):
+        raise EventDataError(f"{source}: {name} must be (H, W), two positive whole numbers; got {value!r}") from None
+
+
+def read_evreal_folder(folder, *, time_unit="auto") -> Recording:
     """An EVREAL per-sequence folder of .npy files.
 
-    Files: events_ts.npy [N] float64 s, events_xy.npy [N, 2] (x first), events_p.npy [N] in {0, 1},
-    images.npy [F, H, W, 1] uint8, images_ts.npy [F], metadata.json {"sensor_resolution": [H, W]},
-    image_event_indices.npy (optional, kept in ``meta``).
+    Files: events_ts.npy [N] float64 s, events_xy.npy [N, 2] (x first), events_p.npy [N] in {0, 1}
+    (or -1/+1), images.npy [F, H, W, 1] uint8, images_ts.npy [F], metadata.json
+    {"sensor_resolution": [H, W]}, image_event_indices.npy (optional, kept in ``meta``).
+
+    Args:
+        time_unit: unit of events_ts.npy and images_ts.npy; 'auto': integers are microseconds (with a
+            TimeUnitWarning), floats seconds.
     """
     folder = _existing(folder, "folder")
     needed = ("events_ts.npy", "events_xy.npy", "events_p.npy", "metadata.json")
@@ -234,106 +325,177 @@ def read_evreal_folder(folder) -> Recording:
     if missing:
         raise EventDataError(f"{folder}: missing {', '.join(missing)}; an EVREAL folder holds {', '.join(needed)} "
                              "(and images.npy, images_ts.npy for frames)")
-    metadata = json.loads((folder / "metadata.json").read_text())
+    metadata = _json_file(folder / "metadata.json")
     if "sensor_resolution" not in metadata:
         raise EventDataError(f"{folder / 'metadata.json'}: no 'sensor_resolution'; add \"sensor_resolution\": [H, W]")
-    sensor_size = tuple(int(v) for v in metadata["sensor_resolution"])
-    load = lambda name: np.load(folder / name, allow_pickle=False)  # noqa: E731
+    sensor_size = _size_value(folder / "metadata.json", metadata["sensor_resolution"], "sensor_resolution")
+    load = lambda name: _load_npy(_existing(folder / name))  # noqa: E731
     ts, xy, p = load("events_ts.npy"), load("events_xy.npy"), load("events_p.npy")
-    if xy.ndim != 2 or xy.shape[1] != 2:
-        raise EventDataError(f"{folder / 'events_xy.npy'}: expected shape [N, 2] (x, y), got {xy.shape}")
-    t, origin = relative_seconds(ts, "s")
-    events = _build_events(folder, t, xy[:, 0], xy[:, 1], p, sensor_size, polarity="01", t_origin=origin)
+    if ts.ndim != 1 or ts.dtype.kind not in "iuf":
+        raise EventDataError(f"{folder / 'events_ts.npy'}: expected a 1-D numeric array of timestamps, got shape "
+                             f"{ts.shape} dtype {ts.dtype}")
+    if xy.ndim != 2 or xy.shape[1] != 2 or xy.dtype.kind not in "iuf":
+        raise EventDataError(f"{folder / 'events_xy.npy'}: expected a numeric array of shape [N, 2] (x, y), got "
+                             f"{xy.shape} dtype {xy.dtype}")
+    if p.dtype.kind not in "iufb":
+        raise EventDataError(f"{folder / 'events_p.npy'}: expected numeric polarities, got dtype {p.dtype}")
+    t, origin, unit = _seconds(folder / "events_ts.npy", ts, time_unit)
+    events = _build_events(folder, t, xy[:, 0], xy[:, 1], p, sensor_size, polarity="auto", t_origin=origin)
     frames = None
     if (folder / "images.npy").exists():
+        if not (folder / "images_ts.npy").exists():
+            raise EventDataError(f"{folder}: images.npy without images_ts.npy; add the frame timestamps or remove "
+                                 "images.npy")
         images, images_ts = load("images.npy"), load("images_ts.npy")
+        if images_ts.ndim != 1 or images_ts.dtype.kind not in "iuf":
+            raise EventDataError(f"{folder / 'images_ts.npy'}: expected a 1-D numeric array, got shape "
+                                 f"{images_ts.shape} dtype {images_ts.dtype}")
+        frame_t = np.asarray(images_ts, np.float64) * TIME_UNITS[unit] - origin
         try:
-            frames = Frames(images, np.asarray(images_ts, np.float64) - origin, origin).sorted()
+            frames = Frames(images, frame_t, origin).sorted()
         except EventDataError as err:
             raise EventDataError(f"{folder / 'images.npy'}: {err}") from None
         if frames.size != sensor_size:
             raise EventDataError(f"{folder}: frames are {frames.size} but sensor_resolution is "
                                  f"{sensor_size} (both (H, W))")
-    meta = {"format": "evreal", "path": str(folder), "metadata": metadata}
+    meta = {"format": "evreal", "path": str(folder), "metadata": metadata, "time_unit": unit}
     if (folder / "image_event_indices.npy").exists():
         meta["image_event_indices"] = load("image_event_indices.npy")
     return Recording(events, frames, meta)
 
 
-def _bisect_h5(ts, value: float, origin: float, lo: int, hi: int) -> int:
-    """First index in [lo, hi) with ts[i] - origin >= value, reading single elements from disk."""
+def _bisect_h5(ts, value_units: float, lo: int, hi: int) -> int:
+    """First index in [lo, hi) with ts[i] >= value_units (file units), reading single elements from disk."""
     while lo < hi:
         mid = (lo + hi) // 2
-        if float(ts[mid]) - origin < value:
+        if float(ts[mid]) < value_units:
             lo = mid + 1
         else:
             hi = mid
     return lo
 
 
-def read_h5(path, *, t_start=None, t_end=None) -> Recording:
+def _h5_damaged(path, err) -> EventDataError:
+    return EventDataError(f"{path}: the HDF5 file is damaged or incomplete ({type(err).__name__}: {err}); copy or "
+                          "convert it again")
+
+
+def read_h5(path, *, t_start=None, t_end=None, time_unit="auto") -> Recording:
     """An HQF-style h5 file, optionally only the time window [t_start, t_end).
 
-    Layout: events/xs, events/ys (int), events/ts (float64 s, sorted), events/ps (bool);
-    images/image%09d (uint8) with attrs 'timestamp' (and 'event_idx'); root attr
+    Layout: events/xs, events/ys (int), events/ts (float64 s, sorted), events/ps (bool, 0/1 or
+    -1/+1); images/image%09d (uint8) with attrs 'timestamp' (and 'event_idx'); root attr
     'sensor_resolution' (H, W).
 
     Args:
         t_start, t_end: seconds on the returned clock (file time minus ``t_origin``). The window
             is found by binary search on the ts dataset on disk and only that slice is read; frames
             are restricted to the same window. Frames come sorted by timestamp.
+        time_unit: unit of events/ts and the frames' timestamps; 'auto': an integer dataset is
+            microseconds (with a TimeUnitWarning), floats seconds.
+    Raises:
+        EventDataError for a missing, damaged or incomplete file, missing datasets or attributes.
     """
     import h5py
 
     path = _existing(path)
-    with h5py.File(path, "r") as f:
-        names = ("events/xs", "events/ys", "events/ts", "events/ps")
-        missing = [n for n in names if n not in f]
-        if missing:
-            raise EventDataError(f"{path}: missing datasets {missing}; expected the HQF layout {list(names)}")
-        if "sensor_resolution" not in f.attrs:
-            raise EventDataError(f"{path}: no root attribute 'sensor_resolution' (H, W); add it, e.g. "
-                                 "h5py.File(path, 'r+').attrs['sensor_resolution'] = (H, W)")
-        sensor_size = tuple(int(v) for v in f.attrs["sensor_resolution"])
-        ts = f["events/ts"]
-        n = ts.shape[0]
-        if any(f[name].shape != (n,) for name in names):
-            raise EventDataError(f"{path}: {names} must be 1-D with the same length, got "
-                                 f"{[f[name].shape for name in names]}")
-        origin = auto_origin(float(ts[0])) if n else 0.0
-        if t_start is not None and t_end is not None and t_end <= t_start:
-            raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
-        lo = 0 if t_start is None else _bisect_h5(ts, t_start, origin, 0, n)
-        hi = n if t_end is None else _bisect_h5(ts, t_end, origin, lo, n)
-        if hi <= lo:
-            span = f"[{float(ts[0]) - origin:.6f}, {float(ts[n - 1]) - origin:.6f}] s" if n else "nothing"
-            raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
-                                 f"{span} (relative to t_origin = {origin}); choose a window inside that range")
-        t = ts[lo:hi].astype(np.float64) - origin
-        x, y, p = (f[name][lo:hi] for name in ("events/xs", "events/ys", "events/ps"))
-        events = _build_events(path, t, x, y, p, sensor_size, polarity="bool", t_origin=origin)
+    try:
+        f = h5py.File(path, "r")
+    except OSError as err:
+        raise _h5_damaged(path, err) from None
+    try:
+        with f:
+            return _read_h5_open(f, path, t_start, t_end, time_unit)
+    except EventDataError:
+        raise
+    except (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError) as err:
+        raise _h5_damaged(path, err) from None
 
-        frames, meta = None, {"format": "h5", "path": str(path), "attrs": dict(f.attrs), "event_slice": (lo, hi)}
-        if "images" in f and len(f["images"]):
-            group = f["images"]
-            keys = np.array(sorted(group))
-            stamps = np.array([float(group[k].attrs["timestamp"]) for k in keys]) - origin
-            keep = np.ones(len(keys), dtype=bool)
-            if t_start is not None:
-                keep &= stamps >= t_start
-            if t_end is not None:
-                keep &= stamps < t_end
-            order = np.argsort(stamps[keep], kind="stable")  # one HQF sequence has a frame out of order
-            keys, stamps = keys[keep][order], stamps[keep][order]
-            if len(keys):
-                images = np.stack([to_grey_uint8(group[k][()], f"{path}:images/{k}") for k in keys])
-                frames = Frames(images, stamps, origin)
-                if frames.size != sensor_size:
-                    raise EventDataError(f"{path}: frames are {frames.size} but sensor_resolution is "
-                                         f"{sensor_size} (both (H, W))")
-                if all("event_idx" in group[k].attrs for k in keys):  # indices into the file's events
-                    meta["frame_event_idx"] = np.array([int(group[k].attrs["event_idx"]) for k in keys])
+
+def _read_h5_open(f, path, t_start, t_end, time_unit) -> Recording:
+    import h5py
+
+    names = ("events/xs", "events/ys", "events/ts", "events/ps")
+    missing = [n for n in names if n not in f or not isinstance(f[n], h5py.Dataset)]
+    if missing:
+        raise EventDataError(f"{path}: missing datasets {missing}; expected the HQF layout {list(names)}")
+    if "sensor_resolution" not in f.attrs:
+        raise EventDataError(f"{path}: no root attribute 'sensor_resolution' (H, W); add it, e.g. "
+                             "h5py.File(path, 'r+').attrs['sensor_resolution'] = (H, W)")
+    sensor_size = _size_value(path, f.attrs["sensor_resolution"], "the attribute sensor_resolution")
+    ts = f["events/ts"]
+    n = ts.shape[0] if ts.ndim == 1 else -1
+    if any(f[name].shape != (n,) for name in names):
+        raise EventDataError(f"{path}: {names} must be 1-D with the same length, got "
+                             f"{[f[name].shape for name in names]}")
+    for name in names:
+        if f[name].dtype.kind not in "iufb":
+            raise EventDataError(f"{path}: {name} must be numeric, got dtype {f[name].dtype}")
+    unit = resolve_time_unit(ts.dtype.kind if n else "f", time_unit, f"{path}: events/ts")
+    per_s = 1.0 / TIME_UNITS[unit]
+    if n and not (math.isfinite(float(ts[0])) and math.isfinite(float(ts[n - 1]))):
+        raise EventDataError(f"{path}: events/ts holds non-finite timestamps; the file is damaged")
+    origin = auto_origin(float(ts[0]) / per_s) if n else 0.0
+    if t_start is not None and t_end is not None and t_end <= t_start:
+        raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
+    lo = 0 if t_start is None else _bisect_h5(ts, (t_start + origin) * per_s, 0, n)
+    hi = n if t_end is None else _bisect_h5(ts, (t_end + origin) * per_s, lo, n)
+    if hi <= lo:
+        span = f"[{float(ts[0]) / per_s - origin:.6f}, {float(ts[n - 1]) / per_s - origin:.6f}] s" if n else "nothing"
+        raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
+                             f"{span} (relative to t_origin = {origin}); choose a window inside that range")
+    raw_t = ts[lo:hi]
+    if raw_t.dtype.kind in "iu":
+        t = (raw_t.astype(np.int64) - int(round(origin * per_s))) / per_s
+    else:
+        t = raw_t.astype(np.float64) / per_s - origin
+    check_time_span(t, f"{path}: events/ts", unit)
+    x, y, p = (f[name][lo:hi] for name in ("events/xs", "events/ys", "events/ps"))
+    events = _build_events(path, t, x, y, p, sensor_size, polarity="auto", t_origin=origin)
+
+    frames, meta = None, {"format": "h5", "path": str(path), "attrs": {k: _plain(v) for k, v in f.attrs.items()},
+                          "event_slice": (lo, hi), "time_unit": unit}
+    if "images" in f and isinstance(f["images"], h5py.Group) and len(f["images"]):
+        group = f["images"]
+        keys = np.array(sorted(group))
+        stamps = []
+        for k in keys:
+            value = group[k].attrs.get("timestamp")
+            try:
+                stamp = float(np.asarray(value).reshape(()))
+            except (TypeError, ValueError):
+                raise EventDataError(f"{path}: images/{k} has no numeric 'timestamp' attribute (got {value!r}); "
+                                     "every frame needs one") from None
+            if not math.isfinite(stamp):
+                raise EventDataError(f"{path}: images/{k} has a non-finite 'timestamp'; repair or remove that frame")
+            stamps.append(stamp)
+        stamps = np.array(stamps) / per_s - origin
+        keep = np.ones(len(keys), dtype=bool)
+        if t_start is not None:
+            keep &= stamps >= t_start
+        if t_end is not None:
+            keep &= stamps < t_end
+        order = np.argsort(stamps[keep], kind="stable")  # one HQF sequence has a frame out of order
+        keys, stamps = keys[keep][order], stamps[keep][order]
+        if len(keys):
+            images = [to_grey_uint8(group[k][()], f"{path}:images/{k}") for k in keys]
+            if len({im.shape for im in images}) > 1:
+                raise EventDataError(f"{path}: the frames have different sizes {sorted({im.shape for im in images})}")
+            frames = Frames(np.stack(images), stamps, origin)
+            if frames.size != sensor_size:
+                raise EventDataError(f"{path}: frames are {frames.size} but sensor_resolution is "
+                                     f"{sensor_size} (both (H, W))")
+            if all("event_idx" in group[k].attrs for k in keys):  # indices into the file's events
+                meta["frame_event_idx"] = np.array([int(np.asarray(group[k].attrs["event_idx"]).reshape(()))
+                                                    for k in keys])
     return Recording(events, frames, meta)
+
+
+def _plain(value):
+    """An HDF5 attribute as a plain value (bytes decoded)."""
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    return value
 
 
 def _looks_like_event_text(path: Path) -> bool:
@@ -363,10 +525,21 @@ def detect_format(path) -> str:
     """
     from .formats import sniff_format
 
+    import stat
+
     path = Path(path)
     if not path.exists():
         raise EventDataError(f"no such file or folder: {path}; check the path")
+    try:
+        mode = path.stat().st_mode
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read ({err.strerror})") from None
+    if not (stat.S_ISDIR(mode) or stat.S_ISREG(mode)):
+        raise EventDataError(f"{path} is not a regular file or folder (a FIFO, pipe or device); save the recording "
+                             "to a file first")
     if path.is_dir():
+        if not os.access(path, os.R_OK | os.X_OK):
+            raise EventDataError(f"{path}: no permission to read this folder")
         if (path / "events.txt").exists():
             return "ijrr"
         if (path / "events_ts.npy").exists():
@@ -374,7 +547,12 @@ def detect_format(path) -> str:
         raise EventDataError(f"{path}: folder of unknown format (no events.txt or events_ts.npy); "
                              f"supported formats: {SUPPORTED_FORMATS}")
     suffix = path.suffix.lower()
-    kind = sniff_format(path)
+    if path.stat().st_size == 0:
+        raise EventDataError(f"{path} is empty (0 bytes); the file was not written completely: copy it again")
+    try:
+        kind = sniff_format(path)
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read ({err.strerror}); check its permissions") from None
     if kind == "hdf5":
         from .canonical import is_canonical
 

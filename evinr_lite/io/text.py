@@ -22,12 +22,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.events import LARGE_T, EventDataError, auto_origin
+from ..core.events import LARGE_T, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit
 
 __all__ = ["EventBlock", "parse_event_block", "parse_event_text", "parse_frame_list", "line_blocks",
-           "origin_to_ns", "NS", "CHUNK_BYTES", "EVENT_COLUMNS"]
+           "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
 
 NS = 10**9              # nanoseconds per second
+NS_PER_UNIT = {"s": NS, "ms": 10**6, "us": 10**3, "ns": 1}   # nanoseconds per unit of a timestamp token
 CHUNK_BYTES = 1 << 20   # the text parser works on 1 MiB of whole lines at a time (cache-friendly)
 EVENT_COLUMNS = "`t x y p` (time in seconds, x = column, y = row, polarity)"
 FRAME_COLUMNS = "`t images/frame_%08d.png`"
@@ -108,8 +109,8 @@ def _parse_digits(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.n
     """
     lengths = ends - starts
     width = int(lengths.max()) if len(lengths) else 0
-    if width > 18:  # would overflow int64
-        return None
+    if width > 19 or (width == 19 and np.any((lengths == 19) & (buf.take(starts, mode="clip") > 56))):
+        return None  # would overflow int64 (19 digits fit when the first is at most 8)
     value = np.zeros(len(starts), dtype=np.int64)
     for k in range(width):
         inside = lengths > k
@@ -158,13 +159,31 @@ def _parse_number(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.n
     return np.where(first == 45, -value, value)
 
 
-def _parse_time(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, origin_ns: int) -> np.ndarray:
-    """Timestamp tokens (seconds) -> float64 [N] seconds relative to ``origin_ns`` nanoseconds.
+def _unit_ns(buf, starts, ends, unit: str):
+    """Exact integer nanoseconds of timestamp tokens in ``unit`` (plain decimals), or None."""
+    parsed = _parse_decimal(buf, starts, ends)
+    if parsed is None:
+        return None
+    sign, whole, nanos = parsed
+    scale = NS_PER_UNIT[unit]
+    if unit != "s" and np.any(whole > (2**62) // scale):
+        return None
+    return sign * (whole * scale + (nanos * scale) // NS)
 
-    With a non-zero origin the tokens are parsed as integers (whole seconds and nanoseconds) and
-    the origin is subtracted exactly, so relative times keep nanosecond resolution. With origin 0
-    (small timestamps) this is a plain float64 parse. Raises _BadToken.
+
+def _parse_time(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, origin_ns: int,
+                unit: str = "s") -> np.ndarray:
+    """Timestamp tokens (in ``unit``, default seconds) -> float64 [N] seconds relative to ``origin_ns``.
+
+    With a non-zero origin, or a unit other than seconds, the tokens are parsed as integers (whole
+    units and nanoseconds of a unit) and the origin is subtracted exactly, so relative times keep
+    nanosecond resolution. With origin 0 and seconds this is a plain float64 parse. Raises _BadToken.
     """
+    if unit != "s":
+        value_ns = _unit_ns(buf, starts, ends, unit)
+        if value_ns is None:   # exponents / nan / inf / huge: float parse, then scaled
+            return _parse_float(buf, starts, ends) * (NS_PER_UNIT[unit] / NS) - origin_ns / NS
+        return (value_ns - origin_ns) / NS
     parsed = _parse_decimal(buf, starts, ends) if origin_ns != 0 else None
     if parsed is None:  # small times, or exponents / nan / inf: plain float64 parse
         return _parse_float(buf, starts, ends) - origin_ns / NS
@@ -173,18 +192,25 @@ def _parse_time(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray, origin_ns
     return rel_ns / NS
 
 
-def _first_time_origin(buf: np.ndarray, start: int, end: int) -> int:
+def _first_time_origin(buf: np.ndarray, start: int, end: int, unit: str = "s") -> int:
     """The automatic origin (integer ns) from the first timestamp token: its whole seconds if large."""
     starts, ends = np.array([start]), np.array([end])
-    parsed = _parse_decimal(buf, starts, ends)
-    if parsed is not None:
-        sign, whole, nanos = (int(a[0]) for a in parsed)
-        value_ns = sign * (whole * NS + nanos)
+    value = _unit_ns(buf, starts, ends, unit)
+    if value is not None:
+        value_ns = int(value[0])
         return (value_ns // NS) * NS if abs(value_ns) >= LARGE_T * NS else 0
     try:
-        return int(auto_origin(float(_parse_float(buf, starts, ends)[0]))) * NS
+        return int(auto_origin(float(_parse_float(buf, starts, ends)[0]) * NS_PER_UNIT[unit] / NS)) * NS
     except _BadToken:
         return 0  # reported with its line number by the caller
+
+
+def _plain_integers(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> bool:
+    """True when every token is a plain integer (optional sign, digits only)."""
+    first = buf[starts]
+    signed = (first == 45) | (first == 43)
+    return bool(len(starts)) and not np.any(ends - starts - signed < 1) and \
+        _parse_digits(buf, starts + signed, ends) is not None
 
 
 def _line_text(buf: np.ndarray, newlines: np.ndarray, line: int) -> str:
@@ -222,10 +248,11 @@ class EventBlock:
     header: tuple[int, int] | None   # (H, W) from a `W H` header line (first block only)
     origin_ns: int | None            # t_origin in integer nanoseconds (None: the block had no events)
     n_lines: int                     # lines in the block
+    time_unit: str = "s"             # unit the timestamps were read in ('s', 'ms', 'us', 'ns')
 
 
 def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0, first: bool = False,
-                      t_last: float | None = None) -> EventBlock:
+                      t_last: float | None = None, time_unit: str = "s") -> EventBlock:
     """Parse one block of whole `t x y p` lines, all vectorised.
 
     Args:
@@ -236,6 +263,9 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         line_base: lines before this block (for the line numbers in messages).
         first: the block opens the file, so an rpg_e2vid header `W H` may be its first line.
         t_last: the last timestamp of the previous block; when given, timestamps must not decrease.
+        time_unit: unit of the timestamp tokens, 's', 'ms', 'us' or 'ns'; 'auto': plain integer
+            tokens are microseconds (with a TimeUnitWarning), decimals seconds. The unit used is
+            returned in ``EventBlock.time_unit`` (pass it to the next block).
     Raises:
         EventDataError naming ``source``, the line number and the line's text.
     """
@@ -263,14 +293,19 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         hint = " (a `W H` header is allowed only as the first line)" if counts[i] == 2 else ""
         fail(i, f"found {counts[i]} columns, expected 4: {EVENT_COLUMNS}{hint}")
     empty = np.zeros(0, dtype=np.int64)
+    if time_unit not in TIME_UNITS and time_unit != "auto":
+        raise EventDataError(f"unknown time_unit={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
     if len(starts) == 0:
-        return EventBlock(np.zeros(0), empty, empty, empty.astype(np.int8), header, origin_ns, n_lines)
+        return EventBlock(np.zeros(0), empty, empty, empty.astype(np.int8), header, origin_ns, n_lines,
+                          time_unit)
     starts, ends = starts.reshape(-1, 4), ends.reshape(-1, 4)
+    if time_unit == "auto":
+        time_unit = resolve_time_unit("i" if _plain_integers(buf, starts[:, 0], ends[:, 0]) else "f", None, source)
 
     if origin_ns is None:
-        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0])
+        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0], time_unit)
     try:
-        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
+        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns, time_unit)
     except _BadToken as err:
         fail(row_line(err.row), f"the timestamp is not a number; expected {EVENT_COLUMNS}")
     xyp = []
@@ -297,35 +332,69 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
                 fail(row_line(not_whole[0]), f"{name} must be a whole pixel index")
     if np.all(np.isin(p, (-1, 0, 1))):
         p = p.astype(np.int8)
-    return EventBlock(t, x.astype(np.int64), y.astype(np.int64), p, header, origin_ns, n_lines)
+    return EventBlock(t, x.astype(np.int64), y.astype(np.int64), p, header, origin_ns, n_lines, time_unit)
 
 
-def parse_event_text(path, origin_ns: int | None = None) -> EventBlock:
+def read_text_bytes(path, what: str = "file") -> bytes:
+    """The bytes of a text file, refusing (EventDataError naming the file) what is not one: a missing
+    path, a folder, a FIFO / pipe / device (reading would block or never end), an empty file, an
+    unreadable one, UTF-16/32 text. A UTF-8 byte-order mark is dropped."""
+    import stat
+
+    path = Path(path)
+    try:
+        st = path.stat()
+    except FileNotFoundError:
+        raise EventDataError(f"no such file: {path}; check the path") from None
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read ({err.strerror})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise EventDataError(f"{path} is a folder, not a {what}; pass the {what} (or the folder that holds it)")
+    if not stat.S_ISREG(st.st_mode):
+        raise EventDataError(f"{path} is not a regular file (a FIFO, pipe or device); save the data to a file first")
+    try:
+        data = path.read_bytes()
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read ({err.strerror}); check its permissions") from None
+    if not data.strip():
+        raise EventDataError(f"{path} is empty; expected lines {EVENT_COLUMNS}" if what == "event file"
+                             else f"{path} is empty")
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    if data.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in data[:4096]:
+        raise EventDataError(f"{path}: UTF-16/32 or binary content, not plain text; save it as plain UTF-8 (ASCII) "
+                             f"text with lines {EVENT_COLUMNS}")
+    return data
+
+
+def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto") -> EventBlock:
     """A whole `t x y p` text file (optionally after a `W H` header), block by block.
 
     Timestamps must be finite and non-decreasing. ``origin_ns`` None picks the origin from the
-    first timestamp. Raises EventDataError naming the file and line.
+    first timestamp. ``time_unit``: see :func:`parse_event_block` ('auto': integers are
+    microseconds, decimals seconds). Raises EventDataError naming the file and line.
     """
     path = Path(path)
-    data = path.read_bytes()
+    data = read_text_bytes(path, "event file")
     everything = np.frombuffer(data, dtype=np.uint8)
     parts, header, line_base, t_last = [], None, 0, -np.inf
     for lo, hi in line_blocks(data, CHUNK_BYTES):
         block = parse_event_block(everything[lo:hi], origin_ns, source=path, line_base=line_base,
-                                  first=lo == 0, t_last=t_last)
+                                  first=lo == 0, t_last=t_last, time_unit=time_unit)
         header = block.header if lo == 0 else header
         origin_ns = block.origin_ns
         line_base += block.n_lines
         if len(block.t):
+            time_unit = block.time_unit
             parts.append((block.t, block.x, block.y, block.p))
             t_last = block.t[-1]
     if not parts:
         raise EventDataError(f"{path}: no events found; expected lines {EVENT_COLUMNS}")
     t, x, y, p = (np.concatenate(c) for c in zip(*parts))
-    return EventBlock(t, x, y, p, header, origin_ns, line_base)
+    return EventBlock(t, x, y, p, header, origin_ns, line_base, time_unit)
 
 
-def parse_frame_list(buf, origin_ns: int | None, *, source) -> tuple[np.ndarray, list[str], int]:
+def parse_frame_list(buf, origin_ns: int | None, *, source, time_unit: str = "s") -> tuple[np.ndarray, list[str], int]:
     """IJRR images.txt (`t images/frame_%08d.png` per line) -> (t float64 [F] s, names, origin_ns).
 
     ``origin_ns`` None picks it from the first timestamp, as for the events. Raises EventDataError
@@ -342,12 +411,16 @@ def parse_frame_list(buf, origin_ns: int | None, *, source) -> tuple[np.ndarray,
         return np.zeros(0), [], origin_ns
     starts, ends = starts.reshape(-1, 2), ends.reshape(-1, 2)
     if origin_ns is None:
-        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0])
+        origin_ns = _first_time_origin(buf, starts[0, 0], ends[0, 0], time_unit)
     try:
-        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns)
+        t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns, time_unit)
     except _BadToken as err:
         i = int(np.searchsorted(newlines, starts[err.row, 0]))
         raise EventDataError(f"{source}, line {i + 1}: the timestamp is not a number "
                              f"(line reads {_line_text(buf, newlines, i)!r})") from None
+    if not np.all(np.isfinite(t)):
+        i = int(np.searchsorted(newlines, starts[int(np.flatnonzero(~np.isfinite(t))[0]), 0]))
+        raise EventDataError(f"{source}, line {i + 1}: the timestamp is not finite "
+                             f"(line reads {_line_text(buf, newlines, i)!r})")
     names = [bytes(buf[s:e]).decode("utf-8", "replace") for s, e in zip(starts[:, 1], ends[:, 1])]
     return t, names, origin_ns
