@@ -85,9 +85,16 @@ def parse_controls(**controls) -> list[Control]:
     return [_parse_one(name, spec) for name, spec in controls.items()]
 
 
+LIVE_ENV_VAR = "EVINR_LIVE_WIDGETS"   # "1": controls even in fast mode (the browser test); "0": never
+
+
 def live_frontend() -> bool:
-    """True in a live Jupyter kernel with ipywidgets available and fast mode off."""
-    if fast_mode():
+    """True in a live Jupyter kernel with ipywidgets available and fast mode off (``EVINR_LIVE_WIDGETS=1``
+    keeps the controls in fast mode, ``EVINR_LIVE_WIDGETS=0`` turns them off everywhere)."""
+    import os
+
+    forced = os.environ.get(LIVE_ENV_VAR, "").strip().lower()
+    if forced in ("0", "false", "no", "off") or (fast_mode() and forced not in ("1", "true", "yes", "on")):
         return False
     try:
         from IPython import get_ipython
