@@ -95,6 +95,7 @@ class TimeUnitWarning(UserWarning):
 
 MAX_SPAN_S = 1e5        # seconds; a recording longer than about 28 hours is taken as a wrong time unit
 MIN_RATE_PER_S = 10.0   # events per second; thousands of events at a lower mean rate also mean a wrong unit
+MAX_RATE_PER_S = 1e10   # events per second; no camera comes near (about 1e9 at the most), so a wrong unit
 
 
 def resolve_time_unit(t, time_unit: str | None, source, *, flag: str = "time_unit") -> str:
@@ -121,8 +122,8 @@ def resolve_time_unit(t, time_unit: str | None, source, *, flag: str = "time_uni
 
 def check_time_span(t, source, time_unit: str, *, flag: str = "time_unit") -> None:
     """Refuse timestamps (seconds, sorted or not) whose span is implausible for an event recording:
-    longer than :data:`MAX_SPAN_S`, or at least 1000 events at under :data:`MIN_RATE_PER_S` per second;
-    both mean the unit is wrong. The message names the unit used and the option to change it."""
+    longer than :data:`MAX_SPAN_S`, at least 1000 events at under :data:`MIN_RATE_PER_S` per second, or
+    a mean rate over :data:`MAX_RATE_PER_S`; each means the unit is wrong. The message names the unit used and the option to change it."""
     t = np.asarray(t)
     if t.size < 2:
         return
@@ -130,11 +131,12 @@ def check_time_span(t, source, time_unit: str, *, flag: str = "time_unit") -> No
     if finite.size < 2:
         return
     span = float(finite.max() - finite.min())
-    if span > MAX_SPAN_S or (t.size >= 1000 and span > 0 and t.size / span < MIN_RATE_PER_S):
+    rate = t.size / span if span > 0 else math.inf
+    if span > MAX_SPAN_S or (t.size >= 1000 and rate < MIN_RATE_PER_S) or (t.size >= 1000 and rate > MAX_RATE_PER_S):
         others = [u for u in ("ms", "us", "ns") if u != time_unit]
         raise EventDataError(
             f"{source}: read in {time_unit!r}, the timestamps span {span:,.6g} s ({span / 3600:,.3g} hours) with "
-            f"{t.size:,} events ({t.size / span:,.3g} per second); that is implausible for an event recording, so "
+            f"{t.size:,} events ({rate:,.3g} per second); that is implausible for an event recording, so "
             f"the time unit is probably wrong: pass {flag}={others[0]!r} (or {', '.join(repr(u) for u in others[1:])})")
 
 

@@ -74,9 +74,14 @@ def is_canonical(path) -> bool:
         return False
     try:
         with h5py.File(path, "r") as f:
-            return f.attrs.get("format") == FORMAT_NAME
-    except OSError:
+            return _attr(f.attrs.get("format")) == FORMAT_NAME
+    except Exception:   # a damaged file (h5py raises OSError, KeyError, RuntimeError, ...): not canonical
         return False
+
+
+def _damaged(path, err) -> EventDataError:
+    return EventDataError(f"{path}: the canonical file is damaged or incomplete ({type(err).__name__}: {err}); delete "
+                          "it and convert again (python -m data_fetch get/convert ...)")
 
 
 def _open(path):
@@ -85,33 +90,48 @@ def _open(path):
     path = Path(path)
     if not path.exists():
         raise EventDataError(f"no such file: {path}; check the path (data_fetch.get(...) returns it)")
+    if not path.is_file():
+        raise EventDataError(f"{path} is not a file; pass the converted .h5 file")
     try:
         f = h5py.File(path, "r")
     except OSError as err:
         raise EventDataError(f"{path}: not a readable HDF5 file ({err}); the file is damaged or incomplete: "
                              "delete it and convert again (python -m data_fetch get/convert ...)") from None
-    if f.attrs.get("format") != FORMAT_NAME:
+    try:
+        fmt = _attr(f.attrs.get("format"))
+        if fmt != FORMAT_NAME:
+            raise EventDataError(f"{path}: not an evinr-lite canonical file (root attribute format is "
+                                 f"{fmt!r}); convert the raw recording with "
+                                 "`python -m data_fetch convert <raw path>`, or read an HQF-style h5 "
+                                 "with evinr_lite.io.readers.read_h5")
+        try:
+            version = int(np.asarray(f.attrs.get("format_version", 0)).reshape(()))
+        except (TypeError, ValueError):
+            raise EventDataError(f"{path}: the attribute format_version is not a number; convert the file again") from None
+        if version > FORMAT_VERSION:
+            raise EventDataError(f"{path}: canonical format version {version} is newer than this evinr-lite "
+                                 f"reads ({FORMAT_VERSION}); update evinr-lite")
+        missing = [f"events/{k}" for k in EVENT_FIELDS if f"events/{k}" not in f]
+        if missing:
+            raise EventDataError(f"{path}: missing datasets {missing}; the file is incomplete: convert it again")
+        n = f["events/t"].shape
+        bad = [k for k in EVENT_FIELDS if f[f"events/{k}"].shape != n or len(n) != 1]
+        if bad:
+            raise EventDataError(f"{path}: events/{bad[0]} has shape {f[f'events/{bad[0]}'].shape}, expected {n} like "
+                                 "events/t; the file is damaged: convert it again")
+    except EventDataError:
         f.close()
-        raise EventDataError(f"{path}: not an evinr-lite canonical file (root attribute format is "
-                             f"{f.attrs.get('format')!r}); convert the raw recording with "
-                             "`python -m data_fetch convert <raw path>`, or read an HQF-style h5 "
-                             "with evinr_lite.io.readers.read_h5")
-    version = int(f.attrs.get("format_version", 0))
-    if version > FORMAT_VERSION:
+        raise
+    except (OSError, KeyError, RuntimeError, TypeError, ValueError) as err:
         f.close()
-        raise EventDataError(f"{path}: canonical format version {version} is newer than this evinr-lite "
-                             f"reads ({FORMAT_VERSION}); update evinr-lite")
-    missing = [f"events/{k}" for k in EVENT_FIELDS if f"events/{k}" not in f]
-    if missing:
-        f.close()
-        raise EventDataError(f"{path}: missing datasets {missing}; the file is incomplete: convert it again")
+        raise _damaged(path, err) from None
     return f
 
 
 def _attr(value):
     """h5py attribute -> plain Python value (str, float, int, tuple)."""
     if isinstance(value, bytes):
-        return value.decode()
+        return value.decode("utf-8", "replace")
     if isinstance(value, np.ndarray):
         return tuple(v.item() for v in value.ravel())
     if isinstance(value, np.generic):
@@ -121,12 +141,43 @@ def _attr(value):
 
 def _info_from(f, path) -> dict:
     info = {k: _attr(v) for k, v in f.attrs.items() if k != "meta_json"}
-    info["meta"] = json.loads(f.attrs["meta_json"]) if "meta_json" in f.attrs else {}
-    info["sensor_size"] = tuple(int(v) for v in f.attrs["sensor_size"])
+    try:
+        info["meta"] = json.loads(_attr(f.attrs["meta_json"])) if "meta_json" in f.attrs else {}
+    except (TypeError, ValueError) as err:
+        raise EventDataError(f"{path}: the attribute meta_json is not JSON ({err}); convert the file again") from None
+    if not isinstance(info["meta"], dict):
+        raise EventDataError(f"{path}: the attribute meta_json is not a JSON object; convert the file again")
+    if "sensor_size" not in f.attrs:
+        raise EventDataError(f"{path}: no attribute sensor_size (H, W); the file is incomplete: convert it again")
+    size = np.asarray(f.attrs["sensor_size"]).ravel()
+    if size.size != 2 or size.dtype.kind not in "iuf" or not np.all(np.isfinite(size)) or np.any(size <= 0):
+        raise EventDataError(f"{path}: the attribute sensor_size must be (H, W), two positive numbers; got "
+                             f"{f.attrs['sensor_size']!r}: convert the file again")
+    info["sensor_size"] = tuple(int(v) for v in size)
+    try:
+        origin = float(np.asarray(f.attrs.get("t_origin", 0.0)).reshape(()))
+    except (TypeError, ValueError):
+        origin = math.nan
+    if not math.isfinite(origin):
+        raise EventDataError(f"{path}: the attribute t_origin is not a finite number of seconds; convert the file again")
+    info["t_origin"] = origin
+    for key in ("C", "t_first", "t_last", "t_zero"):
+        if key in info and not isinstance(info[key], (int, float)):
+            raise EventDataError(f"{path}: the attribute {key} is not a number (got {info[key]!r}); convert the file again")
+    for key in ("n_events", "n_frames"):
+        if key in info and not isinstance(info[key], int):
+            raise EventDataError(f"{path}: the attribute {key} is not a whole number (got {info[key]!r}); convert "
+                                 "the file again")
+    if "C" in info and not (math.isfinite(info["C"]) and info["C"] > 0):
+        raise EventDataError(f"{path}: the stored contrast threshold C = {info['C']} is not a positive number; "
+                             "convert the file again with a valid --C")
     for key in ("eval_window", "eval_window_published"):   # NaN, NaN on disk = the whole sequence
         window = info.get(key)
-        if window is not None and not all(math.isfinite(v) for v in window):
-            window = None
+        if window is not None:
+            if not isinstance(window, tuple) or len(window) != 2 or not all(isinstance(v, (int, float)) for v in window):
+                raise EventDataError(f"{path}: the attribute {key} must be two numbers (start, end); got {window!r}")
+            if not all(math.isfinite(v) for v in window):
+                window = None
         info[key] = window
     info["path"] = str(path)
     return info
@@ -135,7 +186,12 @@ def _info_from(f, path) -> dict:
 def canonical_info(path) -> dict:
     """The file's attributes as a dict (``meta`` decoded from JSON; ``eval_window`` None = whole)."""
     with _open(path) as f:
-        return _info_from(f, path)
+        try:
+            return _info_from(f, path)
+        except EventDataError:
+            raise
+        except (OSError, KeyError, RuntimeError, TypeError, ValueError) as err:
+            raise _damaged(path, err) from None
 
 
 def find_time_index(f, value: float, side: str = "left") -> int:
@@ -183,6 +239,35 @@ def _events(f, lo: int, hi: int, sensor_size, origin: float, source) -> Events:
         raise EventDataError(f"{source}: {err}") from None
 
 
+def _read_open(f, path, t_start, t_end, frames):
+    info = _info_from(f, path)
+    sensor_size, origin = info["sensor_size"], float(info["t_origin"])
+    for name, value in (("t_start", t_start), ("t_end", t_end)):
+        if value is not None and not math.isfinite(value):
+            raise EventDataError(f"{name}= must be a finite number of seconds, got {value}")
+    lo, hi = _window(f, path, t_start, t_end)
+    if hi <= lo and (t_start is not None or t_end is not None):
+        first, last = info.get("t_first"), info.get("t_last")
+        span = f"[{first:.6f}, {last:.6f}] s" if info.get("n_events") and first is not None else "nothing (no events)"
+        raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
+                             f"{span} (relative to t_origin = {origin}); choose a window inside that range")
+    events = _events(f, lo, hi, sensor_size, origin, path)
+    gt = None
+    if frames and "frames/t" in f and f["frames/t"].shape[0]:
+        ft = f["frames/t"][()]
+        a = 0 if t_start is None else int(np.searchsorted(ft, t_start, side="left"))
+        b = len(ft) if t_end is None else int(np.searchsorted(ft, t_end, side="left"))
+        if b > a:
+            if "frames/images" not in f or f["frames/images"].shape[0] != len(ft):
+                raise EventDataError(f"{path}: frames/t and frames/images do not match; the file is damaged: convert "
+                                     "it again")
+            try:
+                gt = Frames(f["frames/images"][a:b], ft[a:b], origin)
+            except EventDataError as err:
+                raise EventDataError(f"{path}: {err}") from None
+    return info, lo, hi, events, gt
+
+
 def read_canonical(path, t_start: float | None = None, t_end: float | None = None, *,
                    frames: bool = True):
     """A canonical sequence file as a :class:`~evinr_lite.core.recording.Recording`.
@@ -202,22 +287,12 @@ def read_canonical(path, t_start: float | None = None, t_end: float | None = Non
     from ..core.recording import Recording
 
     with _open(path) as f:
-        info = _info_from(f, path)
-        sensor_size, origin = info["sensor_size"], float(info["t_origin"])
-        lo, hi = _window(f, path, t_start, t_end)
-        if hi <= lo and (t_start is not None or t_end is not None):
-            first, last = info.get("t_first"), info.get("t_last")
-            span = f"[{first:.6f}, {last:.6f}] s" if info.get("n_events") else "nothing (no events)"
-            raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
-                                 f"{span} (relative to t_origin = {origin}); choose a window inside that range")
-        events = _events(f, lo, hi, sensor_size, origin, path)
-        gt = None
-        if frames and "frames/t" in f and f["frames/t"].shape[0]:
-            ft = f["frames/t"][()]
-            a = 0 if t_start is None else int(np.searchsorted(ft, t_start, side="left"))
-            b = len(ft) if t_end is None else int(np.searchsorted(ft, t_end, side="left"))
-            if b > a:
-                gt = Frames(f["frames/images"][a:b], ft[a:b], origin)
+        try:
+            info, lo, hi, events, gt = _read_open(f, path, t_start, t_end, frames)
+        except EventDataError:
+            raise
+        except (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError) as err:
+            raise _damaged(path, err) from None
     meta = {"format": "canonical", **{k: v for k, v in info.items() if k not in ("format", "meta")},
             **info["meta"], "event_slice": (lo, hi)}
     meta["path"] = str(path)
@@ -234,11 +309,22 @@ def iter_canonical_events(path, t_start: float | None = None, t_end: float | Non
     if chunk_events < 1:
         raise EventDataError(f"chunk_events must be a positive number of events, got {chunk_events}")
     with _open(path) as f:
-        info = _info_from(f, path)
-        lo, hi = _window(f, path, t_start, t_end)
+        try:
+            info = _info_from(f, path)
+            lo, hi = _window(f, path, t_start, t_end)
+        except EventDataError:
+            raise
+        except (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError) as err:
+            raise _damaged(path, err) from None
         for start in range(lo, hi, chunk_events):
-            yield _events(f, start, min(start + chunk_events, hi), info["sensor_size"],
-                          float(info["t_origin"]), path)
+            try:
+                chunk = _events(f, start, min(start + chunk_events, hi), info["sensor_size"],
+                                float(info["t_origin"]), path)
+            except EventDataError:
+                raise
+            except (OSError, KeyError, RuntimeError, TypeError, ValueError) as err:
+                raise _damaged(path, err) from None
+            yield chunk
 
 
 # ---- writing ----------------------------------------------------------------------------

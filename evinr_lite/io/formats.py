@@ -15,6 +15,9 @@ integer arithmetic (exact), as everywhere in the package.
 """
 from __future__ import annotations
 
+import os
+import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +44,37 @@ def _decoder_failed(err: BaseException) -> bool:
     """True for what faery's decoders raise on damaged or unsupported input: plain exceptions, and Rust
     panics (pyo3's PanicException derives from BaseException); False for Ctrl-C and exits."""
     return not isinstance(err, (KeyboardInterrupt, SystemExit, GeneratorExit))
+
+
+@contextmanager
+def _decoder_stderr():
+    """Catch what faery's Rust code prints on the process's stderr (a panic message, before pyo3
+    turns the panic into an exception): dropped when the block raises (the clean EventDataError
+    says what went wrong), passed on otherwise."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):
+        yield
+        return
+    import tempfile
+
+    failed = False
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), 2)
+        try:
+            yield
+        except BaseException:
+            failed = True
+            raise
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            if not failed:
+                tmp.seek(0)
+                text = tmp.read()
+                if text:
+                    sys.stderr.write(text.decode("utf-8", "replace"))
 
 
 def _prophesee_header(path: Path, limit: int = 1 << 16) -> list[str]:
@@ -152,6 +186,29 @@ def _check_size(path, declared, sensor_size, where: str):
     return declared
 
 
+def _check_aedat4_header(path: Path) -> None:
+    """Check what faery 0.7.1 cannot survive: its decoder aborts the whole process (a Rust panic
+    inside a panic) when the header's description XML is not UTF-8, so the header is read here first:
+    its size must fit in the file and its XML must decode."""
+    size_on_disk = path.stat().st_size
+    with open(path, "rb") as f:
+        head = f.read(18)
+        if len(head) < 18 or not head.startswith(b"#!AER-DAT4"):
+            raise EventDataError(f"{path}: not an AEDAT4 file (no `#!AER-DAT4` header); the file is damaged or not AEDAT4")
+        n = int.from_bytes(head[14:18], "little", signed=True)
+        if n <= 0 or 18 + n > size_on_disk:
+            raise EventDataError(f"{path}: the AEDAT4 header claims {n} bytes but the file holds {size_on_disk}; the "
+                                 "file is damaged or truncated")
+        region = f.read(min(n, 1 << 24))
+    start = region.find(b"<")
+    xml = region[start:].split(b"\0")[0] if start >= 0 else b""
+    try:
+        xml.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise EventDataError(f"{path}: the AEDAT4 header's description is not valid text ({err}); the file is "
+                             "damaged") from None
+
+
 def _existing_file(path) -> Path:
     path = Path(path)
     if not path.is_file():
@@ -172,6 +229,24 @@ def read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: 
             file is decoded packet by packet, so memory holds only the window.
     Returns:
         Recording(events, frames or None, meta) with meta["format"] = "aedat4" and the tracks.
+    Raises:
+        EventDataError for a damaged or truncated file (the decoder's own messages are not printed).
+    """
+    with _decoder_stderr():
+        return _read_aedat4(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end)
+
+
+def _read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None):
+    """An AEDAT4 recording (DV software, DAVIS / DVXplorer cameras) as a Recording.
+
+    Args:
+        path: the ``.aedat4`` file.
+        sensor_size: (H, W) to check against the file's (optional; a mismatch is an error).
+        t_start, t_end: seconds relative to ``t_origin`` (the whole seconds of the first event on
+            an absolute clock); only events and frames with t_start <= t < t_end are kept. The
+            file is decoded packet by packet, so memory holds only the window.
+    Returns:
+        Recording(events, frames or None, meta) with meta["format"] = "aedat4" and the tracks.
     """
     from faery.extension import aedat
 
@@ -179,6 +254,7 @@ def read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: 
     from ..core.frames import to_grey_uint8 as _to_grey_uint8
 
     path = _existing_file(path)
+    _check_aedat4_header(path)
     try:
         decoder = aedat.Decoder(path)
     except BaseException as err:
@@ -230,6 +306,17 @@ def read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: 
 
 def read_prophesee(path, *, sensor_size=None, version: str | None = None,
                    t_start: float | None = None, t_end: float | None = None):
+    """A Prophesee recording: EVT 2 / 3 ``.raw`` or DAT ``.dat`` (CD events) as a Recording.
+
+    See :func:`_read_prophesee` for the arguments; the decoder's own messages (Rust panics on
+    damaged input) are not printed, the EventDataError says what is wrong.
+    """
+    with _decoder_stderr():
+        return _read_prophesee(path, sensor_size=sensor_size, version=version, t_start=t_start, t_end=t_end)
+
+
+def _read_prophesee(path, *, sensor_size=None, version: str | None = None,
+                    t_start: float | None = None, t_end: float | None = None):
     """A Prophesee recording: EVT 2 / 2.1 / 3 ``.raw`` or DAT ``.dat`` (CD events) as a Recording.
 
     Args:

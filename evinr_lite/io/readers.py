@@ -73,11 +73,10 @@ def _existing(path, kind: str = "file") -> Path:
 
 def _load_npy(path: Path):
     """np.load of one plain array, every failure an EventDataError naming the file."""
-    import zipfile
-
-    try:
-        return np.load(path, allow_pickle=False)
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile, TypeError) as err:
+    try:   # memory-mapped first: a damaged header that claims more data than the file holds fails, not allocates
+        array = np.load(path, allow_pickle=False, mmap_mode="r")
+        return np.array(array) if isinstance(array, np.memmap) else array
+    except Exception as err:   # numpy raises ValueError, SyntaxError, TokenError, OSError, ... on a damaged header
         raise EventDataError(f"{path}: not a readable numeric .npy array ({type(err).__name__}: {err}); the file is "
                              "damaged or incomplete, or not saved with np.save(path, array)") from None
 
