@@ -84,7 +84,10 @@ def get_weights(name: str, files=("all",), *, verify: bool = True, progress: boo
     unknown = [f for f in wanted if f not in entries]
     if unknown:
         raise DataFetchError(f"weight set {name!r} has no file {unknown[0]!r}; known: {', '.join(entries)}, all")
+    from .conversion import check_writable_folder
+
     folder = weights_dir(name)
+    check_writable_folder(cache_dir(), "cache folder")
     return {f: fetch_url(entries[f].url, folder / entries[f].file, known_hash=entries[f].known_hash if verify else None,
                          progress=progress, retries=retries) for f in wanted}
 
@@ -130,17 +133,20 @@ def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str 
         handler.setFormatter(logging.Formatter("%(message)s"))
         log.addHandler(handler)
         log.setLevel(logging.INFO)
+    from .conversion import check_writable_folder
+
     ds = get_dataset(dataset)
+    seq = get_sequence(ds.name, sequence)     # an unknown name is refused here, before any download
     out = canonical_path(ds.name, sequence)
     if not force and is_canonical(out):
         return out
+    check_writable_folder(cache_dir(), "cache folder")
     if ds.method == "manual":
         placed = raw_path(ds.name, sequence)
         if placed.is_dir():
             from .conversion import convert as _convert
-            return _convert(placed, out, dataset=ds.name, sequence=sequence, progress=progress)
+            return _convert(placed, out, dataset=ds.name, sequence=sequence, progress=progress, overwrite=True)
         raise NotDownloadable(_manual_message(ds, sequence))
-    seq = get_sequence(ds.name, sequence)
     raw = raw_path(ds.name, seq.name)
     pinned = known_hash if (known_hash or url) else seq.known_hash
     pinned = pinned if verify else None
@@ -163,7 +169,7 @@ def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str 
                             f"({', '.join(ds.sequences)}); check the name.") from None
     from .conversion import convert as _convert
 
-    path = _convert(raw, out, dataset=ds.name, sequence=seq.name, progress=progress)
+    path = _convert(raw, out, dataset=ds.name, sequence=seq.name, progress=progress, overwrite=True)
     if not keep_raw and raw.exists():
         raw.unlink()
     return path

@@ -6,6 +6,12 @@
     python -m data_fetch get ijrr all                every evaluation sequence of a dataset
     python -m data_fetch convert RAW [--out PATH]    a raw file you already have
     python -m data_fetch info FILE.h5                what a converted file holds
+
+Exit status: 0 done; 2 bad input or an environment problem (``data_fetch: error: ...``: an unknown
+dataset or sequence, a damaged or missing file, an unreachable server, a cache folder that cannot be
+written, an existing --out without --overwrite); 1 an internal error (a bug: rerun with --debug for
+the traceback); 128 + n after signal n (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP): nothing half-written
+is left, and the same command resumes a download.
 """
 from __future__ import annotations
 
@@ -85,7 +91,8 @@ def _cmd_convert(args) -> int:
 
     print(convert(args.raw, args.out, dataset=args.dataset, sequence=args.sequence,
                   sensor_size=tuple(args.sensor_size) if args.sensor_size else None, C=args.C,
-                  event_topic=args.event_topic, image_topic=args.image_topic, progress=not args.quiet))
+                  event_topic=args.event_topic, image_topic=args.image_topic, progress=not args.quiet,
+                  overwrite=args.overwrite, time_unit=args.time_unit))
     return 0
 
 
@@ -104,9 +111,18 @@ def _cmd_info(args) -> int:
     return 0
 
 
+EXIT_ERROR, EXIT_INTERNAL = 2, 1
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        self.exit(EXIT_ERROR, f"data_fetch: error: {message} (see `{self.prog} --help`)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="python -m data_fetch", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = _Parser(prog="python -m data_fetch", description=__doc__,
+                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--debug", action="store_true", help="show the traceback of an internal error")
     sub = p.add_subparsers(dest="command", required=True)
     q = sub.add_parser("list", help="datasets and sequences")
     q.add_argument("dataset", nargs="?")
@@ -129,6 +145,10 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--sequence")
     q.add_argument("--sensor-size", nargs=2, type=int, metavar=("H", "W"))
     q.add_argument("--C", type=float, help="contrast threshold to store (default: the dataset's)")
+    q.add_argument("--time-unit", choices=("s", "ms", "us", "ns"),
+                   help="unit of the raw timestamps of IJRR text and HQF-style h5 (default: decimals are seconds, "
+                        "integers microseconds)")
+    q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     q.add_argument("--event-topic")
     q.add_argument("--image-topic")
     q.add_argument("--quiet", action="store_true")
@@ -140,7 +160,15 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run the command; 0 ok, 2 bad input, 1 internal error (``--debug`` shows the traceback), 128 + n after signal n."""
+    import signal
+    import traceback
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        args = build_parser().parse_args([str(a) for a in argv])
+    except SystemExit as exc:
+        return exc.code if isinstance(exc.code, int) else EXIT_ERROR
     log = logging.getLogger("data_fetch")
     if not log.handlers:
         handler = logging.StreamHandler()
@@ -148,16 +176,29 @@ def main(argv=None) -> int:
         log.addHandler(handler)
         log.propagate = False
     log.setLevel(logging.WARNING if getattr(args, "quiet", False) else logging.INFO)
-    from evinr_lite.core.events import EventDataError
+    from evinr_lite.core.events import InputError
+    from evinr_lite.io.output import Interrupted, termination_signals
 
     try:
-        return args.func(args)
-    except (DataFetchError, EventDataError) as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print("interrupted; run the same command again to resume", file=sys.stderr)
-        return 130
+        with termination_signals():
+            return args.func(args)
+    except KeyboardInterrupt as exc:
+        signum = exc.signum if isinstance(exc, Interrupted) else signal.SIGINT
+        print(f"data_fetch: interrupted by {signal.Signals(signum).name}; nothing half-written was kept: run the same "
+              "command again to resume", file=sys.stderr)
+        return 128 + int(signum)
+    except (DataFetchError, InputError, OSError) as err:
+        text = f"{err.filename}: {err.strerror}" if isinstance(err, OSError) and err.strerror and err.filename else err
+        print(f"data_fetch: error: {text}", file=sys.stderr)
+        return EXIT_ERROR
+    except Exception as err:
+        if args.debug:
+            traceback.print_exc()
+        else:
+            print(f"data_fetch: internal error: {type(err).__name__}: {err}\n  This is a bug in data_fetch, not a "
+                  f"problem with your input. Rerun with --debug to see the traceback:\n  python -m data_fetch --debug "
+                  f"{' '.join(argv)}", file=sys.stderr)
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

@@ -76,9 +76,50 @@ def _kind(path: Path) -> str:
                           "ROS1 .bag files, CED zips of bags, MVSEC .hdf5 and HQF-style .h5")
 
 
+def check_writable_folder(folder: Path, what: str) -> None:
+    """Refuse (DataFetchError) a folder that cannot be created or written, before any download or conversion."""
+    import os
+
+    anchor = folder
+    while not anchor.exists() and anchor != anchor.parent:
+        anchor = anchor.parent
+    if not anchor.is_dir():
+        raise DataFetchError(f"the {what} {folder} cannot be created: {anchor} is a file, not a folder; set "
+                             "EVINR_DATA to a folder (or choose another --out)")
+    if not os.access(anchor, os.W_OK | os.X_OK):
+        raise DataFetchError(f"the {what} {folder} cannot be written: no permission to write in {anchor}; set "
+                             "EVINR_DATA to a folder you can write (or choose another --out)")
+
+
+def check_settings(*, C=None, sensor_size=None, eval_window=None, time_unit=None) -> None:
+    """Values that are stored in the converted file, checked before converting (DataFetchError)."""
+    import math
+
+    from evinr_lite.core.events import TIME_UNITS
+
+    if C is not None and (isinstance(C, bool) or not isinstance(C, (int, float)) or not math.isfinite(C) or C <= 0):
+        raise DataFetchError(f"C must be a positive finite contrast threshold, got {C!r} (--C)")
+    if sensor_size is not None:
+        try:
+            H, W = (int(v) for v in sensor_size)
+        except (TypeError, ValueError):
+            raise DataFetchError(f"sensor size must be (H, W), two positive integers; got {sensor_size!r}") from None
+        if not (0 < H <= 1 << 16 and 0 < W <= 1 << 16):
+            raise DataFetchError(f"sensor size must be (H, W) with sides in 1..65536; got {(H, W)} (--sensor-size H W)")
+    if eval_window not in (None, _UNSET):
+        try:
+            lo, hi = (float(v) for v in eval_window)
+        except (TypeError, ValueError):
+            raise DataFetchError(f"eval_window must be (start, end) seconds, got {eval_window!r}") from None
+        if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
+            raise DataFetchError(f"eval_window must be finite with end > start, got {eval_window!r}")
+    if time_unit not in (None, "auto") and time_unit not in TIME_UNITS:
+        raise DataFetchError(f"time unit must be one of {', '.join(TIME_UNITS)}, got {time_unit!r} (--time-unit)")
+
+
 def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None = None, sensor_size=None,
             C: float | None = None, eval_window=_UNSET, event_topic: str | None = None, image_topic=None,
-            progress: bool = True) -> Path:
+            progress: bool = True, overwrite: bool = False, time_unit: str | None = None) -> Path:
     """Convert a raw recording to the canonical HDF5 file and return its path.
 
     Args:
@@ -96,9 +137,13 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
         eval_window: (start, end) seconds after the sequence's zero, or None for the whole
             sequence; default: the registry's.
         event_topic, image_topic: bag topics (defaults: see :func:`data_fetch.convert_bag.convert_bag`).
+        overwrite: replace an existing file at ``out`` (refused otherwise, whatever it holds).
+        time_unit: unit of the raw timestamps of text recordings (IJRR folders / zips) and HQF-style
+            h5 ('s', 'ms', 'us', 'ns'); None: decimals are seconds, integers microseconds.
     """
     from . import cache_dir
 
+    check_settings(C=C, sensor_size=sensor_size, eval_window=eval_window, time_unit=time_unit)
     raw = Path(raw).expanduser()
     if not raw.exists():
         raise DataFetchError(f"no such file or folder: {raw}")
@@ -121,14 +166,21 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
         out = Path(out).expanduser()
         if out.is_dir() or out.suffix.lower() not in (".h5", ".hdf5"):
             out = out / f"{name}.h5"
-    if out.resolve() == raw.resolve():
-        raise DataFetchError(f"the output {out} is the raw file itself; choose another --out")
+    if out.resolve() == raw.resolve() or raw.resolve() in out.resolve().parents:
+        raise DataFetchError(f"the output {out} is (or lies inside) the raw recording itself; choose another --out")
+    if out.is_dir():
+        raise DataFetchError(f"the output {out} is a folder; choose a file name ending in .h5 as --out")
+    if out.exists() and not overwrite:
+        raise DataFetchError(f"the output {out} already exists; it is left as it is: choose another --out or pass "
+                             "--overwrite (overwrite=True) to replace it")
+    check_writable_folder(out.parent, "output folder")
     if ds is not None and ds.method == "manual":   # AED: a sequence folder placed by hand (layout: convert_aed.py)
         from .convert_aed import convert_aed
 
         return convert_aed(raw, out, raw_sensor_size=sensor_size, C=float(C if C is not None else ds.C),
                            eval_window=None if eval_window is _UNSET else eval_window, dataset=ds.name,
-                           sequence=name, source=ds.title, progress=progress)
+                           sequence=name, source=ds.title, progress=progress,
+                           time_unit=None if time_unit in (None, "auto") else time_unit)
     kind = _kind(raw)
     common = dict(
         sensor_size=sensor_size if sensor_size is not None else (ds.sensor_size if ds else None),
@@ -139,14 +191,16 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
     if ds is None and C is None:
         log.warning("data_fetch: %s is not a registered sequence; storing C = 1.0 and no evaluation window", raw)
 
+    if time_unit not in (None, "auto") and kind not in ("ijrr", "h5"):
+        raise DataFetchError(f"{raw}: a {kind} recording stores its time unit itself; leave --time-unit out")
     if kind == "ijrr":
         from .convert_ijrr import convert_ijrr
 
-        return convert_ijrr(raw, out, **common)
+        return convert_ijrr(raw, out, **common, time_unit=time_unit or "auto")
     if kind == "h5":
         from .convert_h5 import convert_h5
 
-        return convert_h5(raw, out, **common)
+        return convert_h5(raw, out, **common, time_unit=time_unit)
     from .convert_bag import convert_bag
 
     topics = dict(event_topic=event_topic or (ds.event_topic if ds else None),

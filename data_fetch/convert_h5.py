@@ -77,7 +77,7 @@ def _mvsec(f, path, writer_args, sensor_size, side, progress):
         writer.abort()
 
 
-def _hqf(f, path, writer_args, sensor_size, progress):
+def _hqf(f, path, writer_args, sensor_size, progress, time_unit=None):
     from tqdm.auto import tqdm
 
     if "sensor_resolution" in f.attrs:
@@ -94,13 +94,23 @@ def _hqf(f, path, writer_args, sensor_size, progress):
         raise ConversionError(f"{path}: events/xs, ys, ts, ps must be 1-D of one length")
     if n == 0:
         raise ConversionError(f"{path}: events/ts holds no events")
-    origin = auto_origin(float(ts[0]))
+    from evinr_lite.core.events import TIME_UNITS, check_time_span, resolve_time_unit
+
+    if ts.dtype.kind not in "iuf":
+        raise ConversionError(f"{path}: events/ts must be numeric, got dtype {ts.dtype}")
+    unit = resolve_time_unit(ts.dtype.kind, time_unit, f"{path}: events/ts")
+    per_s = 1.0 / TIME_UNITS[unit]
+    try:
+        check_time_span(np.array([float(ts[0]), float(ts[n - 1])]) / per_s, f"{path}: events/ts", unit)
+    except Exception as err:
+        raise ConversionError(str(err)) from None
+    origin = auto_origin(float(ts[0]) / per_s)
     polarity = PolarityMapper(f"{path}: events/ps")
     writer = CanonicalWriter(sensor_size=sensor_size, t_origin=origin, **writer_args)
     try:
         for start in tqdm(range(0, n, ROWS), desc=f"{path.name}: events", disable=not progress):
             sl = slice(start, start + ROWS)
-            writer.add_events(ts[sl].astype(np.float64) - origin, xs[sl], ys[sl], polarity(ps[sl], f" [{start}..]"),
+            writer.add_events(ts[sl].astype(np.float64) / per_s - origin, xs[sl], ys[sl], polarity(ps[sl], f" [{start}..]"),
                               where=f"events [{start}..]")
         if "images" in f:
             group = f["images"]
@@ -108,7 +118,7 @@ def _hqf(f, path, writer_args, sensor_size, progress):
                 stamp = float(group[k].attrs["timestamp"]) if "timestamp" in group[k].attrs else math.nan
                 if not math.isfinite(stamp):
                     raise ConversionError(f"{path}: images/{k} has no 'timestamp' attribute")
-                writer.add_frame(_to_grey_uint8(group[k][()], f"{path}:images/{k}"), stamp - origin)
+                writer.add_frame(_to_grey_uint8(group[k][()], f"{path}:images/{k}"), stamp / per_s - origin)
         return writer.close()
     finally:
         writer.abort()
@@ -116,7 +126,7 @@ def _hqf(f, path, writer_args, sensor_size, progress):
 
 def convert_h5(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None, dataset: str = "",
                sequence: str | None = None, source: str = "", source_url: str = "", side: str = "left",
-               progress: bool = True) -> Path:
+               progress: bool = True, time_unit: str | None = None) -> Path:
     """Convert an MVSEC ``_data.hdf5`` or an HQF-style ``.h5`` to the canonical file ``out``."""
     import h5py
 
@@ -134,6 +144,6 @@ def convert_h5(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None,
         if layout == "mvsec":
             return _mvsec(f, path, args, sensor_size, side, progress)
         if layout == "hqf":
-            return _hqf(f, path, args, sensor_size, progress)
+            return _hqf(f, path, args, sensor_size, progress, time_unit)
     raise ConversionError(f"{path}: unknown HDF5 layout (neither MVSEC davis/left/events nor HQF events/xs..); "
                           "if it is already a canonical file, read it with evinr_lite.io.canonical.read_canonical")

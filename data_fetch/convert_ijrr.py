@@ -125,13 +125,14 @@ def _damaged(src: IJRRSource, member: str, err) -> ConversionError:
                            "damaged or was cut off: delete it and run the command again to download it anew")
 
 
-def _frame_list(src: IJRRSource, origin_ns: int):
+def _frame_list(src: IJRRSource, origin_ns: int, time_unit: str = "s"):
     """[(t seconds since origin, member name)] from images.txt."""
     listing = src.member("images.txt")
     if listing is None:
         return []
     try:
-        t, names, _ = parse_frame_list(src.read(listing), origin_ns, source=f"{src.path}: images.txt")
+        t, names, _ = parse_frame_list(src.read(listing), origin_ns, source=f"{src.path}: images.txt",
+                                       time_unit=time_unit)
     except EventDataError as err:
         raise ConversionError(str(err)) from None
     return list(zip(t.tolist(), names))
@@ -158,19 +159,20 @@ def _load_image(src: IJRRSource, name: str) -> np.ndarray:
         raise ConversionError(str(err)) from None
 
 
-def _parse_block(block: bytes, origin_ns, line_base: int, src, first: bool):
-    """One block of whole lines -> (t, x, y, p raw or None, header (H, W) or None, origin_ns, n_lines)."""
+def _parse_block(block: bytes, origin_ns, line_base: int, src, first: bool, time_unit: str = "s"):
+    """One block of whole lines -> (t, x, y, p raw or None, header (H, W) or None, origin_ns, n_lines, unit)."""
     try:
-        b = parse_event_block(block, origin_ns, source=f"{src.path}: events.txt", line_base=line_base, first=first)
+        b = parse_event_block(block, origin_ns, source=f"{src.path}: events.txt", line_base=line_base, first=first,
+                              time_unit=time_unit)
     except EventDataError as err:
         raise ConversionError(str(err)) from None
     parsed = (b.t, b.x, b.y, b.p) if len(b.t) else None
-    return parsed, b.header, b.origin_ns, b.n_lines
+    return parsed, b.header, b.origin_ns, b.n_lines, (b.time_unit if parsed is not None else time_unit)
 
 
 def convert_ijrr(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None, dataset: str = "ijrr",
                  sequence: str | None = None, source: str = "", source_url: str = "",
-                 progress: bool = True, t_origin=None) -> Path:
+                 progress: bool = True, t_origin=None, time_unit: str = "auto") -> Path:
     """Convert an IJRR text sequence (zip or folder) to the canonical file ``out``.
 
     Args:
@@ -180,6 +182,8 @@ def convert_ijrr(path, out, *, sensor_size=None, C: float = 1.0, eval_window=Non
         C, eval_window, dataset, sequence, source, source_url: stored as attributes.
         t_origin: seconds subtracted from all timestamps; None: the whole seconds of the first
             event when the clock is absolute (>= 1e5 s), else 0.
+        time_unit: unit of events.txt and images.txt timestamps ('s', 'ms', 'us', 'ns'); 'auto':
+            decimals are seconds, plain integers microseconds (with a warning).
     """
     from tqdm.auto import tqdm
 
@@ -219,7 +223,8 @@ def convert_ijrr(path, out, *, sensor_size=None, C: float = 1.0, eval_window=Non
             with src.open(events_member) as fh:
                 for block in _blocks(fh, BLOCK_BYTES):
                     bar.update(len(block))
-                    parsed, header, origin_ns, n_lines = _parse_block(block, origin_ns, line_base, src, first)
+                    parsed, header, origin_ns, n_lines, time_unit = _parse_block(block, origin_ns, line_base, src,
+                                                                                 first, time_unit)
                     if first and header is not None:
                         if sensor_size is not None and header != sensor_size:
                             raise ConversionError(f"{path}: events.txt's header `{header[1]} {header[0]}` (W H) "
@@ -243,7 +248,7 @@ def convert_ijrr(path, out, *, sensor_size=None, C: float = 1.0, eval_window=Non
                     line_base += n_lines
             if writer is None:
                 raise ConversionError(f"{path}: events.txt holds no events")
-            for t_frame, name in _frame_list(src, origin_ns):
+            for t_frame, name in _frame_list(src, origin_ns, "s" if time_unit == "auto" else time_unit):
                 writer.add_frame(_load_image(src, name), t_frame)
             return writer.close()
         except (zipfile.BadZipFile, zlib.error, EOFError) as err:

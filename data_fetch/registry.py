@@ -89,6 +89,14 @@ def _ijrr() -> Dataset:
     )
 
 
+# Every sequence of the Event Camera Dataset's text release (https://rpg.ifi.uzh.ch/davis_data.html); names
+# outside this list are refused before any download.
+ECD_NAMES = ("shapes_rotation", "shapes_translation", "shapes_6dof", "poster_rotation", "poster_translation",
+             "poster_6dof", "boxes_rotation", "boxes_translation", "boxes_6dof", "hdr_poster", "hdr_boxes",
+             "outdoors_walking", "outdoors_running", "dynamic_rotation", "dynamic_translation", "dynamic_6dof",
+             "calibration", "office_zigzag", "office_spiral", "slider_close", "slider_far", "slider_hdr_close",
+             "slider_hdr_far", "slider_depth", "urban")
+
 HQF_NAMES = ("bike_bay_hdr", "boxes", "desk", "desk_fast", "desk_hand_only", "desk_slow",
              "engineering_posters", "high_texture_plants", "poster_pillar_1", "poster_pillar_2",
              "reflective_materials", "slow_and_fast_desk", "slow_hand", "still_life")
@@ -221,12 +229,12 @@ def get_sequence(dataset: str, name: str) -> Sequence:
     ds = get_dataset(dataset)
     if name in ds.sequences:
         return ds.sequences[name]
-    if ds.url_pattern and re.fullmatch(r"[A-Za-z0-9_]+", name):
+    if ds.url_pattern and re.fullmatch(r"[A-Za-z0-9_]+", name) and (ds.name != "ijrr" or name in ECD_NAMES):
         return Sequence(name, f"{name}.zip", ds.url_pattern.format(name=name), None, None, evaluation=False)
     if ds.method == "manual":
         return Sequence(name, name, None, None, None, evaluation=False)
-    known = ", ".join(ds.sequences)
-    raise DataFetchError(f"{ds.name} has no sequence {name!r}; known sequences: {known}")
+    known = ", ".join(ECD_NAMES if ds.name == "ijrr" else ds.sequences)
+    raise DataFetchError(f"{ds.name} has no sequence {name!r} (nothing was downloaded); known sequences: {known}")
 
 
 # ---- model weights (not datasets): fetched with `python -m data_fetch get <name> all` ----------

@@ -666,9 +666,9 @@ def test_command_line(tmp_path, cache, small_sensor, capsys):
     check_events(read_canonical(written), ev)
     assert cli(["info", str(written)]) == 0
     assert "300 events" in capsys.readouterr().out
-    assert cli(["get", "aed", "seq1"]) == 1
+    assert cli(["get", "aed", "seq1"]) == 2
     assert "error: " in capsys.readouterr().err
-    assert cli(["convert", str(tmp_path / "missing.zip")]) == 1
+    assert cli(["convert", str(tmp_path / "missing.zip")]) == 2
 
 
 def test_import_is_light():
