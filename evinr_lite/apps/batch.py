@@ -305,24 +305,27 @@ def _summary_files(summary: dict) -> dict[str, str]:
 
 # ---- memory ----------------------------------------------------------------------------------
 
-def estimate_task_memory_mb(sensor_size, duration_s: float, n_events: int, *, bin_duration: float = 1 / 32,
-                            hidden_features: int = 512, tau: float | None = 5.0, overlap: float = 0.5) -> float:
+PROCESS_MIB = 900.0   # a worker with Python, torch and the libraries loaded, reading and scoring (measured ~740-950)
+
+
+def estimate_task_memory_mb(sensor_size, duration_s: float, n_events: int, *, n_frames: int = 0,
+                            config=None) -> float:
     """A rough upper estimate of one task's memory in MiB (the README's batch section explains it).
 
-    Terms: the process itself (Python, torch, libraries: about 600 MiB); the events (17 bytes
-    each: t float64, x and y int32, p int8, twice while they are read); the event frames and the
-    network's outputs and gradients at every bin (about 8 float32 copies of [bins, H, W]); each
-    network's H*W output layer with its gradient and two Adam moments (4 float32 copies of
-    hidden_features x H x W), one network per ``tau`` seconds.
+    The process itself (PROCESS_MIB: Python, torch, the libraries, a reader and the scoring), the
+    events in memory (17 bytes each: t float64, x and y int32, p int8; twice while they are read),
+    and the reconstruction as :func:`evinr_lite.apps.recon_job.estimate_memory` counts it (each
+    network's weights, gradients and Adam moments with its H*W head, one network per ``tau``
+    seconds; the event bins; the ``n_frames`` queried frames) for ``config`` (default: the paper's).
     """
-    H, W = (int(v) for v in sensor_size)
-    n_bins = max(1, math.ceil(duration_s / bin_duration))
-    n_models = 1 if tau is None or duration_s <= tau else math.ceil((duration_s - overlap) / (tau - overlap))
-    mib = 1024.0 ** 2
-    events = 2 * 17 * n_events / mib
-    bins = 8 * 4 * n_bins * H * W / mib
-    heads = 4 * 4 * hidden_features * H * W * n_models / mib
-    return 600.0 + events + bins + heads
+    from ..core.events import Events
+    from ..core.recording import Recording
+    from ..method.solver import EvINRConfig
+    from .recon_job import estimate_memory
+
+    rec = Recording(Events.empty(tuple(int(v) for v in sensor_size)), None, {"window": (0.0, float(duration_s))})
+    solver = estimate_memory(rec, np.zeros(max(int(n_frames), 1)), config or EvINRConfig(progress=False))["total"]
+    return PROCESS_MIB + (2 * 17 * n_events + solver) / 1024.0 ** 2
 
 
 # ---- the whole batch -------------------------------------------------------------------------
