@@ -64,9 +64,14 @@ def notebook_paths(folder: Path = NOTEBOOKS, only=None) -> list[Path]:
     return paths
 
 
+LATEX = {"Theta": "Θ", "theta": "θ", "times": "×", "lambda": "λ", "gamma": "γ", "tau": "τ", "partial": "∂",
+         "Delta": "Δ", "mu": "µ", "sigma": "σ", "approx": "≈", "le": "≤", "ge": "≥", "cdot": "·"}
+
+
 def _markdown_text(md: str) -> str:
-    """Markdown to plain text, enough for a one-paragraph summary."""
-    md = re.sub(r"\$([^$]+)\$", r"\1", md)
+    """Markdown to plain text, enough for a one-paragraph summary (inline maths as Unicode)."""
+    md = re.sub(r"\$([^$]+)\$", lambda m: re.sub(r"\\([A-Za-z]+)", lambda c: LATEX.get(c.group(1), c.group(1)),
+                                                 m.group(1)), md)
     md = re.sub(r"[*_`]+", "", md)
     md = re.sub(r"\[([^\]]+)\]\([^)]+\)", r"\1", md)
     return " ".join(md.split())
