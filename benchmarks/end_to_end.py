@@ -5,7 +5,7 @@
     python benchmarks/end_to_end.py --device cuda   # on a GPU (the paper: about 8 s per sequence on an RTX 3090)
 
 Protocol: the built-in "camera" scene (natural image drifting, rotating, zooming) on 240x180 for
-5 s, events simulated with C = 0.2 (seed 0). ``reconstruct`` with ``EvINRConfig(C=0.2)`` and
+5 s, events simulated with C = 0.2 (seed 0). ``reconstruct`` with ``EvINRConfig.v0_1(C=0.2)`` and
 otherwise the paper's defaults: SIREN 512 x 3, 300 Adam iterations (lr 1e-4, x0.95 every 10),
 coarse-to-fine bisection at iterations 100 and 200 ending at 1/32 s bins, Tikhonov lambda = 0.05,
 tau = 5 s (one network for this sub-sequence). Reported: training time (the optimisation loop),
@@ -71,7 +71,7 @@ def run(quick: bool = False, device: str | None = None, reference: bool = True, 
     log(f"end to end: {size[1]}x{size[0]}, {duration:g} s, {len(events):,} events (simulated in {simulate_s:.1f} s)")
     rows = []
     for dev in devices(device):
-        cfg = EvINRConfig(C=0.2, n_iters=iters, c2f_iters=(iters // 3, 2 * iters // 3), device=dev, progress=False)
+        cfg = EvINRConfig.v0_1(C=0.2, n_iters=iters, c2f_iters=(iters // 3, 2 * iters // 3), device=dev, progress=False)
         rec, wall = timed(lambda: reconstruct(events, q, cfg), dev)
         if reference:   # reference path, then the fast path again: the two fast runs bracket it
             ref, wall_ref = timed(lambda: reconstruct_reference(events, q, cfg), dev)

@@ -62,7 +62,7 @@ def compare(setting: str, n_models: int = 10, repeats: int = 2, device="cpu", it
     assert len(windows) == n_models, len(windows)
     events = random_events(int(s["rate"] * span), span, s["size"])
     c2f = (iters // 3, 2 * iters // 3)
-    cfg = EvINRConfig(C=0.2, hidden_features=s["hidden"], hidden_layers=s["layers"], n_iters=iters,
+    cfg = EvINRConfig.v0_1(C=0.2, hidden_features=s["hidden"], hidden_layers=s["layers"], n_iters=iters,
                       coarse_to_fine=s["c2f"], c2f_iters=c2f, tau=s["tau"], overlap=s["overlap"],
                       device=device, progress=False)
     init = FrameINR(s["size"], windows, s["hidden"], s["layers"], cfg.omega_0, cfg.first_omega_0, seed=0).to(device)
@@ -84,7 +84,7 @@ def compare(setting: str, n_models: int = 10, repeats: int = 2, device="cpu", it
         sync(device)
         return time.perf_counter() - t0, singles
 
-    warm_cfg = EvINRConfig(**{**cfg.__dict__, "n_iters": 1, "coarse_to_fine": False})
+    warm_cfg = EvINRConfig.v0_1(**{**cfg.__dict__, "n_iters": 1, "coarse_to_fine": False})
     train_frame_inr(events, windows[:1], warm_cfg, model=init.network(0))        # warm-up (allocations, kernels)
     train_frame_inr(events, windows, warm_cfg, model=copy.deepcopy(init))
     times = {"batched": [], "sequential": []}

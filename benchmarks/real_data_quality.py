@@ -26,7 +26,7 @@ from evinr_lite.method.solver import EvINRConfig  # noqa: E402
 
 
 def variants(n_iters: int) -> dict[str, EvINRConfig]:
-    paper = EvINRConfig(n_iters=n_iters, c2f_iters=(n_iters // 3, 2 * n_iters // 3), progress=False)
+    paper = EvINRConfig.v0_1(n_iters=n_iters, c2f_iters=(n_iters // 3, 2 * n_iters // 3), progress=False)
     out = {f"paper, head_lr_scale {s:g}": replace(paper, head_lr_scale=s) for s in (30.0, 10.0, 3.0, 1.0)}
     out["difference + TV"] = replace(paper, temporal_loss="difference", regularizer="tv")
     return out
@@ -45,7 +45,7 @@ def main(argv=None) -> int:
     idx = frames_to_score(rec.frames.t, rec.events)
     gt, gt_t = rec.frames.images[idx], rec.frames.t[idx]
     print(f"{path}: {len(rec.events):,} events, {len(idx)} frames scored")
-    rows = evaluate(rec.events, gt, gt_t, methods=("integration", "hf"), config=EvINRConfig(progress=False),
+    rows = evaluate(rec.events, gt, gt_t, methods=("integration", "hf"), config=EvINRConfig.v0_1(progress=False),
                     lpips_model=False)
     for name, cfg in variants(a.iters).items():
         new = evaluate(rec.events, gt, gt_t, methods=("evinr",), config=cfg, lpips_model=False, keep_frames=True)

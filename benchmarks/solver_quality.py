@@ -37,7 +37,7 @@ def variants(C: float, iters: int) -> dict:
             "EvINR Base + Reg.": table2["Base + Reg."],
             "EvINR Base + C2F": table2["Base + C2F"],
             "EvINR Full (paper recipe)": table2["Full"],
-            "EvINR Full, boundary difference + TV": EvINRConfig(**{**common, "temporal_loss": "difference",
+            "EvINR Full, boundary difference + TV": EvINRConfig.v0_1(**{**common, "temporal_loss": "difference",
                                                                    "regularizer": "tv"})}
 
 

@@ -84,7 +84,7 @@ def test_recipe_variants_change_one_thing_per_step_and_end_at_the_reference_code
 
 def test_run_variants_rows_hold_scores_times_and_frames(tiny_scene):
     events, gt, times = tiny_scene
-    variants = {"Full": EvINRConfig(**TINY), "integration": ab.integration_baseline(0.2)}
+    variants = {"Full": EvINRConfig.v0_1(**TINY), "integration": ab.integration_baseline(0.2)}
     rows = ab.run_variants(events, gt, times, variants, t_start=0.0, t_end=0.5, n_inference=8)
     assert [r["name"] for r in rows] == ["Full", "integration"]
     for r in rows:
@@ -109,23 +109,23 @@ def test_run_variants_cache_reuses_identical_configs(tiny_scene, monkeypatch):
     real = ab.reconstruct
     monkeypatch.setattr(ab, "reconstruct", lambda *a, **k: calls.append(1) or real(*a, **k))
     cache = {}
-    first = ab.run_variants(events, gt, times, {"A": EvINRConfig(**TINY)}, cache=cache, n_inference=4)
-    second = ab.run_variants(events, gt, times, {"B": EvINRConfig(**TINY, progress=True),
-                                                 "C": EvINRConfig(**{**TINY, "lam": 0.1})}, cache=cache, n_inference=4)
+    first = ab.run_variants(events, gt, times, {"A": EvINRConfig.v0_1(**TINY)}, cache=cache, n_inference=4)
+    second = ab.run_variants(events, gt, times, {"B": EvINRConfig.v0_1(**TINY, progress=True),
+                                                 "C": EvINRConfig.v0_1(**{**TINY, "lam": 0.1})}, cache=cache, n_inference=4)
     assert len(calls) == 2                                          # B reused A's run, C trained
     assert second[0]["reused_from"] == "A" and second[0]["ssim_none"] == first[0]["ssim_none"]
     assert "reused_from" not in second[1]
     assert "(= A)" in ab.ablation_table(second)
-    other_truth = ab.run_variants(events, gt * 0.5, times, {"D": EvINRConfig(**TINY)}, cache=cache, n_inference=4)
+    other_truth = ab.run_variants(events, gt * 0.5, times, {"D": EvINRConfig.v0_1(**TINY)}, cache=cache, n_inference=4)
     assert len(calls) == 3 and "reused_from" not in other_truth[0]      # scores depend on the ground truth
 
 
 def test_run_variants_rejects_bad_input(tiny_scene):
     events, gt, times = tiny_scene
     with pytest.raises(EventDataError, match="sensor"):
-        ab.run_variants(events, gt[:, :5], times, {"Full": EvINRConfig(**TINY)})
+        ab.run_variants(events, gt[:, :5], times, {"Full": EvINRConfig.v0_1(**TINY)})
     with pytest.raises(EventDataError, match="len\\(gt_times\\)"):
-        ab.run_variants(events, gt, times[:2], {"Full": EvINRConfig(**TINY)})
+        ab.run_variants(events, gt, times[:2], {"Full": EvINRConfig.v0_1(**TINY)})
     with pytest.raises(EventDataError, match="returned frames of shape"):
         ab.run_variants(events, gt, times, {"bad": lambda ev, t: gt[:1]})
     with pytest.raises(TypeError, match="EvINRConfig or a function"):
@@ -247,7 +247,7 @@ def test_a_real_reduced_table2_runs(slider_depth_dir):
     inside = rec.frames.t <= rec.events.t[-1]
     cfg = dict(TINY, n_iters=6, c2f_iters=(2, 4))
     rows = ab.run_variants(rec.events, rec.frames.images[inside], rec.frames.t[inside],
-                           {"Full": EvINRConfig(**cfg), "integration": ab.integration_baseline(0.2)},
+                           {"Full": EvINRConfig.v0_1(**cfg), "integration": ab.integration_baseline(0.2)},
                            t_start=0.0, n_inference=4)
     assert [r["frames"].shape for r in rows] == [(int(inside.sum()), 180, 240)] * 2
     assert all(np.isfinite(r["ssim_clahe"]) for r in rows)

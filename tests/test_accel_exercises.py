@@ -107,7 +107,7 @@ def test_varying_speed_scene_is_the_base_scene_at_warped_times():
 def ensemble():
     scene = accel.VaryingSpeedScene(make_scene("camera", sensor_size=(12, 16), duration=2.0))
     events = simulate_scene(scene, 0.0, 2.0, C=0.2, seed=0)
-    cfg = EvINRConfig(C=0.2, n_iters=6, c2f_iters=(2, 4), tau=0.8, overlap=0.2, **TINY)
+    cfg = EvINRConfig.v0_1(C=0.2, n_iters=6, c2f_iters=(2, 4), tau=0.8, overlap=0.2, **TINY)
     return reconstruct(events, [0.5, 1.5], cfg, t_start=0.0, t_end=2.0)
 
 

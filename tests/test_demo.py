@@ -12,7 +12,7 @@ from evinr_lite.method.solver import EvINRConfig
 
 def test_demo_writes_frames_and_scores(tmp_path):
     out = tmp_path / "demo"
-    cfg = EvINRConfig(C=0.2, n_iters=60, c2f_iters=(20, 40), hidden_features=64, hidden_layers=2, progress=False)
+    cfg = EvINRConfig.v0_1(C=0.2, n_iters=60, c2f_iters=(20, 40), hidden_features=64, hidden_layers=2, progress=False)
     summary = run_demo(out, sensor_size=(40, 56), duration=0.5, n_frames=3, config=cfg, log=lambda *a: None)
     saved = json.loads((out / "metrics.json").read_text())
     assert saved["n_events"] == summary["n_events"] > 1000

@@ -103,7 +103,7 @@ def test_evaluate_scores_evinr_and_baselines_through_one_path():
     events = simulate_scene(scene, 0.0, 0.4, C=0.2, seed=0)
     gt_t = np.array([0.1, 0.2, 0.3])
     gt = tonemap_reinhard(scene.log_intensity(gt_t))
-    cfg = EvINRConfig(C=0.2, n_iters=6, hidden_features=16, c2f_iters=(2, 4), progress=False)
+    cfg = EvINRConfig.v0_1(C=0.2, n_iters=6, hidden_features=16, c2f_iters=(2, 4), progress=False)
     rows = evaluate(events, gt, gt_t, methods=("evinr", "integration", "leaky", "hf"), config=cfg,
                     baseline_params={"leaky": {"leak_hz": 1.0}, "hf": {"cutoff_hz": 2.0}})
     assert [(r["method"], r["equalization"]) for r in rows] == [

@@ -195,7 +195,7 @@ def small_events():
 
 
 def _cfg(**kw):
-    return EvINRConfig(**{"C": 0.2, "hidden_features": 32, "hidden_layers": 2, "n_iters": 24, "c2f_iters": (8, 16),
+    return EvINRConfig.v0_1(**{"C": 0.2, "hidden_features": 32, "hidden_layers": 2, "n_iters": 24, "c2f_iters": (8, 16),
                           "lr": 1e-3, "bin_duration": 0.1, "progress": False, "device": "cpu", **kw})
 
 

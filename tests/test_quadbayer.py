@@ -208,7 +208,7 @@ def test_channel_offsets_from_a_uniform_colour():
 def test_reconstruct_colour_shapes_thresholds_and_offsets(colour_events):
     scene, ev = colour_events
     streams = demosaic_events_rgb(ev, scene.phase)
-    cfg = EvINRConfig(hidden_features=16, n_iters=6, c2f_iters=(2, 4), progress=False)
+    cfg = EvINRConfig.v0_1(hidden_features=16, n_iters=6, c2f_iters=(2, 4), progress=False)
     q = [0.1, 0.3]
     rec = reconstruct_colour(streams, q, cfg, C=0.2, t_start=0.0, t_end=0.5)
     assert rec.frames.shape == (2, 8, 12, 3) and rec.frames.min() >= 0 and rec.frames.max() <= 1

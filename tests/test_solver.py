@@ -29,9 +29,9 @@ def test_split_windows_cover_span_with_equal_overlapping_windows():
 
 def test_config_validates_choices():
     with pytest.raises(ValueError, match="temporal_loss must be one of"):
-        EvINRConfig(temporal_loss="exact")
+        EvINRConfig.v0_1(temporal_loss="exact")
     with pytest.raises(ValueError, match="tau > overlap"):
-        EvINRConfig(tau=0.5, overlap=0.5)
+        EvINRConfig.v0_1(tau=0.5, overlap=0.5)
     base = EvINRConfig.base()
     assert base.regularizer == "none" and not base.coarse_to_fine and base.n_bisections == 0
 
@@ -47,7 +47,7 @@ def changes_correlation(L, L_true):
 def test_recovers_log_intensity_up_to_offset(scene_and_events, form):
     scene, events = scene_and_events
     q = np.linspace(0.05, 0.95, 8)
-    cfg = EvINRConfig(C=0.2, n_iters=150, c2f_iters=(50, 100), temporal_loss=form, **SMALL)
+    cfg = EvINRConfig.v0_1(C=0.2, n_iters=150, c2f_iters=(50, 100), temporal_loss=form, **SMALL)
     rec = reconstruct(events, q, cfg)
     assert rec.frames.shape == (8, 24, 32) and 0 <= rec.frames.min() and rec.frames.max() <= 1
     assert rec.history["n_bins"][0] * 4 == rec.history["n_bins"][-1] == 32  # 1/32 s at the end
@@ -61,7 +61,7 @@ def test_recovers_log_intensity_up_to_offset(scene_and_events, form):
 
 def test_deterministic_with_seed(scene_and_events):
     _, events = scene_and_events
-    cfg = EvINRConfig(C=0.2, n_iters=20, **SMALL)
+    cfg = EvINRConfig.v0_1(C=0.2, n_iters=20, **SMALL)
     a = reconstruct(events, [0.5], cfg).log_intensity
     b = reconstruct(events, [0.5], cfg).log_intensity
     np.testing.assert_array_equal(a, b)
@@ -69,7 +69,7 @@ def test_deterministic_with_seed(scene_and_events):
 
 def test_bad_queries_are_refused(scene_and_events):
     _, events = scene_and_events
-    cfg = EvINRConfig(C=0.2, n_iters=1, **SMALL)
+    cfg = EvINRConfig.v0_1(C=0.2, n_iters=1, **SMALL)
     with pytest.raises(EventDataError, match="outside"):
         reconstruct(events, [2.0], cfg, t_end=1.0)
     with pytest.raises(EventDataError, match="non-empty"):
@@ -81,7 +81,7 @@ def test_ensemble_has_no_seam():
     # must be no larger than elsewhere - and without the alignment it is (the test can fail)
     scene = make_scene("bar", sensor_size=(20, 24), duration=3.0)
     events = simulate_scene(scene, 0.0, 3.0, C=0.15, seed=1)
-    cfg = EvINRConfig(C=0.15, n_iters=200, c2f_iters=(70, 140), tau=1.2, overlap=0.3,
+    cfg = EvINRConfig.v0_1(C=0.15, n_iters=200, c2f_iters=(70, 140), tau=1.2, overlap=0.3,
                       temporal_loss="difference", **SMALL)
     q = np.linspace(0.05, 2.95, 117)
     rec = reconstruct(events, q, cfg)

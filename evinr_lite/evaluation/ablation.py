@@ -25,6 +25,8 @@ plain function ``method(events, times) -> frames [Q, H, W] in [0, 1]`` (a baseli
     frames                    the predicted frames [Q, H, W] (float32)
     protocol                  one paragraph saying how all of the above was measured
 
+The variant builders start from :meth:`EvINRConfig.v0_1` (the paper's training recipe as the kit ran
+it before the scene zoo), because they reproduce the paper's Tables 2-3, which are about training.
 The paper's numbers are in :data:`PAPER_TABLE2` and :data:`PAPER_TABLE3`;
 :func:`compare_with_paper` sets our relative changes next to theirs.
 """
@@ -75,9 +77,9 @@ def table2_variants(**common) -> dict[str, EvINRConfig]:
     """The paper's Table 2: Base (no regularizer, no coarse-to-fine), Base + Reg. (Tikhonov, lambda
     0.05), Base + C2F, Full. ``common``: EvINRConfig fields shared by all four (C, n_iters, ...)."""
     return {"Base": EvINRConfig.base(**common),
-            "Base + Reg.": EvINRConfig(**{**common, "coarse_to_fine": False}),
-            "Base + C2F": EvINRConfig(**{**common, "regularizer": "none"}),
-            "Full": EvINRConfig(**common)}
+            "Base + Reg.": EvINRConfig.v0_1(**{**common, "coarse_to_fine": False}),
+            "Base + C2F": EvINRConfig.v0_1(**{**common, "regularizer": "none"}),
+            "Full": EvINRConfig.v0_1(**common)}
 
 
 def tau_for_networks(n_networks: int, duration: float, overlap: float) -> float | None:
@@ -96,13 +98,13 @@ def tau_for_networks(n_networks: int, duration: float, overlap: float) -> float 
 
 def ensemble_variants(duration: float, n_networks=(1, 2, 4), *, overlap: float = 0.1, **common) -> dict[str, EvINRConfig]:
     """Table 3: the Full recipe with N networks over ``duration`` seconds, one variant per N."""
-    return {f"N = {n}": EvINRConfig(**{**common, "tau": tau_for_networks(n, duration, overlap), "overlap": overlap})
+    return {f"N = {n}": EvINRConfig.v0_1(**{**common, "tau": tau_for_networks(n, duration, overlap), "overlap": overlap})
             for n in n_networks}
 
 
 def lambda_variants(lams, regularizers=("tikhonov",), **common) -> dict[str, EvINRConfig]:
     """The Full recipe with each regularizer weight in ``lams``, for each regularizer ("tikhonov", "tv")."""
-    return {f"{reg}, lambda = {lam:g}": EvINRConfig(**{**common, "regularizer": reg, "lam": float(lam)})
+    return {f"{reg}, lambda = {lam:g}": EvINRConfig.v0_1(**{**common, "regularizer": reg, "lam": float(lam)})
             for reg in regularizers for lam in lams}
 
 
@@ -110,7 +112,7 @@ def temporal_loss_variants(**common) -> dict[str, EvINRConfig]:
     """Derivative (Eq. 5-6, dF/dt at bin mid-points) versus boundary difference (F(b_{i+1}) - F(b_i)),
     each on Base and on Full."""
     out = {}
-    for recipe, make in (("Base", EvINRConfig.base), ("Full", EvINRConfig)):
+    for recipe, make in (("Base", EvINRConfig.base), ("Full", EvINRConfig.v0_1)):
         for loss in ("derivative", "difference"):
             out[f"{recipe}, {loss}"] = make(**{**common, "temporal_loss": loss})
     return out
@@ -137,7 +139,7 @@ def recipe_variants(n_events: int, span_s: float, **common) -> dict[str, EvINRCo
         common: EvINRConfig fields shared by every row (C, n_iters, sizes, ...); tau must be None or
             at least span_s (one network), since equal-count bins are counted per network.
     """
-    base = EvINRConfig(**common)
+    base = EvINRConfig.v0_1(**common)
     if base.tau is not None and base.tau < span_s:
         raise ValueError(f"recipe_variants counts bins over one window: use tau=None or tau >= span_s ({span_s} s)")
     n_fixed = max(1, int(round(span_s / base.bin_duration)))
@@ -151,7 +153,7 @@ def recipe_variants(n_events: int, span_s: float, **common) -> dict[str, EvINRCo
     out, changes = {}, {}
     for name, change in steps:
         changes = {**changes, **change}
-        out[name] = EvINRConfig(**{**common, **changes})
+        out[name] = EvINRConfig.v0_1(**{**common, **changes})
     reference = EvINRConfig.reference_code(**{**common, **code_bins})
     if asdict(reference) != asdict(out[steps[-1][0]]):  # the preset changed: say so rather than mislabel
         raise RuntimeError("EvINRConfig.reference_code() no longer matches the last step of recipe_variants; update both")
@@ -268,7 +270,7 @@ def _run_one(name, variant, events, times, t_start, t_end, repeats, n_inference)
         return {"name": name, "train_time_s": float(best), "inference_fps": float(infer_fps),
                 "fps": n / (best + n / infer_fps), "n_frames": n,
                 "n_networks": len(rec.windows), "n_params": rec.model.num_parameters(),
-                "final_bins": rec.history["n_bins"][-1], "bins_processed": len(rec.windows) * sum(rec.history["n_bins"]),
+                "final_bins": rec.history["final_bins"], "bins_processed": len(rec.windows) * sum(rec.history["n_bins"]),
                 "config": variant, "frames": rec.frames}
     if not callable(variant):
         raise TypeError(f"variant {name!r} must be an EvINRConfig or a function (events, times) -> frames, "

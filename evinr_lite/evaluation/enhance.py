@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.events import EventDataError, Events
+from ..sim.simulate import add_background_noise  # noqa: F401  (notebook 08 imports it from here too)
 
 __all__ = ["render_event_counts", "render_counts", "signed_to_polarity_counts", "event_counts", "model_event_counts",
            "add_background_noise", "count_scores"]
@@ -79,30 +80,6 @@ def model_event_counts(rec, boundaries, C: float) -> np.ndarray:
     """Events re-rendered from a trained reconstruction (anything with ``.at(times)``): int64 [2, B, H, W]."""
     L = np.asarray(rec.at(np.asarray(boundaries, dtype=np.float64)), dtype=np.float64)
     return signed_to_polarity_counts(render_event_counts(L, C))
-
-
-def add_background_noise(events: Events, rate_hz: float, seed=0, t_start: float | None = None,
-                         t_end: float | None = None) -> Events:
-    """The events plus background noise: per pixel a Poisson process of ``rate_hz`` events per second,
-    uniform times in [t_start, t_end] (default: the events' span), polarity +1 or -1 with probability 1/2.
-
-    Args:
-        seed: int or np.random.Generator.
-    """
-    if not (np.isscalar(rate_hz) and np.isfinite(rate_hz) and rate_hz >= 0):
-        raise EventDataError(f"rate_hz must be a finite number >= 0 (events per pixel per second), got {rate_hz!r}")
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    t0 = events.t[0] if t_start is None else float(t_start)
-    t1 = events.t[-1] if t_end is None else float(t_end)
-    if not t1 > t0:
-        raise EventDataError(f"noise span [{t0}, {t1}] s is empty; give t_end > t_start")
-    H, W = events.sensor_size
-    counts = rng.poisson(rate_hz * (t1 - t0), size=H * W)
-    pix = np.repeat(np.arange(H * W), counts)
-    t = t0 + (t1 - t0) * rng.random(pix.size)
-    p = np.where(rng.random(pix.size) < 0.5, -1, 1)
-    noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
-    return Events.concatenate([events, noise])
 
 
 def count_scores(counts, clean_counts, C: float = 1.0) -> dict:

@@ -36,8 +36,10 @@ from .binning import bisect_boundaries, equal_count_boundaries, events_to_frames
 from ..core.runtime import default_device
 from ..core.events import EventDataError, Events
 from .fused import head_losses
+from .head_solve import solve_head
 from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
 from .models import FrameINR
+from .offset import median_gradient_offset
 from .tonemap import anchor_level, tonemap_reinhard
 
 __all__ = ["EvINRConfig", "Reconstruction", "reconstruct", "split_windows", "train_frame_inr",
@@ -82,6 +84,13 @@ class EvINRConfig:
     Ensembling:
         tau: longest window per network in seconds (paper: 5); None for one network.
         overlap: seconds shared by neighbouring windows (used to align and cross-fade them).
+    Beyond the paper:
+        head_solve: after the Adam iterations, set the H*W output layer to the exact optimum of the
+            loss for the trained hidden layers (a linear least-squares problem solved in closed form,
+            :mod:`evinr_lite.method.head_solve`; needs regularizer "tikhonov" or "none").
+        offset_solve: how the per-pixel offset that events cannot fix is chosen: "none" (left to the
+            regularizer, as in the paper) or "median_gradient" (:mod:`evinr_lite.method.offset`:
+            the offset that makes the temporal median of each pixel's gradient zero).
     Output:
         gamma: tone-mapping exponent (paper: 0.6). display_mean: the tone-mapped value that the
             mean log intensity is anchored to (see the module docstring).
@@ -94,24 +103,26 @@ class EvINRConfig:
     bin_duration: float = 1 / 32
     binning: str = "fixed"
     events_per_bin: int = 100
-    temporal_loss: str = "derivative"
+    temporal_loss: str = "difference"
     regularizer: str = "tikhonov"
-    lam: float = 0.05
-    hidden_features: int = 512
+    lam: float = 0.01
+    hidden_features: int = 256
     hidden_layers: int = 3
     omega_0: float = 30.0
     first_omega_0: float | None = 10.0
-    n_iters: int = 300
+    n_iters: int = 0
     lr: float = 1e-4
     lr_decay: float = 0.95
     lr_decay_every: int = 10
     head_lr_scale: float = 30.0
-    coarse_to_fine: bool = True
+    coarse_to_fine: bool = False
     c2f_iters: tuple = (100, 200)
     tau: float | None = 5.0
     overlap: float = 0.5
     gamma: float = 0.6
     display_mean: float = 0.5
+    head_solve: bool = True
+    offset_solve: str = "median_gradient"
     seed: int = 0
     device: str | None = None
     progress: bool = True
@@ -119,10 +130,13 @@ class EvINRConfig:
     def __post_init__(self):
         # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
-                   "regularizer": ("tikhonov", "tv", "none")}
+                   "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient")}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+        if self.head_solve and self.regularizer == "tv":
+            raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
+                                 "pass head_solve=False to train the head with Adam")
 
         def number(name, value, *, integer=False):
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or (
@@ -135,7 +149,7 @@ class EvINRConfig:
                 raise EventDataError(f"{name} must be positive, got {getattr(self, name)}")
         if self.first_omega_0 is not None and not number("first_omega_0", self.first_omega_0) > 0:
             raise EventDataError(f"first_omega_0 must be positive (or None), got {self.first_omega_0}")
-        for name, low in (("n_iters", 1), ("hidden_features", 1), ("hidden_layers", 0), ("lr_decay_every", 1),
+        for name, low in (("n_iters", 0 if self.head_solve else 1), ("hidden_features", 1), ("hidden_layers", 0), ("lr_decay_every", 1),
                           ("events_per_bin", 1)):
             if number(name, getattr(self, name), integer=True) < low:
                 raise EventDataError(f"{name} must be at least {low}, got {getattr(self, name)}")
@@ -163,9 +177,29 @@ class EvINRConfig:
                               stacklevel=3)
 
     @classmethod
+    def paper(cls, **overrides) -> "EvINRConfig":
+        """The paper's recipe exactly (Sec. 3-4): SIREN 3 x 512 with omega_0 = 30 in every layer, the
+        derivative loss (Eq. 5-6) on 1/32 s bins, Tikhonov with lambda 0.05, Adam lr 1e-4 x 0.95 every
+        10 iterations for 300 iterations, coarse-to-fine at 100 and 200, 5 s sub-sequences; one
+        learning rate for every layer; no head or offset solve."""
+        return cls(**{"C": 1.0, "bin_duration": 1 / 32, "binning": "fixed", "temporal_loss": "derivative",
+                      "regularizer": "tikhonov", "lam": 0.05, "hidden_features": 512, "hidden_layers": 3,
+                      "omega_0": 30.0, "first_omega_0": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
+                      "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
+                      "tau": 5.0, "overlap": 0.5, "gamma": 0.6, "head_solve": False, "offset_solve": "none",
+                      **overrides})
+
+    @classmethod
+    def v0_1(cls, **overrides) -> "EvINRConfig":
+        """The kit's default of version 0.1 (before the scene zoo): the paper's recipe with
+        first_omega_0 = 10 and head_lr_scale = 30, tuned on the demo scene alone. Kept so that
+        benchmarks compare today's default with it in the same run."""
+        return cls.paper(**{"first_omega_0": 10.0, "head_lr_scale": 30.0, **overrides})
+
+    @classmethod
     def base(cls, **overrides) -> "EvINRConfig":
         """The paper's ablation 'Base': no spatial regularization, no coarse-to-fine."""
-        return cls(**{"regularizer": "none", "coarse_to_fine": False, **overrides})
+        return cls.v0_1(**{"regularizer": "none", "coarse_to_fine": False, **overrides})
 
     @classmethod
     def reference_code(cls, **overrides) -> "EvINRConfig":
@@ -177,8 +211,8 @@ class EvINRConfig:
         bisection at n_iters / 2): pass ``events_per_bin=n_events // 100, c2f_iters=(n_iters // 2,)``.
         Not expressible here: AdamW at a fixed lr 3e-4 for 1000 steps, the extra regularizer terms,
         the sigmoid tone mapping."""
-        return cls(**{"regularizer": "tv", "binning": "equal_count", "temporal_loss": "difference",
-                      "omega_0": 10.0, "head_lr_scale": 10.0, **overrides})
+        return cls.paper(**{"regularizer": "tv", "binning": "equal_count", "temporal_loss": "difference",
+                            "omega_0": 10.0, "first_omega_0": 10.0, "head_lr_scale": 10.0, **overrides})
 
     @property
     def n_bisections(self) -> int:
@@ -350,6 +384,11 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
         if it % 10 == 0:
             bar.set_postfix(loss=f"{history['loss'][-1]:.4g}", bins=history["n_bins"][-1])
     bar.close()
+    if cfg.head_solve:   # the output layer's exact optimum for the (trained or initial) hidden layers
+        solved = solve_head(model, bins.boundaries, bins.frames, cfg.temporal_loss, regularizer, cfg.lam)
+        history["head_solve_s"] = solved["seconds"]
+        history["temporal_after_solve"] = solved["temporal"]
+    history["final_bins"] = int(bins.frames.shape[1])
     if device.type == "cuda":
         torch.cuda.synchronize(device)
     history["train_time_s"] = time.perf_counter() - t0
@@ -476,8 +515,11 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     model, history = train_frame_inr(events, windows, cfg)
     model.eval()
     offsets = alignment_offsets(model, windows)
+    grid = np.linspace(t_start, t_end, max(64, 8 * len(windows)) if cfg.offset_solve != "none" else
+                       min(64, 8 * len(windows)))
+    if cfg.offset_solve == "median_gradient":   # one offset image for all networks: the alignment stays
+        offsets += median_gradient_offset(blend_networks(model, windows, grid, offsets)).astype(np.float32)
     # anchor: mean log intensity over the sequence tone-maps to display_mean
-    grid = np.linspace(t_start, t_end, min(64, 8 * len(windows)))
     mean_L = float(blend_networks(model, windows, grid, offsets).mean())
     offsets += np.float32(anchor_level(cfg.gamma, cfg.display_mean) - mean_L)
     L = blend_networks(model, windows, q, offsets)

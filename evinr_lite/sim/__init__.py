@@ -1,10 +1,14 @@
 """Synthetic data with ground truth: scenes, the event simulator, Quad Bayer, recordings on disk."""
-from .scenes import Scene, MovingImageScene, MovingBarScene, make_scene
-from .simulate import simulate_events_1d, simulate_video, simulate_scene, pixel_events
+from .scenes import (Scene, MovingImageScene, MovingBarScene, VaryingSpeedScene, WarpedImageScene,
+                     ObjectOverBackgroundScene, LightingScene, make_scene)
+from .simulate import (simulate_events_1d, simulate_video, simulate_scene, pixel_events, add_background_noise,
+                       add_hot_pixels)
 from .quadbayer import QuadBayerScene, simulate_colour_video
 from .recordings import write_example_recording, synthetic_recording, find_recording
+from . import zoo
 
-__all__ = ["Scene", "MovingImageScene", "MovingBarScene", "make_scene", "simulate_events_1d",
-           "simulate_video", "simulate_scene", "pixel_events", "QuadBayerScene",
+__all__ = ["Scene", "MovingImageScene", "MovingBarScene", "VaryingSpeedScene", "WarpedImageScene",
+           "ObjectOverBackgroundScene", "LightingScene", "make_scene", "simulate_events_1d",
+           "simulate_video", "simulate_scene", "pixel_events", "add_background_noise", "add_hot_pixels", "QuadBayerScene",
            "simulate_colour_video", "write_example_recording", "synthetic_recording",
-           "find_recording"]
+           "find_recording", "zoo"]

@@ -22,7 +22,8 @@ from scipy import ndimage
 from ..core.events import EventDataError, check_sensor_size
 from ..core.frames import Frames
 
-__all__ = ["Scene", "MovingImageScene", "MovingBarScene", "make_scene", "IMAGE_NAMES", "SCENE_NAMES"]
+__all__ = ["Scene", "MovingImageScene", "MovingBarScene", "VaryingSpeedScene", "WarpedImageScene",
+           "ObjectOverBackgroundScene", "LightingScene", "make_scene", "IMAGE_NAMES", "SCENE_NAMES"]
 
 # scikit-image sample images that ship with the package (no download needed).
 IMAGE_NAMES = ("camera", "astronaut", "coffee", "chelsea", "cat", "coins", "moon", "rocket", "brick",
@@ -257,6 +258,159 @@ class MovingBarScene(Scene):
         profile = 0.5 * (np.tanh((u - d + half) / self.edge) - np.tanh((u - d - half) / self.edge))
         bg, bar = self.intensities
         return np.log(bg + (bar - bg) * profile)
+
+
+class VaryingSpeedScene(Scene):
+    """``base`` played at a varying speed: L(t) = base.L(s(t)), s(t) = t + depth sin(w t) / w, w = 2 pi / period.
+
+    The playback speed s'(t) = 1 + depth cos(2 pi t / period) swings between 1 - depth and 1 + depth,
+    so the event rate rises and falls with it (0 <= depth < 1).
+    """
+
+    def __init__(self, base: Scene, depth: float = 0.8, period: float = 2.0):
+        super().__init__(base.sensor_size, base.duration)
+        if not 0 <= depth < 1:
+            raise EventDataError(f"depth must be in [0, 1) so that time keeps running forward, got {depth}")
+        if not period > 0:
+            raise EventDataError(f"period must be positive seconds, got {period}")
+        self.base, self.depth, self.period = base, float(depth), float(period)
+
+    def warp(self, t) -> np.ndarray:
+        """s(t): the base scene's time shown at time t (seconds)."""
+        w = 2 * np.pi / self.period
+        return np.asarray(t, dtype=np.float64) + self.depth * np.sin(w * np.asarray(t, dtype=np.float64)) / w
+
+    def speed(self, t) -> np.ndarray:
+        """s'(t): playback speed relative to the base scene."""
+        return 1 + self.depth * np.cos(2 * np.pi * np.asarray(t, dtype=np.float64) / self.period)
+
+    @property
+    def max_speed(self) -> float:
+        return float(self.base.max_speed) * (1 + self.depth)
+
+    def _log_intensity(self, t: np.ndarray) -> np.ndarray:
+        return self.base.log_intensity(self.warp(t))
+
+
+class WarpedImageScene(MovingImageScene):
+    """A :class:`MovingImageScene` seen through a shear and a perspective tilt that grow over time.
+
+    Before the moving image's own mapping, sensor position q = (x, y) (pixels from the centre) is
+    mapped by the homography with tau = t - duration / 2 (r: half the sensor diagonal):
+
+        x' = (x + shear[0] tau y) / w,   y' = (y + shear[1] tau x) / w,   w = 1 + (tilt[0] x + tilt[1] y) tau / r
+
+    so straight lines stay straight while the view shears (1/s) and tilts (1/s) like a camera
+    turning towards a plane. All other arguments are :class:`MovingImageScene`'s.
+    """
+
+    def __init__(self, image="camera", sensor_size=(120, 160), duration=2.0, *, shear=(0.15, 0.0),
+                 tilt=(0.2, 0.0), **kwargs):
+        super().__init__(image, sensor_size, duration, **kwargs)
+        self.shear = tuple(float(v) for v in shear)
+        self.tilt = tuple(float(v) for v in tilt)
+        if len(self.shear) != 2 or len(self.tilt) != 2 or not np.all(np.isfinite(self.shear + self.tilt)):
+            raise EventDataError(f"shear and tilt must be (x, y) pairs of finite rates (1/s), got {shear!r}, {tilt!r}")
+        self._r = float(np.hypot(*self.sensor_size) / 2)
+        if max(abs(v) for v in self.tilt) * self.duration / 2 >= 0.5:
+            raise EventDataError(f"tilt {tilt} over {duration} s folds the view; keep |tilt| * duration / 2 below 0.5")
+
+    @property
+    def max_speed(self) -> float:
+        extra = (abs(self.shear[0]) + abs(self.shear[1]) + 2 * (abs(self.tilt[0]) + abs(self.tilt[1]))) * self._r
+        return super().max_speed + float(extra)
+
+    def _log_intensity(self, t: np.ndarray) -> np.ndarray:
+        tau = (t - self.duration / 2)[:, None, None]
+        x, y = self._x[None], self._y[None]
+        w = 1 + (self.tilt[0] * x + self.tilt[1] * y) * tau / self._r
+        xw, yw = (x + self.shear[0] * tau * y) / w, (y + self.shear[1] * tau * x) / w
+        gx, gy = self._x, self._y
+        out = np.empty((t.size, *self.sensor_size))
+        try:                                    # the parent's mapping, on the warped grid
+            for k in range(t.size):
+                self._x, self._y = xw[k], yw[k]
+                out[k] = super()._log_intensity(t[k:k + 1])[0]
+        finally:
+            self._x, self._y = gx, gy
+        return out
+
+
+class ObjectOverBackgroundScene(Scene):
+    """A static camera: a textured object moving over a static textured background.
+
+    The background is ``background`` (an image name or array) at rest; the object is a disc of
+    ``radius`` pixels cut from ``object_image``, with a soft edge of ``edge`` pixels, whose centre
+    moves from ``start`` to ``end`` (pixels from the sensor centre) over the duration. Where the
+    object is, L = log of the object's texture; elsewhere the background's. Events come only from the
+    object and the background it uncovers: the background's static structure is invisible to events.
+    """
+
+    def __init__(self, background="brick", object_image="coffee", sensor_size=(120, 160), duration=2.0, *,
+                 radius=None, edge=2.0, start=None, end=None, blur=0.75, intensity_range=(0.05, 1.0)):
+        super().__init__(sensor_size, duration)
+        H, W = self.sensor_size
+        self.radius = float(min(H, W) / 4 if radius is None else radius)
+        self.edge = float(edge)
+        if not (self.radius > 0 and self.edge > 0):
+            raise EventDataError(f"radius and edge must be positive pixels, got {radius!r}, {edge!r}")
+        self.start = np.asarray((-W / 2 + self.radius, -H / 6) if start is None else start, dtype=np.float64)
+        self.end = np.asarray((W / 2 - self.radius, H / 6) if end is None else end, dtype=np.float64)
+        still = dict(velocity=(0.0, 0.0), rotation=0.0, zoom=0.0, blur=blur, intensity_range=intensity_range)
+        self._background = MovingImageScene(background, sensor_size, duration, **still).log_intensity(0.0)
+        self._object = MovingImageScene(object_image, sensor_size, duration, **still)
+        self._x, self._y = self._grid()
+
+    @property
+    def max_speed(self) -> float:
+        return float(np.hypot(*(self.end - self.start)) / self.duration)
+
+    def _log_intensity(self, t: np.ndarray) -> np.ndarray:
+        frac = (t / self.duration)[:, None]
+        centre = self.start[None] + frac * (self.end - self.start)[None]             # [T, 2] (x, y)
+        dx = self._x[None] - centre[:, 0, None, None]
+        dy = self._y[None] - centre[:, 1, None, None]
+        mask = 0.5 * (1 - np.tanh((np.hypot(dx, dy) - self.radius) / self.edge))       # 1 inside the disc
+        out = np.empty((t.size, *self.sensor_size))
+        obj = self._object
+        for k in range(t.size):                 # the object's texture travels with it
+            gx, gy = obj._x, obj._y
+            try:
+                obj._x, obj._y = self._x - centre[k, 0], self._y - centre[k, 1]
+                L_obj = obj._log_intensity(np.array([obj.duration / 2]))[0]
+            finally:
+                obj._x, obj._y = gx, gy
+            out[k] = (1 - mask[k]) * self._background + mask[k] * L_obj
+        return out
+
+
+class LightingScene(Scene):
+    """``base`` under changing light: L(t) = base.L(t) + s (global + vignette * r^2 / r_max^2),
+    with s = t / duration - 1/2, r the distance from the sensor centre.
+
+    ``global_change``: the log intensity added over the whole duration everywhere (e.g. 0.5: the
+    light grows by a factor e^0.5); ``vignette``: the log intensity added at the corners over the
+    duration (negative: the corners darken). A change of light is a change of log intensity that
+    events record like any other.
+    """
+
+    def __init__(self, base: Scene, global_change: float = 0.4, vignette: float = -0.5):
+        super().__init__(base.sensor_size, base.duration)
+        self.base = base
+        self.global_change, self.vignette = float(global_change), float(vignette)
+        if not (np.isfinite(self.global_change) and np.isfinite(self.vignette)):
+            raise EventDataError(f"global_change and vignette must be finite log intensities, got "
+                                 f"{global_change!r}, {vignette!r}")
+        x, y = self._grid()
+        self._shape = self.global_change + self.vignette * (x ** 2 + y ** 2) / (x ** 2 + y ** 2).max()
+
+    @property
+    def max_speed(self) -> float:
+        return float(self.base.max_speed)
+
+    def _log_intensity(self, t: np.ndarray) -> np.ndarray:
+        s = (t / self.duration - 0.5)[:, None, None]
+        return self.base.log_intensity(t) + s * self._shape[None]
 
 
 def make_scene(name="camera", sensor_size=(120, 160), duration=2.0, **kwargs) -> Scene:

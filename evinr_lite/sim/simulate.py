@@ -46,7 +46,7 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 
-__all__ = ["simulate_events_1d", "pixel_events", "simulate_video", "simulate_scene", "sample_thresholds",
+__all__ = ["simulate_events_1d", "pixel_events", "add_background_noise", "add_hot_pixels", "simulate_video", "simulate_scene", "sample_thresholds",
            "MIN_THRESHOLD_FRACTION", "MAX_PX_PER_SAMPLE"]
 
 MIN_THRESHOLD_FRACTION = 0.1   # mismatched thresholds are clipped below at this x nominal
@@ -426,3 +426,56 @@ def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, *
     opts = dict(C_pos=None, C_neg=None, threshold_sigma=0.0, refractory=0.0, noise_rate=0.0, seed=0)
     opts.update(kwargs)
     return _video_events(t, _scene_frames(scene, t), tuple(scene.sensor_size), C, **opts)
+
+
+# ---- sensor noise added to simulated events ------------------------------------------------
+
+def add_background_noise(events: Events, rate_hz: float, seed=0, t_start: float | None = None,
+                         t_end: float | None = None) -> Events:
+    """The events plus background noise: per pixel a Poisson process of ``rate_hz`` events per second,
+    uniform times in [t_start, t_end] (default: the events' span), polarity +1 or -1 with probability 1/2.
+
+    Args:
+        seed: int or np.random.Generator.
+    """
+    if not (np.isscalar(rate_hz) and np.isfinite(rate_hz) and rate_hz >= 0):
+        raise EventDataError(f"rate_hz must be a finite number >= 0 (events per pixel per second), got {rate_hz!r}")
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    t0 = events.t[0] if t_start is None else float(t_start)
+    t1 = events.t[-1] if t_end is None else float(t_end)
+    if not t1 > t0:
+        raise EventDataError(f"noise span [{t0}, {t1}] s is empty; give t_end > t_start")
+    H, W = events.sensor_size
+    counts = rng.poisson(rate_hz * (t1 - t0), size=H * W)
+    pix = np.repeat(np.arange(H * W), counts)
+    t = t0 + (t1 - t0) * rng.random(pix.size)
+    p = np.where(rng.random(pix.size) < 0.5, -1, 1)
+    noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
+    return Events.concatenate([events, noise])
+
+
+def add_hot_pixels(events: Events, n_pixels: int, rate_hz: float, seed=0, t_start: float | None = None,
+                   t_end: float | None = None) -> tuple[Events, np.ndarray]:
+    """The events plus ``n_pixels`` hot pixels, each firing a Poisson process of ``rate_hz`` events
+    per second over [t_start, t_end] (default: the events' span), nearly all of one polarity (90 %,
+    the pixel's own sign), as a stuck or leaky DVS pixel does.
+
+    Returns:
+        (events, hot): the merged events and the hot pixels' flat indices y * W + x (int64 [n_pixels]).
+    """
+    if not (np.isscalar(rate_hz) and np.isfinite(rate_hz) and rate_hz >= 0):
+        raise EventDataError(f"rate_hz must be a finite number >= 0 (events per second), got {rate_hz!r}")
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    H, W = events.sensor_size
+    if not 0 <= int(n_pixels) <= H * W:
+        raise EventDataError(f"n_pixels must be in [0, {H * W}], got {n_pixels!r}")
+    t0 = events.t[0] if t_start is None else float(t_start)
+    t1 = events.t[-1] if t_end is None else float(t_end)
+    hot = np.sort(rng.choice(H * W, size=int(n_pixels), replace=False)).astype(np.int64)
+    sign = np.where(rng.random(hot.size) < 0.5, -1, 1)
+    counts = rng.poisson(rate_hz * (t1 - t0), size=hot.size)
+    pix = np.repeat(hot, counts)
+    t = t0 + (t1 - t0) * rng.random(pix.size)
+    p = np.repeat(sign, counts) * np.where(rng.random(pix.size) < 0.9, 1, -1)
+    noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
+    return Events.concatenate([events, noise]), hot

@@ -11,7 +11,7 @@ The reference solutions of the notebook's exercises live here and are registered
 
 Helpers for the experiments:
 
-- :class:`VaryingSpeedScene`: a scene played at a speed that swings up and down, so that the event
+- :class:`~evinr_lite.sim.scenes.VaryingSpeedScene` (re-exported here): a scene played at a speed that swings up and down, so that the event
   rate varies in time (equal-count bins then differ from equal-duration bins).
 - :func:`ensemble_predictions`: an ensemble's log intensity with or without the offset alignment
   and with or without the cross-fade (a hard switch at the middle of each overlap).
@@ -33,10 +33,10 @@ import torch
 from . import exercises
 from ..method.binning import events_to_frames
 from ..core.runtime import default_device
-from ..core.events import EventDataError, Events
+from ..core.events import Events
 from ..method.losses import spatial_differences
 from ..method.models import FrameINR
-from ..sim.scenes import Scene
+from ..sim.scenes import VaryingSpeedScene
 from ..method.solver import blend_networks, predict_networks
 
 __all__ = [
@@ -216,38 +216,6 @@ exercises.register(
 
 
 # ---- a scene whose event rate varies --------------------------------------------------------
-
-class VaryingSpeedScene(Scene):
-    """``base`` played at a varying speed: L(t) = base.L(s(t)), s(t) = t + depth sin(w t) / w, w = 2 pi / period.
-
-    The playback speed s'(t) = 1 + depth cos(2 pi t / period) swings between 1 - depth and 1 + depth,
-    so the event rate rises and falls with it (0 <= depth < 1).
-    """
-
-    def __init__(self, base: Scene, depth: float = 0.8, period: float = 2.0):
-        super().__init__(base.sensor_size, base.duration)
-        if not 0 <= depth < 1:
-            raise EventDataError(f"depth must be in [0, 1) so that time keeps running forward, got {depth}")
-        if not period > 0:
-            raise EventDataError(f"period must be positive seconds, got {period}")
-        self.base, self.depth, self.period = base, float(depth), float(period)
-
-    def warp(self, t) -> np.ndarray:
-        """s(t): the base scene's time shown at time t (seconds)."""
-        w = 2 * np.pi / self.period
-        return np.asarray(t, dtype=np.float64) + self.depth * np.sin(w * np.asarray(t, dtype=np.float64)) / w
-
-    def speed(self, t) -> np.ndarray:
-        """s'(t): playback speed relative to the base scene."""
-        return 1 + self.depth * np.cos(2 * np.pi * np.asarray(t, dtype=np.float64) / self.period)
-
-    @property
-    def max_speed(self) -> float:
-        return float(self.base.max_speed) * (1 + self.depth)
-
-    def _log_intensity(self, t: np.ndarray) -> np.ndarray:
-        return self.base.log_intensity(self.warp(t))
-
 
 # ---- seams ----------------------------------------------------------------------------------
 

@@ -1,0 +1,311 @@
+"""The scene zoo: reconstruction quality and time on scenes nobody tuned to, against the baselines.
+
+    python benchmarks/quality_zoo.py                       # every scene, every method (about 10 min on 2 cores)
+    python benchmarks/quality_zoo.py --quick               # smaller sensors, shorter scenes (a few minutes)
+    python benchmarks/quality_zoo.py --scenes camera_translate,noisy_gravel --methods kit,integration
+    python benchmarks/quality_zoo.py --variant "lam 0.1=lam=0.1"        # add an EvINR variant (NAME=field=value,...)
+    python -m benchmarks --only zoo                        # the same, from the benchmark runner
+
+Each scene is seeded and documented in one line in ``evinr_lite.sim.zoo.ZOO``; together they vary texture (five
+natural images and one low-texture scene), motion (translation, rotation + zoom, shear and
+perspective, non-uniform speed, a static camera with an object moving over a static background),
+light (a global change and vignetting), the sensor (background activity, hot pixels, C+ != C-,
+threshold mismatch, a refractory period), size (120x160 to 180x240) and length (2-3 s). The real
+IJRR slider_depth chunk beside the project is scored too when present.
+
+Methods: ``kit`` (``EvINRConfig()``, the kit's default), ``paper`` (``EvINRConfig.paper()``, the
+paper's recipe exactly), ``v0_1`` (the kit's default before the zoo), ``integration`` and ``hf``
+(the baselines), and the oracle: the events integrated from the true frame at the first scored
+time, as linear intensity (``oracle_linear``) and tone-mapped (``oracle_tonemapped``). The oracle
+is what the events carry once the unknown per-pixel offset is given; no method sees that frame.
+
+Every method is scored at 10 ground-truth times through ``evinr_lite.evaluation.score_sequence``
+under both protocols (no equalisation, and CLAHE on both images). Per scene the table gives the
+kit's CLAHE-SSIM over the best baseline's and over the better oracle, and whether its plain SSIM is
+at least the best baseline's. Writes JSON (``--json``), a markdown table (``--md``) and one figure
+(``--figure``: ground truth and every method on three scenes).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from evinr_lite.core.events import Events  # noqa: E402
+from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
+from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
+from evinr_lite.method.tonemap import anchor_mean, tonemap_reinhard  # noqa: E402
+from evinr_lite.sim.zoo import ZOO, effective_C, quick, simulate  # noqa: E402
+
+EQUALIZATIONS = ("none", "clahe")
+BASELINES = ("integration", "hf")
+ORACLES = ("oracle_linear", "oracle_tonemapped")
+EVINR = ("kit", "paper", "v0_1")
+METHODS = EVINR + BASELINES + ORACLES
+
+
+def evinr_config(name: str, C: float, variants: dict) -> EvINRConfig:
+    base = {"kit": EvINRConfig, "paper": EvINRConfig.paper, "v0_1": EvINRConfig.v0_1}
+    if name in base:
+        return base[name](C=C, progress=False)
+    return EvINRConfig(**{**variants[name], "C": C, "progress": False})
+
+
+def run_method(name: str, events: Events, times: np.ndarray, C: float, variants: dict, L_first=None):
+    """(frames [Q, H, W] in [0, 1], seconds) of one method."""
+    t0 = time.perf_counter()
+    if name in BASELINES:
+        frames = reconstruct_baseline(events, times, name, C=C).frames
+    elif name in ORACLES:
+        L = L_first + integrate_events(events, times, C=C) - integrate_events(events, times[:1], C=C)
+        frames = np.clip(np.exp(L), 0, 1) if name == "oracle_linear" else tonemap_reinhard(anchor_mean(L))
+    else:
+        frames = reconstruct(events, times, evinr_config(name, C, variants)).frames
+    return np.asarray(frames, np.float32), time.perf_counter() - t0
+
+
+def score(frames, times, gt, gt_t) -> dict:
+    out = {}
+    for eq in EQUALIZATIONS:
+        s = score_sequence(frames, times, gt, gt_t, eq, lpips_model=False)
+        out[f"mse_{eq}"], out[f"ssim_{eq}"] = s["mse"], s["ssim"]
+    return out
+
+
+def summarise(rows: dict) -> dict:
+    """Per-scene ratios: kit / best baseline (CLAHE-SSIM), kit / better oracle, plain SSIM vs baselines."""
+    kit = rows.get("kit")
+    base = [rows[m] for m in BASELINES if m in rows]
+    orac = [rows[m] for m in ORACLES if m in rows]
+    out = {}
+    if kit and base:
+        best_c = max(b["ssim_clahe"] for b in base)
+        best_n = max(b["ssim_none"] for b in base)
+        out.update(kit_over_best_baseline_clahe=kit["ssim_clahe"] / best_c,
+                   kit_plain_ssim_minus_best_baseline=kit["ssim_none"] - best_n)
+    if kit and orac:
+        out["kit_over_oracle_clahe"] = kit["ssim_clahe"] / max(o["ssim_clahe"] for o in orac)
+    return out
+
+
+def run_zoo(scenes, methods, variants, log=print) -> dict:
+    results = {}
+    for z in scenes:
+        scene, events, times, gt = simulate(z)
+        C = effective_C(z)
+        L_first = scene.log_intensity(times[0])
+        log(f"{z.name}: {z.size[0]}x{z.size[1]}, {z.duration:g} s, {len(events):,} events ({z.doc})")
+        rows, frames = {}, {}
+        for m in methods:
+            f, seconds = run_method(m, events, times, C, variants, L_first)
+            rows[m] = {**score(f, times, gt, times), "time_s": seconds}
+            frames[m] = f[len(f) // 2]
+            log(f"    {m:<22s} SSIM {rows[m]['ssim_none']:.3f}  CLAHE-SSIM {rows[m]['ssim_clahe']:.3f}  "
+                f"MSE {rows[m]['mse_none']:.4f}  {seconds:6.1f} s")
+        results[z.name] = {"doc": z.doc, "size": list(z.size), "duration_s": z.duration, "n_events": len(events),
+                           "noise_free": z.noise_free, "C_given": C, "rows": rows, "summary": summarise(rows),
+                           "figure": {"gt": gt[len(gt) // 2], **frames}}
+    return results
+
+
+def run_real(methods, variants, log=print) -> dict | None:
+    """The IJRR slider_depth chunk beside the project, C = 1 (the paper's for IJRR); no oracle."""
+    from evinr_lite.io.readers import read_recording
+    from evinr_lite.io.sample_data import sample_recording_path
+
+    path = sample_recording_path()
+    if path is None:
+        log("real chunk: not found (shared/data/ijrr_slider_depth_chunk); skipped")
+        return None
+    rec = read_recording(path)
+    idx = frames_to_score(rec.frames.t, rec.events)
+    gt, gt_t = rec.frames.images[idx], rec.frames.t[idx]
+    log(f"real slider_depth chunk: {len(rec.events):,} events, {len(idx)} frames")
+    rows, frames = {}, {}
+    for m in [m for m in methods if m not in ORACLES]:
+        f, seconds = run_method(m, rec.events, gt_t, 1.0, variants)
+        rows[m] = {**score(f, gt_t, gt, gt_t), "time_s": seconds}
+        frames[m] = f[len(f) // 2]
+        log(f"    {m:<22s} SSIM {rows[m]['ssim_none']:.3f}  CLAHE-SSIM {rows[m]['ssim_clahe']:.3f}  "
+            f"MSE {rows[m]['mse_none']:.4f}  {seconds:6.1f} s")
+    return {"doc": "IJRR slider_depth chunk (real DAVIS240C), C = 1", "rows": rows, "summary": summarise(rows),
+            "figure": {"gt": gt[len(gt) // 2].astype(np.float32) / 255.0, **frames}}
+
+
+def markdown(results: dict, methods) -> str:
+    lines = ["| scene | " + " | ".join(methods) + " | kit / best baseline (CLAHE) | kit / oracle (CLAHE) | "
+             "kit plain SSIM - best baseline |",
+             "|---" * (len(methods) + 4) + "|"]
+    for name, r in results.items():
+        cells = []
+        for m in methods:
+            row = r["rows"].get(m)
+            cells.append("-" if row is None else f"{row['ssim_clahe']:.3f} / {row['ssim_none']:.3f} / "
+                                                 f"{row['mse_none']:.4f} / {row['time_s']:.1f} s")
+        s = r["summary"]
+        lines.append(f"| {name} | " + " | ".join(cells) + " | "
+                     + " | ".join(f"{s[k]:.3f}" if k in s else "-" for k in
+                                  ("kit_over_best_baseline_clahe", "kit_over_oracle_clahe",
+                                   "kit_plain_ssim_minus_best_baseline")) + " |")
+    synth = [r for n, r in results.items() if n != "real_slider_chunk"]
+    means = []
+    for m in methods:
+        vals = [r["rows"][m] for r in synth if m in r["rows"]]
+        means.append("-" if not vals else f"{np.mean([v['ssim_clahe'] for v in vals]):.3f} / "
+                                          f"{np.mean([v['ssim_none'] for v in vals]):.3f} / "
+                                          f"{np.mean([v['mse_none'] for v in vals]):.4f} / "
+                                          f"{np.mean([v['time_s'] for v in vals]):.1f} s")
+    lines.append("| **zoo mean** | " + " | ".join(means) + " | | | |")
+    lines.append("")
+    lines.append("Cells: CLAHE-SSIM / SSIM / MSE (no equalisation) / wall time. Scored at 10 ground-truth times "
+                 "per scene through evinr_lite.evaluation.score_sequence (SSIM: gaussian sigma 1.5, data_range 1; "
+                 "CLAHE: cv2, clip 2.0, 8x8 tiles, on both images).")
+    return "\n".join(lines)
+
+
+def figure(results: dict, names, methods, path: Path) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cols = ["gt"] + [m for m in methods]
+    fig, axes = plt.subplots(len(names), len(cols), figsize=(1.9 * len(cols), 1.7 * len(names)), squeeze=False)
+    for i, n in enumerate(names):
+        for j, m in enumerate(cols):
+            ax = axes[i, j]
+            img = results[n]["figure"].get(m)
+            if img is not None:
+                ax.imshow(img, cmap="gray", vmin=0, vmax=1)
+            ax.set_xticks([]), ax.set_yticks([])
+            if i == 0:
+                ax.set_title("ground truth" if m == "gt" else m, fontsize=9)
+            if j == 0:
+                ax.set_ylabel(n, fontsize=9)
+    fig.suptitle("The scene zoo at mid-sequence (no equalisation)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def target_rows(results: dict) -> list[dict]:
+    """The issue's targets as rows of the benchmark table (benchmarks/common.row)."""
+    from benchmarks.common import row
+
+    synth = {n: r for n, r in results.items() if n != "real_slider_chunk"}
+    rows = []
+    ratios = {n: r["summary"].get("kit_over_best_baseline_clahe") for n, r in synth.items()}
+    ratios = {n: v for n, v in ratios.items() if v is not None}
+    if ratios:
+        worst = min(ratios, key=ratios.get)
+        rows.append(row("zoo: kit CLAHE-SSIM / best baseline's, worst scene", ratios[worst], "x", 1.10,
+                        note=f"worst: {worst}; {sum(v >= 1.10 for v in ratios.values())} of {len(ratios)} scenes >= 1.10"))
+        plain = {n: r["summary"]["kit_plain_ssim_minus_best_baseline"] for n, r in synth.items()}
+        rows.append(row("zoo: scenes where kit plain SSIM >= best baseline's", sum(v >= 0 for v in plain.values()),
+                        "scenes", len(plain), note=f"lowest margin {min(plain.values()):+.3f} ({min(plain, key=plain.get)})"))
+    oracle = {n: r["summary"].get("kit_over_oracle_clahe") for n, r in synth.items() if r["noise_free"]}
+    oracle = {n: v for n, v in oracle.items() if v is not None}
+    if oracle:
+        worst = min(oracle, key=oracle.get)
+        rows.append(row("zoo: kit / oracle CLAHE-SSIM, worst noise-free scene", oracle[worst], "x", 0.95,
+                        note=f"worst: {worst}; mean {np.mean(list(oracle.values())):.3f}"))
+    both = [r["rows"] for r in synth.values() if "kit" in r["rows"] and "v0_1" in r["rows"]]
+    if both:
+        t_old, t_new = sum(r["v0_1"]["time_s"] for r in both), sum(r["kit"]["time_s"] for r in both)
+        q_old = np.mean([r["v0_1"]["ssim_clahe"] for r in both])
+        q_new = np.mean([r["kit"]["ssim_clahe"] for r in both])
+        rows.append(row("zoo: v0.1 default time / kit default time (same run)", t_old / t_new, "x", 3.0,
+                        note=f"zoo-mean CLAHE-SSIM {q_new:.3f} (kit) vs {q_old:.3f} (v0.1); "
+                             f"{t_new:.0f} s vs {t_old:.0f} s in all"))
+    if "camera_240x180" in synth and "kit" in synth["camera_240x180"]["rows"]:
+        rows.append(row("zoo: kit default on 240x180, 2 s (camera_240x180), wall time",
+                        synth["camera_240x180"]["rows"]["kit"]["time_s"], "s", 15.0, higher_is_better=False))
+    real = results.get("real_slider_chunk")
+    if real and "kit" in real["rows"]:
+        for eq, label in (("clahe", "CLAHE-SSIM"), ("none", "SSIM")):
+            best = max(real["rows"][m][f"ssim_{eq}"] for m in BASELINES if m in real["rows"])
+            rows.append(row(f"real slider chunk: kit {label} / best baseline's", real["rows"]["kit"][f"ssim_{eq}"] / best,
+                            "x", 1.0))
+    return rows
+
+
+def run(quick: bool = False, log=print) -> list[dict]:
+    """The whole zoo (``python -m benchmarks`` calls this): writes the JSON, markdown and figure beside
+    this script (``zoo_results[_quick].*``) and returns the target rows."""
+    suffix = "_quick" if quick else ""
+    main(([ "--quick"] if quick else []) + [f"--json=benchmarks/zoo_results{suffix}.json",
+                                            f"--md=benchmarks/zoo_results{suffix}.md",
+                                            f"--figure=benchmarks/zoo_figure{suffix}.png"])
+    results = json.loads(Path(f"benchmarks/zoo_results{suffix}.json").read_text())["scenes"]
+    return target_rows(results)
+
+
+def parse_variant(text: str) -> tuple[str, dict]:
+    """'NAME=field=value,field=value' -> (NAME, {field: value}); values parsed as Python literals."""
+    import ast
+
+    name, _, rest = text.partition("=")
+    out = {}
+    for item in filter(None, rest.split(",")):
+        k, _, v = item.partition("=")
+        try:
+            out[k.strip()] = ast.literal_eval(v.strip())
+        except (ValueError, SyntaxError):
+            out[k.strip()] = v.strip()
+    return name.strip(), out
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--quick", action="store_true", help="smaller, shorter scenes")
+    p.add_argument("--scenes", default=None, help="comma-separated scene names (default: all)")
+    p.add_argument("--methods", default=",".join(METHODS), help=f"comma-separated, from {METHODS} and variants")
+    p.add_argument("--variant", action="append", default=[], help="an EvINR variant NAME=field=value,... (repeat)")
+    p.add_argument("--no-real", action="store_true", help="skip the real slider_depth chunk")
+    p.add_argument("--json", default="benchmarks/zoo_results.json")
+    p.add_argument("--md", default="benchmarks/zoo_results.md")
+    p.add_argument("--figure", default="benchmarks/zoo_figure.png")
+    a = p.parse_args(argv)
+    variants = dict(parse_variant(v) for v in a.variant)
+    methods = [m for m in a.methods.split(",") if m] + [v for v in variants if v not in a.methods.split(",")]
+    unknown = [m for m in methods if m not in METHODS and m not in variants]
+    if unknown:
+        p.error(f"unknown methods {unknown}; use {METHODS} or add --variant NAME=...")
+    scenes = ZOO if a.scenes is None else [z for z in ZOO if z.name in a.scenes.split(",")]
+    if a.scenes and len(scenes) != len(a.scenes.split(",")):
+        p.error(f"unknown scenes in {a.scenes}; the zoo holds {[z.name for z in ZOO]}")
+    scenes = [quick(z) for z in scenes] if a.quick else scenes
+    t0 = time.perf_counter()
+    results = run_zoo(scenes, methods, variants)
+    if not a.no_real:
+        real = run_real(methods, variants)
+        if real is not None:
+            results["real_slider_chunk"] = real
+    md = markdown(results, methods)
+    print("\n" + md)
+    print(f"\nzoo run: {time.perf_counter() - t0:.0f} s")
+    for r in target_rows(results):
+        print(f"  {r['name']}: {r['measured']:.3g} {r['unit']} (target {r['target_kind'] or ''} {r['target']}; "
+              f"met: {r['met']}) {r.get('note', '')}")
+    shown = [n for n in ("camera_translate", "object_static_cam", "noisy_gravel") if n in results][:3] or \
+        list(results)[:3]
+    if a.figure:
+        figure(results, shown, methods, Path(a.figure))
+        print(f"figure: {a.figure}")
+    if a.md:
+        Path(a.md).write_text(md + "\n")
+    if a.json:
+        clean = {n: {k: v for k, v in r.items() if k != "figure"} for n, r in results.items()}
+        Path(a.json).write_text(json.dumps({"quick": a.quick, "methods": methods, "variants": variants,
+                                            "scenes": clean}, indent=2, default=float) + "\n")
+        print(f"json: {a.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

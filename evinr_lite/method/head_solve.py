@@ -1,0 +1,112 @@
+"""The output layer in closed form: the exact optimum of the loss over the head's weights.
+
+A frame-based INR is F(t) = h(t) W + b, with h(t) [d] the last hidden layer and W [d, H*W] the
+head. For fixed hidden layers the temporal loss is quadratic in W (both forms of it are linear in
+F), and so is the Tikhonov regularizer: the head that Adam approaches in hundreds of steps can be
+computed at once. Per network, with A [B, d] the features' change over each bin (difference
+loss: h(b_{i+1}) - h(b_i); derivative loss: dh/dt(c_i) (b_{i+1} - b_i)), E [B, P] the event frames
+and H_c [T, d] the features at the regularizer's times minus their mean:
+
+    minimise  |A W - E|^2  +  lam' * sum_t |D (h_c(t) W)|^2            (D: pixel differences)
+
+The bias b only shifts every frame by one per-pixel image, which neither term sees apart from
+the regularizer's pull towards flat frames; it is set here so that F has zero mean over time at
+every pixel, and the per-pixel offset is chosen afterwards (:mod:`evinr_lite.method.offset`).
+
+D^T D is the grid Laplacian with Neumann borders, which the orthonormal 2-D DCT-II diagonalises
+(eigenvalues 2 - 2 cos(pi k / W) along x, likewise along y). In that basis each spatial frequency
+mu gives an independent d x d system (A^T A + lam' mu H_c^T H_c) w = A^T e. One generalised
+eigendecomposition A^T A V = H_c^T H_c V Lambda (V^T H_c^T H_c V = I) solves all of them:
+w = V (Lambda + lam' mu)^-1 V^T A^T e. Cost: O(d^3 + B d P + d^2 P), a few seconds at 240x180.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft
+import scipy.linalg
+import torch
+
+__all__ = ["solve_head", "laplacian_eigenvalues"]
+
+
+def laplacian_eigenvalues(sensor_size, cx: float = 1.0, cy: float = 1.0) -> np.ndarray:
+    """Eigenvalues [H, W] of cx Dx^T Dx + cy Dy^T Dy (forward differences, Neumann borders) in the
+    orthonormal DCT-II basis (``scipy.fft.dctn(..., norm="ortho")``); [0, 0] is 0 (constants)."""
+    H, W = sensor_size
+    ex = 2 - 2 * np.cos(np.pi * np.arange(W) / W)
+    ey = 2 - 2 * np.cos(np.pi * np.arange(H) / H)
+    return cy * ey[:, None] + cx * ex[None, :]
+
+
+def _weights(B: int, T: int, sensor_size, lam: float) -> tuple[float, float]:
+    """lam' along x and y, so that the solve minimises exactly the training loss's
+    mean-over-(bins, pixels) temporal term + lam * (mean dx^2 + mean dy^2 over the T frames)."""
+    H, W = sensor_size
+    P = H * W
+    cx = lam * B * P / (T * H * (W - 1)) if W > 1 else 0.0
+    cy = lam * B * P / (T * (H - 1) * W) if H > 1 else 0.0
+    return cx, cy
+
+
+@torch.no_grad()
+def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temporal_loss: str = "difference",
+               regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7) -> dict:
+    """Set ``model.head_weight`` and ``model.head_bias`` to the loss's optimum for its hidden layers.
+
+    Args:
+        model: a :class:`~evinr_lite.method.models.FrameINR` with N networks (changed in place).
+        boundaries: float64 [N, B + 1] bin edges (s). event_frames: [N, B, H, W], C * sum of p per bin.
+        temporal_loss: "difference" (F at the bin edges) or "derivative" (dF/dt at the bin mid-points).
+        regularizer: "tikhonov" or "none" (TV has no closed form; train it with Adam instead).
+        lam: the regularizer's weight, as in the training loss.
+        ridge: relative ridge added to both Gram matrices (numerical safety; 1e-7 of their trace / d).
+
+    Returns:
+        {"seconds": time taken, "temporal": temporal loss after the solve (mean over bins, pixels, networks)}.
+    """
+    import time
+
+    if regularizer not in ("tikhonov", "none"):
+        raise ValueError(f"the closed-form head needs regularizer 'tikhonov' or 'none', got {regularizer!r}; "
+                         "use head_solve=False with TV")
+    if temporal_loss not in ("difference", "derivative"):
+        raise ValueError(f"temporal_loss must be 'difference' or 'derivative', got {temporal_loss!r}")
+    t0 = time.perf_counter()
+    H, W = model.sensor_size
+    P = H * W
+    device, dtype = model.head_weight.device, model.head_weight.dtype
+    edges = boundaries.to(device)
+    if temporal_loss == "difference":
+        h, _ = model.features(edges)                                     # [N, B + 1, d]
+        A = h[:, 1:] - h[:, :-1]
+        reg_h = h
+    else:
+        centers = 0.5 * (edges[:, 1:] + edges[:, :-1])
+        h, dh = model.features(centers, with_derivative=True)
+        A = dh * (edges[:, 1:] - edges[:, :-1]).to(dh.dtype)[..., None]
+        reg_h = h
+    N, B, d = A.shape
+    T = reg_h.shape[1]
+    E = event_frames.to(device).reshape(N, B, P)
+    mean_h = reg_h.mean(dim=1, keepdim=True)                             # [N, 1, d]
+    Hc = (reg_h - mean_h).double().cpu().numpy()
+    A64 = A.double().cpu().numpy()
+    rhs = torch.bmm(A.transpose(1, 2).float(), E.float()).double().cpu().numpy()   # [N, d, P] = A^T E
+    cx, cy = _weights(B, T, (H, W), lam if regularizer == "tikhonov" else 0.0)
+    mu = laplacian_eigenvalues((H, W), cx, cy).ravel()                  # [P]
+    weights = np.empty((N, d, P), dtype=np.float32)
+    for n in range(N):
+        S = A64[n].T @ A64[n]
+        G = Hc[n].T @ Hc[n]
+        eps_s = ridge * max(np.trace(S) / d, 1e-30)
+        eps_g = ridge * max(np.trace(G) / d, 1e-30)
+        lam_, V = scipy.linalg.eigh(S + eps_s * np.eye(d), G + eps_g * np.eye(d))   # S V = G V diag(lam_)
+        R = scipy.fft.dctn(rhs[n].reshape(d, H, W), type=2, norm="ortho", axes=(1, 2), workers=-1).reshape(d, P)
+        X = V @ ((V.T @ R) / (lam_[:, None] + mu[None, :]))             # every spatial frequency at once
+        weights[n] = scipy.fft.idctn(X.reshape(d, H, W), type=2, norm="ortho", axes=(1, 2),
+                                     workers=-1).reshape(d, P)
+    Wt = torch.as_tensor(weights, device=device, dtype=dtype)
+    model.head_weight.copy_(Wt)
+    model.head_bias.copy_(-torch.bmm(mean_h.to(dtype), Wt))                # zero mean over time at every pixel
+    temporal = float(((torch.bmm(A.to(dtype), Wt) - E) ** 2).mean())
+    return {"seconds": time.perf_counter() - t0, "temporal": temporal}

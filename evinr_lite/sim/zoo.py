@@ -1,0 +1,124 @@
+"""The scene zoo: seeded synthetic scenes nobody tuned to, with their sensor models.
+
+    from evinr_lite.sim import zoo
+    for z in zoo.ZOO:                                   # one line of documentation each: z.doc
+        scene, events, times, gt = zoo.simulate(z)      # ground-truth intensities at 10 scored times
+        C = zoo.effective_C(z)                          # the one threshold every method is given
+
+Together the scenes vary texture (five natural images and one low-texture scene), motion
+(translation, rotation + zoom, shear and perspective, non-uniform speed, a static camera with an
+object moving over a static background), light (a global change and vignetting), the sensor
+(background activity, hot pixels, C+ != C-, threshold mismatch, a refractory period), size
+(120x160 to 180x240) and length (2-3 s). ``benchmarks/quality_zoo.py`` scores every method on
+them; the kit's defaults were chosen on their mean, never on one scene.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from . import scenes as sc
+from .simulate import add_background_noise, add_hot_pixels, simulate_scene
+
+__all__ = ["ZooScene", "ZOO", "N_SCORED", "quick", "simulate", "effective_C", "get"]
+
+N_SCORED = 10   # ground-truth times scored per scene, evenly spread over [0.1, 0.95] of the duration
+
+
+@dataclass
+class ZooScene:
+    """One seeded scene: how to build it, the sensor's model, and one line saying what it tests."""
+
+    name: str
+    doc: str
+    build: object                        # (sensor_size, duration) -> Scene
+    size: tuple = (120, 160)
+    duration: float = 2.0
+    C: float = 0.2                       # nominal threshold; C_pos / C_neg below when asymmetric
+    C_pos: float | None = None
+    C_neg: float | None = None
+    threshold_sigma: float = 0.0         # relative mismatch between pixels
+    refractory: float = 0.0              # seconds
+    noise_hz: float = 0.0                # background activity per pixel
+    hot_pixels: int = 0                  # stuck pixels firing hot_hz each
+    hot_hz: float = 50.0
+    seed: int = 0
+    tags: tuple = field(default_factory=tuple)
+
+    @property
+    def noise_free(self) -> bool:
+        return self.noise_hz == 0 and self.hot_pixels == 0 and self.threshold_sigma == 0
+
+
+ZOO = [
+    ZooScene("camera_translate", "camera image, translation with a slight rotation and zoom; clean sensor",
+             lambda s, d: sc.MovingImageScene("camera", s, d, velocity=(20.0, 8.0), rotation=0.08, zoom=0.05)),
+    ZooScene("astronaut_rotzoom", "astronaut, rotation 0.35 rad/s and zoom 0.25/s about the centre; clean sensor",
+             lambda s, d: sc.MovingImageScene("astronaut", s, d, velocity=(4.0, -3.0), rotation=0.35, zoom=0.25),
+             size=(150, 200), duration=2.5),
+    ZooScene("coffee_warp", "coffee, shear and perspective tilt growing over time; C+ 0.24 != C- 0.16",
+             lambda s, d: sc.WarpedImageScene("coffee", s, d, velocity=(10.0, 5.0), rotation=0.0, zoom=0.0,
+                                              shear=(0.25, 0.1), tilt=(0.3, 0.15)),
+             C_pos=0.24, C_neg=0.16),
+    ZooScene("chelsea_speed", "chelsea, speed swinging 0.2x-1.8x; 4 % threshold mismatch, 1 ms refractory",
+             lambda s, d: sc.VaryingSpeedScene(sc.MovingImageScene("chelsea", s, d, velocity=(-22.0, 6.0),
+                                                                   rotation=0.05, zoom=0.0), depth=0.8, period=d),
+             duration=3.0, threshold_sigma=0.04, refractory=1e-3),
+    ZooScene("object_static_cam", "static camera: a coffee-textured disc crossing a static brick wall; clean",
+             lambda s, d: sc.ObjectOverBackgroundScene("brick", "coffee", s, d)),
+    ZooScene("lowtex_light", "low texture (moon, blurred) under a global light change and vignetting; clean",
+             lambda s, d: sc.LightingScene(sc.MovingImageScene("moon", s, d, velocity=(15.0, 10.0), rotation=0.1,
+                                                               zoom=0.0, blur=2.5), global_change=0.5,
+                                           vignette=-0.6)),
+    ZooScene("noisy_gravel", "gravel at 180x240: 0.5 Hz background activity, 20 hot pixels, C+ != C-, 5 % mismatch",
+             lambda s, d: sc.MovingImageScene("gravel", s, d, velocity=(18.0, -10.0), rotation=0.05, zoom=0.05),
+             size=(180, 240), C_pos=0.22, C_neg=0.18, threshold_sigma=0.05, refractory=5e-4, noise_hz=0.5,
+             hot_pixels=20, seed=1),
+    ZooScene("grass_light_noisy", "grass under vignetting light, 0.2 Hz background activity, 10 hot pixels, 3 s",
+             lambda s, d: sc.LightingScene(sc.MovingImageScene("grass", s, d, velocity=(12.0, 12.0), rotation=-0.1,
+                                                               zoom=0.08), global_change=-0.3, vignette=-0.4),
+             duration=3.0, threshold_sigma=0.03, noise_hz=0.2, hot_pixels=10, seed=2),
+    ZooScene("camera_240x180", "camera at 180x240 (the paper's DAVIS240 size), 2 s: the timing target; clean",
+             lambda s, d: sc.MovingImageScene("camera", s, d, velocity=(25.0, 10.0), rotation=0.1, zoom=0.1),
+             size=(180, 240)),
+]
+
+
+def quick(z: ZooScene) -> ZooScene:
+    """A smaller, shorter version (--quick): 3/5 of the size, 3/4 of the length."""
+    H, W = z.size
+    return ZooScene(**{**asdict(z), "build": z.build, "size": (int(H * 0.6) // 2 * 2, int(W * 0.6) // 2 * 2),
+                       "duration": round(z.duration * 0.75, 3)})
+
+
+def simulate(z: ZooScene):
+    """(scene, events, gt times [10], gt intensity frames [10, H, W] in (0, 1])."""
+    scene = z.build(z.size, z.duration)
+    kw = {} if z.C_pos is None else {"C_pos": z.C_pos, "C_neg": z.C_neg}
+    events = simulate_scene(scene, 0.0, z.duration, C=z.C, threshold_sigma=z.threshold_sigma,
+                            refractory=z.refractory, seed=z.seed, **kw)
+    rng = np.random.default_rng(z.seed + 100)
+    if z.noise_hz > 0:
+        events = add_background_noise(events, z.noise_hz, seed=rng, t_start=0.0, t_end=z.duration)
+    if z.hot_pixels:
+        events, _ = add_hot_pixels(events, z.hot_pixels, z.hot_hz, seed=rng, t_start=0.0, t_end=z.duration)
+    times = np.linspace(0.1 * z.duration, 0.95 * z.duration, N_SCORED)
+    return scene, events, times, scene.intensity(times).astype(np.float32)
+
+
+def effective_C(z: ZooScene) -> float:
+    """The one threshold every method is given: the mean of C+ and C- (the solvers take one C)."""
+    return z.C if z.C_pos is None else 0.5 * (z.C_pos + z.C_neg)
+
+
+
+
+def get(name: str) -> ZooScene:
+    """The zoo scene called ``name``."""
+    for z in ZOO:
+        if z.name == name:
+            return z
+    from ..core.events import EventDataError
+
+    raise EventDataError(f"no zoo scene {name!r}; the zoo holds {[z.name for z in ZOO]}")

@@ -1,0 +1,147 @@
+"""The closed-form output layer, the explicit per-pixel offset, and the named presets."""
+import numpy as np
+import pytest
+import scipy.fft
+import scipy.ndimage
+import torch
+
+from evinr_lite import EvINRConfig, make_scene, reconstruct, simulate_scene
+from evinr_lite.method.head_solve import laplacian_eigenvalues, solve_head
+from evinr_lite.method.models import FrameINR
+from evinr_lite.method.offset import median_gradient_offset, poisson_integrate
+from evinr_lite.method.solver import _Bins, alignment_offsets, step_losses
+
+
+def _differences(n):
+    D = np.zeros((n - 1, n))
+    D[np.arange(n - 1), np.arange(n - 1)] = -1
+    D[np.arange(n - 1), np.arange(1, n)] = 1
+    return D
+
+
+def test_laplacian_eigenvalues_diagonalise_the_grid_laplacian():
+    H, W = 5, 7
+    Dx = np.kron(np.eye(H), _differences(W))          # x differences of a row-major image
+    Dy = np.kron(_differences(H), np.eye(W))
+    L = 0.3 * Dx.T @ Dx + 1.7 * Dy.T @ Dy
+    basis = scipy.fft.dctn(np.eye(H * W).reshape(H * W, H, W), norm="ortho", axes=(1, 2)).reshape(H * W, H * W)
+    M = basis.T @ L @ basis                            # L in the orthonormal DCT-II basis (rows: DCT of e_i)
+    np.testing.assert_allclose(np.diag(M), laplacian_eigenvalues((H, W), 0.3, 1.7).ravel(), atol=1e-10)
+    np.testing.assert_allclose(M - np.diag(np.diag(M)), 0, atol=1e-10)
+
+
+def _setup(temporal_loss, seed=0):
+    scene = make_scene("camera", sensor_size=(12, 16), duration=0.6)
+    events = simulate_scene(scene, 0.0, 0.6, C=0.2, seed=seed)
+    windows = np.array([[0.0, 0.6]])
+    model = FrameINR((12, 16), windows, hidden_features=48, hidden_layers=2, first_omega_0=10.0, seed=seed)
+    bins = _Bins.build(events, [np.linspace(0.0, 0.6, 21)], 0.2, torch.device("cpu"))
+    return model, bins
+
+
+@pytest.mark.parametrize("temporal_loss", ["difference", "derivative"])
+@pytest.mark.parametrize("lam", [0.0, 0.05])
+def test_solved_head_is_a_stationary_point_of_the_training_loss(temporal_loss, lam):
+    model, bins = _setup(temporal_loss)
+
+    def loss_and_grad():
+        model.zero_grad()
+        temporal, reg = step_losses(model, bins, temporal_loss, "tikhonov", fused=False)
+        loss = temporal + lam * reg
+        loss.backward()
+        return loss.item(), model.head_weight.grad.norm().item()
+
+    _, grad_before = loss_and_grad()                  # the initial (SIREN) head
+    solve_head(model, bins.boundaries, bins.frames, temporal_loss, "tikhonov", lam)
+    loss, grad_after = loss_and_grad()
+    assert grad_after < 1e-3 * grad_before
+    temporal, reg = step_losses(model, bins, temporal_loss, "tikhonov", fused=False)
+    # and Adam cannot improve on it: a few steps on the head only raise the loss or leave it
+    best = float(temporal + lam * reg)
+    assert best == pytest.approx(loss, rel=1e-6)
+    opt = torch.optim.Adam([model.head_weight], lr=1e-4)
+    for _ in range(5):
+        opt.zero_grad()
+        t, r = step_losses(model, bins, temporal_loss, "tikhonov", fused=False)
+        (t + lam * r).backward()
+        opt.step()
+    t, r = step_losses(model, bins, temporal_loss, "tikhonov", fused=False)
+    assert float(t + lam * r) >= best * (1 - 1e-4)
+
+
+def test_without_regularizer_the_difference_loss_is_fitted_exactly_and_frames_have_zero_temporal_mean():
+    model, bins = _setup("difference")
+    out = solve_head(model, bins.boundaries, bins.frames, "difference", "none", 0.0)
+    assert out["temporal"] < 1e-6 * float((bins.frames ** 2).mean())
+    with torch.no_grad():
+        F = model(bins.boundaries)
+    np.testing.assert_allclose(F.mean(dim=1).numpy(), 0, atol=1e-4)
+
+
+def test_head_solve_refuses_tv():
+    model, bins = _setup("difference")
+    with pytest.raises(ValueError, match="tikhonov"):
+        solve_head(model, bins.boundaries, bins.frames, "difference", "tv", 0.05)
+    with pytest.raises(ValueError, match="head_solve"):
+        EvINRConfig(regularizer="tv")
+
+
+def test_poisson_integrate_recovers_an_image_from_its_gradients():
+    g = np.random.default_rng(0).normal(size=(9, 13))
+    got = poisson_integrate(np.diff(g, axis=1), np.diff(g, axis=0))
+    np.testing.assert_allclose(got, g - g.mean(), atol=1e-10)
+
+
+def test_median_gradient_offset_removes_an_unknown_offset_of_a_moving_texture():
+    """Frames of a translating texture plus one unknown image g0: the solve returns about -g0."""
+    rng = np.random.default_rng(1)
+    texture = scipy.ndimage.gaussian_filter(rng.normal(size=(40, 200)), 1.0)
+    frames = np.stack([texture[:, 4 * k: 4 * k + 48] for k in range(30)])        # moving 4 px per frame
+    g0 = scipy.ndimage.gaussian_filter(rng.normal(size=(40, 48)), 3.0) * 5
+    g = median_gradient_offset(frames + g0)
+    err_before = np.std((frames + g0) - frames - g0.mean())
+    err_after = np.std((frames + g0 + g) - frames - (g0 + g).mean())
+    assert err_after < 0.2 * err_before
+
+
+def test_ensembles_keep_their_alignment_with_the_offset_solve():
+    scene = make_scene("camera", sensor_size=(16, 20), duration=1.6)
+    events = simulate_scene(scene, 0.0, 1.6, C=0.2, seed=0)
+    cfg = EvINRConfig(C=0.2, hidden_features=32, hidden_layers=2, tau=0.9, overlap=0.2, progress=False)
+    rec = reconstruct(events, np.linspace(0.1, 1.5, 5), cfg)
+    assert len(rec.windows) == 2
+    chained = alignment_offsets(rec.model, rec.windows)
+    np.testing.assert_allclose(rec.offsets[1] - rec.offsets[0], chained[1] - chained[0], atol=1e-5)
+
+
+def test_presets():
+    paper = EvINRConfig.paper()
+    assert (paper.hidden_features, paper.hidden_layers, paper.n_iters, paper.lam, paper.lr) == (512, 3, 300, 0.05, 1e-4)
+    assert (paper.temporal_loss, paper.regularizer, paper.head_lr_scale, paper.first_omega_0) == (
+        "derivative", "tikhonov", 1.0, None)
+    assert paper.c2f_iters == (100, 200) and paper.coarse_to_fine and not paper.head_solve
+    assert paper.offset_solve == "none" and paper.bin_duration == 1 / 32 and paper.tau == 5.0
+    old = EvINRConfig.v0_1()
+    assert (old.first_omega_0, old.head_lr_scale) == (10.0, 30.0)
+    assert {k: v for k, v in vars(old).items() if k not in ("first_omega_0", "head_lr_scale")} == \
+        {k: v for k, v in vars(paper).items() if k not in ("first_omega_0", "head_lr_scale")}
+    kit = EvINRConfig()
+    assert kit.head_solve and kit.offset_solve == "median_gradient" and kit.n_iters == 0
+    assert EvINRConfig.paper(C=0.2).C == 0.2
+
+
+def test_kit_default_beats_integration_on_a_small_scene():
+    """The default's job in miniature: better than direct integration under both protocols."""
+    from evinr_lite import reconstruct_baseline
+    from evinr_lite.evaluation import score_sequence
+
+    scene = make_scene("camera", sensor_size=(48, 64), duration=1.0)
+    events = simulate_scene(scene, 0.0, 1.0, C=0.2, seed=0)
+    times = np.linspace(0.1, 0.9, 5)
+    gt = scene.intensity(times)
+    kit = reconstruct(events, times, EvINRConfig(C=0.2, progress=False)).frames
+    base = reconstruct_baseline(events, times, "integration", C=0.2).frames
+    for eq in ("none", "clahe"):
+        a = score_sequence(kit, times, gt, times, eq, lpips_model=False)["ssim"]
+        b = score_sequence(base, times, gt, times, eq, lpips_model=False)["ssim"]
+        assert a > b, (eq, a, b)

@@ -1,0 +1,74 @@
+"""The zoo's scenes and sensor models (evinr_lite.sim.scenes, simulate.add_hot_pixels, sim.zoo)."""
+import numpy as np
+import pytest
+
+from evinr_lite.core.events import EventDataError, Events
+from evinr_lite.sim import zoo
+from evinr_lite.sim.scenes import (LightingScene, MovingImageScene, ObjectOverBackgroundScene, VaryingSpeedScene,
+                                   WarpedImageScene)
+from evinr_lite.sim.simulate import add_hot_pixels
+
+T = np.array([0.0, 0.7, 1.3, 2.0])
+
+
+def test_warped_scene_without_warp_is_the_moving_image():
+    a = WarpedImageScene("camera", (24, 32), 2.0, shear=(0.0, 0.0), tilt=(0.0, 0.0))
+    b = MovingImageScene("camera", (24, 32), 2.0)
+    np.testing.assert_allclose(a.log_intensity(T), b.log_intensity(T), atol=1e-12)
+    warped = WarpedImageScene("camera", (24, 32), 2.0, shear=(0.3, 0.0), tilt=(0.2, 0.0))
+    assert np.abs(warped.log_intensity(T[-1:]) - b.log_intensity(T[-1:])).max() > 0.05
+    np.testing.assert_allclose(warped.log_intensity(1.0), b.log_intensity(1.0), atol=1e-12)   # tau = 0: no warp
+    with pytest.raises(EventDataError, match="folds"):
+        WarpedImageScene("camera", (24, 32), 2.0, tilt=(0.6, 0.0))
+
+
+def test_object_over_static_background():
+    s = ObjectOverBackgroundScene("brick", "coffee", (40, 60), 2.0, radius=6.0)
+    L = s.log_intensity(np.linspace(0, 2, 9))
+    changes = np.abs(np.diff(L, axis=0)).max(axis=0)
+    assert changes[0, 0] < 1e-3 and changes[-1, 0] < 1e-3        # corners far from the path (soft edge: tanh tail)
+    assert changes.max() > 0.3                                    # the object's path does
+    assert s.max_speed == pytest.approx(np.hypot(*(s.end - s.start)) / 2.0)
+
+
+def test_lighting_adds_global_change_and_vignette():
+    base = MovingImageScene("chelsea", (20, 30), 2.0)
+    lit = LightingScene(base, global_change=0.4, vignette=-0.5)
+    d = lit.log_intensity(T) - base.log_intensity(T)
+    s = T / 2.0 - 0.5
+    np.testing.assert_allclose(d[:, 10, 15] / s[:, None][:, 0], 0.4, atol=0.01)   # near the centre: global only
+    assert d[-1, 0, 0] - d[0, 0, 0] == pytest.approx(0.4 - 0.5, abs=1e-9)         # a corner: global + vignette
+
+
+def test_varying_speed_scene_moved_to_sim():
+    from evinr_lite.teaching import accel_exercises
+
+    assert accel_exercises.VaryingSpeedScene is VaryingSpeedScene
+
+
+def test_hot_pixels():
+    ev = Events.from_arrays([0.0, 2.0], [0, 1], [0, 0], [1, -1], (8, 10))
+    out, hot = add_hot_pixels(ev, 5, 100.0, seed=3)
+    again, hot2 = add_hot_pixels(ev, 5, 100.0, seed=3)
+    np.testing.assert_array_equal(out.t, again.t) and np.testing.assert_array_equal(hot, hot2)
+    flat = out.y.astype(np.int64) * 10 + out.x
+    counts = np.bincount(flat, minlength=80)
+    assert set(np.flatnonzero(counts > 20)) == set(hot.tolist())
+    assert np.all(np.abs(counts[hot] - 200) < 5 * np.sqrt(200))   # Poisson(rate x span)
+    for h in hot:
+        p = out.p[flat == h]
+        assert max(np.mean(p > 0), np.mean(p < 0)) > 0.75            # mostly one polarity
+    with pytest.raises(EventDataError, match="n_pixels"):
+        add_hot_pixels(ev, 81, 1.0)
+
+
+def test_zoo_is_documented_and_simulates():
+    names = [z.name for z in zoo.ZOO]
+    assert len(names) == len(set(names)) >= 8 and all(len(z.doc) > 20 for z in zoo.ZOO)
+    assert {z.noise_free for z in zoo.ZOO} == {True, False}
+    z = zoo.quick(zoo.get("noisy_gravel"))
+    scene, events, times, gt = zoo.simulate(z)
+    assert gt.shape == (zoo.N_SCORED, *z.size) and len(events) > 1000 and events.sensor_size == z.size
+    assert zoo.effective_C(z) == pytest.approx(0.2)
+    with pytest.raises(EventDataError, match="no zoo scene"):
+        zoo.get("nope")
