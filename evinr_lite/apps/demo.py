@@ -1,10 +1,11 @@
 """The README's main job on a built-in synthetic scene (no download).
 
 Simulate events from a moving natural image, reconstruct frames at a few timestamps with EvINR
-(the paper's recipe) and with direct event integration, write them as PNGs with the ground truth
-beside them, and score them against the ground truth:
+(the kit's default, ``EvINRConfig()``; pass ``config=EvINRConfig.paper(...)`` for the paper's
+recipe) and with direct event integration, write them as PNGs with the ground truth beside them,
+and score them against the ground truth:
 
-- ``EvINR``: the frame-based INR trained on the events alone; its brightness level is anchored
+- ``EvINR``: the frame-based INR fitted to the events alone; its brightness level is anchored
   (mean tone-mapped value 0.5), since events only see changes.
 - ``integration (L0 = 0)``: Eq. 2 from an unknown start, anchored the same way.
 - ``integration (L0 = true first frame)``: an oracle that is handed the first frame.
@@ -88,7 +89,8 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
     gt = tonemap_reinhard(sc.log_intensity(t_query), cfg.gamma)
     t1 = time.perf_counter()
     rec = reconstruct(events, t_query, cfg, t_start=0.0, t_end=duration)
-    log(f"EvINR trained in {rec.history['train_time_s']:.1f} s ({cfg.n_iters} iterations, "
+    steps = f"{cfg.n_iters} Adam iterations" + (" + the closed-form output layer" if cfg.head_solve else "")
+    log(f"EvINR fitted in {rec.history['train_time_s']:.1f} s ({steps}, "
         f"{len(rec.windows)} network(s), {rec.model.num_parameters():,} parameters in all)")
     t2 = time.perf_counter()
     L_int = integrate_events(events, t_query, C=C)
