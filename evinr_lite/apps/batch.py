@@ -213,7 +213,8 @@ def evaluate_recording(item: dict, out_dir, settings: dict) -> dict:
         t_start, t_end = _eval_window(item["path"])
         run = run_reconstruct(item["path"], out, sensor_size=settings.get("sensor_size"), C=settings.get("C"),
                               fps=settings.get("fps"), t_start=t_start, t_end=t_end, device=settings.get("device"),
-                              n_iters=int(settings.get("n_iters", 300)), seed=int(settings.get("seed", 0)),
+                              n_iters=settings.get("n_iters"), recipe=settings.get("recipe", "kit"),
+                              seed=int(settings.get("seed", 0)),
                               overwrite=True, video=bool(settings.get("video", False)), progress=False,
                               log=lambda *a, **k: None)
     except Exception as exc:   # a bad recording is a result, not a crash of the batch
@@ -349,12 +350,13 @@ def _check_settings(out_dir: Path, settings: dict) -> None:
         _write_atomic(path, json.dumps(settings, indent=2) + "\n")
 
 
-RESULT_SETTINGS = ("C", "fps", "n_iters", "seed", "sensor_size")   # settings that change the scores
+RESULT_SETTINGS = ("C", "fps", "n_iters", "recipe", "seed", "sensor_size")   # settings that change the scores
 
 
 def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | None = None, client=None,
               sequential: bool = False, torch_threads: int = 1, C: float | None = None, fps: float | None = None,
-              n_iters: int = 300, seed: int = 0, device: str | None = None, video: bool = False,
+              n_iters: int | None = None, recipe: str = "kit", seed: int = 0, device: str | None = None,
+              video: bool = False,
               sensor_size=None, cache=None, progress: bool = True, log=print) -> dict:
     """Reconstruct and score every recording of ``inputs``, one Dask task each; returns the summary.
 
@@ -369,7 +371,7 @@ def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | N
         client: an existing ``distributed.Client`` to use instead (a notebook's).
         sequential: run the tasks one after the other in this process, without Dask (a reference).
         torch_threads: torch threads per task (default 1: one per worker process).
-        C, fps, n_iters, seed, device, video, sensor_size: as for ``evinr-lite reconstruct``
+        C, fps, n_iters, recipe, seed, device, video, sensor_size: as for ``evinr-lite reconstruct``
             (``video`` off by default: PNG frames and scores only).
     Returns:
         the summary (see :func:`summarize`), also written to ``out_dir/summary.json|csv|md``.
@@ -377,14 +379,15 @@ def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | N
     from filelock import FileLock, Timeout
 
     out_dir = Path(out_dir)
-    if n_iters < 1:
-        raise EventDataError(f"n_iters= must be at least 1, got {n_iters}")
+    if n_iters is not None and n_iters < 1:
+        raise EventDataError(f"n_iters= must be at least 1 (or None: the recipe's own), got {n_iters}")
     if workers is not None and workers < 1:
         raise EventDataError(f"workers= must be at least 1, got {workers}")
     if sum(x is not None for x in (scheduler, workers, client)) + bool(sequential) > 1:
         raise EventDataError("give at most one of scheduler=, workers=, client= and sequential=True")
     items = resolve_inputs(inputs, cache=cache, log=log)
-    settings = {"C": C, "fps": fps, "n_iters": int(n_iters), "seed": int(seed), "device": device, "video": bool(video),
+    settings = {"C": C, "fps": fps, "n_iters": None if n_iters is None else int(n_iters), "recipe": recipe,
+                "seed": int(seed), "device": device, "video": bool(video),
                 "sensor_size": list(sensor_size) if sensor_size is not None else None,
                 "torch_threads": int(torch_threads)}
     out_dir.mkdir(parents=True, exist_ok=True)

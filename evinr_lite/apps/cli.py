@@ -85,6 +85,13 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_ERROR, f"evinr-lite: error: {message} (see `{self.prog} --help`)\n")
 
 
+RECIPE_CHOICES = ("kit", "paper", "v0_1")
+RECIPE_HELP = ("the solver's recipe: kit (default; the closed-form output layer and the explicit per-pixel offset, "
+               "chosen on the scene zoo), paper (the paper's recipe exactly), v0_1 (the kit's earlier default)")
+ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose output layer is solved in closed "
+              "form; 300 for paper and v0_1, with coarse-to-fine at a third and two thirds)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from ..io.readers import SUPPORTED_FORMATS
 
@@ -123,7 +130,8 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--start", type=_finite, help="window start, seconds on the recording's clock (see `info`)")
     rec.add_argument("--end", type=_finite, help="window end, seconds on the recording's clock (see `info`)")
     rec.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
-    rec.add_argument("--iters", type=_count, default=300, help="training iterations (default: 300, the paper's)")
+    rec.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
+    rec.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     rec.add_argument("--seed", type=_seed, default=0)
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
@@ -137,7 +145,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--duration", type=_positive, default=2.0, help="seconds of events (default: 2)")
     demo.add_argument("--C", type=_positive, default=0.2, help="contrast threshold (default: 0.2)")
     demo.add_argument("--frames", type=_count, default=8, help="number of frames to reconstruct (default: 8)")
-    demo.add_argument("--iters", type=_count, default=300, help="EvINR training iterations (default: 300, the paper's)")
+    demo.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
+    demo.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     demo.add_argument("--seed", type=_seed, default=0)
     demo.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
 
@@ -161,7 +170,8 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--fps", type=float, help="frames to write per second (default: the ground-truth frame "
                                                  "times); scores are always taken at the ground-truth frames")
     batch.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
-    batch.add_argument("--iters", type=int, default=300, help="training iterations (default: 300, the paper's)")
+    batch.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
+    batch.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     batch.add_argument("--seed", type=int, default=0)
     batch.add_argument("--video", action="store_true", help="also write MP4 / GIF per recording")
     batch.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -181,18 +191,17 @@ def _reconstruct(args) -> None:
 
     run_reconstruct(args.recording, args.out, sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
                     t_start=args.start, t_end=args.end, device=args.device, n_iters=args.iters, seed=args.seed,
-                    overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet,
+                    recipe=args.recipe, overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet,
                     time_unit=args.time_unit, command=" ".join(["evinr-lite", *sys.argv[1:]]))
 
 
 def _demo(args) -> None:
     from .demo import run_demo
     from ..io.output import check_output_path
-    from ..method.solver import EvINRConfig
+    from .recon_job import recipe_config
 
     check_output_path(args.out, overwrite=args.overwrite)   # say so before training, not after
-    c2f = (args.iters // 3, 2 * args.iters // 3) if args.iters >= 3 else ()
-    config = EvINRConfig(C=args.C, n_iters=args.iters, seed=args.seed, c2f_iters=c2f, coarse_to_fine=bool(c2f))
+    config = recipe_config(args.recipe, args.iters, C=args.C, seed=args.seed)
     run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
              n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)
 
@@ -204,7 +213,8 @@ def _batch(args) -> None:
     try:
         summary = run_batch(args.inputs, args.out, scheduler=args.scheduler, workers=args.workers,
                             torch_threads=args.torch_threads, sensor_size=args.sensor, C=args.C, fps=args.fps,
-                            device=args.device, n_iters=args.iters, seed=args.seed, video=args.video,
+                            device=args.device, n_iters=args.iters, recipe=args.recipe, seed=args.seed,
+                            video=args.video,
                             progress=not args.quiet)
     except KeyboardInterrupt as exc:   # finished recordings stay: the same command resumes
         exc.output_note = f"finished recordings stay in {args.out}/; run the same command again to resume"

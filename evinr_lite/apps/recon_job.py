@@ -31,7 +31,8 @@ from ..method.solver import EvINRConfig, Reconstruction, reconstruct
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
-           "check_run_options", "estimate_memory", "check_memory", "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS"]
+           "check_run_options", "estimate_memory", "check_memory", "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS", "RECIPES",
+           "recipe_config"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 DEFAULT_C = 1.0         # the paper's contrast threshold for DAVIS recordings (IJRR, HQF)
@@ -377,8 +378,30 @@ def _jsonable(obj):
 
 # ---- the whole job ---------------------------------------------------------------------------
 
-def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: int = 300, seed: int = 0,
-                      time_unit=None) -> None:
+RECIPES = {"kit": EvINRConfig, "paper": EvINRConfig.paper, "v0_1": EvINRConfig.v0_1}
+
+
+def recipe_config(recipe: str = "kit", n_iters: int | None = None, **fields) -> EvINRConfig:
+    """The EvINRConfig of a named recipe: "kit" (``EvINRConfig()``, the default), "paper" (the paper's
+    recipe exactly) or "v0_1" (the kit's default before the scene zoo).
+
+    ``n_iters`` None keeps the recipe's own (kit: no Adam iteration, the output layer solved in closed
+    form; paper: 300). Given, it sets the Adam iterations; for the recipes with coarse-to-fine the two
+    bisections move to n_iters / 3 and 2 n_iters / 3 (the paper's 100 and 200 of 300).
+    """
+    if recipe not in RECIPES:
+        raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {recipe!r}")
+    make = RECIPES[recipe]
+    if n_iters is not None:
+        fields["n_iters"] = int(n_iters)
+        if make().coarse_to_fine:
+            c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
+            fields.update(c2f_iters=c2f, coarse_to_fine=bool(c2f))
+    return make(**fields)
+
+
+def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: int | None = None, seed: int = 0,
+                      time_unit=None, recipe: str = "kit") -> None:
     """Every option of :func:`run_reconstruct` checked before any file is read (EventDataError naming it)."""
     def finite(name, value):
         if value is None:
@@ -395,8 +418,10 @@ def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: in
     finite("t_end=", t_end)
     if t_start is not None and t_end is not None and not t_end > t_start:
         raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end= must exceed t_start=")
-    if isinstance(n_iters, bool) or not isinstance(n_iters, (int, np.integer)) or n_iters < 1:
-        raise EventDataError(f"n_iters= must be a whole number of at least 1, got {n_iters!r}")
+    if n_iters is not None and (isinstance(n_iters, bool) or not isinstance(n_iters, (int, np.integer)) or n_iters < 1):
+        raise EventDataError(f"n_iters= must be a whole number of at least 1 (or None: the recipe's own), got {n_iters!r}")
+    if recipe not in RECIPES:
+        raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {recipe!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**63:
         raise EventDataError(f"seed must be a whole number in [0, 2**63), got {seed!r}")
     if time_unit is not None and time_unit not in TIME_UNITS:
@@ -480,8 +505,9 @@ def check_memory(rec: Recording, times, config: EvINRConfig, device: str = "cpu"
 
 def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, fps: float | None = None, at=None,
                     t_start: float | None = None, t_end: float | None = None, device: str | None = None,
-                    n_iters: int = 300, seed: int = 0, overwrite: bool = False, video: bool = True,
-                    progress: bool = True, time_unit: str | None = None, log=print, command: str = "") -> dict:
+                    n_iters: int | None = None, seed: int = 0, overwrite: bool = False, video: bool = True,
+                    progress: bool = True, time_unit: str | None = None, log=print, command: str = "",
+                    recipe: str = "kit") -> dict:
     """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
 
     Every check that can fail runs before training: the options, the output folder (checked,
@@ -497,7 +523,8 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
     from ..io.output import OutputDir
 
     t0 = time.perf_counter()
-    check_run_options(C=C, fps=fps, t_start=t_start, t_end=t_end, n_iters=n_iters, seed=seed, time_unit=time_unit)
+    check_run_options(C=C, fps=fps, t_start=t_start, t_end=t_end, n_iters=n_iters, seed=seed, time_unit=time_unit,
+                      recipe=recipe)
     with OutputDir(out_dir, overwrite=overwrite, inputs=[path], log=log, command=command) as target:
         try:
             device_name = str(default_device(device))
@@ -507,16 +534,15 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
         times, source = choose_times(rec, fps=fps, at=at)
         C_source = "given" if C is not None else ("from the file" if rec.meta.get("C") else "default (pass C=)")
         C = float(C if C is not None else rec.meta.get("C") or DEFAULT_C)
-        c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
-        config = EvINRConfig(C=C, n_iters=n_iters, c2f_iters=c2f, coarse_to_fine=bool(c2f), seed=seed,
-                             device=device, progress=progress)
+        config = recipe_config(recipe, n_iters, C=C, seed=seed, device=device, progress=progress)
         check_memory(rec, times, config, device_name)
         lo, hi = rec.meta["window"]
         H, W = rec.events.sensor_size
         log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
             + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
             + f" in {time.perf_counter() - t0:.1f} s")
-        log(f"reconstructing {source} with EvINR (C = {C:g} {C_source}, {n_iters} iterations, {device_name})")
+        log(f"reconstructing {source} with EvINR ({recipe} recipe, C = {C:g} {C_source}, {config.n_iters} Adam "
+            f"iterations{' + the closed-form output layer' if config.head_solve else ''}, {device_name})")
         result = reconstruct_recording(rec, times, config)
         scores = score_recording(result, rec.frames)
         settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
