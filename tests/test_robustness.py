@@ -103,15 +103,20 @@ CONFIG_CASES = [("n_iters", 0), ("n_iters", -1), ("n_iters", 2.5), ("n_iters", m
                 ("overlap", -1), ("head_lr_scale", math.inf), ("display_mean", 1.0), ("n_iters", True)]
 
 
+# Adam-trained and coarse-to-fine, so that n_iters >= 1 and c2f_iters are checked whatever the defaults are
+# (the kit's default solves the output layer in closed form and may run no Adam iteration at all)
+TRAINED = dict(head_solve=False, coarse_to_fine=True, n_iters=300, c2f_iters=(100, 200))
+
+
 @pytest.mark.parametrize("field,value", CONFIG_CASES)
 def test_config_fields(field, value):
-    with pytest.raises(EventDataError, match=field if field != "overlap" else "overlap"):
-        EvINRConfig(**{field: value})
+    with pytest.raises(EventDataError, match=field):
+        EvINRConfig(**{**TRAINED, field: value})
 
 
 def test_config_stages_beyond_the_run_warn():
     with pytest.warns(UserWarning, match="not inside the run"):
-        EvINRConfig(n_iters=50)
+        EvINRConfig(**{**TRAINED, "n_iters": 50})
 
 
 # ---- 3. sizes: memory estimated and refused before allocating -----------------------------------------
