@@ -232,7 +232,7 @@ def target_rows(results: dict) -> list[dict]:
         rows.append(row("zoo: kit default on 240x180, 2 s (camera_240x180), wall time",
                         synth["camera_240x180"]["rows"]["kit"]["time_s"], "s", 15.0, higher_is_better=False))
     real = results.get("real_slider_chunk")
-    if real and "kit" in real["rows"]:
+    if real and "kit" in real["rows"] and any(m in real["rows"] for m in BASELINES):
         for eq, label in (("clahe", "CLAHE-SSIM"), ("none", "SSIM")):
             best = max(real["rows"][m][f"ssim_{eq}"] for m in BASELINES if m in real["rows"])
             rows.append(row(f"real slider chunk: kit {label} / best baseline's", real["rows"]["kit"][f"ssim_{eq}"] / best,
