@@ -145,3 +145,12 @@ def test_kit_default_beats_integration_on_a_small_scene():
         a = score_sequence(kit, times, gt, times, eq, lpips_model=False)["ssim"]
         b = score_sequence(base, times, gt, times, eq, lpips_model=False)["ssim"]
         assert a > b, (eq, a, b)
+
+
+def test_short_windows_get_at_least_min_bins():
+    scene = make_scene("camera", sensor_size=(12, 16), duration=0.5)
+    events = simulate_scene(scene, 0.0, 0.5, C=0.2, seed=0)
+    cfg = EvINRConfig(C=0.2, hidden_features=32, hidden_layers=1, progress=False)
+    assert reconstruct(events, [0.25], cfg).history["final_bins"] == cfg.min_bins == 64
+    paper = EvINRConfig.paper(C=0.2, hidden_features=16, n_iters=3, c2f_iters=(1, 2), progress=False)
+    assert reconstruct(events, [0.25], paper).history["final_bins"] == 16      # 0.5 s at 1/32 s

@@ -58,7 +58,7 @@ class EvINRConfig:
     - ``EvINRConfig.v0_1()``: the kit's earlier default (the paper's plus first_omega_0 = 10 and
       head_lr_scale = 30, tuned on the demo scene alone); notebooks 03-11 train it.
 
-    The kit's default departs from the paper in six fields. Zoo means (CLAHE-SSIM / SSIM / MSE; wall
+    The kit's default departs from the paper in these fields. Zoo means (CLAHE-SSIM / SSIM / MSE; wall
     time per scene, 2 CPU cores shared with other jobs):
     ``python benchmarks/quality_zoo.py``: kit 0.555 / 0.583 / 0.030 in 1.6 s, paper 0.320 / 0.402 /
     0.051 in 92 s, v0.1 0.499 / 0.527 / 0.042 in 69 s, integration 0.425 / 0.513 / 0.042, high-pass
@@ -76,10 +76,16 @@ class EvINRConfig:
       lam from 0.003 to 1 moves CLAHE-SSIM only between 0.256 and 0.272.
     - hidden_features=256: the same zoo scores as 512 (within 0.002) at a quarter of the solve's
       d^2 work.
+    - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
+      2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
+      (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
+      quick zoo (1.5-2.25 s scenes) the mean CLAHE-SSIM drops from 0.528 to 0.522.
 
     Events and bins:
         C: contrast threshold (log units per event; paper: 1 for IJRR/HQF, 0.25 for AED).
         bin_duration: final event-frame length in seconds (paper: 1/32 s).
+        min_bins: at least this many final fixed-duration bins per network window (shorter bins
+            in short windows; 0: bin_duration alone decides, as in the paper).
         binning: "fixed" (paper: fixed-duration bins) or "equal_count" (the reference code).
         events_per_bin: final events per bin for "equal_count". The reference code fixes the number
             of bins instead (50, then 100 after one bisection at n_iters / 2, over the whole window):
@@ -128,6 +134,7 @@ class EvINRConfig:
 
     C: float = 1.0
     bin_duration: float = 1 / 32
+    min_bins: int = 64
     binning: str = "fixed"
     events_per_bin: int = 100
     temporal_loss: str = "difference"
@@ -176,7 +183,7 @@ class EvINRConfig:
                 raise EventDataError(f"{name} must be positive, got {getattr(self, name)}")
         if self.first_omega_0 is not None and not number("first_omega_0", self.first_omega_0) > 0:
             raise EventDataError(f"first_omega_0 must be positive (or None), got {self.first_omega_0}")
-        for name, low in (("n_iters", 0 if self.head_solve else 1), ("hidden_features", 1), ("hidden_layers", 0), ("lr_decay_every", 1),
+        for name, low in (("n_iters", 0 if self.head_solve else 1), ("min_bins", 0), ("hidden_features", 1), ("hidden_layers", 0), ("lr_decay_every", 1),
                           ("events_per_bin", 1)):
             if number(name, getattr(self, name), integer=True) < low:
                 raise EventDataError(f"{name} must be at least {low}, got {getattr(self, name)}")
@@ -210,7 +217,7 @@ class EvINRConfig:
         10 iterations for 300 iterations, coarse-to-fine at 100 and 200, 5 s sub-sequences; one
         learning rate for every layer; no head or offset solve."""
         return cls(**{"C": 1.0, "bin_duration": 1 / 32, "binning": "fixed", "temporal_loss": "derivative",
-                      "regularizer": "tikhonov", "lam": 0.05, "hidden_features": 512, "hidden_layers": 3,
+                      "min_bins": 0, "regularizer": "tikhonov", "lam": 0.05, "hidden_features": 512, "hidden_layers": 3,
                       "omega_0": 30.0, "first_omega_0": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
                       "tau": 5.0, "overlap": 0.5, "gamma": 0.6, "head_solve": False, "offset_solve": "none",
@@ -273,7 +280,7 @@ def _initial_boundaries(events: Events, windows: np.ndarray, cfg: EvINRConfig) -
     factor = 2 ** cfg.n_bisections
     out = []
     if cfg.binning == "fixed":
-        n_final = max(factor, int(round((windows[0, 1] - windows[0, 0]) / cfg.bin_duration)))
+        n_final = max(factor, cfg.min_bins, int(round((windows[0, 1] - windows[0, 0]) / cfg.bin_duration)))
         n0 = max(1, int(round(n_final / factor)))
         for lo, hi in windows:
             out.append(np.linspace(lo, hi, n0 + 1))
