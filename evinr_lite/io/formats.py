@@ -237,17 +237,7 @@ def read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: 
 
 
 def _read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None):
-    """An AEDAT4 recording (DV software, DAVIS / DVXplorer cameras) as a Recording.
-
-    Args:
-        path: the ``.aedat4`` file.
-        sensor_size: (H, W) to check against the file's (optional; a mismatch is an error).
-        t_start, t_end: seconds relative to ``t_origin`` (the whole seconds of the first event on
-            an absolute clock); only events and frames with t_start <= t < t_end are kept. The
-            file is decoded packet by packet, so memory holds only the window.
-    Returns:
-        Recording(events, frames or None, meta) with meta["format"] = "aedat4" and the tracks.
-    """
+    """:func:`read_aedat4`'s body, run inside its guard of the decoder's stderr."""
     from faery.extension import aedat
 
     from ..core.recording import Recording
