@@ -40,7 +40,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from evinr_lite.core.events import Events  # noqa: E402
 from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
 from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
-from evinr_lite.method.offset import median_gradient_offset  # noqa: E402
 from evinr_lite.method.tonemap import anchor_mean, tonemap_reinhard  # noqa: E402
 from evinr_lite.sim.zoo import ZOO, effective_C, quick, simulate  # noqa: E402
 
@@ -65,9 +64,7 @@ def run_method(name: str, events: Events, times: np.ndarray, C: float, variants:
     if name in BASELINES:
         frames = reconstruct_baseline(events, times, name, C=C).frames
     elif name == "integration_offset":
-        span = np.linspace(events.t[0], events.t[-1], 64)
-        g = median_gradient_offset(integrate_events(events, span, C=C))
-        frames = tonemap_reinhard(anchor_mean(integrate_events(events, times, C=C) + g))
+        frames = reconstruct_baseline(events, times, "integration", C=C, offset_solve="median_gradient").frames
     elif name in ORACLES:
         L = L_first + integrate_events(events, times, C=C) - integrate_events(events, times[:1], C=C)
         frames = np.clip(np.exp(L), 0, 1) if name == "oracle_linear" else tonemap_reinhard(anchor_mean(L))

@@ -110,3 +110,21 @@ def test_reconstruct_baseline_rejects_unknown_methods_and_parameters():
         reconstruct_baseline(ev, [0.5], "e2vid")
     with pytest.raises(TypeError, match="cutoff_hz"):
         reconstruct_baseline(ev, [0.5], "leaky", cutoff_hz=1.0)
+
+
+def test_baseline_with_the_offset_solve_removes_integration_ghost():
+    from evinr_lite import make_scene, simulate_scene
+    from evinr_lite.evaluation import score_sequence
+
+    scene = make_scene("camera", sensor_size=(48, 64), duration=1.0)
+    events = simulate_scene(scene, 0.0, 1.0, C=0.2, seed=0)
+    times = np.linspace(0.1, 0.9, 5)
+    gt = scene.intensity(times)
+    plain = reconstruct_baseline(events, times, "integration", C=0.2)
+    solved = reconstruct_baseline(events, times, "integration", C=0.2, offset_solve="median_gradient")
+    assert np.shape(solved.offset) == (48, 64) and solved.params["offset_solve"] == "median_gradient"
+    a = score_sequence(solved.frames, times, gt, times, "clahe", lpips_model=False)["ssim"]
+    b = score_sequence(plain.frames, times, gt, times, "clahe", lpips_model=False)["ssim"]
+    assert a > b
+    with pytest.raises(ValueError, match="offset_solve"):
+        reconstruct_baseline(events, times, "integration", C=0.2, offset_solve="median")

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 from .integration import integrate_events
+from .offset import median_gradient_offset
 from .tonemap import anchor_level, tonemap_reinhard
 
 __all__ = ["leaky_integration", "highpass_filter", "highpass_per_event", "reconstruct_baseline",
@@ -249,7 +250,7 @@ class BaselineReconstruction:
 
 def reconstruct_baseline(events: Events, query_times, method: str = "integration", C=0.2, gamma: float = 0.6,
                          display_mean: float = 0.5, *, t_start: float | None = None, t_end: float | None = None,
-                         **params) -> BaselineReconstruction:
+                         offset_solve: str = "none", **params) -> BaselineReconstruction:
     """Frames from a baseline, made like the EvINR solver's: anchor, then Reinhard tone mapping.
 
     The brightness anchor is the solver's: one constant is added so that the mean log intensity
@@ -260,6 +261,9 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
         method: "integration", "leaky" (params: leak_hz, L0) or "hf" (params: cutoff_hz, L0).
         C: contrast threshold (or (C_pos, C_neg)). gamma: tone-mapping exponent.
         t_start, t_end: span of the anchor (default: first/last event, widened to the queries).
+        offset_solve: "none" (one constant, as always), or "median_gradient": the per-pixel offset of
+            :mod:`evinr_lite.method.offset`, the kit's ghost solve, applied to the baseline (an
+            ablation: ``benchmarks/quality_zoo.py --methods integration_offset``).
 
     Returns:
         BaselineReconstruction with ``.frames`` [Q, H, W] in [0, 1].
@@ -288,11 +292,14 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
     t0 = time.perf_counter()
     grid = np.linspace(lo, hi, 64)
     L_all = fn(np.concatenate([grid, q]))
-    offset = anchor_level(gamma, display_mean) - float(L_all[:len(grid)].mean())
+    if offset_solve not in ("none", "median_gradient"):
+        raise ValueError(f"offset_solve must be 'none' or 'median_gradient', got {offset_solve!r}")
+    g = median_gradient_offset(L_all[:len(grid)]) if offset_solve == "median_gradient" else 0.0
+    offset = g + anchor_level(gamma, display_mean) - float((L_all[:len(grid)] + g).mean())
     L = L_all[len(grid):] + offset
     frames = tonemap_reinhard(L, gamma).astype(np.float32)
     seconds = time.perf_counter() - t0
     rec = BaselineReconstruction(q, L, frames, method, {"C": C, "gamma": gamma, "display_mean": display_mean,
-                                                        **{k: v for k, v in params.items() if k != "L0"}},
+                                                        "offset_solve": offset_solve, **{k: v for k, v in params.items() if k != "L0"}},
                                  offset, {"train_time_s": 0.0, "time_s": seconds}, fn)
     return rec
