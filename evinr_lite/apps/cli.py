@@ -162,17 +162,17 @@ def build_parser() -> argparse.ArgumentParser:
     where = batch.add_mutually_exclusive_group()
     where.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786 "
                                                              "(its workers must see the inputs and --out)")
-    where.add_argument("--workers", type=int, help="worker processes of a LocalCluster on this machine "
+    where.add_argument("--workers", type=_count, help="worker processes of a LocalCluster on this machine "
                                                    "(default: one per CPU core, at most one per recording)")
-    batch.add_argument("--torch-threads", type=int, default=1, help="torch threads per task (default: 1)")
+    batch.add_argument("--torch-threads", type=_count, default=1, help="torch threads per task (default: 1)")
     batch.add_argument("--sensor", type=_size, help="sensor size HxW, for files that do not record it")
-    batch.add_argument("--C", type=float, help="contrast threshold (default: each file's, else 1)")
-    batch.add_argument("--fps", type=float, help="frames to write per second (default: the ground-truth frame "
+    batch.add_argument("--C", type=_positive, help="contrast threshold (default: each file's, else 1)")
+    batch.add_argument("--fps", type=_positive, help="frames to write per second (default: the ground-truth frame "
                                                  "times); scores are always taken at the ground-truth frames")
     batch.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
     batch.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     batch.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
-    batch.add_argument("--seed", type=int, default=0)
+    batch.add_argument("--seed", type=_seed, default=0)
     batch.add_argument("--video", action="store_true", help="also write MP4 / GIF per recording")
     batch.add_argument("--quiet", action="store_true", help="no progress bar")
     return parser

@@ -178,7 +178,11 @@ def format_info(info: dict) -> str:
 def _parse_times(at) -> np.ndarray:
     """Seconds from an array, a list, '0.1,0.2' text, or a file with one time per line."""
     if isinstance(at, (str, Path)) and Path(at).is_file():
-        text = Path(at).read_text()
+        try:
+            text = Path(at).read_bytes().decode("utf-8-sig")
+        except UnicodeDecodeError as err:
+            raise EventDataError(f"{at}: not UTF-8 text (byte {err.start}); save the times as plain text, one number "
+                                 "of seconds per line") from None
         at = [tok for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")
               for tok in line.replace(",", " ").split()[-1:]]
     elif isinstance(at, str):
@@ -221,6 +225,14 @@ def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[
     if not (math.isfinite(fps) and fps > 0):
         raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
     n = int(math.floor((hi - lo) * fps))
+    H, W = rec.events.sensor_size
+    need, free = n * 40.0, _available_bytes("cpu")   # the times alone, before np.arange allocates them (check_memory
+    # then counts the frames)
+    if need > 0.8 * free:
+        raise EventDataError(f"{n:,} frames at {fps:g} per second over [{lo:.6f}, {hi:.6f}] s: this reconstruction "
+                             f"needs about {need / 2**30:,.1f} GiB of memory but about {free / 2**30:,.1f} GiB is free: "
+                             f"most of it for {n:,} output frames of {H}x{W} pixels; ask for fewer frames with fps= or "
+                             "at=, or shorten the window with t_start=/t_end=")
     times = lo + (np.arange(n) + 0.5) / fps if n >= 1 else np.array([0.5 * (lo + hi)])
     return times, f"{len(times)} frames at {fps:g} per second"
 

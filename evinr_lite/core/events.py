@@ -59,6 +59,9 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
         if encoding not in ("auto", "bool"):
             raise EventDataError(f"polarity is boolean but encoding={encoding!r} was requested; use encoding='bool' or 'auto'")
         return np.where(p, 1, -1).astype(np.int8)
+    if p.dtype.kind not in "iuf":
+        raise EventDataError(f"polarity must be numbers (-1/+1 or 0/1) or booleans, got dtype {p.dtype}; convert "
+                             "them to -1 (OFF) / +1 (ON) before loading")
     if not np.all(np.isfinite(p)):
         raise EventDataError("polarity contains NaN or inf; every event needs a polarity of -1/+1 (or 0/1)")
     values = np.unique(p)

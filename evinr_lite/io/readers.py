@@ -434,6 +434,12 @@ def _read_h5_open(f, path, t_start, t_end, time_unit) -> Recording:
     per_s = 1.0 / TIME_UNITS[unit]
     if n and not (math.isfinite(float(ts[0])) and math.isfinite(float(ts[n - 1]))):
         raise EventDataError(f"{path}: events/ts holds non-finite timestamps; the file is damaged")
+    if n and ts.dtype.kind == "f" and ts.dtype.itemsize < 8:   # float32 on an absolute clock rounds to minutes
+        step = float(np.spacing(np.abs(np.asarray([ts[0], ts[n - 1]], dtype=ts.dtype)).max())) / per_s
+        if step > 1e-6:
+            raise EventDataError(f"{path}: events/ts is {ts.dtype}, which at these values resolves only "
+                                 f"{step:.3g} s; the timestamps were rounded when the file was written: write "
+                                 "them as float64 (or integer microseconds)")
     origin = auto_origin(float(ts[0]) / per_s) if n else 0.0
     if t_start is not None and t_end is not None and t_end <= t_start:
         raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
@@ -526,6 +532,8 @@ def detect_format(path) -> str:
 
     import stat
 
+    if isinstance(path, (str, bytes)) and not path.strip():   # Path("") is ".", the current folder
+        raise EventDataError("the recording's path is empty; pass the file or folder to read")
     path = Path(path)
     if not path.exists():
         raise EventDataError(f"no such file or folder: {path}; check the path")
@@ -580,8 +588,8 @@ def read_recording(path, **kwargs) -> Recording:
     .npy -> :func:`read_events_npy` (the last two without frames). ``kwargs`` go to that reader.
     ``meta["format"]`` names the format read.
     """
-    path = Path(path)
     kind = detect_format(path)
+    path = Path(path)
     if kind == "ijrr":
         return read_ijrr_folder(path, **kwargs)
     if kind == "evreal":

@@ -26,6 +26,7 @@ The recipe (paper Sec. 3-4; defaults in :class:`EvINRConfig`):
 from __future__ import annotations
 
 import math
+import re
 import time
 from dataclasses import asdict, dataclass, field
 
@@ -196,6 +197,15 @@ class EvINRConfig:
             raise EventDataError(f"display_mean must be in (0, 1), got {self.display_mean}")
         if self.tau is not None and not number("tau", self.tau) > number("overlap", self.overlap) >= 0:
             raise EventDataError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
+        for name in ("head_solve", "coarse_to_fine", "progress"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise EventDataError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2**63:
+            raise EventDataError(f"seed must be a whole number in [0, 2**63), got {self.seed!r}")
+        if self.device is not None and not (isinstance(self.device, str) and
+                                            re.fullmatch(r"cpu|mps|cuda(:\d+)?", self.device)):
+            raise EventDataError(f"device must be 'cpu', 'cuda', 'cuda:N', 'mps' or None (a GPU when present), "
+                                 f"got {self.device!r}")
         self.c2f_iters = tuple(number("c2f_iters", i, integer=True) for i in self.c2f_iters)
         if self.coarse_to_fine:
             if any(i < 1 for i in self.c2f_iters) or list(self.c2f_iters) != sorted(set(self.c2f_iters)):
