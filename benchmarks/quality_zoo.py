@@ -241,10 +241,9 @@ def run(quick: bool = False, log=print) -> list[dict]:
     """The whole zoo (``python -m benchmarks`` calls this): writes the JSON, markdown and figure beside
     this script (``zoo_results[_quick].*``) and returns the target rows."""
     suffix = "_quick" if quick else ""
-    main(([ "--quick"] if quick else []) + [f"--json=benchmarks/zoo_results{suffix}.json",
-                                            f"--md=benchmarks/zoo_results{suffix}.md",
-                                            f"--figure=benchmarks/zoo_figure{suffix}.png"])
-    results = json.loads(Path(f"benchmarks/zoo_results{suffix}.json").read_text())["scenes"]
+    results = zoo_main((["--quick"] if quick else []) + [f"--json=benchmarks/zoo_results{suffix}.json",
+                                                        f"--md=benchmarks/zoo_results{suffix}.md",
+                                                        f"--figure=benchmarks/zoo_figure{suffix}.png"])
     return target_rows(results)
 
 
@@ -264,6 +263,12 @@ def parse_variant(text: str) -> tuple[str, dict]:
 
 
 def main(argv=None) -> int:
+    zoo_main(argv)
+    return 0
+
+
+def zoo_main(argv=None) -> dict:
+    """The command line's work; returns the results {scene: {"rows", "summary", ...}}."""
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--quick", action="store_true", help="smaller, shorter scenes")
     p.add_argument("--scenes", default=None, help="comma-separated scene names (default: all)")
@@ -307,7 +312,7 @@ def main(argv=None) -> int:
         Path(a.json).write_text(json.dumps({"quick": a.quick, "methods": methods, "variants": variants,
                                             "scenes": clean}, indent=2, default=float) + "\n")
         print(f"json: {a.json}")
-    return 0
+    return results
 
 
 if __name__ == "__main__":

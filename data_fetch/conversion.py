@@ -80,9 +80,9 @@ def check_writable_folder(folder: Path, what: str) -> None:
     """Refuse (DataFetchError) a folder that cannot be created or written, before any download or conversion."""
     import os
 
-    anchor = folder
-    while not anchor.exists() and anchor != anchor.parent:
-        anchor = anchor.parent
+    from evinr_lite.io.output import first_existing
+
+    anchor = first_existing(folder)
     if not anchor.is_dir():
         raise DataFetchError(f"the {what} {folder} cannot be created: {anchor} is a file, not a folder; set "
                              "EVINR_DATA to a folder (or choose another --out)")

@@ -38,7 +38,8 @@ from PIL import Image
 from ..core.events import InputError
 
 __all__ = ["atomic_output_dir", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
-           "termination_signals", "signals_deferred", "save_png", "save_json", "TERMINATION_SIGNALS"]
+           "termination_signals", "signals_deferred", "save_png", "save_json", "first_existing",
+           "TERMINATION_SIGNALS"]
 
 TERMINATION_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
 _TEMP_ROOM = len(".partial-4194304-") + 16 + 1   # bytes a temporary name adds to the folder's name
@@ -117,7 +118,8 @@ def signals_deferred():
                 os.kill(os.getpid(), pending[0])  # the default action, now that the block is done
 
 
-def _first_existing(path: Path) -> Path:
+def first_existing(path: Path) -> Path:
+    """``path`` or its nearest existing ancestor: where a folder that does not exist yet would be created."""
     while not os.path.lexists(path) and path != path.parent:
         path = path.parent
     return path
@@ -165,7 +167,7 @@ def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:
     if out.exists() and _inside(Path.cwd().resolve(), real):
         raise OutputError(f"the output folder {given} is the current folder (or contains it); replacing it would "
                           "delete the folder you are working in: choose a new folder, e.g. out_dir=rec")
-    anchor = _first_existing(out.parent)
+    anchor = first_existing(out.parent)
     if not anchor.is_dir():
         raise OutputError(f"cannot create the output folder {given}: {anchor} is a file, not a folder; choose "
                           "another out_dir=")

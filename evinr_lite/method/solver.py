@@ -559,8 +559,10 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     model, history = train_frame_inr(events, windows, cfg)
     model.eval()
     offsets = alignment_offsets(model, windows)
-    grid = np.linspace(t_start, t_end, max(64, 8 * len(windows)) if cfg.offset_solve != "none" else
-                       min(64, 8 * len(windows)))
+    n_grid = min(64, 8 * len(windows))          # the anchor's times (as the paper's recipe always had them)
+    if cfg.offset_solve == "median_gradient":
+        n_grid = max(64, 8 * len(windows))      # a temporal median wants many frames; the anchor shares them
+    grid = np.linspace(t_start, t_end, n_grid)
     if cfg.offset_solve == "median_gradient":   # one offset image for all networks: the alignment stays
         offsets += median_gradient_offset(blend_networks(model, windows, grid, offsets)).astype(np.float32)
     # anchor: mean log intensity over the sequence tone-maps to display_mean
