@@ -87,3 +87,20 @@ def test_committed_student_copies_are_up_to_date():
     found = msc.problems()
     assert not found, ("student copies differ from what the instructor notebooks generate:\n  "
                        + "\n  ".join(found) + "\nrun `python tools/make_student_copies.py` and commit students/")
+
+
+def test_student_lines_appear_and_instructor_cells_are_left_out():
+    nb = {"cells": [
+        _code("def f(x):\n    ### STUDENT: # TODO: return twice x\n    ### STUDENT: result = ...\n"
+              "    ### BEGIN SOLUTION\n    result = 2 * x\n    ### END SOLUTION\n    return result\n", cell_id="ex"),
+        {"cell_type": "markdown", "id": "ans", "metadata": {"tags": ["instructor"]}, "source": ["**Answer.** 4\n"]},
+        {"cell_type": "markdown", "id": "q", "metadata": {"tags": ["predict"]}, "source": ["**Predict.** f(2)?\n"]},
+    ], "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
+    student = msc.student_copy(nb, "01_x.ipynb")
+    sources = ["".join(c["source"]) for c in student["cells"]]
+    assert sources[1] == ("def f(x):\n    # TODO: return twice x\n    result = ...\n"
+                          "    raise NotImplementedError\n    return result\n")
+    assert [c["id"] for c in student["cells"][1:]] == ["ex", "q"]          # the answer is instructor-only
+    ns = {}
+    exec("".join(nb["cells"][0]["source"]), ns)                           # instructor copy: STUDENT lines are comments
+    assert ns["f"](2) == 4

@@ -7,7 +7,12 @@ For every numbered notebook in notebooks/, the student copy in students/ has:
 
 - each solution between ``### BEGIN SOLUTION`` and ``### END SOLUTION`` lines replaced by
   ``raise NotImplementedError`` (same indentation); stubs, docstrings and checks are kept, so an
-  unfinished exercise falls back to the reference with a "not finished" warning;
+  unfinished exercise falls back to the reference with a "does not pass the check yet" warning;
+- each ``### STUDENT: text`` line (a comment in the instructor copy, so it never runs there) turned
+  into ``text`` at the same indentation: the TODO banner and the skeleton (``result = ...``) that
+  only the student sees, e.g. ``### STUDENT: # TODO: sum the events with t_i <= t_q``;
+- every cell tagged ``instructor`` (cell metadata ``tags``) left out: the answers to the
+  predict-then-run questions and notes for the instructor;
 - all outputs and execution counts removed, and ``# NBVAL_CHECK_OUTPUT`` markers dropped (a student
   copy is only checked to run top to bottom);
 - a first markdown cell saying that it is generated, from which file, and how to regenerate it.
@@ -31,6 +36,8 @@ SOURCE_DIR = ROOT / "notebooks"
 STUDENT_DIR = ROOT / "students"
 PATTERN = "[0-9][0-9]_*.ipynb"
 SOLUTION = re.compile(r"^(?P<indent>[ \t]*)### BEGIN SOLUTION[^\n]*\n.*?^[ \t]*### END SOLUTION[^\n]*(\n|\Z)", re.S | re.M)
+STUDENT_LINE = re.compile(r"^(?P<indent>[ \t]*)### STUDENT: ?(?P<text>[^\n]*)$", re.M)
+INSTRUCTOR_TAG = "instructor"
 CHECK_MARK = re.compile(r"^# NBVAL_CHECK_OUTPUT[^\n]*\n?")
 HEADER_ID = "student-copy-header"
 
@@ -38,6 +45,11 @@ HEADER_ID = "student-copy-header"
 def without_solutions(source: str) -> str:
     """Replace every solution block by ``raise NotImplementedError`` at the block's indentation."""
     return SOLUTION.sub(lambda m: f"{m.group('indent')}raise NotImplementedError\n", source)
+
+
+def student_lines(source: str) -> str:
+    """Uncomment every ``### STUDENT: text`` line: the banner and skeleton only the student copy runs."""
+    return STUDENT_LINE.sub(lambda m: f"{m.group('indent')}{m.group('text')}", source)
 
 
 def count_exercises(nb: dict) -> int:
@@ -71,11 +83,11 @@ def student_copy(nb: dict, name: str) -> dict:
     n_exercises = count_exercises(nb)
     cells = []
     for cell in nb["cells"]:
-        if cell.get("id") == HEADER_ID:
+        if cell.get("id") == HEADER_ID or INSTRUCTOR_TAG in cell.get("metadata", {}).get("tags", []):
             continue
         cell.get("metadata", {}).pop("execution", None)
         if cell["cell_type"] == "code":
-            source = CHECK_MARK.sub("", without_solutions(_text(cell["source"])))
+            source = CHECK_MARK.sub("", student_lines(without_solutions(_text(cell["source"]))))
             cell["source"] = _lines(source)
             cell["outputs"] = []
             cell["execution_count"] = None
