@@ -54,6 +54,53 @@ def test_stub_is_not_done_and_falls_back_with_a_warning(toy, capsys):
     assert fn is _ref_scaled_cumsum
     out = capsys.readouterr().out
     assert "⚠ Exercise 'toy_cumsum' is not finished" in out and "reference solution" in out
+    assert "does not pass" not in out
+
+
+def test_a_finished_but_wrong_function_does_not_pass_yet_rather_than_unfinished(toy, capsys):
+    wrong = lambda x, C: C * np.cumsum(np.abs(x))  # noqa: E731 - finished, but wrong
+    with pytest.warns(ExerciseWarning, match="toy_cumsum' does not pass the check yet.*reference solution"):
+        fn = exercises.use(toy, wrong)
+    assert fn is _ref_scaled_cumsum
+    out = capsys.readouterr().out
+    assert "⚠ Exercise 'toy_cumsum' does not pass the check yet" in out and "not finished" not in out
+
+
+def test_fancy_index_plus_equals_gets_the_add_at_hint(capsys):
+    def ref(idx, w, n):
+        out = np.zeros(n)
+        np.add.at(out, idx, w)
+        return out
+
+    def fancy(idx, w, n):
+        out = np.zeros(n)
+        out[idx] += w  # a repeated index is added once
+        return out
+
+    exercises.register("toy_scatter", ref, lambda rng: [dict(idx=np.array([0, 2, 2, 3, 3, 3]), w=np.full(6, 0.2), n=5)])
+    try:
+        assert not exercises.check("toy_scatter", fancy)
+        assert "np.add.at" in capsys.readouterr().out
+    finally:
+        exercises._REGISTRY.pop("toy_scatter", None)
+
+
+def test_differences_along_the_wrong_axes_get_an_axis_hint(capsys):
+    img = np.random.default_rng(1).normal(size=(4, 5))
+    ref = lambda a: (np.diff(a, axis=-1)[:-1], np.diff(a, axis=-2)[:, :-1])  # noqa: E731 - (dx, dy), 3 x 4 each
+    swapped = lambda a: ref(a)[::-1]  # noqa: E731
+    wrong_axis = lambda a: np.diff(a, axis=-2)[:, :-1]  # noqa: E731 - rows instead of columns
+    exercises.register("toy_grad", ref, lambda rng: [dict(a=img)])
+    exercises.register("toy_dx", lambda a: ref(a)[0], lambda rng: [dict(a=np.random.default_rng(2).normal(size=(4, 4)))])
+    try:
+        assert not exercises.check("toy_grad", swapped)
+        out = capsys.readouterr().out
+        assert "swapped" in out or "wrong image axis" in out
+        assert not exercises.check("toy_dx", wrong_axis)
+        assert "wrong image axis" in capsys.readouterr().out
+    finally:
+        exercises._REGISTRY.pop("toy_grad", None)
+        exercises._REGISTRY.pop("toy_dx", None)
 
 
 def test_wrong_values_name_the_input_the_index_and_the_hint(toy, capsys):

@@ -1,5 +1,8 @@
 """A student copy (solutions removed by tools/make_student_copies.py) runs top to bottom, and every
-unfinished exercise shows a visible "not finished" warning (the cells below use the reference)."""
+unfinished exercise shows a visible "not finished" warning (the cells below use the reference).
+
+The student copies' stubs raise NotImplementedError, so they say "not finished"; a finished but
+wrong function would say "does not pass the check yet" instead (tests/test_exercises.py)."""
 import importlib.util
 import json
 from pathlib import Path

@@ -60,6 +60,7 @@ REFERENCE_MODULES = ["evinr_lite.teaching." + name for name in (
     "discussion_exercises", "realdata_exercises", "aed_exercises", "recording_exercises")]
 
 SEED = 0
+NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
 
 
 class ExerciseWarning(UserWarning):
@@ -276,7 +277,90 @@ def _generic_hint(got, expected) -> str | None:
             return f"off by a constant offset of {d[0]:.4g}"
         if np.allclose(g[1:], e[:-1], atol=tol) or np.allclose(g[:-1], e[1:], atol=tol):
             return "the values are shifted by one position; check the window/boundary indexing (< versus <=)"
+    axes = _axes_hint(_to_numpy(got), _to_numpy(expected), tol)
+    if axes:
+        return axes
+    if _one_contribution_per_entry(g, e, tol):
+        return ("each entry holds at most one contribution where several are expected: with fancy indexing, "
+                "`a[idx] += v` adds only once for a repeated index; accumulate with `np.add.at(a, idx, v)` "
+                "(or `np.bincount(idx, weights=v)`, or `index_put_(..., accumulate=True)` in torch)")
     return None
+
+
+def _axes_hint(g: np.ndarray, e: np.ndarray, tol: float) -> str | None:
+    """A pair of outputs (x part, y part) returned in the wrong order."""
+    g = np.asarray(g, dtype=np.float64)
+    e = np.asarray(e, dtype=np.float64)
+    if g.shape != e.shape or g.ndim < 2 or g.shape[0] != 2 or g[0].size < 2:
+        return None
+    if np.allclose(g[::-1], e, atol=tol) and not np.allclose(g, e, atol=tol):
+        return ("the two outputs are swapped: x is the column axis (axis -1, `np.diff(a, axis=-1)`), "
+                "y the row axis (axis -2)")
+    return None
+
+
+def _swap_last_axes(v):
+    """``v`` with the last two axes of every array (or tensor) of >= 2 dimensions swapped, recursively."""
+    if _is_tensor(v):
+        return v.transpose(-1, -2) if v.dim() >= 2 else v
+    if isinstance(v, np.ndarray):
+        return np.swapaxes(v, -1, -2) if v.ndim >= 2 else v
+    if isinstance(v, tuple):
+        return tuple(_swap_last_axes(x) for x in v)
+    if isinstance(v, list):
+        return [_swap_last_axes(x) for x in v]
+    return v
+
+
+def _has_image(v) -> bool:
+    if _is_tensor(v):
+        return v.dim() >= 2 and v.shape[-1] > 1 and v.shape[-2] > 1
+    if isinstance(v, np.ndarray):
+        return v.ndim >= 2 and v.shape[-1] > 1 and v.shape[-2] > 1
+    if isinstance(v, (tuple, list)):
+        return any(_has_image(x) for x in v)
+    return False
+
+
+def _wrong_axes_hint(ex: "Exercise", args: tuple, kwargs: dict, got) -> str | None:
+    """The learner's output equals the reference run on transposed images, transposed back.
+
+    That is the sign of differences (or sums) taken along the wrong image axis: rows for columns.
+    """
+    if not (any(_has_image(a) for a in args) or any(_has_image(v) for v in kwargs.values())):
+        return None
+    try:
+        w = _run(ex.reference, _swap_last_axes(args), {k: _swap_last_axes(v) for k, v in kwargs.items()})
+        w = _swap_last_axes(w)
+    except Exception:
+        return None
+    candidates = [w] + ([type(w)(reversed(w))] if isinstance(w, (tuple, list)) and len(w) == 2 else [])
+    for c in candidates:
+        try:
+            if _compare(got, c, ex.rtol, ex.atol) is None:
+                return ("the differences (or sums) run along the wrong image axis: x is the column "
+                        "index (axis -1), y the row index (axis -2)")
+        except Exception:
+            continue
+    return None
+
+
+def _one_contribution_per_entry(g: np.ndarray, e: np.ndarray, tol: float) -> bool:
+    """True when ``g`` looks like a scatter-add that kept one contribution per repeated index.
+
+    The sign of that mistake: the non-zero entries of ``g`` all have one magnitude (one event's
+    contribution), sit where ``e`` is non-zero or where contributions cancelled, and ``e`` has at
+    least one entry made of several contributions (a larger magnitude).
+    """
+    nzg = np.abs(g) > tol
+    if nzg.sum() < 1 or g.size < 2:
+        return False
+    mags = np.abs(g[nzg])
+    unit = mags[0]
+    if np.ptp(mags) > 1e-6 * max(unit, 1e-12):
+        return False
+    differ = np.abs(g - e) > tol
+    return bool(differ.any() and np.any(np.abs(e[differ]) > unit * (1 + 1e-6)))
 
 
 def _where_raised(err: BaseException) -> list[str]:
@@ -307,7 +391,7 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         try:
             got = _run(fn, args, kwargs)
         except NotImplementedError:
-            return False, "not done yet: the function raises NotImplementedError", [
+            return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except Exception as err:
             return False, f"raised {type(err).__name__} on {where}", [f"{type(err).__name__}: {err}"] + _where_raised(err)
@@ -330,6 +414,8 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                         break
                 except Exception:
                     continue
+            if hint is None:
+                hint = _wrong_axes_hint(ex, args, kwargs, got)
             if hint is None:
                 hint = _generic_hint(got, expected)
         if hint:
@@ -376,12 +462,15 @@ def use(name: str, fn: Callable, *, verbose: bool = True) -> Callable:
         if verbose:
             print(f"✓ Using your {name}.")
         return fn
-    banner = f"⚠ Exercise '{name}' is not finished: the cells below use the reference solution."
+    # "not finished" only for a stub that still raises NotImplementedError; a finished function
+    # that gives wrong values "does not pass the check yet" (its author did finish it).
+    state = "is not finished" if headline.startswith(NOT_DONE) else "does not pass the check yet"
+    banner = f"⚠ Exercise '{name}' {state}: the cells below use the reference solution."
     if verbose:
         rule = "=" * 88
         print(f"{rule}\n{banner}\n  Why: {headline}.\n"
               f"  Run exercises.check({name!r}, your_function) for details.\n{rule}")
-    warnings.warn(f"Exercise '{name}' is not finished ({headline}); the cells below use the reference solution.",
+    warnings.warn(f"Exercise '{name}' {state} ({headline}); the cells below use the reference solution.",
                   ExerciseWarning, stacklevel=2)
     return ex.reference
 
