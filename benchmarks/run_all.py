@@ -13,6 +13,7 @@ Benchmarks (each is also a script with its own --help):
     inference    benchmarks/inference.py       frames per second at 240x180 and 408x306
     end_to_end   benchmarks/end_to_end.py      a 5 s 240x180 sequence with the paper's defaults: time and quality
     zoo          benchmarks/quality_zoo.py     quality and time on the scene zoo (kit, paper, v0.1, baselines, oracle)
+    robustness   benchmarks/robustness.py      quality as events are thinned, noise added, C mis-given (3 zoo scenes)
 
 ratio >= 1 means the target is met (measured / target, or target / measured for times and memory).
 Times are wall-clock on this machine, the fastest of several repeats; on a machine shared with
@@ -28,8 +29,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks import (binning_speed, end_to_end, ensemble_speed, inference, quality_zoo, simulate_speed,  # noqa: E402
-                        train_step)
+from benchmarks import (binning_speed, end_to_end, ensemble_speed, inference, quality_zoo, robustness,  # noqa: E402
+                        simulate_speed, train_step)
 from benchmarks.common import machine, print_table, write_json  # noqa: E402
 
 BENCHMARKS = {
@@ -40,6 +41,7 @@ BENCHMARKS = {
     "inference": lambda a: inference.run(a.quick, a.device),
     "end_to_end": lambda a: end_to_end.run(a.quick, a.device),
     "zoo": lambda a: quality_zoo.run(a.quick),
+    "robustness": lambda a: robustness.run(a.quick),
 }
 
 

@@ -1,4 +1,4 @@
-"""Figures of scores: results bar charts, ablation panels, the time/quality trade-off."""
+"""Figures of scores: results bar charts, ablation panels, the time/quality trade-off, robustness sweeps."""
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
@@ -6,7 +6,7 @@ import numpy as np
 
 from ..evaluation.ablation import COLUMN_LABELS, pareto_front
 
-__all__ = ["plot_results", "plot_ablation", "plot_tradeoff"]
+__all__ = ["plot_results", "plot_ablation", "plot_tradeoff", "plot_robustness"]
 
 
 def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
@@ -119,3 +119,58 @@ def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = 
            title=title or "time against quality")
     ax.legend(fontsize=8)
     return ax
+
+
+def plot_robustness(results: dict, metrics=("ssim_clahe", "ssim_none"), *, fontsize: float = 9, fig=None):
+    """Robustness sweeps: one column of panels per sweep, one row per metric, one line per method.
+
+    Args:
+        results: {"methods": [names], "sweeps": {name: {"label": x-axis label with units, "levels": [L],
+            "clean": the unperturbed level, "means": {method: {metric: [L values, None where not run]}}}}}
+            (what ``benchmarks/robustness.py`` writes). A sweep named "C_scale" gets a log x axis.
+        metrics: one row of panels each (default CLAHE-SSIM over plain SSIM).
+        fontsize: points, for every label, tick and legend (>= 9 for print).
+        fig: a figure to draw into (cleared); a new one when None.
+
+    Returns:
+        The figure: len(metrics) x len(sweeps) axes, each with one line per method that has values,
+        and a dotted vertical line at the clean level.
+    """
+    sweeps = results.get("sweeps") or {}
+    if not sweeps:
+        raise ValueError("results hold no sweeps; pass what benchmarks/robustness.py writes (results['sweeps'])")
+    methods = list(results.get("methods") or next(iter(sweeps.values()))["means"])
+    names = {"ssim_clahe": "CLAHE-SSIM", "ssim_none": "SSIM (no equalisation)", "mse_none": "MSE (no equalisation)"}
+    if fig is None:
+        fig = plt.figure(figsize=(3.6 * len(sweeps), 2.7 * len(metrics) + 0.5))
+    else:
+        fig.clf()
+    axes = fig.subplots(len(metrics), len(sweeps), squeeze=False)
+    colours = {m: f"C{i}" for i, m in enumerate(methods)}
+    for j, (s, sw) in enumerate(sweeps.items()):
+        x = np.asarray(sw["levels"], dtype=np.float64)
+        for i, metric in enumerate(metrics):
+            ax = axes[i, j]
+            for m in methods:
+                vals = sw["means"].get(m, {}).get(metric)
+                if vals is None:
+                    continue
+                y = np.array([np.nan if v is None else v for v in vals], dtype=np.float64)
+                ok = np.isfinite(y)
+                if ok.any():
+                    ax.plot(x[ok], y[ok], "o-", color=colours[m], label=m, ms=4, lw=1.5)
+            ax.axvline(sw["clean"], color="0.6", ls=":", lw=1)
+            if s == "C_scale":
+                ax.set_xscale("log")
+                ax.set_xticks(x, [f"{v:g}" for v in x])
+                ax.minorticks_off()
+            ax.set_xlabel(sw.get("label", s), fontsize=fontsize)
+            ax.set_ylabel(names.get(metric, metric), fontsize=fontsize)
+            ax.tick_params(labelsize=fontsize)
+            if i == 0:
+                ax.set_title(s, fontsize=fontsize + 1)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=max(1, len(labels)), fontsize=fontsize, frameon=False)
+    fig.suptitle("Robustness: mean over scenes (dotted: the clean condition)", fontsize=fontsize + 1)
+    fig.tight_layout(rect=(0, 0.4 / fig.get_figheight(), 1, 1))
+    return fig
