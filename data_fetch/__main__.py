@@ -92,7 +92,8 @@ def _cmd_convert(args) -> int:
     print(convert(args.raw, args.out, dataset=args.dataset, sequence=args.sequence,
                   sensor_size=tuple(args.sensor_size) if args.sensor_size else None, C=args.C,
                   event_topic=args.event_topic, image_topic=args.image_topic, progress=not args.quiet,
-                  overwrite=args.overwrite, time_unit=args.time_unit))
+                  overwrite=args.overwrite, time_unit=args.time_unit, grey=args.grey,
+                  **({} if args.cfa is None else {"cfa": None if args.cfa == "none" else args.cfa})))
     return 0
 
 
@@ -151,6 +152,9 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     q.add_argument("--event-topic")
     q.add_argument("--image-topic")
+    q.add_argument("--cfa", choices=("RGGB", "GRBG", "GBRG", "BGGR", "none"),
+                   help="colour filter of a colour camera's bag (default: the dataset's; CED: RGGB); none: mono")
+    q.add_argument("--grey", action="store_true", help="store grey frames only (default: colour frames stay colour)")
     q.add_argument("--quiet", action="store_true")
     q.set_defaults(func=_cmd_convert)
     q = sub.add_parser("info", help="describe a converted .h5")

@@ -119,7 +119,8 @@ def check_settings(*, C=None, sensor_size=None, eval_window=None, time_unit=None
 
 def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None = None, sensor_size=None,
             C: float | None = None, eval_window=_UNSET, event_topic: str | None = None, image_topic=None,
-            progress: bool = True, overwrite: bool = False, time_unit: str | None = None) -> Path:
+            progress: bool = True, overwrite: bool = False, time_unit: str | None = None, cfa=_UNSET,
+            grey: bool = False) -> Path:
     """Convert a raw recording to the canonical HDF5 file and return its path.
 
     Args:
@@ -140,10 +141,18 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
         overwrite: replace an existing file at ``out`` (refused otherwise, whatever it holds).
         time_unit: unit of the raw timestamps of text recordings (IJRR folders / zips) and HQF-style
             h5 ('s', 'ms', 'us', 'ns'); None: decimals are seconds, integers microseconds.
+        cfa: colour filter of a colour camera's bag ("RGGB", "GRBG", "GBRG", "BGGR"; None: mono);
+            default: the registry's (CED: "RGGB"), stored as the canonical ``cfa`` attribute.
+        grey: store grey frames only (the layout before colour was kept); default False keeps
+            colour frames (/frames/rgb) beside their grey version.
     """
     from . import cache_dir
 
     check_settings(C=C, sensor_size=sensor_size, eval_window=eval_window, time_unit=time_unit)
+    if cfa is not _UNSET:
+        from evinr_lite.io.canonical import check_cfa
+
+        cfa = check_cfa(cfa, DataFetchError)
     raw = Path(raw).expanduser()
     if not raw.exists():
         raise DataFetchError(f"no such file or folder: {raw}")
@@ -193,6 +202,8 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
 
     if time_unit not in (None, "auto") and kind not in ("ijrr", "h5"):
         raise DataFetchError(f"{raw}: a {kind} recording stores its time unit itself; leave --time-unit out")
+    if cfa not in (_UNSET, None) and kind not in ("bag", "bag-zip"):
+        raise DataFetchError(f"{raw}: cfa= applies to ROS bags (CED) only, not a {kind} recording; leave it out")
     if kind == "ijrr":
         from .convert_ijrr import convert_ijrr
 
@@ -204,7 +215,8 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
     from .convert_bag import convert_bag
 
     topics = dict(event_topic=event_topic or (ds.event_topic if ds else None),
-                  image_topic=image_topic or ((ds.image_topics or None) if ds else None))
+                  image_topic=image_topic or ((ds.image_topics or None) if ds else None),
+                  cfa=(ds.cfa if ds else None) if cfa is _UNSET else cfa, grey=grey)
     if kind == "bag":
         return convert_bag(raw, out, **common, **topics)
     # a CED-style zip of bags: take out the one bag, convert it, delete the copy

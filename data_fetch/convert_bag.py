@@ -7,6 +7,13 @@ after the header come height, width, the event count and then packed 13-byte eve
 (uint16 x, uint16 y, uint32 sec, uint32 nsec, uint8 polarity), which is far faster than building a
 Python object per event. The numpy path is used only when the connection's message definition has
 the dvs_msgs/EventArray md5; any other definition goes through rosbags' deserializer.
+
+Colour cameras (CED's Color DAVIS346: a 2 x 2 RGGB Bayer filter over both the events and the APS):
+``cfa="RGGB"`` records the filter with the events (the canonical ``cfa`` attribute), and colour frames
+are kept in colour (/frames/rgb, with their grey version in /frames/images): rgb8 / bgr8 / rgba8 /
+bgra8 as they are, bayer_rggb8-style mosaics and (with ``cfa``) mono8 raw mosaics debayered
+bilinearly (:func:`debayer`). ``grey=True`` stores grey frames
+only, as before colour was kept.
 """
 from __future__ import annotations
 
@@ -18,11 +25,12 @@ import numpy as np
 from evinr_lite.core.events import LARGE_T, EventDataError
 from evinr_lite.io.text import NS
 from evinr_lite.core.frames import to_grey_uint8 as _to_grey_uint8
+from evinr_lite.io.canonical import CFA_NAMES, check_cfa
 
 from .canonical import CanonicalWriter
 from .errors import ConversionError
 
-__all__ = ["convert_bag", "decode_event_array", "decode_image", "EVENT_DTYPE", "EVENT_ARRAY_MD5"]
+__all__ = ["convert_bag", "decode_event_array", "decode_image", "debayer", "EVENT_DTYPE", "EVENT_ARRAY_MD5"]
 
 log = logging.getLogger("data_fetch")
 
@@ -60,18 +68,50 @@ def _events_from_message(msg) -> tuple[int, int, np.ndarray]:
     return int(msg.height), int(msg.width), ev
 
 
-def decode_image(msg, source: str = "image") -> np.ndarray:
-    """sensor_msgs/Image (rosbags object) -> grey uint8 [H, W].
+def debayer(raw: np.ndarray, cfa: str) -> np.ndarray:
+    """A raw 2 x 2 Bayer mosaic uint8 [H, W] (filter ``cfa``, e.g. "RGGB") -> colour uint8 [H, W, 3].
 
-    Supports mono8/8UC1, mono16/16UC1, rgb8, bgr8, rgba8, bgra8 (colour is converted to grey with
-    ITU-R 709 weights). Bayer mosaics are refused: use the bag's demosaiced colour topic.
+    Bilinear: every photosite keeps its own value in its own channel; a missing channel is the mean
+    of that channel's nearest photosites (the 2 or 4 neighbours: weights 1 2 1 / 2 4 2 / 1 2 1).
+    """
+    from scipy import ndimage
+
+    from evinr_lite.sim.quadbayer import BAYER, cfa_pattern
+
+    raw = np.asarray(raw)
+    H, W = raw.shape
+    if H % 2 or W % 2:
+        raise ConversionError(f"a {cfa} mosaic must have an even size to be debayered, got {raw.shape}")
+    pattern = cfa_pattern((H, W), CFA_NAMES[cfa], block=BAYER)
+    kernel = np.array([[1.0, 2.0, 1.0], [2.0, 4.0, 2.0], [1.0, 2.0, 1.0]])
+    values = raw.astype(np.float64)
+    out = []
+    for c in range(3):
+        mask = (pattern == c).astype(np.float64)
+        num = ndimage.convolve(values * mask, kernel, mode="mirror")
+        den = ndimage.convolve(mask, kernel, mode="mirror")
+        out.append(np.where(mask > 0, values, num / den))
+    return np.clip(np.round(np.stack(out, axis=-1)), 0, 255).astype(np.uint8)
+
+
+def decode_image(msg, source: str = "image", *, colour: bool = False, cfa: str | None = None) -> np.ndarray:
+    """sensor_msgs/Image (rosbags object) -> grey uint8 [H, W], or colour uint8 [H, W, 3] (R, G, B).
+
+    Supports mono8/8UC1, mono16/16UC1, rgb8, bgr8, rgba8, bgra8 and the Bayer mosaics bayer_rggb8,
+    bayer_grbg8, bayer_gbrg8, bayer_bggr8 (debayered bilinearly). ``colour``: colour images are
+    returned in colour (else converted to grey with ITU-R 709 weights). ``cfa``: the camera's colour
+    filter; mono8 images are then raw mosaics with that filter and are debayered.
     """
     h, w, step, enc = int(msg.height), int(msg.width), int(msg.step), msg.encoding.lower()
     data = np.asarray(msg.data, dtype=np.uint8)
     if data.size < h * step:
         raise ConversionError(f"{source}: image data holds {data.size} bytes, expected {h} x {step}")
     rows = data[:h * step].reshape(h, step)
-    if enc in ("mono8", "8uc1"):
+    if enc.startswith("bayer_") and enc.endswith("8") and enc[6:10].upper() in CFA_NAMES:
+        img = debayer(rows[:, :w], enc[6:10].upper())
+    elif enc in ("mono8", "8uc1") and cfa is not None:
+        img = debayer(rows[:, :w], cfa)
+    elif enc in ("mono8", "8uc1"):
         img = rows[:, :w]
     elif enc in ("mono16", "16uc1"):
         img = rows[:, :2 * w].copy().view(">u2" if msg.is_bigendian else "<u2").astype(np.uint16)
@@ -82,7 +122,9 @@ def decode_image(msg, source: str = "image") -> np.ndarray:
             img = img[..., [2, 1, 0]]
     else:
         raise ConversionError(f"{source}: image encoding {msg.encoding!r} is not supported (mono8, mono16, rgb8, "
-                              "bgr8); for a Bayer mosaic pick the demosaiced colour topic with image_topic=")
+                              "bgr8, bayer_rggb8, ...); pick another image topic with image_topic=")
+    if colour and img.ndim == 3 and img.dtype == np.uint8:
+        return np.ascontiguousarray(img[..., :3])
     try:
         return _to_grey_uint8(img, source)
     except EventDataError as err:
@@ -146,7 +188,8 @@ class _Ordered:
 
 def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None, dataset: str = "",
                 sequence: str | None = None, source: str = "", source_url: str = "",
-                event_topic: str | None = None, image_topic=None, progress: bool = True) -> Path:
+                event_topic: str | None = None, image_topic=None, progress: bool = True, cfa: str | None = None,
+                grey: bool = False) -> Path:
     """Convert a ROS1 bag with dvs_msgs/EventArray events (and sensor_msgs/Image frames) to ``out``.
 
     Args:
@@ -157,6 +200,10 @@ def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None
         event_topic: topic of the events; None: /dvs/events, /davis/left/events, or the only one.
         image_topic: topic (or list of topics in order of preference) of the frames; None:
             /dvs/image_raw, /davis/left/image_raw, /dvs/image_color, or the only one.
+        cfa: the colour filter of a colour camera ("RGGB" for CED's Color DAVIS346; None: mono),
+            stored as the file's ``cfa`` attribute; mono8 frames are then raw mosaics, debayered.
+        grey: store grey frames only (colour frames converted with ITU-R 709 weights), the
+            layout from before colour was kept; False keeps colour frames in /frames/rgb.
     """
     from rosbags.rosbag1 import Reader, ReaderError
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
@@ -164,6 +211,7 @@ def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None
 
     path = Path(path)
     sequence = sequence or path.stem
+    cfa = check_cfa(cfa, ConversionError)
     damaged = (f"the bag is damaged or incomplete (or not a ROS1 bag): delete {path} and run the command "
                "again to download it anew")
     try:
@@ -194,7 +242,7 @@ def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None
             H, W = state["size"]
             w = CanonicalWriter(out, sensor_size=(H, W), t_origin=float(state["origin"]), dataset=dataset,
                                 sequence=sequence, source=source, source_url=source_url, raw_file=path.name,
-                                C=C, eval_window=eval_window, converter="data_fetch.convert_bag",
+                                C=C, eval_window=eval_window, converter="data_fetch.convert_bag", cfa=cfa,
                                 meta={"event_topic": ev_conn.topic,
                                       "image_topic": img_conn.topic if img_conn is not None else None})
             writer_box["w"] = w
@@ -207,8 +255,8 @@ def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None
             if w_ is None:
                 return
             for sec, nsec, im in frames:
-                if im.shape != tuple(state["size"]):
-                    raise ConversionError(f"{path}: frames on {img_conn.topic} are {im.shape} but the events' "
+                if im.shape[:2] != tuple(state["size"]):
+                    raise ConversionError(f"{path}: frames on {img_conn.topic} are {im.shape[:2]} but the events' "
                                           f"sensor is {tuple(state['size'])} (H, W); pick another image_topic")
                 w_.add_frame(im, ((sec - state["origin"]) * NS + nsec) / NS)
             frames.clear()
@@ -241,7 +289,7 @@ def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None
                     ordered.add(rel_ns / NS, ev["x"], ev["y"], np.where(ev["p"] > 0, 1, -1).astype(np.int8))
                 else:
                     msg = store.deserialize_ros1(raw, conn.msgtype)
-                    image = decode_image(msg, f"{path}:{conn.topic}")
+                    image = decode_image(msg, f"{path}:{conn.topic}", colour=not grey, cfa=cfa)
                     frames.append((int(msg.header.stamp.sec), int(msg.header.stamp.nanosec), image))
                 drain()
         ordered.flush()

@@ -67,6 +67,7 @@ class Dataset:
     note: str = ""
     url_pattern: str | None = None   # for names not in `sequences` (IJRR): "{name}" is replaced
     citation: str = ""
+    cfa: str | None = None           # colour filter of a colour sensor (2 x 2 Bayer, e.g. "RGGB"); None: mono
 
     def sequence(self, name: str) -> Sequence:
         return get_sequence(self.name, name)
@@ -190,8 +191,10 @@ def _ced() -> Dataset:
         "https://rpg.ifi.uzh.ch/CED.html", seqs,
         event_topic="/dvs/events", image_topics=("/dvs/image_color", "/dvs/image_raw"),
         note="one zip of rosbags per category (simple, people, indoors, ...); the bag is taken out of the "
-             "zip; frames come from image_color converted to grey; a bag placed by hand is used as is",
+             "zip; events keep their RGGB colour filter (cfa attribute) and frames stay colour (image_color; "
+             "image_raw mosaics are debayered); convert --grey for grey frames; a bag placed by hand is used as is",
         citation="Scheerlinck et al., CED: Color event camera dataset, CVPRW 2019",
+        cfa="RGGB",   # Color DAVIS346: photosite (0, 0) red, as rpg_e2vid's colour split assumes
     )
 
 

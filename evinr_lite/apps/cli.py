@@ -133,6 +133,10 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     rec.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     rec.add_argument("--seed", type=_seed, default=0)
+    rec.add_argument("--colour", action="store_true",
+                     help="reconstruct in colour from a colour event camera (a recording with a 2x2 colour filter, "
+                          "e.g. CED converted by data_fetch): one EvINR per channel, colour frames at half the "
+                          "sensor's size; scored on grey, plus the chroma correlation against colour frames")
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -192,7 +196,7 @@ def _reconstruct(args) -> None:
     run_reconstruct(args.recording, args.out, sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
                     t_start=args.start, t_end=args.end, device=args.device, n_iters=args.iters, seed=args.seed,
                     recipe=args.recipe, overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet,
-                    time_unit=args.time_unit, command=" ".join(["evinr-lite", *sys.argv[1:]]))
+                    time_unit=args.time_unit, command=" ".join(["evinr-lite", *sys.argv[1:]]), colour=args.colour)
 
 
 def _demo(args) -> None:

@@ -139,7 +139,7 @@ def describe_recording(rec: Recording) -> dict:
         info.update(n_frames=len(fr), frame_size=list(fr.size), frames_t_first=float(fr.t[0]),
                     frames_t_last=float(fr.t[-1]),
                     frame_rate_per_s=(len(fr) - 1) / float(fr.t[-1] - fr.t[0]) if len(fr) > 1 and fr.t[-1] > fr.t[0] else None)
-    for key in ("C", "eval_window", "dataset", "sequence", "encoding"):
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "cfa"):
         if rec.meta.get(key) is not None:
             value = rec.meta[key]
             info[key] = list(value) if isinstance(value, tuple) else value
@@ -167,7 +167,7 @@ def format_info(info: dict) -> str:
                      + (f" ({fr:.1f} per s)" if fr else "") + "  -> reconstructions are scored against them")
     else:
         lines.append("frames        none (nothing to score against)")
-    for key in ("C", "eval_window", "dataset", "sequence", "encoding"):
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "cfa"):
         if key in info:
             lines.append(f"{key:<13} {info[key]}")
     return "\n".join(lines)
@@ -519,7 +519,7 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
                     t_start: float | None = None, t_end: float | None = None, device: str | None = None,
                     n_iters: int | None = None, seed: int = 0, overwrite: bool = False, video: bool = True,
                     progress: bool = True, time_unit: str | None = None, log=print, command: str = "",
-                    recipe: str = "kit") -> dict:
+                    recipe: str = "kit", colour: bool = False) -> dict:
     """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
 
     Every check that can fail runs before training: the options, the output folder (checked,
@@ -528,7 +528,8 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
     C: the contrast threshold; None takes the file's (canonical files store it), else DEFAULT_C = 1
     (the paper's for DAVIS data). time_unit: the unit of integer or text timestamps ('s', 'ms',
     'us', 'ns'; None: the reader's detection). ``command`` is recorded in the lock so a second run
-    can name this one.
+    can name this one. colour: reconstruct in colour from a recording with a colour filter
+    (``meta["cfa"]``; :mod:`evinr_lite.apps.colour_job`), writing colour frames at (H/2, W/2).
     Returns the contents of run.json (with "scores" when the recording has frames).
     """
     from ..core.runtime import default_device
@@ -543,6 +544,10 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
         except RuntimeError as err:
             raise EventDataError(str(err)) from None
         rec = load_recording(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
+        if colour:   # before any training: a mono recording is refused with the fix
+            from .colour_job import check_colour_recording
+
+            check_colour_recording(rec)
         times, source = choose_times(rec, fps=fps, at=at)
         C_source = "given" if C is not None else ("from the file" if rec.meta.get("C") else "default (pass C=)")
         C = float(C if C is not None else rec.meta.get("C") or DEFAULT_C)
@@ -555,9 +560,18 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
             + f" in {time.perf_counter() - t0:.1f} s")
         log(f"reconstructing {source} with EvINR ({recipe} recipe, C = {C:g} {C_source}, {config.n_iters} Adam "
             f"iterations{' + the closed-form output layer' if config.head_solve else ''}, {device_name})")
-        result = reconstruct_recording(rec, times, config)
-        scores = score_recording(result, rec.frames)
+        if colour:   # one EvINR per channel of the colour filter (apps/colour_job.py)
+            from .colour_job import reconstruct_colour_recording, score_colour_recording
+
+            result = reconstruct_colour_recording(rec, times, config)
+            scores, colour_scores = score_colour_recording(result, rec, score_predictions)
+        else:
+            result = reconstruct_recording(rec, times, config)
+            scores = score_recording(result, rec.frames)
         settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
+        if colour:
+            settings["colour"] = {"cfa": result.history["cfa"], "thresholds": result.history["thresholds"],
+                                  "grid": list(result.frames.shape[1:3]), **(colour_scores or {})}
         run = export_reconstruction(target, rec, result, scores, settings=settings, video=video, log=log)
     seconds = time.perf_counter() - t0
     out_dir = target.given
@@ -569,6 +583,9 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
         line += f"; scored against {scores['none']['n_frames']} ground-truth frames ({'; '.join(parts)})"
     else:
         line += "; no ground-truth frames, not scored"
+    chroma = (run.get("colour") or {}).get("chroma_correlation")
+    if chroma:
+        line += f"; colour (grey world): chroma correlation R-G {chroma['R-G']:.3f}, B-G {chroma['B-G']:.3f}"
     log(line)
     run["total_time_s"] = seconds
     return run

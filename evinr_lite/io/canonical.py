@@ -10,14 +10,30 @@ exists) ends up in this one layout, so the rest of the kit has a single real-dat
                            = whole sequence), eval_window_published (as published, seconds
                            after t_zero), t_zero (s, the zero of the published windows:
                            earliest event or frame), n_events, n_frames, t_first, t_last,
-                           converter, meta_json (a JSON object: calibration, notes, ...)
+                           converter, meta_json (a JSON object: calibration, notes, ...);
+                           optional cfa (colour sensors only, see below)
     /events/t              float64 [N], seconds since t_origin, non-decreasing
     /events/x, /events/y   uint16 [N], column and row
     /events/p              int8 [N], polarity -1 / +1
     /events/t_index        float64 [ceil(N / stride)], t[::stride] (attr "stride"): a coarse
                            index so that a time window is found by reading one chunk
     /frames/images         uint8 [F, H, W], ground-truth frames (grey), one chunk per frame
+    /frames/rgb            optional, uint8 [F, H, W, 3]: the same frames in colour (R, G, B),
+                           present only when the source frames are colour; /frames/images then
+                           holds their grey version (ITU-R 709 weights, core.frames.to_grey_uint8)
     /frames/t              float64 [F], seconds since t_origin, non-decreasing
+
+Colour sensors (e.g. the Color DAVIS346 of CED, a 2 x 2 Bayer filter over both the events and the
+APS frames) carry the root attribute ``cfa``: the colours of the photosites (row 0, column 0),
+(0, 1), (1, 0), (1, 1) of the event sensor, one of "RGGB", "GRBG", "GBRG", "BGGR" (the phase is in
+the name: "GRBG" is RGGB shifted by one column). Events stay at the photosites (full resolution);
+split them by colour with :func:`evinr_lite.sim.quadbayer.demosaic_events_rgb` (``block=1``,
+``phase=cfa_phase(cfa)``). Files without ``cfa`` are mono; files without /frames/rgb have grey
+frames only. Both additions are optional, so format_version stays 1: files written before them
+read as before, and a reader that ignores them still finds grey frames in /frames/images.
+:func:`read_canonical` exposes them as ``meta["cfa"]`` (None for mono), ``meta["frames_rgb"]``
+(uint8 [F, H, W, 3], one per frame of ``recording.frames``, or None) and ``meta["frames_rgb_t"]``
+(their times, equal to ``recording.frames.t``).
 
 Event datasets are chunked and compressed; readers never load more than the requested
 window (or one chunk at a time with :func:`iter_canonical_events`), so a sequence of 10^8
@@ -40,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.events import EventDataError, Events
-from ..core.frames import Frames
+from ..core.frames import Frames, to_grey_uint8
 
 __all__ = [
     "CanonicalWriter",
@@ -54,6 +70,9 @@ __all__ = [
     "read_canonical",
     "iter_canonical_events",
     "find_time_index",
+    "CFA_NAMES",
+    "check_cfa",
+    "cfa_phase",
 ]
 
 FORMAT_NAME = "evinr-lite canonical"
@@ -63,6 +82,29 @@ COMPRESSION = dict(compression="gzip", compression_opts=4, shuffle=True)
 DTYPES = {"t": np.float64, "x": np.uint16, "y": np.uint16, "p": np.int8}
 log = logging.getLogger("evinr_lite")
 EVENT_FIELDS = ("t", "x", "y", "p")
+# 2 x 2 Bayer filters by the colours of photosites (0, 0), (0, 1), (1, 0), (1, 1) -> phase (dy, dx) of
+# the RGGB tile (evinr_lite.sim.quadbayer's convention, block = 1)
+CFA_NAMES = {"RGGB": (0, 0), "GRBG": (0, 1), "GBRG": (1, 0), "BGGR": (1, 1)}
+
+
+def check_cfa(cfa, error=EventDataError) -> str | None:
+    """A colour filter name checked (None = mono): one of :data:`CFA_NAMES`, upper-cased."""
+    if cfa is None:
+        return None
+    name = str(cfa).upper() if isinstance(cfa, str) else None
+    if name not in CFA_NAMES:
+        raise error(f"cfa must be one of {', '.join(CFA_NAMES)} (the colours of the photosites (0, 0), (0, 1), "
+                    f"(1, 0), (1, 1)) or None for a mono sensor; got {cfa!r}")
+    return name
+
+
+def cfa_phase(cfa) -> tuple[int, int]:
+    """(dy, dx) of a 2 x 2 Bayer filter name in the RGGB tile: "RGGB" (0, 0), "GRBG" (0, 1), "GBRG"
+    (1, 0), "BGGR" (1, 1); the ``phase`` of :mod:`evinr_lite.sim.quadbayer` with ``block=1``."""
+    name = check_cfa(cfa)
+    if name is None:
+        raise EventDataError("cfa_phase needs a colour filter name (RGGB, GRBG, GBRG, BGGR), got None (mono)")
+    return CFA_NAMES[name]
 
 
 def is_canonical(path) -> bool:
@@ -179,6 +221,8 @@ def _info_from(f, path) -> dict:
             if not all(math.isfinite(v) for v in window):
                 window = None
         info[key] = window
+    info["cfa"] = check_cfa(info.get("cfa"), lambda msg: EventDataError(f"{path}: the attribute {msg}; convert "
+                                                                         "the file again"))
     info["path"] = str(path)
     return info
 
@@ -265,6 +309,13 @@ def _read_open(f, path, t_start, t_end, frames):
                 gt = Frames(f["frames/images"][a:b], ft[a:b], origin)
             except EventDataError as err:
                 raise EventDataError(f"{path}: {err}") from None
+            if "frames/rgb" in f:
+                rgb = f["frames/rgb"]
+                if rgb.shape != (len(ft), *f["frames/images"].shape[1:], 3) or rgb.dtype != np.uint8:
+                    raise EventDataError(f"{path}: frames/rgb is {rgb.dtype} {rgb.shape}, expected uint8 "
+                                         f"{(len(ft), *f['frames/images'].shape[1:], 3)} like frames/images; the "
+                                         "file is damaged: convert it again")
+                info["frames_rgb"], info["frames_rgb_t"] = rgb[a:b], gt.t.copy()
     return info, lo, hi, events, gt
 
 
@@ -282,7 +333,9 @@ def read_canonical(path, t_start: float | None = None, t_end: float | None = Non
 
     Returns:
         Recording(events, frames or None, meta) with meta holding dataset, sequence, source, C,
-        eval_window (None = whole sequence), t_zero, event_slice (lo, hi) and the stored meta.
+        eval_window (None = whole sequence), t_zero, event_slice (lo, hi), cfa (the colour filter
+        name, None for a mono sensor), frames_rgb / frames_rgb_t (colour frames uint8 [F, H, W, 3]
+        and their times, one per grey frame, or None) and the stored meta.
     """
     from ..core.recording import Recording
 
@@ -293,8 +346,8 @@ def read_canonical(path, t_start: float | None = None, t_end: float | None = Non
             raise
         except (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError) as err:
             raise _damaged(path, err) from None
-    meta = {"format": "canonical", **{k: v for k, v in info.items() if k not in ("format", "meta")},
-            **info["meta"], "event_slice": (lo, hi)}
+    meta = {"format": "canonical", "frames_rgb": None, "frames_rgb_t": None,
+            **{k: v for k, v in info.items() if k not in ("format", "meta")}, **info["meta"], "event_slice": (lo, hi)}
     meta["path"] = str(path)
     return Recording(events, gt, meta)
 
@@ -364,6 +417,11 @@ class CanonicalWriter:
         eval_window: (start, end) seconds after the sequence's zero (earliest event or frame), as
             published; None = the whole sequence.
         meta: JSON-serialisable extras (calibration, notes).
+        cfa: the colour filter of a colour sensor ("RGGB", "GRBG", "GBRG", "BGGR"; see the module
+            docstring), None for a mono sensor.
+
+    Frames are grey [H, W] or colour [H, W, 3] uint8 (one kind per file): colour frames are stored
+    in /frames/rgb and their grey version in /frames/images.
 
     Use as a context manager; leaving the block with an exception deletes the partial file.
     Problems raise :attr:`error` (``EventDataError``; ``data_fetch`` sets its ``ConversionError``).
@@ -373,7 +431,7 @@ class CanonicalWriter:
 
     def __init__(self, out, *, sensor_size, t_origin: float = 0.0, dataset: str = "", sequence: str = "",
                  source: str = "", source_url: str = "", raw_file: str = "", C: float = 1.0,
-                 eval_window=None, converter: str = "", meta: dict | None = None):
+                 eval_window=None, converter: str = "", meta: dict | None = None, cfa: str | None = None):
         import h5py
 
         self.out = Path(out)
@@ -385,6 +443,10 @@ class CanonicalWriter:
                           raw_file=raw_file, C=float(C), converter=converter)
         self.eval_window = None if eval_window is None else tuple(float(v) for v in eval_window)
         self.meta = dict(meta or {})
+        self.cfa = check_cfa(cfa, self.error)
+        if self.cfa is not None and (self.H % 2 or self.W % 2):
+            raise self.error(f"a colour sensor with a 2 x 2 filter ({self.cfa}) must have an even size; got (H, W) = "
+                             f"{(self.H, self.W)}")
         self.f = h5py.File(self.tmp, "w")
         ev = self.f.create_group("events")
         self.ds = {k: ev.create_dataset(k, shape=(0,), maxshape=(None,), dtype=dt, chunks=(CHUNK_EVENTS,),
@@ -397,6 +459,7 @@ class CanonicalWriter:
         self.index: list[np.ndarray] = []
         self.frame_t: list[float] = []
         self.frames = None
+        self.rgb = None              # /frames/rgb once a colour frame arrived
         self.closed = False
 
     # ---- events -----------------------------------------------------------------------------
@@ -458,22 +521,35 @@ class CanonicalWriter:
 
     # ---- frames -----------------------------------------------------------------------------
     def add_frame(self, image, t: float) -> None:
-        """Append one grey uint8 frame [H, W] taken at ``t`` (s since t_origin)."""
+        """Append one uint8 frame taken at ``t`` (s since t_origin): grey [H, W] or colour (R, G, B)
+        [H, W, 3]; all frames of a file are of one kind (a colour frame is also stored as grey)."""
         image = np.asarray(image)
-        if image.dtype != np.uint8 or image.ndim != 2:
-            raise self.error(f"frames must be grey uint8 [H, W]; got {image.dtype} {image.shape}")
+        colour = image.ndim == 3 and image.shape[-1] == 3
+        if image.dtype != np.uint8 or not (image.ndim == 2 or colour):
+            raise self.error(f"frames must be grey uint8 [H, W] or colour uint8 [H, W, 3]; got {image.dtype} "
+                             f"{image.shape}")
         if not math.isfinite(t):
             raise self.error(f"frame {len(self.frame_t)} has a non-finite timestamp")
+        k = len(self.frame_t)
+        if k and colour != (self.rgb is not None):
+            raise self.error(f"frame {k} is {'colour' if colour else 'grey'} but the first frame is "
+                             f"{'grey' if colour else 'colour'}; all frames of a sequence must be of one kind")
+        grey = to_grey_uint8(image, f"frame {k}") if colour else image
         if self.frames is None:
-            h, w = image.shape
+            h, w = grey.shape
             self.frames = self.f.create_dataset("frames/images", shape=(0, h, w), maxshape=(None, h, w),
                                                 dtype=np.uint8, chunks=(1, h, w), **COMPRESSION)
-        if image.shape != self.frames.shape[1:]:
-            raise self.error(f"frame {len(self.frame_t)} is {image.shape} but the first frame is "
+            if colour:
+                self.rgb = self.f.create_dataset("frames/rgb", shape=(0, h, w, 3), maxshape=(None, h, w, 3),
+                                                 dtype=np.uint8, chunks=(1, h, w, 3), **COMPRESSION)
+        if grey.shape != self.frames.shape[1:]:
+            raise self.error(f"frame {k} is {grey.shape} but the first frame is "
                                   f"{self.frames.shape[1:]}; all frames of a sequence must share one size")
-        k = len(self.frame_t)
         self.frames.resize((k + 1, *self.frames.shape[1:]))
-        self.frames[k] = image
+        self.frames[k] = grey
+        if colour:
+            self.rgb.resize((k + 1, *self.rgb.shape[1:]))
+            self.rgb[k] = image
         self.frame_t.append(float(t))
 
     # ---- finishing --------------------------------------------------------------------------
@@ -489,8 +565,9 @@ class CanonicalWriter:
             if np.any(np.diff(ft) < 0):
                 order = np.argsort(ft, kind="stable")
                 log.warning("frames are not in time order; sorting them")
-                images = self.frames[()]
-                self.frames[...] = images[order]
+                for ds in (self.frames, self.rgb):
+                    if ds is not None:
+                        ds[...] = ds[()][order]
                 ft = ft[order]
                 self.meta["frames_sorted"] = True
         self.f.create_dataset("frames/t", data=ft, dtype=np.float64)
@@ -530,6 +607,8 @@ class CanonicalWriter:
         a["t_first"] = float(self.t_first)
         a["t_last"] = float(self.t_last)
         a["meta_json"] = json.dumps(self.meta, sort_keys=True)
+        if self.cfa is not None:
+            a["cfa"] = self.cfa
         self.f.close()
         os.replace(self.tmp, self.out)
         self.closed = True

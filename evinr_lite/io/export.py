@@ -1,6 +1,7 @@
 """Writing reconstructed frames: numbered PNGs, an animated GIF (Pillow), an MP4 (OpenCV).
 
-Frames are grey float arrays [F, H, W] in [0, 1] (or uint8). These functions write into a folder
+Frames are grey float arrays [F, H, W] or colour (R, G, B) arrays [F, H, W, 3], in [0, 1] (or
+uint8); colour frames give colour PNGs, GIF and MP4. These functions write into a folder
 they are given; the reconstruct job hands them the temporary folder of
 :func:`evinr_lite.io.output.atomic_output_dir`, so an interrupted export never looks complete.
 """
@@ -19,15 +20,16 @@ __all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_c
 
 
 def to_uint8(frames) -> np.ndarray:
-    """[F, H, W] floats in [0, 1] (clipped) or uint8 -> uint8 [F, H, W]."""
+    """[F, H, W] or [F, H, W, 3] floats in [0, 1] (clipped) or uint8 -> uint8 of the same shape."""
     frames = np.asarray(frames)
-    if frames.ndim != 3:
-        raise ValueError(f"frames must have shape [F, H, W] (grey), got {frames.shape}")
+    if not (frames.ndim == 3 or (frames.ndim == 4 and frames.shape[-1] == 3)):
+        raise ValueError(f"frames must have shape [F, H, W] (grey) or [F, H, W, 3] (colour), got {frames.shape}")
     return metrics_to_uint8(frames)
 
 
 def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
-    """Write frames [F, H, W] as ``folder/<prefix>00000.png``, ... (8-bit grey). Returns the paths."""
+    """Write frames [F, H, W] or [F, H, W, 3] as ``folder/<prefix>00000.png``, ... (8-bit grey or RGB).
+    Returns the paths."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -38,7 +40,7 @@ def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
 
 
 def save_gif(path, frames, fps: float) -> Path:
-    """An animated grey GIF of frames [F, H, W] at ``fps`` frames per second (to the GIF's 10 ms
+    """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (to the GIF's 10 ms
     resolution, at most 50 per second), looping."""
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps}")
@@ -49,7 +51,7 @@ def save_gif(path, frames, fps: float) -> Path:
 
 
 def save_mp4(path, frames, fps: float) -> Path:
-    """An MP4 video (MPEG-4 part 2, 'mp4v') of frames [F, H, W] at ``fps`` frames per second.
+    """An MP4 video (MPEG-4 part 2, 'mp4v') of frames [F, H, W] or [F, H, W, 3] (RGB) at ``fps`` per second.
 
     Odd widths or heights are padded by one black row / column (most players need even sizes).
     Raises RuntimeError when OpenCV cannot open a writer (an OpenCV build without video support).
@@ -59,10 +61,13 @@ def save_mp4(path, frames, fps: float) -> Path:
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps}")
     frames = to_uint8(frames)
-    F, H, W = frames.shape
-    frames = np.pad(frames, ((0, 0), (0, H % 2), (0, W % 2)))
+    colour = frames.ndim == 4
+    F, H, W = frames.shape[:3]
+    frames = np.pad(frames, ((0, 0), (0, H % 2), (0, W % 2)) + (((0, 0),) if colour else ()))
+    if colour:
+        frames = np.ascontiguousarray(frames[..., ::-1])   # OpenCV writes BGR
     writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
-                             (frames.shape[2], frames.shape[1]), isColor=False)
+                             (frames.shape[2], frames.shape[1]), isColor=colour)
     if not writer.isOpened():
         raise RuntimeError(f"OpenCV could not open an MP4 writer for {path}; the GIF and PNGs are still written")
     try:

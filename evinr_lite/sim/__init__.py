@@ -4,11 +4,12 @@ from .scenes import (Scene, MovingImageScene, MovingBarScene, VaryingSpeedScene,
 from .simulate import (simulate_events_1d, simulate_video, simulate_scene, pixel_events, add_background_noise,
                        add_hot_pixels)
 from .quadbayer import QuadBayerScene, simulate_colour_video
+from .colour_davis import colour_davis_recording, write_colour_davis_recording
 from .recordings import write_example_recording, synthetic_recording, find_recording
 from . import zoo
 
 __all__ = ["Scene", "MovingImageScene", "MovingBarScene", "VaryingSpeedScene", "WarpedImageScene",
            "ObjectOverBackgroundScene", "LightingScene", "make_scene", "simulate_events_1d",
            "simulate_video", "simulate_scene", "pixel_events", "add_background_noise", "add_hot_pixels", "QuadBayerScene",
-           "simulate_colour_video", "write_example_recording", "synthetic_recording",
+           "simulate_colour_video", "colour_davis_recording", "write_colour_davis_recording", "write_example_recording", "synthetic_recording",
            "find_recording", "zoo"]
