@@ -24,14 +24,14 @@ def close_figures():
 @pytest.fixture(scope="module")
 def tiny_results():
     levels = {"keep": [0.1, 1.0], "noise_hz": [0.0, 3.0], "C_scale": [0.5, 1.0]}
-    return rb.run_sweeps([TINY], ("integration", "kit"), levels, paper_levels=0, log=lambda *a, **k: None)
+    return rb.run_sweeps([TINY], ("integration", "hf"), levels, paper_levels=0, log=lambda *a, **k: None)
 
 
 def test_sweeps_have_one_score_per_method_scene_and_level(tiny_results):
     r = tiny_results
     assert r["scenes"] == ["tiny"] and set(r["sweeps"]) == {"keep", "noise_hz", "C_scale"}
     for sw in r["sweeps"].values():
-        for m in ("integration", "kit"):
+        for m in ("integration", "hf"):
             assert len(sw["scores"][m]["tiny"]) == 2 and all(s is not None for s in sw["scores"][m]["tiny"])
             for k in rb.METRICS:
                 assert len(sw["means"][m][k]) == 2 and all(0 <= v <= 1 for v in sw["means"][m][k])
@@ -39,8 +39,8 @@ def test_sweeps_have_one_score_per_method_scene_and_level(tiny_results):
 
 def test_the_clean_condition_is_one_run_shared_by_the_sweeps(tiny_results):
     sw = tiny_results["sweeps"]
-    assert sw["keep"]["scores"]["kit"]["tiny"][1] is sw["noise_hz"]["scores"]["kit"]["tiny"][0]
-    assert sw["keep"]["scores"]["kit"]["tiny"][1] is sw["C_scale"]["scores"]["kit"]["tiny"][1]
+    assert sw["keep"]["scores"]["hf"]["tiny"][1] is sw["noise_hz"]["scores"]["hf"]["tiny"][0]
+    assert sw["keep"]["scores"]["hf"]["tiny"][1] is sw["C_scale"]["scores"]["hf"]["tiny"][1]
 
 
 def test_thinning_and_noise_change_the_events_and_degrade_integration(tiny_results):
