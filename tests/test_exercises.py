@@ -78,11 +78,16 @@ def test_fancy_index_plus_equals_gets_the_add_at_hint(capsys):
         return out
 
     exercises.register("toy_scatter", ref, lambda rng: [dict(idx=np.array([0, 2, 2, 3, 3, 3]), w=np.full(6, 0.2), n=5)])
+    exercises.register("toy_sum", lambda x, C: C * np.cumsum(x), lambda rng: [dict(x=np.array([1.0, 1.0, -1.0]), C=0.2)])
     try:
         assert not exercises.check("toy_scatter", fancy)
         assert "np.add.at" in capsys.readouterr().out
+        # no index array among the inputs: the same pattern of values gets no scatter-add hint
+        assert not exercises.check("toy_sum", lambda x, C: C * x)
+        assert "np.add.at" not in capsys.readouterr().out
     finally:
         exercises._REGISTRY.pop("toy_scatter", None)
+        exercises._REGISTRY.pop("toy_sum", None)
 
 
 def test_differences_along_the_wrong_axes_get_an_axis_hint(capsys):
@@ -253,3 +258,32 @@ def test_eq4_error_vs_window_has_both_regimes():
     assert res["events"][0] > res["events"][1]  # quantisation dominates short windows
     with pytest.raises(ValueError):
         pde1d.eq4_error_vs_window(L, [2.0], (0, 1))
+
+
+def _strict_integrate(t_events, p_events, C, t_query):  # t_i < t_q: an event at the query time left out
+    return np.array([C * np.sum(p_events[t_events < q]) for q in t_query])
+
+
+def _strict_rate(t_events, p_events, C, boundaries):  # (b_k, b_{k+1}): an event on the end edge left out
+    return C * np.array([p_events[(t_events > b1) & (t_events < b2)].sum()
+                         for b1, b2 in zip(boundaries[:-1], boundaries[1:])], float) / np.diff(boundaries)
+
+
+def _left_rate(t_events, p_events, C, boundaries):  # [b_k, b_{k+1}) in place of (b_k, b_{k+1}]
+    i = np.searchsorted(boundaries, t_events, side="right") - 1
+    keep = (i >= 0) & (i < len(boundaries) - 1)
+    return C * np.bincount(i[keep], weights=p_events[keep].astype(float), minlength=len(boundaries) - 1) / np.diff(boundaries)
+
+
+@pytest.mark.parametrize("name, wrong, hint", [
+    ("integrate_events_1d", _strict_integrate, "t_i <= t_q"),
+    ("integrate_events_1d", lambda t_events, p_events, C, t_query:
+        C * np.concatenate([[0.0], np.cumsum(p_events)])[np.searchsorted(t_events, t_query, side="left")], "side=\"right\""),
+    ("event_rate_derivative", _strict_rate, "not a strict `<`"),
+    ("event_rate_derivative", _left_rate, "(b_k, b_{k+1}]"),
+])
+def test_boundary_rules_are_checked(name, wrong, hint, capsys):
+    """The text's boundary rules (t_i <= t_q; windows (b_k, b_{k+1}]) have check cases on the boundary,
+    so the off-by-one variants fail the check and get the hint that names the rule."""
+    assert exercises.check(name, wrong) is False
+    assert hint in capsys.readouterr().out

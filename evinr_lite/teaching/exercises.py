@@ -253,8 +253,12 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
     return None
 
 
-def _generic_hint(got, expected) -> str | None:
-    """Recognise a few common patterns between a wrong and a right numeric output."""
+def _generic_hint(got, expected, indexed: bool = False) -> str | None:
+    """Recognise a few common patterns between a wrong and a right numeric output.
+
+    ``indexed``: the inputs hold an index array with repeated entries (event coordinates, say),
+    so a scatter-add that kept one contribution per index is a likely mistake.
+    """
     try:
         g = _to_numpy(got).astype(np.float64).ravel()
         e = _to_numpy(expected).astype(np.float64).ravel()
@@ -280,7 +284,7 @@ def _generic_hint(got, expected) -> str | None:
     axes = _axes_hint(_to_numpy(got), _to_numpy(expected), tol)
     if axes:
         return axes
-    if _one_contribution_per_entry(g, e, tol):
+    if indexed and _one_contribution_per_entry(g, e, tol):
         return ("each entry holds at most one contribution where several are expected: with fancy indexing, "
                 "`a[idx] += v` adds only once for a repeated index; accumulate with `np.add.at(a, idx, v)` "
                 "(or `np.bincount(idx, weights=v)`, or `index_put_(..., accumulate=True)` in torch)")
@@ -363,6 +367,26 @@ def _one_contribution_per_entry(g: np.ndarray, e: np.ndarray, tol: float) -> boo
     return bool(differ.any() and np.any(np.abs(e[differ]) > unit * (1 + 1e-6)))
 
 
+def _is_repeated_index(v) -> bool:
+    """An integer index array (values beyond the +-1 of polarities) in which some index repeats."""
+    a = _to_numpy(v) if _is_tensor(v) else v
+    if not isinstance(a, np.ndarray) or a.ndim != 1 or a.dtype.kind not in "iu" or a.size < 2:
+        return False
+    return bool(np.abs(a).max() > 1 and np.unique(a).size < a.size)
+
+
+def _has_repeated_index(args: tuple, kwargs: dict) -> bool:
+    """Any input (or an input's ``x`` / ``y`` attribute, as on Events) that is a repeated index array."""
+    for v in list(args) + list(kwargs.values()):
+        for item in (v, getattr(v, "x", None), getattr(v, "y", None)):
+            try:
+                if item is not None and _is_repeated_index(item):
+                    return True
+            except Exception:
+                continue
+    return False
+
+
 def _where_raised(err: BaseException) -> list[str]:
     """The line of the learner's code that raised (the last frame outside this module)."""
     frames = [f for f in traceback.extract_tb(err.__traceback__) if f.filename != __file__]
@@ -417,7 +441,7 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
             if hint is None:
                 hint = _wrong_axes_hint(ex, args, kwargs, got)
             if hint is None:
-                hint = _generic_hint(got, expected)
+                hint = _generic_hint(got, expected, indexed=_has_repeated_index(args, kwargs))
         if hint:
             details.append(f"hint: {hint}")
         return False, f"does not match the reference on {where}", details

@@ -8,6 +8,7 @@ and are registered with :mod:`evinr_lite.teaching.exercises` at import.
 - :func:`temporal_loss`: Eq. 5-6, (Delta L - dF/dt * (t2 - t1))^2 averaged over windows.
 - :func:`taylor_error`, :func:`eq4_error_vs_window`: how good Eq. 3's mid-point derivative is.
 - :func:`fit_siren_1d`: solve Eq. 4 for one pixel with a small SIREN F(t).
+- :func:`bin_residuals`: does a fitted F match each window's events at the mid-point only, or over the window?
 
 Times are float64 seconds; polarities are +-1; C is the contrast threshold (log units).
 """
@@ -29,7 +30,7 @@ from . import exercises
 __all__ = [
     "integrate_events_1d", "event_rate_derivative", "window_sums", "temporal_loss",
     "taylor_error", "eq4_error_vs_window", "TimeSiren1D", "time_derivative",
-    "fit_siren_1d", "evaluate_temporal_loss",
+    "fit_siren_1d", "evaluate_temporal_loss", "bin_residuals",
 ]
 
 
@@ -115,6 +116,11 @@ def _inputs_integrate(rng):
         t, p = _sorted_events(rng, n)
         tq = np.sort(np.concatenate([[-0.1, 1.1], rng.uniform(0, 1, q - 2)]))
         cases.append(dict(t_events=t, p_events=p, C=C, t_query=tq))
+    # the boundary rule t_i <= t_q: queries exactly at event times (and at a repeated time) count
+    # the event, so side="left" or a strict `<` fails here
+    t = np.array([0.1, 0.25, 0.25, 0.5, 0.8])
+    p = np.array([1, 1, 1, -1, 1], dtype=np.int8)
+    cases.append(dict(t_events=t, p_events=p, C=0.2, t_query=np.array([0.0, 0.1, 0.25, 0.3, 0.5, 0.8, 1.0])))
     return cases
 
 
@@ -124,7 +130,35 @@ def _inputs_rate(rng):
         t, p = _sorted_events(rng, n)
         inner = np.sort(rng.uniform(0.05, 0.95, B - 1))
         cases.append(dict(t_events=t, p_events=p, C=C, boundaries=np.concatenate([[0.0], inner, [1.0]])))
+    # the boundary rule (b_k, b_{k+1}]: events exactly on an inner edge and on the last edge belong to
+    # the window that ends there, so `<` in place of `<=` (or side="left" / "right" swapped) fails here
+    b = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    t = np.array([0.1, 0.25, 0.25, 0.4, 0.5, 0.6, 0.75, 1.0])
+    p = np.array([1, 1, -1, 1, 1, -1, 1, 1], dtype=np.int8)
+    cases.append(dict(t_events=t, p_events=p, C=0.5, boundaries=b))
     return cases
+
+
+def _integrate_strict(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): events exactly at t_q left out (t_i < t_q)."""
+    csum = np.concatenate([[0.0], np.cumsum(np.asarray(p_events, dtype=np.float64))])
+    return C * csum[np.searchsorted(np.asarray(t_events, float), np.asarray(t_query, float), side="left")]
+
+
+def _rate_open(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): windows (b_k, b_{k+1}) with a strict `<`, edge events dropped."""
+    t, b = np.asarray(t_events, float), np.asarray(boundaries, float)
+    p = np.asarray(p_events, float)
+    sums = [p[(t > b1) & (t < b2)].sum() for b1, b2 in zip(b[:-1], b[1:])]
+    return C * np.array(sums) / np.diff(b)
+
+
+def _rate_left_closed(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): windows [b_k, b_{k+1}) instead of (b_k, b_{k+1}]."""
+    t, b = np.asarray(t_events, float), np.asarray(boundaries, float)
+    p = np.asarray(p_events, float)
+    sums = [p[(t >= b1) & (t < b2)].sum() for b1, b2 in zip(b[:-1], b[1:])]
+    return C * np.array(sums) / np.diff(b)
 
 
 def _inputs_loss(rng):
@@ -145,6 +179,9 @@ exercises.register(
             lambda t_events, p_events, C, t_query: integrate_events_1d(t_events, np.abs(p_events), C, t_query),
         "did you forget to multiply by the contrast threshold C?":
             lambda t_events, p_events, C, t_query: integrate_events_1d(t_events, p_events, 1.0, t_query),
+        "an event exactly at a query time counts (t_i <= t_q): use side=\"right\" in np.searchsorted, "
+        "or `<=` rather than `<`":
+            _integrate_strict,
     })
 
 exercises.register(
@@ -156,6 +193,12 @@ exercises.register(
             lambda t_events, p_events, C, boundaries: event_rate_derivative(t_events, np.abs(p_events), C, boundaries),
         "did you forget to multiply by the contrast threshold C?":
             lambda t_events, p_events, C, boundaries: event_rate_derivative(t_events, p_events, 1.0, boundaries),
+        "windows are (b_k, b_{k+1}]: an event exactly on an edge belongs to the window that ends there "
+        "(b_k < t <= b_{k+1}), not to the one that starts there":
+            _rate_left_closed,
+        "an event exactly on a window's end edge b_{k+1} belongs to that window: (b_k, b_{k+1}] needs "
+        "`t <= b_{k+1}`, not a strict `<`":
+            _rate_open,
     })
 
 exercises.register(
@@ -317,6 +360,31 @@ def _predicted_change(model, b: torch.Tensor, form: str, create_graph: bool) -> 
     raise ValueError(f"form must be 'derivative' (Eq. 5) or 'difference' (F(t2) - F(t1)), got {form!r}")
 
 
+def bin_residuals(model: TimeSiren1D, boundaries, delta_L) -> dict:
+    """How well a fitted F explains each window's events, measured two ways (log units, RMS over windows).
+
+    - ``"slope"``: dF/dt at the mid-point times the window length minus Delta L: what the
+      derivative loss (Eq. 5-6) penalises;
+    - ``"change"``: F(b_{k+1}) - F(b_k) minus Delta L: what the events actually say about F over
+      the window (Eq. 2). A small ``"slope"`` with a large ``"change"`` residual means F has the
+      right slope at every mid-point but wanders in between.
+
+    Args:
+        model: a fitted :class:`TimeSiren1D`.
+        boundaries: float [B + 1] window edges (s).
+        delta_L: float [B] summed events per window (:func:`window_sums`).
+
+    Returns:
+        dict of floats ``"slope"``, ``"change"``.
+    """
+    b = np.asarray(boundaries, dtype=np.float64)
+    dL = np.asarray(delta_L, dtype=np.float64)
+    slope = model.derivative(0.5 * (b[1:] + b[:-1])) * np.diff(b)
+    change = np.diff(model.predict(b))
+    return {"slope": float(np.sqrt(np.mean((slope - dL) ** 2))),
+            "change": float(np.sqrt(np.mean((change - dL) ** 2)))}
+
+
 def fit_siren_1d(events, t_range, C: float, n_iters: int = 300, window: float = 0.025, seed: int = 0, *,
                  anchor: tuple[float, float] | None = None, prior_mean: float | None = None,
                  anchor_weight: float = 1.0, form: str = "derivative", lr: float = 3e-3,
@@ -337,7 +405,9 @@ def fit_siren_1d(events, t_range, C: float, n_iters: int = 300, window: float = 
         prior_mean: also penalise ``anchor_weight * (mean of F over the windows - prior_mean)^2``
             (a prior on the overall brightness instead of a known frame).
         form: ``"derivative"`` (Eq. 5, the paper) or ``"difference"`` (F(t2) - F(t1)).
-        lr: Adam learning rate, multiplied by ``lr_decay`` every 10 steps (the paper's schedule).
+        lr, lr_decay: Adam learning rate, multiplied by ``lr_decay`` every 10 steps: the form of the
+            paper's schedule, not its values (the paper trains whole videos with lr 1e-4, x0.95; the
+            defaults 3e-3, x0.98 are this kit's choice for one pixel).
         hidden_features, hidden_layers, omega_0, first_omega_0: the SIREN (see :class:`Siren`).
         device: torch device (default: :func:`evinr_lite.core.runtime.default_device`).
 
