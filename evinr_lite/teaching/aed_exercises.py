@@ -4,6 +4,9 @@
   given phase (see :mod:`evinr_lite.sim.quadbayer` for the convention);
 - ``grey_event_frame``: demosaic events onto the reduced grey grid and sum them into one event
   frame, each event weighing C / 16 (the effective grey threshold).
+
+Helper: :func:`jensen_gap`, the difference between the mean of a window's log intensities and the
+log of its mean intensity, next to its second-order approximation (notebook 10, section 4).
 """
 from __future__ import annotations
 
@@ -11,7 +14,7 @@ import numpy as np
 
 from . import exercises
 
-__all__ = ["quad_bayer_channel", "grey_event_frame"]
+__all__ = ["quad_bayer_channel", "grey_event_frame", "jensen_gap"]
 
 
 def quad_bayer_channel(y, x, phase):
@@ -46,6 +49,29 @@ def grey_event_frame(x, y, p, C, raw_size):
     frame = np.zeros((H // 4, W // 4))
     np.add.at(frame, (np.asarray(y) // 4, np.asarray(x) // 4), C * np.asarray(p, dtype=np.float64) / 16)
     return frame
+
+
+def jensen_gap(intensity, block: int = 4):
+    """Jensen's gap of each block x block window, exact and to second order.
+
+    For the window's intensities I_k (mean m, variance v), the mean of the logs and the log of the
+    mean agree to first order in the spread; their difference is the gap
+    mean_k log I_k - log m = -v / (2 m^2) + O(spread^3) (Taylor expansion of log about m).
+
+    Args:
+        intensity: float [..., H, W] linear intensities > 0 (H, W multiples of ``block``).
+        block: window size in photosites (4 for a Quad Bayer grey pixel).
+    Returns:
+        (gap, second_order): float64 [..., H // block, W // block] each: mean of logs minus log of
+        mean (always <= 0), and -v / (2 m^2).
+    """
+    I = np.asarray(intensity, dtype=np.float64)
+    *lead, H, W = I.shape
+    windows = I.reshape(*lead, H // block, block, W // block, block)
+    m = windows.mean(axis=(-3, -1))
+    v = windows.var(axis=(-3, -1))
+    gap = np.log(windows).mean(axis=(-3, -1)) - np.log(m)
+    return gap, -v / (2 * m * m)
 
 
 # ---- seeded inputs and known mistakes ----------------------------------------------------
@@ -85,7 +111,11 @@ exercises.register(
 
 
 def _inputs_grey(rng):
-    cases = []
+    # first a square sensor whose events sit in the top-right window only (3 ON events on one photosite
+    # and 2 OFF on another): rows and columns swapped give wrong values (with a hint), not an IndexError,
+    # and fancy-index `+=` keeps one event per pixel
+    cases = [dict(x=np.array([4, 4, 4, 7, 6]), y=np.array([1, 1, 1, 3, 0]), p=np.array([1, 1, 1, -1, -1], np.int8),
+                  C=0.25, raw_size=(8, 8))]
     for H, W, n, C in ((4, 8, 12, 0.2), (8, 12, 60, 0.25), (12, 8, 200, 0.1)):
         cases.append(dict(x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=rng.choice([-1, 1], n).astype(np.int8),
                           C=C, raw_size=(H, W)))
@@ -100,9 +130,28 @@ def _grey_quarter_weight(x, y, p, C, raw_size):
     return grey_event_frame(x, y, p, C * 4, raw_size)
 
 
+def _grey_fancy_index(x, y, p, C, raw_size):
+    """The mistake: ``frame[y // 4, x // 4] += ...`` keeps only one of several events on a pixel."""
+    H, W = raw_size
+    frame = np.zeros((H // 4, W // 4))
+    frame[np.asarray(y) // 4, np.asarray(x) // 4] += C * np.asarray(p, dtype=np.float64) / 16
+    return frame
+
+
+def _grey_rows_columns_swapped(x, y, p, C, raw_size):
+    H, W = raw_size
+    if H != W:
+        return np.zeros((H // 4, W // 4))     # a swapped frame of another shape cannot match anyway
+    return grey_event_frame(y, x, p, C, raw_size)
+
+
 exercises.register(
     "grey_event_frame", grey_event_frame, _inputs_grey,
     hints={
         "each event carries C / 16, not C: the grey log intensity is the mean over 16 photosites": _grey_no_weight,
         "a grey pixel merges 16 photosites (4 x 4), so divide by 16, not 4": _grey_quarter_weight,
+        "`frame[y // 4, x // 4] += ...` adds only one of the events that share a pixel (fancy indexing "
+        "does not accumulate repeated indices): use np.add.at(frame, (y // 4, x // 4), C * p / 16)":
+            _grey_fancy_index,
+        "rows are y and columns are x: index the frame as [y // 4, x // 4]": _grey_rows_columns_swapped,
     })

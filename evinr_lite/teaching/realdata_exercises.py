@@ -1,21 +1,23 @@
-"""Notebook 09 (real data): the event-rate exercise.
+"""Notebook 09 (real data): the event-rate and contrast-threshold exercises.
 
 - ``event_rate``: events per second in fixed bins, the first look at any recording. The reference
   below is the teaching version (times only, one rate); it re-implements, on purpose, the
   library's :func:`evinr_lite.method.binning.event_rate` (ON and OFF rates of an ``Events``),
-  and ``tests/test_realdata.py`` pins the two together.
-
-The contrast threshold fitted from APS frames (notebook 09's second exercise) is
-:func:`evinr_lite.method.contrast.estimate_contrast_threshold`, which notebook 11 applies again
-to the reader's own recording.
+  and ``tests/test_realdata.py`` pins the two together. Bins are half-open, [b_k, b_{k+1}): an
+  event exactly on an edge belongs to the later bin, and the check has such events.
+- ``estimate_contrast_threshold``: the least-squares C relating the log-intensity change of APS
+  frames to the net event count between them, ΔL ≈ C n. The reference is the library's
+  :func:`evinr_lite.method.contrast.estimate_contrast_threshold`, which notebook 11 applies to the
+  reader's own recording (the exercise is notebook 09's only: one C-fit exercise in the series).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..method.contrast import estimate_contrast_threshold
 from . import exercises
 
-__all__ = ["event_rate"]
+__all__ = ["event_rate", "estimate_contrast_threshold"]
 
 
 def event_rate(t, bin_s):
@@ -27,7 +29,8 @@ def event_rate(t, bin_s):
 
     Returns:
         (centers, rate): float64 [B] bin centres (s) and events per second in each bin, with bins
-        [t0 + k * bin_s, t0 + (k + 1) * bin_s) starting at t0 = t[0] and covering every event.
+        [t0 + k * bin_s, t0 + (k + 1) * bin_s) starting at t0 = t[0] and covering every event
+        (an event exactly on an edge counts in the later bin).
     """
     t = np.asarray(t, dtype=np.float64)
     n_bins = max(int(np.floor((t[-1] - t[0]) / bin_s)) + 1, 1)
@@ -43,7 +46,21 @@ def _inputs_rate(rng):
     for n, span, bin_s in ((50, 1.0, 0.1), (200, 0.37, 0.05), (7, 2.0, 0.5)):
         t = np.sort(rng.uniform(0.0, span, n)) + rng.uniform(0, 3)
         cases.append(dict(t=t, bin_s=bin_s))
+    # events exactly on bin edges (dyadic times, so t - t0 and the edges are exact in float64): the
+    # rule [b_k, b_{k+1}) puts each in the later bin; a (b_k, b_{k+1}] rule or searchsorted(side="left")
+    # moves them one bin down. The last event sits on an edge too, and gets a bin of its own.
+    cases.append(dict(t=np.array([1.0, 1.125, 1.25, 1.25, 1.3, 1.5, 1.625, 2.0]), bin_s=0.125))
+    cases.append(dict(t=np.array([0.5, 0.5, 0.75, 1.0, 1.0, 1.0, 1.5]), bin_s=0.25))
     return cases
+
+
+def _rate_edges_to_lower_bin(t, bin_s):
+    """The mistake: bins (b_k, b_{k+1}] (ceil - 1, or searchsorted(edges, t, side="left") - 1)."""
+    t = np.asarray(t, dtype=np.float64)
+    n_bins = max(int(np.floor((t[-1] - t[0]) / bin_s)) + 1, 1)
+    k = np.clip(np.ceil((t - t[0]) / bin_s).astype(np.int64) - 1, 0, n_bins - 1)
+    counts = np.bincount(k, minlength=n_bins)
+    return t[0] + (np.arange(n_bins) + 0.5) * bin_s, counts / bin_s
 
 
 exercises.register(
@@ -51,4 +68,41 @@ exercises.register(
     hints={"divide the counts by the bin width to get events per second":
            lambda t, bin_s: (event_rate(t, bin_s)[0], event_rate(t, bin_s)[1] * bin_s),
            "return the bin centres, not the left edges":
-           lambda t, bin_s: (event_rate(t, bin_s)[0] - bin_s / 2, event_rate(t, bin_s)[1])})
+           lambda t, bin_s: (event_rate(t, bin_s)[0] - bin_s / 2, event_rate(t, bin_s)[1]),
+           "an event exactly on a bin edge t0 + k bin_s belongs to bin k (bins are [b_k, b_{k+1})): use "
+           "floor((t - t0) / bin_s), or searchsorted(edges, t, side='right') - 1, not ceil - 1 or side='left'":
+           _rate_edges_to_lower_bin})
+
+
+def _inputs_threshold(rng):
+    cases = []
+    for C, M, noise in ((0.3, 50, 0.05), (0.8, 200, 0.2), (0.15, 30, 0.0)):
+        n = rng.integers(-4, 5, M)
+        n[0] = 3                      # never all zero
+        cases.append(dict(log_changes=C * n + noise * rng.standard_normal(M), net_counts=n))
+    return cases
+
+
+def _mean_of_ratios(log_changes, net_counts):
+    d, n = np.asarray(log_changes, float), np.asarray(net_counts, float)
+    keep = n != 0
+    return float(np.mean(d[keep] / n[keep]))
+
+
+exercises.register(
+    "estimate_contrast_threshold", estimate_contrast_threshold, _inputs_threshold, rtol=1e-6,
+    hints={
+        "C multiplies n: the least-squares slope is sum(ΔL n) / sum(n^2), not sum(n^2) / sum(ΔL n)":
+            lambda log_changes, net_counts: float(np.sum(np.square(np.asarray(net_counts, float)))
+                                                  / np.sum(np.asarray(log_changes) * net_counts)),
+        "a mean of per-pixel ratios ΔL / n weights noisy single-event pixels as much as the rest; "
+        "fit the line through all pixels at once":
+            _mean_of_ratios,
+        "regressing n on ΔL gives sum(ΔL^2) / sum(ΔL n), biased by the noise in ΔL; regress ΔL on n":
+            lambda log_changes, net_counts: float(np.sum(np.square(log_changes))
+                                                  / np.sum(np.asarray(log_changes) * net_counts)),
+        "a line through the origin has no intercept: sum(ΔL n) / sum(n^2), not the slope of a fit with an "
+        "intercept (np.polyfit(n, ΔL, 1))":
+            lambda log_changes, net_counts: float(np.polyfit(np.asarray(net_counts, float),
+                                                             np.asarray(log_changes, float), 1)[0]),
+    })

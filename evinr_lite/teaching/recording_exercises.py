@@ -2,11 +2,15 @@
 
 Exercises (registered with :mod:`evinr_lite.teaching.exercises` at import):
 
-- ``estimate_contrast_threshold``: the least-squares C relating the log-intensity change of
-  ground-truth frames to the net event count between them, ΔL ≈ C n (the reference is the
-  library's :func:`evinr_lite.method.contrast.estimate_contrast_threshold`);
+- ``hot_pixel_mask``: the pixels that fire far more often than the sensor's typical firing pixel
+  (count > factor x the median count of the pixels that fired; a pixel exactly at the threshold is
+  not hot), the first thing to check on a recording from your own camera;
 - ``event_count_windows``: cut a recording into windows of (nearly) equal event counts, so each
   reconstruction costs about the same and fits in memory.
+
+The contrast threshold fitted from frames (ΔL ≈ C n) is notebook 09's exercise
+(:mod:`evinr_lite.teaching.realdata_exercises`); notebook 11 applies the library's
+:func:`evinr_lite.method.contrast.estimate_contrast_threshold` to the reader's recording.
 
 Helpers: :func:`windows_from_indices` and :func:`window_table`. The recording to use comes from
 :func:`evinr_lite.sim.recordings.find_recording`; ΔL and n between frame pairs from
@@ -20,41 +24,114 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
-from ..method.contrast import estimate_contrast_threshold
 from . import exercises
 
-__all__ = ["event_count_windows", "windows_from_indices", "window_table"]
+__all__ = ["hot_pixel_mask", "event_count_windows", "windows_from_indices", "window_table"]
 
 
-# ---- exercise 1: the contrast threshold from frames ---------------------------------------
+# ---- exercise 1: a hot-pixel map from per-pixel counts ---------------------------------------
 
-def _inputs_threshold(rng):
+def hot_pixel_mask(x, y, sensor_size, factor: float = 10.0) -> np.ndarray:
+    """Pixels that fire far more often than a typical firing pixel.
+
+    A hot pixel (a defect, or a bias set too low for it) fires steadily whatever the scene does, often
+    hundreds of times more than its neighbours. The typical rate is the median count over the pixels
+    that fired at all: on a short or quiet recording most pixels never fire, so the median over all
+    pixels is 0 and would call every firing pixel hot; a mean would be pulled up by the hot pixels
+    themselves.
+
+    Args:
+        x, y: int [N] event columns and rows (N >= 1). sensor_size: (H, W).
+        factor: how many times the median count a pixel must exceed to be hot.
+    Returns:
+        bool [H, W]: count > factor * median(count of the pixels with count > 0) (strictly: a pixel
+        exactly at the threshold is not hot).
+    """
+    H, W = sensor_size
+    counts = np.bincount(np.asarray(y, dtype=np.int64) * W + np.asarray(x, dtype=np.int64),
+                         minlength=H * W).reshape(H, W)
+    typical = np.median(counts[counts > 0])
+    return counts > factor * typical
+
+
+def _events_from_counts(counts, rng):
+    """x, y [N] (shuffled) of a recording whose per-pixel counts are ``counts`` [H, W]."""
+    y, x = np.nonzero(counts)
+    reps = counts[y, x]
+    order = rng.permutation(int(reps.sum()))
+    return np.repeat(x, reps)[order], np.repeat(y, reps)[order]
+
+
+def _inputs_hot(rng):
     cases = []
-    for C, M, noise in ((0.3, 50, 0.05), (0.8, 200, 0.2), (0.15, 30, 0.0)):
-        n = rng.integers(-4, 5, M)
-        n[0] = 3                      # never all zero
-        cases.append(dict(log_changes=C * n + noise * rng.standard_normal(M), net_counts=n))
+    # 16 of 25 pixels silent, so the median over all pixels is 0; the firing pixels' median is 2, so with
+    # factor 5 the threshold is 10: the pixel with 10 events is exactly on it (not hot), 11 and 60 are hot;
+    # the mean (10.3) would flag only the 60
+    counts = np.zeros((5, 5), np.int64)
+    for (r, c), n in {(0, 1): 2, (1, 0): 2, (1, 2): 2, (2, 3): 2, (4, 4): 3, (3, 0): 1,
+                      (0, 3): 10, (3, 1): 11, (2, 4): 60}.items():
+        counts[r, c] = n
+    x, y = _events_from_counts(counts, rng)
+    cases.append(dict(x=x, y=y, sensor_size=(5, 5), factor=5.0))
+    # a sensor with Poisson activity, a third of it silent, and three hot pixels
+    counts = rng.poisson(3.0, (6, 9)) * (rng.uniform(size=(6, 9)) > 0.33)
+    counts.ravel()[rng.choice(54, 3, replace=False)] = (150, 400, 31)
+    x, y = _events_from_counts(counts, rng)
+    cases.append(dict(x=x, y=y, sensor_size=(6, 9), factor=10.0))
+    # the median is 1 (most firing pixels fired once); 4 = 4 x 1 is on the threshold, 5 above it
+    counts = np.zeros((5, 3), np.int64)
+    counts[0, 0], counts[1, 1], counts[2, 2], counts[3, 0], counts[4, 1], counts[4, 2] = 1, 1, 1, 4, 5, 1
+    x, y = _events_from_counts(counts, rng)
+    cases.append(dict(x=x, y=y, sensor_size=(5, 3), factor=4.0))
     return cases
 
 
-def _mean_of_ratios(log_changes, net_counts):
-    d, n = np.asarray(log_changes, float), np.asarray(net_counts, float)
-    keep = n != 0
-    return float(np.mean(d[keep] / n[keep]))
+def _pixel_counts(x, y, sensor_size):
+    H, W = sensor_size
+    counts = np.zeros((H, W), np.int64)
+    np.add.at(counts, (np.asarray(y), np.asarray(x)), 1)
+    return counts
+
+
+def _hot_at_threshold(x, y, sensor_size, factor=10.0):
+    counts = _pixel_counts(x, y, sensor_size)
+    return counts >= factor * np.median(counts[counts > 0])
+
+
+def _hot_median_all_pixels(x, y, sensor_size, factor=10.0):
+    counts = _pixel_counts(x, y, sensor_size)
+    return counts > factor * np.median(counts)
+
+
+def _hot_mean(x, y, sensor_size, factor=10.0):
+    counts = _pixel_counts(x, y, sensor_size)
+    return counts > factor * counts[counts > 0].mean()
+
+
+def _hot_fancy_index(x, y, sensor_size, factor=10.0):
+    counts = np.zeros(sensor_size, np.int64)
+    counts[np.asarray(y), np.asarray(x)] += 1
+    return counts > factor * np.median(counts[counts > 0])
+
+
+def _hot_rows_columns_swapped(x, y, sensor_size, factor=10.0):
+    H, W = sensor_size
+    if H != W:
+        return np.zeros((H, W), bool)
+    return hot_pixel_mask(y, x, sensor_size, factor)
 
 
 exercises.register(
-    "estimate_contrast_threshold", estimate_contrast_threshold, _inputs_threshold, rtol=1e-6,
+    "hot_pixel_mask", hot_pixel_mask, _inputs_hot,
     hints={
-        "C multiplies n: the least-squares slope is sum(ΔL n) / sum(n^2), not sum(n^2) / sum(ΔL n)":
-            lambda log_changes, net_counts: float(np.sum(np.square(np.asarray(net_counts, float)))
-                                                  / np.sum(np.asarray(log_changes) * net_counts)),
-        "a mean of per-pixel ratios ΔL / n weights noisy single-event pixels as much as the rest; "
-        "fit the line through all pixels at once":
-            _mean_of_ratios,
-        "regressing n on ΔL gives sum(ΔL^2) / sum(ΔL n), biased by the noise in ΔL; regress ΔL on n":
-            lambda log_changes, net_counts: float(np.sum(np.square(log_changes))
-                                                  / np.sum(np.asarray(log_changes) * net_counts)),
+        "a pixel exactly at factor x median is not hot: use a strict `>`, not `>=`": _hot_at_threshold,
+        "take the median over the pixels that fired (count > 0): with most pixels silent the median of all "
+        "pixels is 0 and every firing pixel looks hot": _hot_median_all_pixels,
+        "use the median, not the mean: the hot pixels pull the mean up and hide themselves": _hot_mean,
+        "`counts[y, x] += 1` counts a pixel once however often it fired (fancy indexing does not accumulate "
+        "repeated indices): use np.add.at(counts, (y, x), 1) or np.bincount(y * W + x, minlength=H * W)":
+            _hot_fancy_index,
+        "rows are y and columns are x: count into counts[y, x]": _hot_rows_columns_swapped,
     })
 
 

@@ -1,0 +1,118 @@
+"""Exercise checks of notebooks 09-11 catch the mistakes they name: events on a bin edge, fancy-index `+=`,
+rows and columns swapped, `>=` on a stated strict threshold; and notebook 10's Jensen's-gap helper."""
+import numpy as np
+import pytest
+
+from evinr_lite.teaching import aed_exercises, exercises, realdata_exercises, recording_exercises
+from evinr_lite.method.contrast import estimate_contrast_threshold
+
+
+def _fails_with_hint(capsys, name, wrong, words):
+    capsys.readouterr()
+    assert not exercises.check(name, wrong)
+    out = capsys.readouterr().out
+    assert words in out, out
+
+
+# ---- notebook 09: event_rate, bins [b_k, b_{k+1}) -----------------------------------------------
+
+def _rate_by_edges(t, bin_s, side):
+    t = np.asarray(t, dtype=np.float64)
+    n_bins = max(int(np.floor((t[-1] - t[0]) / bin_s)) + 1, 1)
+    edges = t[0] + np.arange(n_bins + 1) * bin_s
+    k = np.clip(np.searchsorted(edges, t, side=side) - 1, 0, n_bins - 1)
+    return t[0] + (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
+
+
+def test_event_rate_check_has_events_on_bin_edges(capsys):
+    assert exercises.check("event_rate", realdata_exercises.event_rate)
+    assert exercises.check("event_rate", lambda t, bin_s: _rate_by_edges(t, bin_s, "right"))   # [b_k, b_{k+1})
+    _fails_with_hint(capsys, "event_rate", lambda t, bin_s: _rate_by_edges(t, bin_s, "left"), "side='right'")
+    ceil_rule = lambda t, bin_s: (realdata_exercises.event_rate(t, bin_s)[0],  # noqa: E731
+                                  realdata_exercises._rate_edges_to_lower_bin(t, bin_s)[1])
+    _fails_with_hint(capsys, "event_rate", ceil_rule, "belongs to bin k")
+    # the boundary cases really put events on edges (else the wrong rules would pass by luck)
+    cases = exercises.get("event_rate").cases()
+    on_edge = [np.any(np.isclose(((kw["t"] - kw["t"][0]) / kw["bin_s"]) % 1, 0) & (kw["t"] > kw["t"][0]))
+               for _, kw in cases]
+    assert sum(on_edge) >= 2
+
+
+def test_contrast_threshold_exercise_is_registered_by_notebook_09s_module(capsys):
+    assert exercises.get("estimate_contrast_threshold").reference is estimate_contrast_threshold
+    assert realdata_exercises.estimate_contrast_threshold is estimate_contrast_threshold
+    assert "estimate_contrast_threshold" not in recording_exercises.__all__    # one C-fit exercise, in 09
+    polyfit = lambda log_changes, net_counts: float(np.polyfit(net_counts, log_changes, 1)[0])  # noqa: E731
+    _fails_with_hint(capsys, "estimate_contrast_threshold", polyfit, "through the origin")
+
+
+# ---- notebook 10: grey_event_frame and Jensen's gap -------------------------------------------
+
+def test_grey_event_frame_catches_fancy_index_and_swapped_axes(capsys):
+    _fails_with_hint(capsys, "grey_event_frame", aed_exercises._grey_fancy_index, "np.add.at")
+
+    def swapped(x, y, p, C, raw_size):
+        H, W = raw_size
+        frame = np.zeros((H // 4, W // 4))
+        np.add.at(frame, (np.asarray(x) // 4, np.asarray(y) // 4), C * np.asarray(p, float) / 16)
+        return frame
+
+    _fails_with_hint(capsys, "grey_event_frame", swapped, "rows are y")
+
+
+def test_jensen_gap_is_negative_and_second_order_where_the_spread_is_small():
+    rng = np.random.default_rng(0)
+    I = np.exp(rng.normal(0.0, 0.05, (3, 8, 12)))                 # small spread
+    gap, second = aed_exercises.jensen_gap(I)
+    assert gap.shape == second.shape == (3, 2, 3)
+    direct = np.log(I[0, :4, :4]).mean() - np.log(I[0, :4, :4].mean())
+    assert np.isclose(gap[0, 0, 0], direct)
+    assert np.all(gap <= 0) and np.all(second <= 0)
+    np.testing.assert_allclose(gap, second, rtol=0.1)             # agree to second order
+    big = np.exp(rng.normal(0.0, 0.8, (8, 8)))                    # large spread: the formula drifts
+    g, s = aed_exercises.jensen_gap(big)
+    assert np.all(g <= 0) and np.abs(g - s).max() > 0.01
+    uniform = np.full((4, 4), 0.3)
+    assert np.allclose(aed_exercises.jensen_gap(uniform)[0], 0)
+
+
+# ---- notebook 11: hot_pixel_mask, count > factor x median (strict) ------------------------------
+
+def test_hot_pixel_check_catches_the_named_mistakes(capsys):
+    assert exercises.check("hot_pixel_mask", recording_exercises.hot_pixel_mask)
+    _fails_with_hint(capsys, "hot_pixel_mask", recording_exercises._hot_at_threshold, "strict `>`")
+    _fails_with_hint(capsys, "hot_pixel_mask", recording_exercises._hot_median_all_pixels, "pixels that fired")
+    _fails_with_hint(capsys, "hot_pixel_mask", recording_exercises._hot_mean, "not the mean")
+    _fails_with_hint(capsys, "hot_pixel_mask", recording_exercises._hot_fancy_index, "np.add.at")
+
+    def swapped(x, y, sensor_size, factor=10.0):
+        counts = np.zeros(sensor_size, np.int64)
+        np.add.at(counts, (np.asarray(x), np.asarray(y)), 1)
+        return counts > factor * np.median(counts[counts > 0])
+
+    _fails_with_hint(capsys, "hot_pixel_mask", swapped, "rows are y")
+
+
+def test_hot_pixel_mask_finds_injected_hot_pixels_and_nothing_else():
+    """The teaching rule on a Poisson sensor with 4 injected hot pixels (pin the library's
+    evinr_lite.method.denoise hot-pixel map to this behaviour once it exists)."""
+    rng = np.random.default_rng(3)
+    H, W = 30, 40
+    counts = rng.poisson(2.0, (H, W)) * (rng.uniform(size=(H, W)) < 0.5)
+    hot = rng.choice(H * W, 4, replace=False)
+    counts.ravel()[hot] = rng.integers(200, 1000, 4)
+    y, x = np.nonzero(counts)
+    reps = counts[y, x]
+    mask = recording_exercises.hot_pixel_mask(np.repeat(x, reps), np.repeat(y, reps), (H, W))
+    assert mask.dtype == bool and mask.shape == (H, W)
+    assert sorted(np.flatnonzero(mask)) == sorted(hot)
+    # the threshold is strict: a pixel at exactly factor x median is not hot
+    m = np.median(counts[counts > 0])
+    assert not recording_exercises.hot_pixel_mask(np.repeat(x, reps), np.repeat(y, reps), (H, W),
+                                                  factor=counts.max() / m).any()
+
+
+@pytest.mark.parametrize("name", ["event_rate", "estimate_contrast_threshold", "quad_bayer_channel",
+                                  "grey_event_frame", "hot_pixel_mask", "event_count_windows"])
+def test_references_pass_their_own_checks(name):
+    assert exercises.check(name, exercises.reference(name), verbose=False)
