@@ -79,10 +79,7 @@ def debayer(raw: np.ndarray, cfa: str) -> np.ndarray:
     from evinr_lite.sim.quadbayer import BAYER, cfa_pattern
 
     raw = np.asarray(raw)
-    H, W = raw.shape
-    if H % 2 or W % 2:
-        raise ConversionError(f"a {cfa} mosaic must have an even size to be debayered, got {raw.shape}")
-    pattern = cfa_pattern((H, W), CFA_NAMES[cfa], block=BAYER)
+    pattern = cfa_pattern(raw.shape, CFA_NAMES[cfa], block=BAYER)
     kernel = np.array([[1.0, 2.0, 1.0], [2.0, 4.0, 2.0], [1.0, 2.0, 1.0]])
     values = raw.astype(np.float64)
     out = []

@@ -70,8 +70,6 @@ def test_old_grey_files_read_as_before(tmp_path):
 def test_writer_and_reader_refuse_bad_colour_input(tmp_path):
     with pytest.raises(EventDataError, match="cfa must be one of"):
         CanonicalWriter(tmp_path / "a.h5", sensor_size=(6, 8), cfa="RGBG")
-    with pytest.raises(EventDataError, match="even size"):
-        CanonicalWriter(tmp_path / "b.h5", sensor_size=(5, 8), cfa="RGGB")
     with pytest.raises(EventDataError, match="of one kind"):
         with CanonicalWriter(tmp_path / "c.h5", sensor_size=(6, 8)) as w:
             w.add_frame(np.zeros((6, 8, 3), np.uint8), 0.0)
@@ -84,6 +82,22 @@ def test_writer_and_reader_refuse_bad_colour_input(tmp_path):
         f.attrs["cfa"] = "XYZW"
     with pytest.raises(EventDataError, match="attribute cfa must be one of.*convert the file again"):
         read_canonical(out)
+
+
+def test_an_odd_sensor_loses_only_its_last_row_and_column():
+    from evinr_lite.apps.colour_job import split_colour_events
+    from evinr_lite.core.events import Events
+
+    rng = np.random.default_rng(0)
+    n = 500
+    ev = Events(np.sort(rng.uniform(0, 1, n)), rng.integers(0, 9, n), rng.integers(0, 7, n),
+                rng.choice([-1, 1], n), (7, 9))
+    streams = split_colour_events(Recording(ev, None, {"cfa": "RGGB"}))
+    assert {s.sensor_size for s in streams} == {(3, 4)}
+    assert sum(len(s) for s in streams) == int(np.sum((ev.x < 8) & (ev.y < 6)))
+    red = streams[0]                                                 # RGGB: red photosites at even (y, x)
+    inside = (ev.x < 8) & (ev.y < 6) & (ev.x % 2 == 0) & (ev.y % 2 == 0)
+    np.testing.assert_array_equal(red.t, ev.t[inside])
 
 
 # ---- data_fetch: the CED converter keeps colour -------------------------------------------

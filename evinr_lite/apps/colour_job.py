@@ -10,7 +10,7 @@ colours of photosites (0, 0), (0, 1), (1, 0), (1, 1), e.g. "RGGB". The steps::
 
 Every 2 x 2 window of photosites becomes one pixel of each channel (the split of
 :func:`evinr_lite.sim.quadbayer.demosaic_events_rgb` with ``block=1``), so the reconstruction is on
-the (H/2, W/2) grid, each channel with its effective threshold (C for R and B, C/2 for G). The white
+the (H/2, W/2) grid (an odd last row or column, which holds no full window, is left out), each channel with its effective threshold (C for R and B, C/2 for G). The white
 balance is the grey world of :func:`evinr_lite.method.colour.reconstruct_colour` (events carry no
 channel offsets). Scores: the colour frames converted to grey (ITU-R 709, as the grey frames)
 against the ground-truth frames averaged over the same 2 x 2 windows, under both protocols; and,
@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.events import EventDataError
+from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from ..core.recording import Recording
 from ..io.canonical import cfa_phase
@@ -47,16 +47,20 @@ def check_colour_recording(rec: Recording) -> str:
                              "cfa attribute: a mono sensor, or a format that does not store it); drop --colour, or "
                              "convert the colour camera's raw recording with `python -m data_fetch convert` (CED "
                              "bags keep their RGGB filter) into a canonical .h5 that records it")
-    H, W = rec.events.sensor_size
-    if H % 2 or W % 2:
-        raise EventDataError(f"{source}: a 2 x 2 colour filter needs an even sensor size, got (H, W) = {(H, W)}")
     cfa_phase(cfa)   # a valid name
     return cfa
 
 
 def split_colour_events(rec: Recording):
-    """(R, G, B) Events on (H/2, W/2), split by the recording's colour filter (``meta["cfa"]``)."""
-    return demosaic_events_rgb(rec.events, cfa_phase(check_colour_recording(rec)), block=BAYER)
+    """(R, G, B) Events on (H // 2, W // 2), split by the recording's colour filter (``meta["cfa"]``);
+    an odd last row or column of photosites is left out (it holds no full 2 x 2 window)."""
+    phase = cfa_phase(check_colour_recording(rec))
+    ev = rec.events
+    H, W = ev.sensor_size
+    if H % 2 or W % 2:
+        ev = ev.take((ev.x < W - W % 2) & (ev.y < H - H % 2))
+        ev = Events(ev.t, ev.x, ev.y, ev.p, (H - H % 2, W - W % 2), t_origin=ev.t_origin, polarity_encoding="pm1")
+    return demosaic_events_rgb(ev, phase, block=BAYER)
 
 
 def colour_frames(rec: Recording) -> np.ndarray | None:
@@ -150,15 +154,16 @@ def score_colour_recording(result: ColourResult, rec: Recording, score_predictio
         return None, None
     rgb = colour_frames(rec)
     h, w = result.frames.shape[1:3]
-    if tuple(gt.size) != (2 * h, 2 * w):
-        raise EventDataError(f"ground-truth frames are {gt.size} but the colour events' sensor is {(2 * h, 2 * w)} "
-                             "(H, W); they cannot be compared")
+    if tuple(gt.size) != tuple(rec.events.sensor_size) or gt.size[0] // 2 != h or gt.size[1] // 2 != w:
+        raise EventDataError(f"ground-truth frames are {gt.size} but the colour events' sensor is "
+                             f"{rec.events.sensor_size} (H, W); they cannot be compared")
     t = gt.t[keep]
     if rgb is not None:
-        true_rgb = _reduce_rgb(rgb[keep])
+        true_rgb = _reduce_rgb(rgb[keep][:, :2 * h, :2 * w])
         grey_gt = true_rgb @ GREY_WEIGHTS
     else:
-        grey_gt = reduce_mean(np.asarray(gt.images[keep], np.float64) / (255.0 if gt.images.dtype == np.uint8 else 1.0), 2)
+        grey = np.asarray(gt.images[keep][:, :2 * h, :2 * w], np.float64)
+        grey_gt = reduce_mean(grey / (255.0 if gt.images.dtype == np.uint8 else 1.0), 2)
         true_rgb = None
     L = result.at(t)
     pred = tonemap_reinhard(L, result.channels[0].config.gamma).astype(np.float32)

@@ -444,9 +444,6 @@ class CanonicalWriter:
         self.eval_window = None if eval_window is None else tuple(float(v) for v in eval_window)
         self.meta = dict(meta or {})
         self.cfa = check_cfa(cfa, self.error)
-        if self.cfa is not None and (self.H % 2 or self.W % 2):
-            raise self.error(f"a colour sensor with a 2 x 2 filter ({self.cfa}) must have an even size; got (H, W) = "
-                             f"{(self.H, self.W)}")
         self.f = h5py.File(self.tmp, "w")
         ev = self.f.create_group("events")
         self.ds = {k: ev.create_dataset(k, shape=(0,), maxshape=(None,), dtype=dt, chunks=(CHUNK_EVENTS,),
