@@ -199,3 +199,21 @@ def test_colour_davis_scene_checks_its_inputs():
         colour_davis_recording(cfa="RGB")
     with pytest.raises(EventDataError, match="multiples"):
         colour_davis_recording(sensor_size=(47, 64))
+
+
+def test_export_writes_colour_gif_and_mp4(tmp_path):
+    import cv2
+
+    from evinr_lite.io.export import save_frames_png, save_gif, save_mp4
+
+    frames = np.zeros((3, 8, 10, 3), np.float32)
+    frames[..., 0] = 1.0                                            # pure red
+    save_gif(tmp_path / "a.gif", frames, 10.0)
+    gif = np.asarray(Image.open(tmp_path / "a.gif").convert("RGB")).astype(int)
+    assert gif.shape == (8, 10, 3) and gif[..., 0].min() > 200 and gif[..., 2].max() < 50
+    save_mp4(tmp_path / "a.mp4", frames, 10.0)
+    ok, first = cv2.VideoCapture(str(tmp_path / "a.mp4")).read()   # BGR
+    assert ok and first.shape == (8, 10, 3) and first[..., 2].mean() > 200 > 50 > first[..., 0].mean()
+    assert Image.open(save_frames_png(tmp_path / "p", frames)[0]).mode == "RGB"
+    with pytest.raises(ValueError, match=r"\[F, H, W, 3\] \(colour\)"):
+        save_frames_png(tmp_path / "q", np.zeros((2, 4, 4, 2)))
