@@ -10,12 +10,14 @@ colours of photosites (0, 0), (0, 1), (1, 0), (1, 1), e.g. "RGGB". The steps::
 
 Every 2 x 2 window of photosites becomes one pixel of each channel (the split of
 :func:`evinr_lite.sim.quadbayer.demosaic_events_rgb` with ``block=1``), so the reconstruction is on
-the (H/2, W/2) grid (an odd last row or column, which holds no full window, is left out), each channel with its effective threshold (C for R and B, C/2 for G). The white
-balance is the grey world of :func:`evinr_lite.method.colour.reconstruct_colour` (events carry no
-channel offsets). Scores: the colour frames converted to grey (ITU-R 709, as the grey frames)
-against the ground-truth frames averaged over the same 2 x 2 windows, under both protocols; and,
-when the recording has colour frames, the chroma correlation (log R/G and log B/G against the truth's,
-each frame's mean removed: 1 = the colour pattern is right, 0 = none of it).
+the (H/2, W/2) grid (an odd last row or column, which holds no full window, is left out), each
+channel with its effective threshold (C for R and B, C/2 for G). The white balance is the grey
+world of :func:`evinr_lite.method.colour.reconstruct_colour` (events carry no channel offsets).
+
+Scores: the colour frames converted to grey (ITU-R 709, as the grey frames) against the
+ground-truth frames averaged over the same 2 x 2 windows, under both protocols; and, when the
+recording has colour frames, the chroma correlation (log R/G and log B/G against the truth's, each
+frame's mean removed: 1 = the colour pattern is right, 0 = none of it).
 """
 from __future__ import annotations
 

@@ -11,5 +11,6 @@ from . import zoo
 __all__ = ["Scene", "MovingImageScene", "MovingBarScene", "VaryingSpeedScene", "WarpedImageScene",
            "ObjectOverBackgroundScene", "LightingScene", "make_scene", "simulate_events_1d",
            "simulate_video", "simulate_scene", "pixel_events", "add_background_noise", "add_hot_pixels", "QuadBayerScene",
-           "simulate_colour_video", "colour_davis_recording", "write_colour_davis_recording", "write_example_recording", "synthetic_recording",
+           "simulate_colour_video", "colour_davis_recording", "write_colour_davis_recording",
+           "write_example_recording", "synthetic_recording",
            "find_recording", "zoo"]
