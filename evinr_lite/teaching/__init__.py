@@ -9,6 +9,7 @@ Only this subpackage knows the registry; the library never registers anything.
 """
 from . import exercises
 
-__all__ = ["exercises", "pde1d", "events2d", "coordinate_exercises", "frame_exercises", "accel_exercises",
+__all__ = ["exercises", "pde1d", "events2d", "coordinate_exercises", "frame_exercises", "training_exercises",
+           "accel_exercises",
            "ablation_exercises", "discussion_exercises", "realdata_exercises", "aed_exercises",
            "recording_exercises"]

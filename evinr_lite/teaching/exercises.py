@@ -56,7 +56,8 @@ __all__ = [
 # Modules that register reference solutions at import; imported on the first lookup of an
 # unknown name, so ``check`` works without the notebook importing them first.
 REFERENCE_MODULES = ["evinr_lite.teaching." + name for name in (
-    "pde1d", "events2d", "coordinate_exercises", "frame_exercises", "accel_exercises", "ablation_exercises",
+    "pde1d", "events2d", "coordinate_exercises", "frame_exercises", "training_exercises", "accel_exercises",
+    "ablation_exercises",
     "discussion_exercises", "realdata_exercises", "aed_exercises", "recording_exercises")]
 
 SEED = 0
@@ -78,6 +79,7 @@ class Exercise:
     rtol: float = 1e-5
     atol: float = 1e-8
     compare: Callable[[Any, Any], str | None] | None = None
+    observe: Callable[[Any, tuple, dict], Any] | None = None
 
     def cases(self) -> list[tuple[tuple, dict]]:
         """The seeded inputs as (args, kwargs) pairs."""
@@ -97,7 +99,8 @@ _REGISTRY: dict[str, Exercise] = {}
 
 def register(name: str, reference: Callable, make_inputs: Callable, *, hints: dict | None = None,
              rtol: float = 1e-5, atol: float = 1e-8,
-             compare: Callable[[Any, Any], str | None] | None = None) -> Exercise:
+             compare: Callable[[Any, Any], str | None] | None = None,
+             observe: Callable[[Any, tuple, dict], Any] | None = None) -> Exercise:
     """Register (or replace) an exercise.
 
     Args:
@@ -110,10 +113,13 @@ def register(name: str, reference: Callable, make_inputs: Callable, *, hints: di
         rtol, atol: tolerances for comparing numbers (``numpy.isclose``).
         compare: optional ``compare(got, expected) -> message or None`` replacing the
             built-in comparison.
+        observe: optional ``observe(result, args, kwargs) -> value``: what is compared, for a
+            function with side effects. It gets the function's result and the (copied) inputs
+            *after* the call, e.g. a model's parameters after one optimiser step.
     """
     if not callable(reference) or not callable(make_inputs):
         raise TypeError("register needs a callable reference and a callable make_inputs(rng)")
-    ex = Exercise(name, reference, make_inputs, dict(hints or {}), rtol, atol, compare)
+    ex = Exercise(name, reference, make_inputs, dict(hints or {}), rtol, atol, compare, observe)
     _REGISTRY[name] = ex
     return ex
 
@@ -172,6 +178,9 @@ def _fmt(v) -> str:
 
 
 def _describe_value(v) -> str:
+    if not isinstance(v, (np.ndarray, np.generic, int, float, str, bool, list, tuple, dict)) and not _is_tensor(v) \
+            and v is not None and ("\n" in repr(v) or len(repr(v)) > 60):
+        return type(v).__name__          # a model or an optimiser: its repr would fill the report
     if _is_tensor(v):
         return f"tensor {str(v.dtype).replace('torch.', '')}{list(v.shape)}"
     if isinstance(v, np.ndarray):
@@ -334,7 +343,7 @@ def _wrong_axes_hint(ex: "Exercise", args: tuple, kwargs: dict, got) -> str | No
     if not (any(_has_image(a) for a in args) or any(_has_image(v) for v in kwargs.values())):
         return None
     try:
-        w = _run(ex.reference, _swap_last_axes(args), {k: _swap_last_axes(v) for k, v in kwargs.items()})
+        w = _run(ex.reference, _swap_last_axes(args), {k: _swap_last_axes(v) for k, v in kwargs.items()}, ex.observe)
         w = _swap_last_axes(w)
     except Exception:
         return None
@@ -397,8 +406,25 @@ def _where_raised(err: BaseException) -> list[str]:
     return [f"raised in {f.name}, line {f.lineno}{code}"]
 
 
-def _run(fn, args, kwargs):
-    return fn(*copy.deepcopy(args), **copy.deepcopy(kwargs))
+def _deepcopy_with_grads(x):
+    """``copy.deepcopy(x)``, also copying the ``.grad`` of torch parameters (which deepcopy drops),
+    so that a case can hold a model with gradients left from an earlier step."""
+    memo: dict = {}
+    y = copy.deepcopy(x, memo)
+    for orig in memo.get(id(memo), []):
+        grad = getattr(orig, "grad", None) if _is_tensor(orig) else None
+        new = memo.get(id(orig))
+        if grad is not None and new is not None and new is not orig and getattr(new, "grad", None) is None:
+            new.grad = grad.detach().clone()
+    return y
+
+
+def _run(fn, args, kwargs, observe=None):
+    """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
+    e.g. a model and its optimiser); with ``observe``, what it says to compare."""
+    args, kwargs = _deepcopy_with_grads((args, kwargs))
+    result = fn(*args, **kwargs)
+    return result if observe is None else observe(result, args, kwargs)
 
 
 def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
@@ -413,13 +439,13 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
     for k, (args, kwargs) in enumerate(cases):
         where = f"input #{k + 1} of {n} ({_describe_case(args, kwargs)})"
         try:
-            got = _run(fn, args, kwargs)
+            got = _run(fn, args, kwargs, ex.observe)
         except NotImplementedError:
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except Exception as err:
             return False, f"raised {type(err).__name__} on {where}", [f"{type(err).__name__}: {err}"] + _where_raised(err)
-        expected = _run(ex.reference, args, kwargs)
+        expected = _run(ex.reference, args, kwargs, ex.observe)
         if ex.compare is not None:
             msg = ex.compare(got, expected)
             problem = None if msg is None else _Problem(msg, values=True)
@@ -432,7 +458,7 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         if problem.values:
             for message, wrong in ex.hints.items():
                 try:
-                    w = _run(wrong, args, kwargs)
+                    w = _run(wrong, args, kwargs, ex.observe)
                     if _compare(got, w, ex.rtol, ex.atol) is None:
                         hint = message
                         break
