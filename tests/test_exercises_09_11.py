@@ -116,3 +116,18 @@ def test_hot_pixel_mask_finds_injected_hot_pixels_and_nothing_else():
                                   "grey_event_frame", "hot_pixel_mask", "event_count_windows"])
 def test_references_pass_their_own_checks(name):
     assert exercises.check(name, exercises.reference(name), verbose=False)
+
+
+def test_hot_pixel_teaching_rule_is_the_librarys_median_rule():
+    """Pins notebook 11's teaching reference to evinr_lite.method.denoise (its rule="median")."""
+    denoise = pytest.importorskip("evinr_lite.method.denoise")
+    from evinr_lite import Events
+    rng = np.random.default_rng(5)
+    for factor in (4.0, 10.0):
+        for case in exercises.get("hot_pixel_mask").cases():
+            kw = case[1]
+            H, W = kw["sensor_size"]
+            n = len(kw["x"])
+            events = Events.from_arrays(np.sort(rng.uniform(0, 1, n)), kw["x"], kw["y"], rng.choice([-1, 1], n), (H, W))
+            np.testing.assert_array_equal(recording_exercises.hot_pixel_mask(kw["x"], kw["y"], (H, W), factor),
+                                          denoise.hot_pixel_mask(events, factor=factor, rule="median"))
