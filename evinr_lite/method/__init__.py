@@ -1,5 +1,5 @@
 """EvINR and its baselines: binning, networks, losses, the solver, tone mapping, colour, C from frames."""
-from .binning import (EventFrames, events_to_frames, events_to_frames_chunked, fixed_duration_boundaries, equal_count_boundaries, bisect_boundaries, event_rate)
+from .binning import (EventFrames, events_to_frames, events_to_frames_chunked, fixed_duration_boundaries, equal_count_boundaries, bisect_boundaries, event_rate, as_thresholds)
 from .siren import Siren, SineLayer
 from .models import FrameINR
 from .solver import EvINRConfig, Reconstruction, reconstruct, split_windows
@@ -8,7 +8,7 @@ from .integration import integrate_events
 from .baselines import reconstruct_baseline, leaky_integration, highpass_filter
 from .coordinate import CoordinateConfig, reconstruct_coordinate
 from .colour import reconstruct_colour
-from .contrast import frame_log_changes, estimate_contrast_threshold
+from .contrast import frame_log_changes, estimate_contrast_threshold, fit_contrast, ContrastFit
 
 __all__ = ["EventFrames", "events_to_frames", "events_to_frames_chunked",
            "fixed_duration_boundaries", "equal_count_boundaries", "bisect_boundaries",
@@ -16,4 +16,4 @@ __all__ = ["EventFrames", "events_to_frames", "events_to_frames_chunked",
            "reconstruct", "split_windows", "tonemap_reinhard", "anchor_level", "anchor_mean",
            "integrate_events", "reconstruct_baseline", "leaky_integration", "highpass_filter",
            "CoordinateConfig", "reconstruct_coordinate", "reconstruct_colour", "frame_log_changes",
-           "estimate_contrast_threshold"]
+           "estimate_contrast_threshold", "fit_contrast", "ContrastFit", "as_thresholds"]

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.events import EventDataError, Events
+from .binning import as_thresholds
 from .integration import integrate_events
 from .offset import median_gradient_offset
 from .tonemap import anchor_level, tonemap_reinhard
@@ -41,13 +42,6 @@ DEFAULT_CUTOFF_HZ = 1.0   # alpha = 2 pi rad/s; a tunable choice (Scheerlinck et
 
 
 # ---- argument checks -------------------------------------------------------------------------
-
-def _thresholds(C) -> tuple[float, float]:
-    C_pos, C_neg = (C, C) if np.isscalar(C) else tuple(C)
-    if not all(np.isscalar(c) and np.isfinite(c) and c > 0 for c in (C_pos, C_neg)):
-        raise EventDataError(f"C must be a positive number or a pair (C_pos, C_neg) of positive numbers, got {C!r}")
-    return float(C_pos), float(C_neg)
-
 
 def _rate(value, name: str) -> float:
     if not (np.isscalar(value) and np.isfinite(value) and value >= 0):
@@ -134,7 +128,7 @@ def leaky_integration(events: Events, query_times, C=0.2, leak_hz: float = 0.0, 
         float64 [Q, H, W] log intensity ([H, W] for a scalar query).
     """
     tq = _query(query_times)
-    C_pos, C_neg = _thresholds(C)
+    C_pos, C_neg = as_thresholds(C)
     leak = _rate(leak_hz, "leak_hz")
     L0 = _initial(L0, events.sensor_size)
     t0 = _start_time(events, tq, t_start)
@@ -159,7 +153,7 @@ def highpass_filter(events: Events, query_times, C=0.2, cutoff_hz: float = DEFAU
         float64 [Q, H, W] ([H, W] for a scalar query).
     """
     tq = _query(query_times)
-    C_pos, C_neg = _thresholds(C)
+    C_pos, C_neg = as_thresholds(C)
     alpha = 2 * math.pi * _rate(cutoff_hz, "cutoff_hz")
     L0 = _initial(L0, events.sensor_size)
     t0 = _start_time(events, tq, t_start)

@@ -6,6 +6,7 @@ fired in between. Events outside [b[0], b[-1]] are not counted.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -13,7 +14,31 @@ import numpy as np
 from ..core.events import EventDataError, Events
 
 __all__ = ["EventFrames", "fixed_duration_boundaries", "equal_count_boundaries", "events_to_frames",
-           "events_to_frames_chunked", "bisect_boundaries", "event_rate"]
+           "events_to_frames_chunked", "bisect_boundaries", "event_rate", "as_thresholds"]
+
+
+def as_thresholds(C, name: str = "C") -> tuple[float, float]:
+    """(c_pos, c_neg) from a contrast threshold given as one number or a pair (log units per event).
+
+    One number c means (c, c); a pair (c_pos, c_neg) weighs ON events by +c_pos and OFF events by
+    -c_neg (real sensors differ, see :mod:`evinr_lite.method.contrast`). The one parser of C for
+    the binning, the integration, the baselines and the solver.
+
+    Raises:
+        EventDataError naming ``name`` when C is not a positive finite number or a pair of them.
+    """
+    if isinstance(C, (str, bytes, bool, np.bool_)):
+        values = None
+    elif np.ndim(C) == 0:
+        values = (C, C)
+    else:
+        values = tuple(np.asarray(C, dtype=object).ravel()) if np.ndim(C) == 1 else None
+    if values is None or len(values) != 2 or not all(
+            not isinstance(c, (bool, np.bool_)) and isinstance(c, (int, float, np.integer, np.floating))
+            and math.isfinite(c) and c > 0 for c in values):
+        raise EventDataError(f"{name} must be a positive number or a pair (c_pos, c_neg) of positive numbers "
+                             f"(log units per event, e.g. {name}=0.2 or {name}=(0.22, 0.18)), got {C!r}")
+    return float(values[0]), float(values[1])
 
 
 @dataclass(frozen=True, eq=False)
@@ -21,7 +46,8 @@ class EventFrames:
     """Binned events.
 
     Attributes:
-        frames: float32 [B, H, W], C * sum of polarities of the events in each bin.
+        frames: float32 [B, H, W], C * sum of polarities of the events in each bin (with a pair
+            C = (c_pos, c_neg): c_pos * #ON - c_neg * #OFF).
         boundaries: float64 [B + 1], bin edges in seconds (same clock as the events).
         counts: int64 [B], number of events per bin.
     """
@@ -106,10 +132,11 @@ def _bin_edges(t: np.ndarray, b: np.ndarray) -> np.ndarray:
     return e
 
 
-def _polarity_sums(events: Events, e: np.ndarray):
+def _polarity_sums(events: Events, e: np.ndarray, weights: np.ndarray | None = None):
     """Yield (i0, i1, sums) for runs of consecutive bins [i0, i1) that hold events.
 
-    sums: float64 [(i1 - i0) * H * W], the polarity sum per (bin, row, column), flattened. Each run
+    sums: float64 [(i1 - i0) * H * W], the polarity sum per (bin, row, column), flattened (the sum
+    of ``weights`` [N] instead of the polarities when given). Each run
     covers about ``_GROUP_CELLS`` cells, so np.bincount's counters stay in cache; the flat index is
     built in place in one int64 array (pixel = y * W + x, plus the bin's offset).
     """
@@ -127,33 +154,40 @@ def _polarity_sums(events: Events, e: np.ndarray):
         flat += events.x[s:stop]
         if i1 - i0 > 1:
             flat += np.repeat(np.arange(i1 - i0, dtype=np.int64) * HW, np.diff(e[i0:i1 + 1]))
-        yield i0, i1, np.bincount(flat, weights=events.p[s:stop], minlength=(i1 - i0) * HW)
+        w = events.p[s:stop] if weights is None else weights[s:stop]
+        yield i0, i1, np.bincount(flat, weights=w, minlength=(i1 - i0) * HW)
 
 
-def events_to_frames(events: Events, boundaries, C: float = 1.0) -> EventFrames:
+def events_to_frames(events: Events, boundaries, C: float | tuple = 1.0) -> EventFrames:
     """Sum p * C per pixel and bin (vectorised; no Python loop over events).
 
     Args:
         events: the events (sorted by time, as `Events` guarantees).
         boundaries: float64 [B + 1] increasing bin edges in seconds; see
             :func:`fixed_duration_boundaries` and :func:`equal_count_boundaries`.
-        C: contrast threshold (log-intensity step per event).
+        C: contrast threshold (log-intensity step per event), or a pair (c_pos, c_neg): ON events
+            weigh +c_pos, OFF events -c_neg (:func:`as_thresholds`). (c, c) gives exactly the frames of c.
 
     Returns:
         EventFrames with frames [B, H, W] float32, the boundaries and per-bin counts.
     """
     b = _check_boundaries(boundaries)
+    c_pos, c_neg = as_thresholds(C)
     H, W = events.sensor_size
     B = b.size - 1
     e = _bin_edges(events.t, b)
     frames = np.zeros((B, H, W), np.float32)
     flat = frames.reshape(-1)
-    for i0, i1, sums in _polarity_sums(events, e):
-        np.multiply(sums, C, out=flat[i0 * H * W:i1 * H * W], casting="unsafe")
+    if c_pos == c_neg:   # one threshold: the polarity sums times C (the float path, unchanged)
+        weights, scale = None, (C if np.ndim(C) == 0 else c_pos)
+    else:                # each event weighs its own polarity's threshold
+        weights, scale = np.where(events.p > 0, c_pos, -c_neg), 1.0
+    for i0, i1, sums in _polarity_sums(events, e, weights):
+        np.multiply(sums, scale, out=flat[i0 * H * W:i1 * H * W], casting="unsafe")
     return EventFrames(frames=frames, boundaries=b, counts=np.diff(e))
 
 
-def events_to_frames_chunked(chunks, boundaries, C: float = 1.0, sensor_size=None) -> EventFrames:
+def events_to_frames_chunked(chunks, boundaries, C: float | tuple = 1.0, sensor_size=None) -> EventFrames:
     """:func:`events_to_frames` of a recording given as time-ordered chunks of Events.
 
     For recordings that do not fit in memory (e.g. ``evinr_lite.io.canonical.iter_canonical_events``):
@@ -163,20 +197,24 @@ def events_to_frames_chunked(chunks, boundaries, C: float = 1.0, sensor_size=Non
 
     Args:
         chunks: iterable of Events, in time order, all on one sensor (chunks may be empty).
-        boundaries: float64 [B + 1] bin edges (seconds). C: contrast threshold.
+        boundaries: float64 [B + 1] bin edges (seconds). C: contrast threshold, or a pair
+            (c_pos, c_neg) (then ON and OFF counts are accumulated apart: twice the int32 memory).
         sensor_size: (H, W); default: the first chunk's.
 
     Returns:
         EventFrames with frames [B, H, W] float32 and counts [B].
     """
     b = _check_boundaries(boundaries)
+    c_pos, c_neg = as_thresholds(C)
+    split = c_pos != c_neg       # asymmetric: OFF counts kept apart in `off` (ON counts in `sums`)
     B = b.size - 1
-    sums = counts = None
+    sums = counts = off = None
     t_last = -np.inf
     for events in chunks:
         if sums is None:
             H, W = events.sensor_size if sensor_size is None else sensor_size
             sums = np.zeros((B, H, W), np.int32)
+            off = np.zeros((B, H, W), np.int32) if split else None
             counts = np.zeros(B, np.int64)
         if tuple(events.sensor_size) != (H, W):
             raise EventDataError(f"chunk on a sensor of {tuple(events.sensor_size)} but the frames are {(H, W)}; "
@@ -190,18 +228,28 @@ def events_to_frames_chunked(chunks, boundaries, C: float = 1.0, sensor_size=Non
         e = _bin_edges(events.t, b)
         counts += np.diff(e)
         flat = sums.reshape(-1)
-        for i0, i1, s in _polarity_sums(events, e):
+        on_w = (events.p > 0).astype(np.float64) if split else None
+        for i0, i1, s in _polarity_sums(events, e, on_w):
             flat[i0 * H * W:i1 * H * W] += s.astype(np.int32)
+        if split:
+            off_flat = off.reshape(-1)
+            for i0, i1, s in _polarity_sums(events, e, (events.p < 0).astype(np.float64)):
+                off_flat[i0 * H * W:i1 * H * W] += s.astype(np.int32)
     if sums is None:
         if sensor_size is None:
             raise EventDataError("no chunks given and no sensor_size; pass sensor_size=(H, W)")
         H, W = sensor_size
         sums, counts = np.zeros((B, H, W), np.int32), np.zeros(B, np.int64)
+        off = np.zeros((B, H, W), np.int32) if split else None
     # int32 -> float32 in place, a few bins at a time (no second [B, H, W] array)
     frames = sums.view(np.float32)
     step = max(1, _GROUP_CELLS // (H * W))
+    scale = C if np.ndim(C) == 0 else c_pos
     for i in range(0, B, step):
-        frames[i:i + step] = C * sums[i:i + step].astype(np.float64)
+        if split:
+            frames[i:i + step] = c_pos * sums[i:i + step].astype(np.float64) - c_neg * off[i:i + step]
+        else:
+            frames[i:i + step] = scale * sums[i:i + step].astype(np.float64)
     return EventFrames(frames=frames, boundaries=b, counts=counts)
 
 

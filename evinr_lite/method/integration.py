@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .binning import events_to_frames
+from .binning import as_thresholds, events_to_frames
 from ..core.events import EventDataError, Events
 
 __all__ = ["integrate_events"]
@@ -43,9 +43,7 @@ def integrate_events(events: Events, t_query, C=1.0, L0=None) -> np.ndarray:
     tq = np.asarray(t_query, dtype=np.float64)
     if tq.ndim > 1 or tq.size == 0 or not np.all(np.isfinite(tq)):
         raise EventDataError(f"t_query must be a finite scalar or a non-empty 1-D array of seconds, got shape {tq.shape}")
-    C_pos, C_neg = (C, C) if np.isscalar(C) else tuple(C)
-    if not all(np.isscalar(c) and np.isfinite(c) and c > 0 for c in (C_pos, C_neg)):
-        raise EventDataError(f"C must be a positive number or a pair (C_pos, C_neg) of positive numbers, got {C!r}")
+    C_pos, C_neg = as_thresholds(C)
     L0 = 0.0 if L0 is None else np.asarray(L0, dtype=np.float64)
     if np.ndim(L0) not in (0, 2) or (np.ndim(L0) == 2 and L0.shape != (H, W)):
         raise EventDataError(f"L0 must be a scalar or an [H, W] = {(H, W)} array, got shape {np.shape(L0)}")

@@ -33,7 +33,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 import torch
 
-from .binning import bisect_boundaries, equal_count_boundaries, events_to_frames
+from .binning import as_thresholds, bisect_boundaries, equal_count_boundaries, events_to_frames
 from ..core.runtime import default_device
 from ..core.events import EventDataError, Events
 from .fused import head_losses
@@ -83,7 +83,9 @@ class EvINRConfig:
       quick zoo (1.5-2.25 s scenes) the mean CLAHE-SSIM drops from 0.528 to 0.522.
 
     Events and bins:
-        C: contrast threshold (log units per event; paper: 1 for IJRR/HQF, 0.25 for AED).
+        C: contrast threshold (log units per event; paper: 1 for IJRR/HQF, 0.25 for AED), or a pair
+            (c_pos, c_neg): ON events weigh +c_pos, OFF events -c_neg (real sensors differ; fit both
+            from APS frames with :func:`evinr_lite.method.contrast.fit_contrast`).
         bin_duration: final event-frame length in seconds (paper: 1/32 s).
         min_bins: at least this many final fixed-duration bins per network window (shorter bins
             in short windows; 0: bin_duration alone decides, as in the paper).
@@ -133,7 +135,7 @@ class EvINRConfig:
         progress: show a progress bar (terminal or notebook).
     """
 
-    C: float = 1.0
+    C: float | tuple = 1.0
     bin_duration: float = 1 / 32
     min_bins: int = 64
     binning: str = "fixed"
@@ -179,7 +181,11 @@ class EvINRConfig:
                 raise EventDataError(f"{name} must be a finite {'whole ' if integer else ''}number, got {value!r}")
             return int(value) if integer else float(value)
 
-        for name in ("C", "bin_duration", "lr", "gamma", "omega_0", "head_lr_scale"):
+        if isinstance(self.C, (tuple, list, np.ndarray)):   # (c_pos, c_neg), checked by the one parser of C
+            self.C = as_thresholds(self.C, "C")
+        elif not number("C", self.C) > 0:
+            raise EventDataError(f"C must be positive (or a pair (c_pos, c_neg) of positive numbers), got {self.C}")
+        for name in ("bin_duration", "lr", "gamma", "omega_0", "head_lr_scale"):
             if not number(name, getattr(self, name)) > 0:
                 raise EventDataError(f"{name} must be positive, got {getattr(self, name)}")
         if self.first_omega_0 is not None and not number("first_omega_0", self.first_omega_0) > 0:
@@ -321,7 +327,7 @@ class _Bins:
     frames: torch.Tensor       # float32 [N, B, H, W], C * sum of p per bin
 
     @classmethod
-    def build(cls, events: Events, boundaries: list[np.ndarray], C: float, device) -> "_Bins":
+    def build(cls, events: Events, boundaries: list[np.ndarray], C: float | tuple, device) -> "_Bins":
         b = np.stack(boundaries)
         frames = np.stack([events_to_frames(events, bb, C).frames for bb in boundaries])
         return cls(
