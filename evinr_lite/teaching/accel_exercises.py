@@ -11,6 +11,8 @@ The reference solutions of the notebook's exercises live here and are registered
 
 Helpers for the experiments:
 
+- :func:`within_bin_detail`: the part of coarse-to-fine's loss jump at a bisection that comes from
+  the events themselves (their change within each coarse bin).
 - :class:`~evinr_lite.sim.scenes.VaryingSpeedScene` (re-exported here): a scene played at a speed that swings up and down, so that the event
   rate varies in time (equal-count bins then differ from equal-duration bins).
 - :func:`ensemble_predictions`: an ensemble's log intensity with or without the offset alignment
@@ -40,7 +42,7 @@ from ..sim.scenes import VaryingSpeedScene
 from ..method.solver import blend_networks, predict_networks
 
 __all__ = [
-    "bisect_equal_count", "crossfade_weights", "VaryingSpeedScene", "ensemble_predictions", "frame_change",
+    "bisect_equal_count", "within_bin_detail", "crossfade_weights", "VaryingSpeedScene", "ensemble_predictions", "frame_change",
     "overlap_mask", "window_bins", "per_network_loss", "train_networks", "single_copies",
     "batched_vs_sequential",
 ]
@@ -91,6 +93,10 @@ def _inputs_bisect(rng):
     t = np.sort(rng.uniform(0.0, 2.0, 101))
     b = np.concatenate([[0.0], np.sort(rng.uniform(0.1, 1.9, 6)), [2.0]])
     cases.append(dict(t_events=t, boundaries=b))
+    # the boundary rule: events exactly on the edges. Those at b_1 = 1 and b_2 = 2 belong to the bin that
+    # ends there, those at b_0 = 0 to bin 0; a half-open [b_i, b_{i+1}) or a strict t < b_{i+1} moves them
+    cases.append(dict(t_events=np.array([0.0, 0.2, 0.6, 1.0, 1.0, 1.5, 2.0, 2.5, 2.9, 3.0]),
+                      boundaries=np.array([0.0, 1.0, 2.0, 3.0])))
     return cases
 
 
@@ -122,9 +128,23 @@ def _cut_at_event(t_events, boundaries):
     return out
 
 
+def _left_closed_bins(t_events, boundaries):
+    """The mistake of bins [b_i, b_{i+1}) (searchsorted side='left' at both ends, or t < b_{i+1})."""
+    t = np.asarray(t_events, dtype=np.float64)
+    out = _midpoints(t, boundaries)
+    for i, (lo, hi) in enumerate(zip(out[0:-1:2], out[2::2])):
+        in_bin = t[(t >= lo) & (t < hi)]
+        n = len(in_bin)
+        if n >= 2 and lo < 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2]) < hi:
+            out[2 * i + 1] = 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2])
+    return out
+
+
 exercises.register(
     "bisect_equal_count", bisect_equal_count, _inputs_bisect,
     hints={
+        "an event exactly on an edge b_{i+1} belongs to bin i, which ends there: bins are (b_i, b_{i+1}] "
+        "(t > b_i and t <= b_{i+1}; bin 0 also holds t == b_0), not [b_i, b_{i+1})": _left_closed_bins,
         "you cut every bin at its time mid-point: that halves the duration, not the number of events; "
         "cut between the two middle events instead": _midpoints,
         "you cut at the mean event time; equal counts need the median (half-way between events "
@@ -132,6 +152,30 @@ exercises.register(
         "you cut exactly at event n//2; cut half-way between events n//2 - 1 and n//2, so that no event "
         "sits on an edge": _cut_at_event,
     })
+
+
+# ---- coarse-to-fine: what the loss does at a bisection ----------------------------------------
+
+def within_bin_detail(events: Events, coarse, fine, C: float) -> float:
+    """The per-bin temporal loss, on the halves ``fine`` of the bins ``coarse``, of a model that fits
+    every coarse bin exactly with a constant slope inside it: mean over halves and pixels of
+    (E_half - E_bin / 2)^2 (log units squared).
+
+    It measures the change *within* each coarse bin that the coarse stage could not see. Right after
+    a bisection, a trained network's loss on the halves exceeds this by whatever it does between
+    the old bin mid-points, where the derivative loss never constrained it.
+
+    Args:
+        events: the events. coarse: float [B + 1] bin edges (s). fine: float [2B + 1], the coarse edges
+            at even positions and one cut inside each bin (e.g. :func:`bisect_equal_count`). C: threshold.
+    """
+    coarse, fine = np.asarray(coarse, dtype=np.float64), np.asarray(fine, dtype=np.float64)
+    if fine.shape != (2 * len(coarse) - 1,) or not np.array_equal(fine[0::2], coarse):
+        raise ValueError(f"fine ({fine.shape[0]} edges) must hold the {len(coarse)} coarse edges at even positions "
+                         "and one cut inside each bin: pass the output of a bisection of coarse")
+    E0 = events_to_frames(events, coarse, C).frames.astype(np.float64)
+    E1 = events_to_frames(events, fine, C).frames.astype(np.float64)
+    return float(((E1 - np.repeat(E0 / 2, 2, axis=0)) ** 2).mean())
 
 
 # ---- exercise 2: cross-fade weights ---------------------------------------------------------

@@ -8,6 +8,11 @@ Exercises (reference solutions, registered with :mod:`evinr_lite.teaching.exerci
   (F(b_{i+1}) - F(b_i) against the events of bin i);
 - notebook 05, ``reinhard_tonemap``: Eq. 12, (e^L / (e^L + 1))^gamma;
 - notebook 05, ``total_variation``: anisotropic total variation by finite differences.
+- notebook 05, ``anchor``: the brightness anchor, L shifted so that its mean tone-maps to a chosen
+  display value (pinned by a test to :func:`evinr_lite.method.tonemap.anchor_mean`);
+- notebook 05, ``offset_gradients``: the gradient field of the per-pixel offset that the kit's default
+  solves for, minus the temporal median of the frames' forward differences (pinned by a test to
+  :func:`evinr_lite.method.offset.median_gradient_offset` through ``poisson_integrate``).
 
 Helpers used by both notebooks:
 
@@ -26,7 +31,7 @@ from . import exercises
 from ..method.losses import spatial_differences
 
 __all__ = ["sine_layer_derivative", "temporal_loss_boundary", "reinhard_tonemap", "total_variation",
-           "best_offsets", "static_residual", "ghost_strength"]
+           "anchor", "offset_gradients", "best_offsets", "static_residual", "ghost_strength"]
 
 
 # ---- notebook 04 ---------------------------------------------------------------------------
@@ -184,6 +189,124 @@ exercises.register(
             lambda F: (F[..., :, 1:] - F[..., :, :-1]).abs().mean(),
         "average each direction over its own differences and add the two means":
             _tv_pooled,
+    })
+
+
+# ---- notebook 05: the brightness anchor and the offset's gradients -------------------------
+
+def anchor(L, gamma, display_mean):
+    """``L`` shifted by one constant so that its mean tone-maps to ``display_mean``.
+
+    The display value of a log intensity F is sigmoid(F) ** gamma (Eq. 12), so the level that shows
+    as ``display_mean`` is F* = logit(display_mean ** (1 / gamma)) = log(s / (1 - s)) with
+    s = display_mean ** (1 / gamma); the result is L + (F* - mean(L)).
+
+    Args:
+        L: numpy float array of log intensities, any shape. gamma: positive float.
+        display_mean: float in (0, 1), the display value the mean should get (0.5: mid-grey).
+
+    Returns:
+        numpy float64 array, the shape of ``L``.
+    """
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    return L + (np.log(s / (1.0 - s)) - L.mean())
+
+
+def _inputs_anchor(rng):
+    return [dict(L=rng.normal(-1.0, 1.0, (3, 4)), gamma=0.6, display_mean=0.5),
+            dict(L=rng.normal(0.5, 2.0, (2, 3, 5)), gamma=2.2, display_mean=0.3),
+            dict(L=rng.uniform(-4.0, 1.0, 9), gamma=0.6, display_mean=0.8),
+            dict(L=np.full((2, 2), 3.0), gamma=1.0, display_mean=0.5)]
+
+
+def _anchor_level_wrong(level):
+    def wrong(L, gamma, display_mean):
+        L = np.asarray(L, dtype=np.float64)
+        return L + (level(gamma, display_mean) - L.mean())
+    return wrong
+
+
+def _logit(s):
+    return np.log(s / (1.0 - s))
+
+
+exercises.register(
+    "anchor", anchor, _inputs_anchor, rtol=1e-9, atol=1e-12,
+    hints={
+        "undo the exponent first: sigmoid(F) ** gamma = display_mean means sigmoid(F) = display_mean ** (1 / gamma)":
+            _anchor_level_wrong(lambda gamma, m: _logit(m)),
+        "the exponent to undo is 1 / gamma, not gamma":
+            _anchor_level_wrong(lambda gamma, m: _logit(m ** gamma)),
+        "I / (I + 1) = s gives I = s / (1 - s): the level is log(s / (1 - s)), not log(s)":
+            _anchor_level_wrong(lambda gamma, m: np.log(m ** (1.0 / gamma))),
+        "shift so that the *mean* lands on the level: add (level - mean(L)), not the level alone":
+            lambda L, gamma, display_mean: np.asarray(L, dtype=np.float64) + _logit(display_mean ** (1.0 / gamma)),
+    })
+
+
+def offset_gradients(frames):
+    """The gradient field (gx, gy) of the per-pixel offset that makes each pixel's median gradient zero.
+
+    gx = -median over time of F[k, :, x+1] - F[k, :, x] (x: the column, axis -1), and
+    gy = -median over time of F[k, y+1, :] - F[k, y, :] (y: the row, axis -2).
+    ``evinr_lite.method.offset.poisson_integrate(gx, gy)`` turns them into the offset image.
+
+    Args:
+        frames: numpy float [K, H, W], log intensities of a reconstruction over the sequence.
+
+    Returns:
+        (gx float64 [H, W - 1], gy float64 [H - 1, W]).
+    """
+    F = np.asarray(frames, dtype=np.float64)
+    return -np.median(np.diff(F, axis=2), axis=0), -np.median(np.diff(F, axis=1), axis=0)
+
+
+def _inputs_offset_gradients(rng):
+    return [dict(frames=rng.normal(0.0, 1.0, (5, 4, 4))), dict(frames=rng.normal(0.0, 1.0, (4, 3, 6))),
+            dict(frames=rng.normal(0.0, 1.0, (7, 5, 2)).cumsum(axis=0))]
+
+
+def _offset_gradients_mean(frames):
+    F = np.asarray(frames, dtype=np.float64)
+    return -np.mean(np.diff(F, axis=2), axis=0), -np.mean(np.diff(F, axis=1), axis=0)
+
+
+def _offset_gradients_swapped_axes(frames):
+    F = np.asarray(frames, dtype=np.float64)
+    return -np.median(np.diff(F, axis=1), axis=0), -np.median(np.diff(F, axis=2), axis=0)
+
+
+def _offset_gradients_no_sign(frames):
+    gx, gy = offset_gradients(frames)
+    return -gx, -gy
+
+
+AXES_HINT = ("gx is the difference along x, the column axis (axis 2 of [K, H, W], shape [H, W - 1]); gy along y, "
+             "the rows (axis 1, shape [H - 1, W])")
+
+
+def _compare_offset_gradients(got, expected):
+    """None when ``got`` is (gx, gy) equal to ``expected``; otherwise what is wrong. Reported as a values
+    problem even for a wrong shape, so that the hints run (differences along the wrong axes change the shapes)."""
+    if not isinstance(got, (tuple, list)) or len(got) != 2:
+        return f"return a pair (gx, gy), got {type(got).__name__}"
+    for name, g, e in zip(("gx", "gy"), got, expected):
+        g = np.asarray(g)
+        if g.shape != e.shape:   # a hint then says whether the axes are swapped
+            return f"{name} has shape {g.shape}, expected {e.shape}"
+        if not np.allclose(g, e, rtol=1e-9, atol=1e-12):
+            return f"{name}: wrong values, largest difference {np.abs(g - e).max():.3g}"
+    return None
+
+
+exercises.register(
+    "offset_gradients", offset_gradients, _inputs_offset_gradients, compare=_compare_offset_gradients,
+    hints={
+        "take the median over time, not the mean: the mean keeps every moving edge's trail (the ghost)":
+            _offset_gradients_mean,
+        AXES_HINT: _offset_gradients_swapped_axes,
+        "the offset cancels the median gradient: return minus the median": _offset_gradients_no_sign,
     })
 
 
