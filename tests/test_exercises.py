@@ -287,3 +287,29 @@ def test_boundary_rules_are_checked(name, wrong, hint, capsys):
     so the off-by-one variants fail the check and get the hint that names the rule."""
     assert exercises.check(name, wrong) is False
     assert hint in capsys.readouterr().out
+
+
+def test_notebook_02_boundary_rule_and_scatter_add_mistakes_fail_with_their_hint(capsys):
+    """esim_interval: a level reached exactly fires (floor, not ceil - 1); events_to_frames_fixed:
+    `frames[i, y, x] += p` drops repeated indices. Both fail the check and name the rule."""
+    from evinr_lite.teaching import events2d
+
+    def strict_esim(L_a, L_b, t_a, t_b, ref, C):   # counts only levels strictly passed
+        times, p, new_ref = events2d.esim_interval(L_a, L_b, t_a, t_b, ref, C)
+        if times.size and np.isclose(abs(L_b - ref) / C, round(abs(L_b - ref) / C)):
+            return times[:-1], p[:-1], new_ref - (1 if L_b > ref else -1) * C
+        return times, p, new_ref
+
+    assert exercises.check("esim_interval", strict_esim) is False
+    assert "reaches exactly fires too" in capsys.readouterr().out
+
+    def fancy_frames(events, boundaries, C):
+        H, W = events.sensor_size
+        i = np.clip(np.searchsorted(boundaries, events.t, side="left") - 1, 0, None)
+        keep = i < len(boundaries) - 1
+        frames = np.zeros((len(boundaries) - 1, H, W))
+        frames[i[keep], events.y[keep], events.x[keep]] += events.p[keep]
+        return (C * frames).astype(np.float32)
+
+    assert exercises.check("events_to_frames_fixed", fancy_frames) is False
+    assert "np.add.at" in capsys.readouterr().out

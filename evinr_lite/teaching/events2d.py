@@ -60,6 +60,10 @@ def _inputs_esim(rng):
                           (0.3, 0.35, 0.2),            # small change: no event
                           (-1.0, -1.0, -1.1)):         # no change at all
         cases.append(dict(L_a=L_a, L_b=L_b, t_a=0.5, t_b=0.52, ref=ref, C=0.25))
+    # the boundary rule "a level that L reaches fires": L_b lands exactly on ref + 2C (and on ref - C),
+    # so counting only levels strictly passed (a strict `<`, or ceil - 1) fails here
+    cases.append(dict(L_a=0.1, L_b=0.5, t_a=0.0, t_b=0.01, ref=0.0, C=0.25))
+    cases.append(dict(L_a=0.0, L_b=-0.25, t_a=0.0, t_b=0.01, ref=0.0, C=0.25))
     for _ in range(3):                                 # random slopes, several crossings
         ref = rng.normal()
         L_a = ref + rng.uniform(-0.19, 0.19)
@@ -78,6 +82,15 @@ def _esim_ref_to_L(L_a, L_b, t_a, t_b, ref, C):
     return times, p, float(L_b) if times.size else float(ref)
 
 
+def _esim_strict(L_a, L_b, t_a, t_b, ref, C):
+    """A wrong version (for the hint): a level that L_b lands on exactly does not fire."""
+    n = max(int(np.ceil(abs(L_b - ref) / C)) - 1, 0)
+    p = 1 if L_b > ref else -1
+    levels = ref + p * C * np.arange(1, n + 1)
+    times = t_a + (levels - L_a) / (L_b - L_a) * (t_b - t_a) if n else np.zeros(0)
+    return times.astype(np.float64), np.full(n, p, dtype=np.int8), float(ref + p * n * C)
+
+
 def _esim_from_sample(L_a, L_b, t_a, t_b, ref, C):
     return esim_interval(L_a, L_b, t_a, t_b, L_a, C)
 
@@ -92,6 +105,9 @@ exercises.register(
             _esim_ref_to_L,
         "measure the change from the reference level `ref`, not from the previous sample L_a":
             _esim_from_sample,
+        "a level that L reaches exactly fires too: the number of levels crossed is floor(|L_b - ref| / C), "
+        "so L_b == ref + 2C gives 2 events":
+            _esim_strict,
     })
 
 
@@ -151,6 +167,18 @@ def _frames_right(events, boundaries, C):
     return (C * frames).astype(np.float32)
 
 
+def _frames_fancy_index(events, boundaries, C):
+    """A wrong version (for the hint): ``frames[i, y, x] += p`` adds a repeated (bin, y, x) only once."""
+    b = np.asarray(boundaries, dtype=np.float64)
+    H, W = events.sensor_size
+    i = np.searchsorted(b, events.t, side="left") - 1
+    i[events.t == b[0]] = 0
+    keep = (i >= 0) & (i < b.size - 1)
+    frames = np.zeros((b.size - 1, H, W))
+    frames[i[keep], events.y[keep], events.x[keep]] += events.p[keep]
+    return (C * frames).astype(np.float32)
+
+
 def _frames_abs(events, boundaries, C):
     ones = Events(events.t, events.x, events.y, np.ones(len(events), np.int8), events.sensor_size)
     return events_to_frames_fixed(ones, boundaries, C)
@@ -174,6 +202,9 @@ exercises.register(
         "an event exactly on an edge b_{i+1} belongs to bin i, (b_i, b_{i+1}]: use "
         "np.searchsorted(boundaries, t, side='left') - 1":
             _frames_right,
+        "`frames[bin, y, x] += p` adds a repeated (bin, y, x) only once (numpy buffers fancy-index "
+        "assignments): accumulate with np.add.at(frames, (bin, y, x), p) or np.bincount on a flat index":
+            _frames_fancy_index,
         "did you forget the sign of the polarity? ON events add C, OFF events subtract C":
             _frames_abs,
         "did you forget to multiply by the contrast threshold C?":

@@ -455,15 +455,17 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
             continue
         details = [problem.message]
         hint = None
+        # a known mistake is recognised by its output, whatever the first difference is (a wrong
+        # count of events is a wrong shape, not wrong values)
+        for message, wrong in ex.hints.items():
+            try:
+                w = _run(wrong, args, kwargs, ex.observe)
+                if _compare(got, w, ex.rtol, ex.atol) is None:
+                    hint = message
+                    break
+            except Exception:
+                continue
         if problem.values:
-            for message, wrong in ex.hints.items():
-                try:
-                    w = _run(wrong, args, kwargs, ex.observe)
-                    if _compare(got, w, ex.rtol, ex.atol) is None:
-                        hint = message
-                        break
-                except Exception:
-                    continue
             if hint is None:
                 hint = _wrong_axes_hint(ex, args, kwargs, got)
             if hint is None:
