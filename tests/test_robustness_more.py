@@ -49,7 +49,9 @@ def _no_training(monkeypatch):
 # ---- 1. option values: reconstruct, info, demo, batch ----------------------------------------------------
 
 RECONSTRUCT_OPTION_CASES = (
-    [(opt, v) for opt in ("--C", "--fps") for v in NUMBER_JUNK + ["-0", "1e-400", "-1e-9", "-inf"]]
+    [(opt, v) for opt in ("--C", "--fps") for v in NUMBER_JUNK + ["-0", "1e-400", "-1e-9", "-inf"]
+     if (opt, v) != ("--C", "1,2")]                       # --C 1,2 is a valid pair C+,C- (issue 15)
+    + [("--C", v) for v in ("1,0", "1,2,3", "1,", "auto,1", "Auto1")]
     + [(opt, v) for opt in ("--start", "--end") for v in NUMBER_JUNK]
     + [(opt, v) for opt in ("--iters", "--seed") for v in ["+inf", "-inf", "1,2", "0x10", " ", "1e9", "--", "3.0"]]
     + [("--iters", "-0"), ("--seed", str(2**63)), ("--seed", "-0.5")]

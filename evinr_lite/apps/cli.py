@@ -1,7 +1,7 @@
 """The ``evinr-lite`` command (also ``python -m evinr_lite``).
 
     evinr-lite info RECORDING                 what a recording holds (format, sensor, events, frames)
-    evinr-lite reconstruct RECORDING --out DIR [--sensor HxW] [--C C] [--fps N | --at TIMES]
+    evinr-lite reconstruct RECORDING --out DIR [--sensor HxW] [--C C|C+,C-|auto] [--fps N | --at TIMES]
                                               [--start S] [--end S] [--device cpu|cuda] [--overwrite]
     evinr-lite demo [--out DIR]               the built-in synthetic scene, no download
     evinr-lite batch INPUTS... --out DIR [--scheduler ADDRESS | --workers N]
@@ -44,6 +44,22 @@ def _positive(text: str) -> float:
     if not value > 0:
         raise argparse.ArgumentTypeError(f"must be positive, got {text!r}")
     return value
+
+
+def _contrast(text: str):
+    """--C of reconstruct: a positive number, a pair "C+,C-" of positive numbers, or "auto"."""
+    if text.strip().lower() == "auto":
+        return "auto"
+    if "," not in text:
+        return _positive(text)
+    parts = text.split(",")
+    try:
+        if len(parts) != 2:
+            raise argparse.ArgumentTypeError("")
+        return tuple(_positive(part) for part in parts)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected a positive number, a pair C+,C- of positive numbers (e.g. "
+                                         f"0.22,0.18) or auto, got {text!r}") from None
 
 
 def _count(text: str) -> int:
@@ -121,7 +137,10 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--out", required=True, help="output folder (refused if it exists, unless --overwrite)")
     rec.add_argument("--sensor", type=_size, help="sensor size HxW (rows x columns), for files that do not "
                                                   "record it; checked against the file's otherwise")
-    rec.add_argument("--C", type=_positive, help="contrast threshold (default: the file's, else 1 as in the paper)")
+    rec.add_argument("--C", type=_contrast, help="contrast threshold: a number, a pair C+,C- (e.g. 0.22,0.18) for ON "
+                                                 "and OFF events, or auto (fit C+ and C- from the recording's APS "
+                                                 "frames in the window; printed with its uncertainty, kept in "
+                                                 "run.json); default: the file's, else 1 as in the paper")
     rec.add_argument("--time-unit", choices=TIME_UNIT_CHOICES, help=unit_help)
     when = rec.add_mutually_exclusive_group()
     when.add_argument("--fps", type=_positive, help="reconstruct this many frames per second over the window")

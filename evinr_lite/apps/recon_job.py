@@ -27,11 +27,13 @@ from ..core.frames import Frames
 from ..core.recording import Recording
 from ..io.readers import detect_format, read_recording
 from ..evaluation.scoring import score_sequence
+from ..method.binning import as_thresholds
+from ..method.contrast import fit_contrast
 from ..method.solver import EvINRConfig, Reconstruction, reconstruct
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
-           "check_run_options", "estimate_memory", "check_memory", "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS", "RECIPES",
+           "check_run_options", "contrast_option", "resolve_contrast", "format_contrast", "estimate_memory", "check_memory", "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS", "RECIPES",
            "recipe_config"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
@@ -412,6 +414,60 @@ def recipe_config(recipe: str = "kit", n_iters: int | None = None, **fields) -> 
     return make(**fields)
 
 
+def contrast_option(C):
+    """run_reconstruct's ``C=`` checked: None (the file's, else DEFAULT_C), a positive number, a pair
+    (c_pos, c_neg) of positive numbers, or "auto" (fitted from the APS frames: :func:`resolve_contrast`).
+    Returns None, "auto", a float or a (c_pos, c_neg) tuple; EventDataError naming C= otherwise."""
+    if C is None or (isinstance(C, str) and C == "auto"):
+        return C
+    if isinstance(C, (tuple, list, np.ndarray)):
+        return as_thresholds(C, "C=")
+    if isinstance(C, bool) or not isinstance(C, (int, float, np.integer, np.floating)) or not math.isfinite(C):
+        raise EventDataError(f"C= must be a finite number, a pair (c_pos, c_neg) or 'auto', got {C!r}")
+    if not C > 0:
+        raise EventDataError(f"C= must be positive (a contrast threshold in log units), got {C}")
+    return float(C)
+
+
+def format_contrast(C) -> str:
+    """'0.2' for one threshold, 'C+ 0.22 / C- 0.18' for a pair."""
+    return f"{C:g}" if np.ndim(C) == 0 else f"C+ {C[0]:.4g} / C- {C[1]:.4g}"
+
+
+def resolve_contrast(rec: Recording, C, path=None, log=print, *, colour: bool = False):
+    """(C for EvINRConfig, where it came from, the ContrastFit or None) for a checked ``C=`` option.
+
+    "auto" fits C+ and C- from the recording's APS frames in the window
+    (:func:`evinr_lite.method.contrast.fit_contrast`) and logs the fit with its uncertainty; None
+    takes the file's C, else DEFAULT_C. Raises EventDataError when "auto" finds no frames or too
+    few usable ones (the message says to pass a number instead).
+    """
+    fit = None
+    if C == "auto":
+        lo, hi = rec.meta["window"]
+        if rec.frames is None or len(rec.frames) < 2:
+            n = 0 if rec.frames is None else len(rec.frames)
+            raise EventDataError(f"{path}: C='auto' fits C from the recording's APS frames, but the window "
+                                 f"[{lo:.6f}, {hi:.6f}] s holds {n} frame(s) (2 or more needed); pass a number instead "
+                                 "(e.g. C=0.2), or widen the window with t_start=/t_end=")
+        try:
+            fit = fit_contrast(rec.frames, rec.events)
+        except EventDataError as err:
+            raise EventDataError(f"{path}: C='auto' could not fit C from the frames in [{lo:.6f}, {hi:.6f}] s: "
+                                 f"{err}") from None
+        log(f"C from the APS frames: {fit}")
+        C, source = fit.C, "fitted from the APS frames (auto)"
+    elif C is not None:
+        source = "given"
+    else:
+        source = "from the file" if rec.meta.get("C") else "default (pass C=)"
+        C = float(rec.meta.get("C") or DEFAULT_C)
+    if colour and np.ndim(C) != 0:
+        raise EventDataError("colour reconstruction takes one C (the photosites' threshold), not a pair or 'auto'; "
+                             "pass a number (e.g. C=0.2)")
+    return C, source, fit
+
+
 def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: int | None = None, seed: int = 0,
                       time_unit=None, recipe: str = "kit") -> None:
     """Every option of :func:`run_reconstruct` checked before any file is read (EventDataError naming it)."""
@@ -422,8 +478,7 @@ def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: in
             raise EventDataError(f"{name} must be a finite number, got {value!r}")
         return float(value)
 
-    if finite("C=", C) is not None and not C > 0:
-        raise EventDataError(f"C= must be positive (a contrast threshold in log units), got {C}")
+    contrast_option(C)
     if finite("fps=", fps) is not None and not fps > 0:
         raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
     finite("t_start=", t_start)
@@ -515,7 +570,7 @@ def check_memory(rec: Recording, times, config: EvINRConfig, device: str = "cpu"
 
 # ---- the whole job ---------------------------------------------------------------------------
 
-def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, fps: float | None = None, at=None,
+def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str | None = None, fps: float | None = None, at=None,
                     t_start: float | None = None, t_end: float | None = None, device: str | None = None,
                     n_iters: int | None = None, seed: int = 0, overwrite: bool = False, video: bool = True,
                     progress: bool = True, time_unit: str | None = None, log=print, command: str = "",
@@ -525,7 +580,9 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
     Every check that can fail runs before training: the options, the output folder (checked,
     locked for the whole run against a second run, a staging folder created beside it), the
     device, the file, its format, the sensor size, the window, the times and the memory needed.
-    C: the contrast threshold; None takes the file's (canonical files store it), else DEFAULT_C = 1
+    C: the contrast threshold; a pair (c_pos, c_neg) for ON and OFF events; "auto" fits C+ and C-
+    from the APS frames in the window (logged with its uncertainty, recorded in run.json as
+    "C_fit"); None takes the file's (canonical files store it), else DEFAULT_C = 1
     (the paper's for DAVIS data). time_unit: the unit of integer or text timestamps ('s', 'ms',
     'us', 'ns'; None: the reader's detection). ``command`` is recorded in the lock so a second run
     can name this one. colour: reconstruct in colour from a recording with a colour filter
@@ -549,8 +606,7 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
 
             check_colour_recording(rec)
         times, source = choose_times(rec, fps=fps, at=at)
-        C_source = "given" if C is not None else ("from the file" if rec.meta.get("C") else "default (pass C=)")
-        C = float(C if C is not None else rec.meta.get("C") or DEFAULT_C)
+        C, C_source, C_fit = resolve_contrast(rec, contrast_option(C), path, log, colour=colour)
         config = recipe_config(recipe, n_iters, C=C, seed=seed, device=device, progress=progress)
         check_memory(rec, times, config, device_name)
         lo, hi = rec.meta["window"]
@@ -558,7 +614,7 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
         log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
             + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
             + f" in {time.perf_counter() - t0:.1f} s")
-        log(f"reconstructing {source} with EvINR ({recipe} recipe, C = {C:g} {C_source}, {config.n_iters} Adam "
+        log(f"reconstructing {source} with EvINR ({recipe} recipe, C = {format_contrast(C)} {C_source}, {config.n_iters} Adam "
             f"iterations{' + the closed-form output layer' if config.head_solve else ''}, {device_name})")
         if colour:   # one EvINR per channel of the colour filter (apps/colour_job.py)
             from .colour_job import reconstruct_colour_recording, score_colour_recording
@@ -569,6 +625,8 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | None = None, 
             result = reconstruct_recording(rec, times, config)
             scores = score_recording(result, rec.frames)
         settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
+        if C_fit is not None:   # --C auto: the fit, its uncertainty and what it used
+            settings["C_fit"] = C_fit.as_dict()
         if colour:
             settings["colour"] = {"cfa": result.history["cfa"], "thresholds": result.history["thresholds"],
                                   "grid": list(result.frames.shape[1:3]), **(colour_scores or {})}

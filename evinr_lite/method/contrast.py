@@ -205,7 +205,7 @@ def _solve(Z: list, X: list, y: np.ndarray, w: np.ndarray) -> np.ndarray:
     A = np.array([[zw @ x for x in X] for zw in Zw])
     if not np.all(np.isfinite(A)) or np.linalg.cond(A) > 1e12:
         raise EventDataError("the fit of C is singular: too few pixels with ON and with OFF events; use a window "
-                             "with more frames and motion, or give C (e.g. --C 0.2)")
+                             "with more frames and motion, or give C yourself (e.g. C=0.2)")
     return np.linalg.solve(A, np.array([zw @ y for zw in Zw]))
 
 
@@ -275,13 +275,15 @@ def fit_contrast_arrays(dL, n_on, n_off, *, offsets=None, instruments=None, grou
     if not (y.shape == on.shape == off.shape == g.shape) or (lab is not None and lab.shape != y.shape):
         raise EventDataError(f"dL, n_on, n_off (and groups, offsets) must have one shape, got {y.shape}, "
                              f"{on.shape}, {off.shape}, {g.shape}")
-    centre = _Centre(lab)
-    span_on, span_off = (on, off) if lab is None else centre([on, off], np.ones_like(on))
-    n_pos, n_neg = int(np.count_nonzero(span_on)), int(np.count_nonzero(span_off))
+    n_pos = n_neg = 0
+    if y.size:     # samples whose counts vary (around the pixel's mean, with offsets): they inform the fit
+        centre = _Centre(lab)
+        span_on, span_off = (on, off) if lab is None else centre([on, off], np.ones_like(on))
+        n_pos, n_neg = int(np.count_nonzero(span_on)), int(np.count_nonzero(span_off))
     if min(n_pos, n_neg) < 20:
         raise EventDataError(f"too few usable samples to fit C+ and C- ({n_pos} with ON events, {n_neg} with OFF "
                              "events, 20 of each needed): use a window with more frames and motion, or give C "
-                             "(e.g. --C 0.2 or C=(0.22, 0.18))")
+                             "yourself (e.g. C=0.2 or C=(0.22, 0.18))")
     X = [on, -off]
     Z = None if method != "iv" else [np.asarray(instruments[0], np.float64).ravel(),
                                      -np.asarray(instruments[1], np.float64).ravel()]
@@ -308,7 +310,7 @@ def fit_contrast_arrays(dL, n_on, n_off, *, offsets=None, instruments=None, grou
     c_pos, c_neg = float(beta[0]), float(beta[1])
     if not (c_pos > 0 and c_neg > 0 and math.isfinite(c_pos) and math.isfinite(c_neg)):
         raise EventDataError(f"the fit gave C+ = {c_pos:.3g}, C- = {c_neg:.3g} (not positive): the frames and events "
-                             "do not agree (check the time alignment and exposure), or give C (e.g. --C 0.2)")
+                             "do not agree (check the time alignment and exposure), or give C yourself (e.g. C=0.2)")
     return ContrastFit(c_pos=c_pos, c_neg=c_neg, c_pos_se=float(se[0]), c_neg_se=float(se[1]),
                        c_pos_interval=(float(lo[0]), float(hi[0])), c_neg_interval=(float(lo[1]), float(hi[1])),
                        c_single=c_single, n_used=int(y.size),
