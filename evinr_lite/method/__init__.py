@@ -1,4 +1,4 @@
-"""EvINR and its baselines: binning, networks, losses, the solver, tone mapping, colour, C from frames."""
+"""EvINR and its baselines: binning, networks, losses, the solver, tone mapping, colour, C from frames, denoising."""
 from .binning import (EventFrames, events_to_frames, events_to_frames_chunked, fixed_duration_boundaries, equal_count_boundaries, bisect_boundaries, event_rate, as_thresholds)
 from .siren import Siren, SineLayer
 from .models import FrameINR
@@ -9,6 +9,7 @@ from .baselines import reconstruct_baseline, leaky_integration, highpass_filter
 from .coordinate import CoordinateConfig, reconstruct_coordinate
 from .colour import reconstruct_colour
 from .contrast import frame_log_changes, estimate_contrast_threshold, fit_contrast, ContrastFit
+from .denoise import DenoiseReport, correlation_filter, denoise, hot_pixel_mask, remove_hot_pixels
 
 __all__ = ["EventFrames", "events_to_frames", "events_to_frames_chunked",
            "fixed_duration_boundaries", "equal_count_boundaries", "bisect_boundaries",
@@ -16,4 +17,5 @@ __all__ = ["EventFrames", "events_to_frames", "events_to_frames_chunked",
            "reconstruct", "split_windows", "tonemap_reinhard", "anchor_level", "anchor_mean",
            "integrate_events", "reconstruct_baseline", "leaky_integration", "highpass_filter",
            "CoordinateConfig", "reconstruct_coordinate", "reconstruct_colour", "frame_log_changes",
-           "estimate_contrast_threshold", "fit_contrast", "ContrastFit", "as_thresholds"]
+           "estimate_contrast_threshold", "denoise", "DenoiseReport", "hot_pixel_mask",
+           "remove_hot_pixels", "correlation_filter", "fit_contrast", "ContrastFit", "as_thresholds"]

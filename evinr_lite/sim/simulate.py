@@ -431,12 +431,19 @@ def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, *
 # ---- sensor noise added to simulated events ------------------------------------------------
 
 def add_background_noise(events: Events, rate_hz: float, seed=0, t_start: float | None = None,
-                         t_end: float | None = None) -> Events:
+                         t_end: float | None = None, *, return_labels: bool = False):
     """The events plus background noise: per pixel a Poisson process of ``rate_hz`` events per second,
     uniform times in [t_start, t_end] (default: the events' span), polarity +1 or -1 with probability 1/2.
 
     Args:
         seed: int or np.random.Generator.
+        return_labels: also return ``added``, bool [N_out], True for the noise events this call added
+            (the truth for measuring a denoiser). The same seed gives the same events either way.
+
+    Returns:
+        The merged events (sorted by time, stable: the input events keep their order, so labels of
+        the input carry over as ``labels_out[~added] = labels_in``); with ``return_labels``,
+        ``(events, added)``.
     """
     if not (np.isscalar(rate_hz) and np.isfinite(rate_hz) and rate_hz >= 0):
         raise EventDataError(f"rate_hz must be a finite number >= 0 (events per pixel per second), got {rate_hz!r}")
@@ -451,17 +458,33 @@ def add_background_noise(events: Events, rate_hz: float, seed=0, t_start: float 
     t = t0 + (t1 - t0) * rng.random(pix.size)
     p = np.where(rng.random(pix.size) < 0.5, -1, 1)
     noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
-    return Events.concatenate([events, noise])
+    return _merge(events, noise, return_labels)
+
+
+def _merge(events: Events, noise: Events, return_labels: bool):
+    """Events.concatenate([events, noise]), and optionally the bool [N] mask of the noise events in it."""
+    merged = Events.concatenate([events, noise])
+    if not return_labels:
+        return merged
+    # concatenate sorts the joined times stably; the same sort of the joined labels follows them
+    order = np.argsort(np.concatenate([events.t, noise.t]), kind="stable")
+    added = np.concatenate([np.zeros(len(events), bool), np.ones(len(noise), bool)])[order]
+    return merged, added
 
 
 def add_hot_pixels(events: Events, n_pixels: int, rate_hz: float, seed=0, t_start: float | None = None,
-                   t_end: float | None = None) -> tuple[Events, np.ndarray]:
+                   t_end: float | None = None, *, return_labels: bool = False):
     """The events plus ``n_pixels`` hot pixels, each firing a Poisson process of ``rate_hz`` events
     per second over [t_start, t_end] (default: the events' span), nearly all of one polarity (90 %,
     the pixel's own sign), as a stuck or leaky DVS pixel does.
 
+    Args:
+        return_labels: also return ``added``, bool [N_out], True for the hot-pixel events this call
+            added (the events the input already had at those pixels stay False).
+
     Returns:
-        (events, hot): the merged events and the hot pixels' flat indices y * W + x (int64 [n_pixels]).
+        (events, hot): the merged events and the hot pixels' flat indices y * W + x (int64 [n_pixels]);
+        with ``return_labels``, (events, hot, added). The input events keep their order (stable merge).
     """
     if not (np.isscalar(rate_hz) and np.isfinite(rate_hz) and rate_hz >= 0):
         raise EventDataError(f"rate_hz must be a finite number >= 0 (events per second), got {rate_hz!r}")
@@ -478,4 +501,7 @@ def add_hot_pixels(events: Events, n_pixels: int, rate_hz: float, seed=0, t_star
     t = t0 + (t1 - t0) * rng.random(pix.size)
     p = np.repeat(sign, counts) * np.where(rng.random(pix.size) < 0.9, 1, -1)
     noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
-    return Events.concatenate([events, noise]), hot
+    if return_labels:
+        merged, added = _merge(events, noise, True)
+        return merged, hot, added
+    return _merge(events, noise, False), hot
