@@ -34,7 +34,14 @@ may be a library function or a teaching version pinned to one by a test)::
 a case is a dict of keyword arguments (preferred: the names appear in the report) or a
 tuple of positional arguments. A hint maps a message to a *wrong version* of the
 reference (same signature) that makes the mistake: when the learner's output matches the
-wrong version's output, the message is shown.
+wrong version's output, the message is shown. Without a matching hint, a few generic ones are
+tried: a flipped sign, a constant factor or offset, a shift by one position (``<`` versus ``<=``),
+differences along the wrong image axis (the reference run on transposed images), and a
+scatter-add that kept one contribution per repeated index (fancy-index ``+=`` for ``np.add.at``).
+
+``use`` says "not finished" for a stub that still raises ``NotImplementedError`` and "does not
+pass the check yet" for a finished function that gives wrong results. For a function with side
+effects (one optimiser step, say), ``register(..., observe=...)`` says what to compare after the call.
 """
 from __future__ import annotations
 
