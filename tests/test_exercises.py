@@ -313,3 +313,19 @@ def test_notebook_02_boundary_rule_and_scatter_add_mistakes_fail_with_their_hint
 
     assert exercises.check("events_to_frames_fixed", fancy_frames) is False
     assert "np.add.at" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("notebook", ["01_event_generation_1d", "02_events_from_video", "03_coordinate_inr", "04_frame_inr"])
+def test_stub_banners_quote_what_the_check_prints(notebook, capsys):
+    """Each stub's banner says which line the check prints on success; that line must be the real one."""
+    import json
+    import re
+    from pathlib import Path
+
+    nb = json.loads((Path(__file__).resolve().parents[1] / "notebooks" / f"{notebook}.ipynb").read_text())
+    quoted = re.findall(r'### STUDENT: # The check below prints "(✓ ([a-z0-9_]+): [^"]+)"',
+                        "".join("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "code"))
+    assert len(quoted) >= 2, f"{notebook}: every exercise stub needs a banner quoting the check's success line"
+    for line, name in quoted:
+        assert exercises.check(name, exercises.reference(name))
+        assert capsys.readouterr().out.strip() == line
