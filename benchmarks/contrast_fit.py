@@ -36,7 +36,7 @@ def main(argv=None) -> None:
     a = ap.parse_args(argv)
     methods = a.fits.split(",")
     print(f"{'scene':<20} {'true C+':>7} {'true C-':>7} {'fit':>16} {'fit C+':>14} {'fit C-':>14} "
-          f"{'err+':>6} {'err-':>6} {'one C':>6} {'pairs':>8} {'s':>5}")
+          f"{'err+':>6} {'err-':>6} {'one C':>6} {'samples':>9} {'s':>5}")
     within = {m: 0 for m in methods}
     for z in zoo.ZOO:
         z = zoo.quick(z) if a.quick else z
@@ -57,7 +57,7 @@ def main(argv=None) -> None:
             within[m] += abs(ep) <= 0.1 and abs(en) <= 0.1
             print(f"{z.name:<20} {cp:7.3f} {cn:7.3f} {m:>16} {f.c_pos:7.3f}±{f.c_pos_se:.3f} "
                   f"{f.c_neg:7.3f}±{f.c_neg_se:.3f} {100 * ep:+5.1f}% {100 * en:+5.1f}% {f.c_single:6.3f} "
-                  f"{f.n_used:8,} {s:5.2f}", flush=True)
+                  f"{f.n_used:9,} {s:5.2f}", flush=True)
     print("scenes with both C+ and C- within 10 %: " + ", ".join(f"{m} {n}/{len(zoo.ZOO)}" for m, n in within.items()))
 
 

@@ -43,7 +43,8 @@ frames = the scene's intensity at 20 frames/s as uint8 (``python benchmarks/cont
 All nine within 10 % (Huber without instruments: 8 of 9, noisy_gravel -11 % / -12 %; least
 squares: 7; consecutive pairs: 6 with Huber, 5 with least squares, lowtex_light refused). The
 worst, lowtex_light (blurred moon under a light change), has few textured pixels (43,000 samples
-against 300,000 to 1,700,000 elsewhere) and the widest intervals.
+against 300,000 to 1,700,000 elsewhere) and the widest intervals. At 10 and 40 frames/s
+(``--rate``) every fitted value moves by 0.2 % or less: 9 of 9 within 10 % again.
 """
 from __future__ import annotations
 
