@@ -44,7 +44,7 @@ All nine within 10 % (Huber without instruments: 8 of 9, noisy_gravel -11 % / -1
 squares: 7; consecutive pairs: 6 with Huber, 5 with least squares, lowtex_light refused). The
 worst, lowtex_light (blurred moon under a light change), has few textured pixels (43,000 samples
 against 300,000 to 1,700,000 elsewhere) and the widest intervals. At 10 and 40 frames/s
-(``--rate``) every fitted value moves by 0.2 % or less: 9 of 9 within 10 % again.
+(``--rate``) no error changes by more than 0.2 percentage points: 9 of 9 within 10 % again.
 """
 from __future__ import annotations
 
