@@ -156,6 +156,11 @@ def build_parser() -> argparse.ArgumentParser:
                      help="reconstruct in colour from a colour event camera (a recording with a 2x2 colour filter, "
                           "e.g. CED converted by data_fetch): one EvINR per channel, colour frames at half the "
                           "sensor's size; scored on grey, plus the chroma correlation against colour frames")
+    rec.add_argument("--anchor", choices=("none", "first", "all"), default="none",
+                     help="use the recording's APS frames as anchors (beyond the paper): none (default, events "
+                          "only), first (the first frame in the window sets each pixel's offset; a static "
+                          "background appears), all (every other frame is a soft anchor, the rest are scored); "
+                          "anchor frames are not scored, run.json says which; output in the frames' intensity")
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -212,7 +217,8 @@ def _info(args) -> None:
 def _reconstruct(args) -> None:
     from .recon_job import run_reconstruct
 
-    run_reconstruct(args.recording, args.out, sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
+    run_reconstruct(args.recording, args.out, anchor=args.anchor,
+                    sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
                     t_start=args.start, t_end=args.end, device=args.device, n_iters=args.iters, seed=args.seed,
                     recipe=args.recipe, overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet,
                     time_unit=args.time_unit, command=" ".join(["evinr-lite", *sys.argv[1:]]), colour=args.colour)
@@ -255,6 +261,7 @@ FLAG_FOR = [
     (re.compile(r"\boverwrite=True"), "--overwrite"),
     (re.compile(r"\bdevice='(\w+)'"), r"--device \1"),
     (re.compile(r"\btime_unit='(\w+)'"), r"--time-unit \1"),
+    (re.compile(r"\banchor='(\w+)'"), r"--anchor \1"),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)=(?=[\w'\"(.+-])"),
      lambda m: FLAGS[m.group(1)] + " "),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)="), lambda m: FLAGS[m.group(1)]),

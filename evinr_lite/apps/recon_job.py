@@ -30,6 +30,7 @@ from ..evaluation.scoring import score_sequence
 from ..method.binning import as_thresholds
 from ..method.contrast import fit_contrast
 from ..method.solver import EvINRConfig, Reconstruction, reconstruct
+from ..method.anchor import ANCHOR_MODES, held_out
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
@@ -240,9 +241,12 @@ def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[
 
 
 def reconstruct_recording(rec: Recording, times, config: EvINRConfig | None = None) -> Reconstruction:
-    """EvINR over the recording's window (``meta["window"]``), queried at ``times`` (seconds)."""
+    """EvINR over the recording's window (``meta["window"]``), queried at ``times`` (seconds); an
+    anchored config (``anchor`` "first" / "all") takes the recording's APS frames as anchors."""
     lo, hi = rec.meta["window"]
-    return reconstruct(rec.events, times, config or EvINRConfig(), t_start=lo, t_end=hi)
+    config = config or EvINRConfig()
+    frames = rec.frames if config.anchor != "none" else None
+    return reconstruct(rec.events, times, config, t_start=lo, t_end=hi, frames=frames)
 
 
 # ---- scoring ---------------------------------------------------------------------------------
@@ -271,12 +275,13 @@ def score_recording(result: Reconstruction, gt: Frames | None) -> dict | None:
     """Score the reconstruction at every ground-truth frame time (see :func:`score_predictions`).
 
     The trained network is queried at the frames' own timestamps, so the scores do not depend on
-    which times were exported. Returns None when no frame lies in the reconstructed span.
+    which times were exported. Frames used as anchors (``result.anchor_times``) are not scored.
+    Returns None when no other frame lies in the reconstructed span.
     """
     if gt is None or not len(gt):
         return None
     lo, hi = result.windows[0, 0], result.windows[-1, 1]
-    keep = (gt.t >= lo) & (gt.t <= hi)
+    keep = (gt.t >= lo) & (gt.t <= hi) & held_out(gt.t, getattr(result, "anchor_times", ()))
     if not keep.any():
         return None
     gt = Frames(gt.images[keep], gt.t[keep], gt.t_origin)
@@ -574,7 +579,7 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
                     t_start: float | None = None, t_end: float | None = None, device: str | None = None,
                     n_iters: int | None = None, seed: int = 0, overwrite: bool = False, video: bool = True,
                     progress: bool = True, time_unit: str | None = None, log=print, command: str = "",
-                    recipe: str = "kit", colour: bool = False) -> dict:
+                    recipe: str = "kit", colour: bool = False, anchor: str = "none") -> dict:
     """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
 
     Every check that can fail runs before training: the options, the output folder (checked,
@@ -587,6 +592,8 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
     'us', 'ns'; None: the reader's detection). ``command`` is recorded in the lock so a second run
     can name this one. colour: reconstruct in colour from a recording with a colour filter
     (``meta["cfa"]``; :mod:`evinr_lite.apps.colour_job`), writing colour frames at (H/2, W/2).
+    anchor: "none" (events only), "first" or "all": the recording's APS frames as anchors
+    (:mod:`evinr_lite.method.anchor`); the anchor frames are not scored, run.json's "anchor" says which.
     Returns the contents of run.json (with "scores" when the recording has frames).
     """
     from ..core.runtime import default_device
@@ -595,19 +602,28 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
     t0 = time.perf_counter()
     check_run_options(C=C, fps=fps, t_start=t_start, t_end=t_end, n_iters=n_iters, seed=seed, time_unit=time_unit,
                       recipe=recipe)
+    if anchor not in ANCHOR_MODES:
+        raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {anchor!r}")
+    if anchor != "none" and colour:
+        raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
     with OutputDir(out_dir, overwrite=overwrite, inputs=[path], log=log, command=command) as target:
         try:
             device_name = str(default_device(device))
         except RuntimeError as err:
             raise EventDataError(str(err)) from None
         rec = load_recording(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
+        if anchor != "none" and rec.frames is None:   # before any training
+            lo, hi = rec.meta["window"]
+            raise EventDataError(f"{path}: anchor='{anchor}' needs APS frames, but the recording has none in the window "
+                                 f"[{lo:.6f}, {hi:.6f}] s; use a recording with frames (DAVIS APS frames, an IJRR folder "
+                                 "with images.txt), widen the window with t_start=/t_end=, or pass anchor='none'")
         if colour:   # before any training: a mono recording is refused with the fix
             from .colour_job import check_colour_recording
 
             check_colour_recording(rec)
         times, source = choose_times(rec, fps=fps, at=at)
         C, C_source, C_fit = resolve_contrast(rec, contrast_option(C), path, log, colour=colour)
-        config = recipe_config(recipe, n_iters, C=C, seed=seed, device=device, progress=progress)
+        config = recipe_config(recipe, n_iters, C=C, seed=seed, device=device, progress=progress, anchor=anchor)
         check_memory(rec, times, config, device_name)
         lo, hi = rec.meta["window"]
         H, W = rec.events.sensor_size
@@ -627,6 +643,9 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
         settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
         if C_fit is not None:   # --C auto: the fit, its uncertainty and what it used
             settings["C_fit"] = C_fit.as_dict()
+        if anchor != "none":   # which frames fixed the offset (not scored) and how many were scored
+            settings["anchor"] = {**result.history["anchor"],
+                                  "n_scored": scores["none"]["n_frames"] if scores else 0}
         if colour:
             settings["colour"] = {"cfa": result.history["cfa"], "thresholds": result.history["thresholds"],
                                   "grid": list(result.frames.shape[1:3]), **(colour_scores or {})}
@@ -641,6 +660,10 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
         line += f"; scored against {scores['none']['n_frames']} ground-truth frames ({'; '.join(parts)})"
     else:
         line += "; no ground-truth frames, not scored"
+    if anchor != "none":
+        a = run["anchor"]
+        line += (f"; anchored ({anchor}) on {a['n_anchors']} APS frame(s) at t = "
+                 f"{', '.join(f'{t:.6f}' for t in a['anchor_times_s'])} s, not scored")
     chroma = (run.get("colour") or {}).get("chroma_correlation")
     if chroma:
         line += f"; colour (grey world): chroma correlation R-G {chroma['R-G']:.3f}, B-G {chroma['B-G']:.3f}"

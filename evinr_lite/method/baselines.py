@@ -35,9 +35,11 @@ from .offset import median_gradient_offset
 from .tonemap import anchor_level, tonemap_reinhard
 
 __all__ = ["leaky_integration", "highpass_filter", "highpass_per_event", "reconstruct_baseline",
-           "BaselineReconstruction", "BASELINES", "DEFAULT_CUTOFF_HZ"]
+           "BaselineReconstruction", "BASELINES", "DEFAULT_CUTOFF_HZ", "complementary_filter", "DEFAULT_GAIN",
+           "FRAME_BASELINES"]
 
 BASELINES = ("integration", "leaky", "hf")
+FRAME_BASELINES = ("complementary",)   # baselines that need APS frames (reconstruct_baseline(frames=...))
 DEFAULT_CUTOFF_HZ = 1.0   # alpha = 2 pi rad/s; a tunable choice (Scheerlinck et al. expose it as a parameter)
 
 
@@ -212,6 +214,115 @@ def highpass_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return state * np.exp(-alpha * (t_end - t_last))
 
 
+# ---- the complementary filter: events plus APS frames ------------------------------------------
+
+DEFAULT_GAIN = 2 * math.pi   # rad/s: Scheerlinck et al.'s crossover of about 1 Hz
+
+
+def _frame_logs(frames, sensor_size):
+    """(times [F], log frames [F, H, W]) of APS frames, checked and sorted (log(I + eps), anchor.frame_log)."""
+    from ..core.frames import Frames
+    from .anchor import frame_log
+
+    if not isinstance(frames, Frames) or len(frames) == 0:
+        raise EventDataError("the complementary filter needs APS frames: pass frames= as a non-empty "
+                             "evinr_lite.core.frames.Frames (e.g. recording.frames) on the events' clock")
+    if tuple(frames.size) != tuple(sensor_size):
+        raise EventDataError(f"the APS frames are {frames.size} (H, W) but the events' sensor is {tuple(sensor_size)}; "
+                             "pass the frames of the same camera")
+    frames = frames.sorted()
+    return frames.t, frame_log(frames.images)
+
+
+def complementary_filter(events: Events, frames, query_times, C=0.2, gain: float = DEFAULT_GAIN,
+                         method: str = "vectorised", *, t_start: float | None = None) -> np.ndarray:
+    """The complementary filter of Scheerlinck, Barnes, Mahony (ACCV 2018): events plus APS frames.
+
+    Per pixel, dL/dt = E(t) - alpha (L - L_F(t)), where E(t) = sum C p_i delta(t - t_i) and L_F(t) is
+    the log of the latest APS frame (log(I + eps), eps = 1/255, as :mod:`evinr_lite.method.anchor`),
+    starting from L(t_start) = L_F(t_start). Events carry the high temporal frequencies, frames the
+    low ones; alpha = ``gain`` (rad/s) is the crossover. With no frame update the state relaxes to
+    the latest frame as exp(-alpha dt); gain 0 is direct integration from the first frame; with
+    L_F = 0 it is :func:`highpass_filter`. Solved exactly between events and frames: the event part
+    is the high-pass filter's decayed sum, the frame part X solves dX/dt = -alpha (X - L_F) exactly on
+    each interval where L_F is constant.
+
+    Args:
+        events: the events. frames: APS frames (:class:`~evinr_lite.core.frames.Frames`, same clock
+            and sensor size); only those up to a query time reach it (causal).
+        query_times: seconds, scalar or [Q], at or after t_start.
+        C: contrast threshold (or (C_pos, C_neg)). gain: alpha in rad/s (>= 0).
+        method: "vectorised" or "per_event" (the published per-event update in a plain loop; a
+            reference for tests).
+        t_start: where the filter starts (seconds); default the first frame's time. A frame must lie
+            at or before it.
+
+    Returns:
+        float64 [Q, H, W] log intensity ([H, W] for a scalar query).
+    """
+    tq = _query(query_times)
+    C_pos, C_neg = as_thresholds(C)
+    alpha = _rate(gain, "gain")
+    ft, LF = _frame_logs(frames, events.sensor_size)
+    t0 = float(ft[0]) if t_start is None else float(t_start)
+    if not ft[0] <= t0:
+        raise EventDataError(f"the complementary filter starts from an APS frame, but t_start = {t0} s is before the "
+                             f"first frame ({ft[0]} s); pass t_start at or after it")
+    if tq.min() < t0:
+        raise EventDataError(f"query time {tq.min()} s is before the filter's start {t0} s (the first frame); "
+                             "query at or after it")
+    if method == "vectorised":
+        def fn(u):
+            return _frame_part(ft, LF, u, alpha, t0) + _decayed_sums(events, u, C_pos, C_neg, alpha, t0)
+    elif method == "per_event":
+        def fn(u):
+            return _complementary_loop(events, ft, LF, u, C_pos, C_neg, alpha, t0)
+    else:
+        raise ValueError(f"method must be 'vectorised' or 'per_event', got {method!r}")
+    return _per_query(fn, tq)
+
+
+def _frame_part(ft, LF, t_sorted, alpha, t0) -> np.ndarray:
+    """X at sorted times [Q]: dX/dt = -alpha (X - L_F(t)), X(t0) = L_F(t0); [Q, H, W] float64."""
+    k = int(np.searchsorted(ft, t0, side="right")) - 1           # the latest frame at t0
+    X, cur, t_prev = LF[k].copy(), LF[k], t0
+    out = np.empty((len(t_sorted), *LF.shape[1:]))
+    for q, t in enumerate(t_sorted):
+        while k + 1 < len(ft) and ft[k + 1] <= t:                # frame switches on the way to t
+            k += 1
+            X = cur + (X - cur) * math.exp(-alpha * (ft[k] - t_prev))
+            cur, t_prev = LF[k], ft[k]
+        out[q] = cur + (X - cur) * math.exp(-alpha * (t - t_prev))
+    return out
+
+
+def _complementary_loop(events: Events, ft, LF, t_sorted, C_pos, C_neg, alpha, t0) -> np.ndarray:
+    """The per-event update in a plain loop over events and frames; snapshots at sorted queries."""
+    k = int(np.searchsorted(ft, t0, side="right")) - 1
+    state, cur = LF[k].copy(), LF[k]
+    t_last = np.full(state.shape, t0)
+    out = np.empty((len(t_sorted), *state.shape))
+    ev = [(t, 1, (x, y, p)) for t, x, y, p in zip(events.t, events.x, events.y, events.p) if t >= t0]
+    fr = [(ft[j], 0, j) for j in range(k + 1, len(ft))]
+    q = 0
+    for t, kind, item in sorted(ev + fr, key=lambda e: (e[0], e[1])):
+        while q < len(t_sorted) and t_sorted[q] < t:
+            out[q] = cur + (state - cur) * np.exp(-alpha * (t_sorted[q] - t_last))
+            q += 1
+        if kind == 0:                                           # a new frame: every pixel brought to t first
+            state = cur + (state - cur) * np.exp(-alpha * (t - t_last))
+            t_last[:] = t
+            cur = LF[item]
+        else:
+            x, y, p = item
+            state[y, x] = cur[y, x] + (state[y, x] - cur[y, x]) * math.exp(-alpha * (t - t_last[y, x])) + \
+                (C_pos if p > 0 else -C_neg)
+            t_last[y, x] = t
+    for j in range(q, len(t_sorted)):
+        out[j] = cur + (state - cur) * np.exp(-alpha * (t_sorted[j] - t_last))
+    return out
+
+
 # ---- frames, as the EvINR solver makes them ----------------------------------------------------
 
 @dataclass(eq=False)
@@ -239,12 +350,16 @@ class BaselineReconstruction:
         return self._fn(np.atleast_1d(np.asarray(times, np.float64))) + self.offset
 
     def frames_at(self, times) -> np.ndarray:
+        if self.method in FRAME_BASELINES:     # in the APS frames' own intensity space
+            from .anchor import linear_frames
+
+            return linear_frames(self.at(times))
         return tonemap_reinhard(self.at(times), self.params["gamma"]).astype(np.float32)
 
 
 def reconstruct_baseline(events: Events, query_times, method: str = "integration", C=0.2, gamma: float = 0.6,
                          display_mean: float = 0.5, *, t_start: float | None = None, t_end: float | None = None,
-                         offset_solve: str = "none", **params) -> BaselineReconstruction:
+                         offset_solve: str = "none", frames=None, **params) -> BaselineReconstruction:
     """Frames from a baseline, made like the EvINR solver's: anchor, then Reinhard tone mapping.
 
     The brightness anchor is the solver's: one constant is added so that the mean log intensity
@@ -258,13 +373,22 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
         offset_solve: "none" (one constant, as always), or "median_gradient": the per-pixel offset of
             :mod:`evinr_lite.method.offset`, the kit's ghost solve, applied to the baseline (an
             ablation: ``benchmarks/quality_zoo.py --methods integration_offset``).
+        frames: APS frames, for method "complementary" (params: gain in rad/s): the
+            :func:`complementary_filter`, which starts at the first frame (default t_start). Its
+            level is the frames': no anchor, no tone map; its frames are the frames' linear
+            intensity, clip(exp(L) - eps, 0, 1) (:func:`evinr_lite.method.anchor.linear_frames`).
 
     Returns:
         BaselineReconstruction with ``.frames`` [Q, H, W] in [0, 1].
     """
-    allowed = {"integration": ("L0",), "leaky": ("leak_hz", "L0"), "hf": ("cutoff_hz", "L0")}
+    allowed = {"integration": ("L0",), "leaky": ("leak_hz", "L0"), "hf": ("cutoff_hz", "L0"), "complementary": ("gain",)}
     if method not in allowed:
-        raise ValueError(f"method must be one of {BASELINES}, got {method!r}")
+        raise ValueError(f"method must be one of {BASELINES + FRAME_BASELINES}, got {method!r}")
+    if method == "complementary":
+        return _complementary_reconstruction(events, query_times, C, frames, params.get("gain", DEFAULT_GAIN),
+                                             t_start, offset_solve, gamma, display_mean, set(params) - {"gain"})
+    if frames is not None:
+        raise TypeError(f"baseline {method!r} takes no frames (events only); frames= is for method='complementary'")
     extra = set(params) - set(allowed[method])
     if extra:
         raise TypeError(f"baseline {method!r} takes parameters {allowed[method]}, not {sorted(extra)}")
@@ -297,3 +421,26 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
                                                         "offset_solve": offset_solve, **{k: v for k, v in params.items() if k != "L0"}},
                                  offset, {"train_time_s": 0.0, "time_s": seconds}, fn)
     return rec
+
+
+def _complementary_reconstruction(events, query_times, C, frames, gain, t_start, offset_solve, gamma, display_mean,
+                                  extra) -> BaselineReconstruction:
+    """reconstruct_baseline(method="complementary"): the filter's log intensity, in the frames' own level."""
+    from .anchor import linear_frames
+
+    if extra:
+        raise TypeError(f"baseline 'complementary' takes parameters ('gain',), not {sorted(extra)}")
+    if offset_solve != "none":
+        raise ValueError("offset_solve must be 'none' for the complementary filter: the frames fix its offset")
+    q = np.atleast_1d(_query(query_times))
+
+    def fn(t):
+        return complementary_filter(events, frames, t, C, gain, t_start=t_start)
+
+    t0 = time.perf_counter()
+    L = fn(q)
+    seconds = time.perf_counter() - t0
+    return BaselineReconstruction(q, L, linear_frames(L), "complementary",
+                                  {"C": C, "gamma": gamma, "display_mean": display_mean, "offset_solve": "none",
+                                   "gain": float(gain), "output": "linear"}, 0.0,
+                                  {"train_time_s": 0.0, "time_s": seconds}, fn)

@@ -39,6 +39,7 @@ from ..core.events import EventDataError, Events
 from .fused import head_losses
 from .head_solve import solve_head
 from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov, total_variation
+from .anchor import ANCHOR_MODES, fit_anchor, frames_in_window, linear_frames
 from .models import FrameINR
 from .offset import median_gradient_offset
 from .tonemap import anchor_level, tonemap_reinhard
@@ -127,6 +128,17 @@ class EvINRConfig:
         offset_solve: how the per-pixel offset that events cannot fix is chosen: "none" (left to the
             regularizer, as in the paper) or "median_gradient" (:mod:`evinr_lite.method.offset`:
             the offset that makes the temporal median of each pixel's gradient zero).
+        anchor: APS frames as anchors (:mod:`evinr_lite.method.anchor`; pass ``frames=`` to
+            :func:`reconstruct`): "none" (events only, the default), "first" (the first frame in the
+            window sets the per-pixel offset) or "all" (every ``anchor_every``-th frame is a soft
+            constraint on a slowly varying per-pixel offset; the others are held out for scoring).
+            Anchored output is the frames' linear intensity, clip(exp(L) - 1/255, 0, 1), instead of
+            the tone map; offset_solve and display_mean are then unused.
+        anchor_every: with anchor "all", frames 0, k, 2k, ... of the window are anchors (k >= 1;
+            default 2: every other frame is held out for scoring).
+        anchor_smoothing: with anchor "all", the time scale s (seconds, >= 0) over which the offset
+            may drift between anchors: 0 passes through every anchor frame, large s fits one
+            least-squares offset per pixel.
     Output:
         gamma: tone-mapping exponent (paper: 0.6). display_mean: the tone-mapped value that the
             mean log intensity is anchored to (see the module docstring).
@@ -160,6 +172,9 @@ class EvINRConfig:
     display_mean: float = 0.5
     head_solve: bool = True
     offset_solve: str = "median_gradient"
+    anchor: str = "none"
+    anchor_every: int = 2
+    anchor_smoothing: float = 0.03
     seed: int = 0
     device: str | None = None
     progress: bool = True
@@ -174,6 +189,16 @@ class EvINRConfig:
         if self.head_solve and self.regularizer == "tv":
             raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
                                  "pass head_solve=False to train the head with Adam")
+        if self.anchor not in ANCHOR_MODES:
+            raise EventDataError(f"anchor must be one of {ANCHOR_MODES}, got {self.anchor!r}")
+        if isinstance(self.anchor_every, bool) or not isinstance(self.anchor_every, (int, np.integer)) or \
+                self.anchor_every < 1:
+            raise EventDataError(f"anchor_every must be a whole number >= 1, got {self.anchor_every!r}")
+        self.anchor_every = int(self.anchor_every)
+        if isinstance(self.anchor_smoothing, bool) or not isinstance(self.anchor_smoothing, (int, float, np.integer, np.floating)) \
+                or not (math.isfinite(self.anchor_smoothing) and self.anchor_smoothing >= 0):
+            raise EventDataError(f"anchor_smoothing must be a finite number of seconds >= 0, got {self.anchor_smoothing!r}")
+        self.anchor_smoothing = float(self.anchor_smoothing)
 
         def number(name, value, *, integer=False):
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or (
@@ -456,6 +481,8 @@ class Reconstruction:
         model: the trained FrameINR (N networks). windows: [N, 2] their time windows (s).
         offsets: float32 [N, H, W] per-network offsets added by the alignment and the anchor.
         config: the EvINRConfig used. history: training curves and time (see train_frame_inr).
+        anchor: the :class:`~evinr_lite.method.anchor.AnchorFit` of an anchored reconstruction
+            (``config.anchor`` "first" or "all"), else None; ``anchor_times`` the frames it used.
     """
 
     times: np.ndarray
@@ -466,13 +493,24 @@ class Reconstruction:
     offsets: np.ndarray
     config: EvINRConfig
     history: dict = field(repr=False)
+    anchor: object = field(default=None, repr=False)
+
+    @property
+    def anchor_times(self) -> np.ndarray:
+        """float64 [K] times (s) of the APS frames used as anchors (empty when events only): not to be scored."""
+        return np.zeros(0) if self.anchor is None else self.anchor.times.copy()
 
     def at(self, times, chunk: int = 256) -> np.ndarray:
         """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W]."""
-        return blend_networks(self.model, self.windows, np.atleast_1d(np.asarray(times, np.float64)), self.offsets, chunk)
+        t = np.atleast_1d(np.asarray(times, np.float64))
+        L = blend_networks(self.model, self.windows, t, self.offsets, chunk)
+        return L if self.anchor is None else L + self.anchor.offset_at(t)
 
     def frames_at(self, times) -> np.ndarray:
-        """Tone-mapped frames in [0, 1] at any times: float32 [Q, H, W]."""
+        """Frames in [0, 1] at any times: float32 [Q, H, W]; tone-mapped, or the APS frames' linear
+        intensity when anchored (:func:`evinr_lite.method.anchor.linear_frames`)."""
+        if self.anchor is not None:
+            return linear_frames(self.at(times))
         return tonemap_reinhard(self.at(times), self.config.gamma).astype(np.float32)
 
 
@@ -534,7 +572,7 @@ def alignment_offsets(model: FrameINR, windows: np.ndarray, n_samples: int = 8) 
 
 
 def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, *,
-                t_start: float | None = None, t_end: float | None = None) -> Reconstruction:
+                t_start: float | None = None, t_end: float | None = None, frames=None) -> Reconstruction:
     """Reconstruct log intensity and tone-mapped frames at ``query_times`` from events alone.
 
     Args:
@@ -543,6 +581,9 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
         config: EvINRConfig (paper defaults when None).
         t_start, t_end: span to reconstruct (seconds); default: from the first to the last event,
             widened to include the query times.
+        frames: the APS frames (:class:`~evinr_lite.core.frames.Frames`, on the events' clock) for
+            ``config.anchor`` "first" or "all" (:mod:`evinr_lite.method.anchor`); frames outside
+            [t_start, t_end] are ignored. Needed by an anchored config, refused by an events-only one.
 
     Returns:
         Reconstruction with frames [Q, H, W] in [0, 1] and log intensities [Q, H, W].
@@ -562,9 +603,23 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     if len(events) < 2:
         raise EventDataError(f"fewer than 2 events in [{t_start}, {t_end}] s; choose a window with events")
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
+    if cfg.anchor != "none":   # checked before training
+        frames = frames_in_window(frames, events.sensor_size, t_start, t_end, cfg.anchor)
+    elif frames is not None:
+        raise EventDataError("frames= were given but config.anchor is 'none' (events only): pass "
+                             "EvINRConfig(anchor='first') or anchor='all' to use them, or leave frames= out")
     model, history = train_frame_inr(events, windows, cfg)
     model.eval()
     offsets = alignment_offsets(model, windows)
+    if cfg.anchor != "none":   # the frames fix the per-pixel offset and the level: no solve, no mean anchor
+        fit = fit_anchor(lambda t: blend_networks(model, windows, t, offsets), frames, cfg.anchor,
+                         every=cfg.anchor_every, smoothing=cfg.anchor_smoothing)
+        history["config"] = asdict(cfg)
+        history["anchor"] = fit.summary()
+        rec = Reconstruction(q, np.zeros((0,)), np.zeros((0,)), model, windows, offsets, cfg, history, fit)
+        rec.log_intensity = rec.at(q)
+        rec.frames = linear_frames(rec.log_intensity)
+        return rec
     n_grid = min(64, 8 * len(windows))          # the anchor's times (as the paper's recipe always had them)
     if cfg.offset_solve == "median_gradient":
         n_grid = max(64, 8 * len(windows))      # a temporal median wants many frames; the anchor shares them
