@@ -45,6 +45,11 @@ squares: 7; consecutive pairs: 6 with Huber, 5 with least squares, lowtex_light 
 worst, lowtex_light (blurred moon under a light change), has few textured pixels (43,000 samples
 against 300,000 to 1,700,000 elsewhere) and the widest intervals. At 10 and 40 frames/s
 (``--rate``) no error changes by more than 0.2 percentage points: 9 of 9 within 10 % again.
+
+What the pair buys (kit default, ``python benchmarks/contrast_fit.py --reconstruct``): CLAHE-SSIM /
+SSIM with the mean C, the true pair and the fitted pair: coffee_warp 0.590 / 0.600, 0.599 / 0.606,
+0.600 / 0.609; noisy_gravel 0.521 / 0.492, 0.536 / 0.504, 0.554 / 0.521. On the real slider_depth
+chunk the fitted pair (C+ 0.66, C- 0.40) moves the scores by less than 0.01 against C = 1.
 """
 from __future__ import annotations
 
