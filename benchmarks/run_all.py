@@ -14,6 +14,7 @@ Benchmarks (each is also a script with its own --help):
     end_to_end   benchmarks/end_to_end.py      a 5 s 240x180 sequence with the paper's defaults: time and quality
     zoo          benchmarks/quality_zoo.py     quality and time on the scene zoo (kit, paper, v0.1, baselines, oracle)
     robustness   benchmarks/robustness.py      quality as events are thinned, noise added, C mis-given (3 zoo scenes)
+    denoise      benchmarks/denoise.py         hot pixels and background removed vs the truth, the gain, tonic
 
 ratio >= 1 means the target is met (measured / target, or target / measured for times and memory).
 Times are wall-clock on this machine, the fastest of several repeats; on a machine shared with
@@ -29,8 +30,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks import (binning_speed, end_to_end, ensemble_speed, inference, quality_zoo, robustness,  # noqa: E402
-                        simulate_speed, train_step)
+from benchmarks import (binning_speed, denoise, end_to_end, ensemble_speed, inference, quality_zoo,  # noqa: E402
+                        robustness, simulate_speed, train_step)
 from benchmarks.common import machine, print_table, write_json  # noqa: E402
 
 BENCHMARKS = {
@@ -42,6 +43,7 @@ BENCHMARKS = {
     "end_to_end": lambda a: end_to_end.run(a.quick, a.device),
     "zoo": lambda a: quality_zoo.run(a.quick),
     "robustness": lambda a: robustness.run(a.quick),
+    "denoise": lambda a: denoise.run(a.quick),
 }
 
 

@@ -161,6 +161,9 @@ def build_parser() -> argparse.ArgumentParser:
                           "only), first (the first frame in the window sets each pixel's offset; a static "
                           "background appears), all (every other frame is a soft anchor, the rest are scored); "
                           "anchor frames are not scored, run.json says which; output in the frames' intensity")
+    rec.add_argument("--denoise", action="store_true",
+                     help="remove hot pixels and background activity from the window's events before "
+                          "reconstructing (evinr_lite.method.denoise defaults); run.json records what was removed")
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -217,7 +220,7 @@ def _info(args) -> None:
 def _reconstruct(args) -> None:
     from .recon_job import run_reconstruct
 
-    run_reconstruct(args.recording, args.out, anchor=args.anchor,
+    run_reconstruct(args.recording, args.out, anchor=args.anchor, denoise=args.denoise,
                     sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
                     t_start=args.start, t_end=args.end, device=args.device, n_iters=args.iters, seed=args.seed,
                     recipe=args.recipe, overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet,

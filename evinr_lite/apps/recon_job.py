@@ -575,11 +575,23 @@ def check_memory(rec: Recording, times, config: EvINRConfig, device: str = "cpu"
 
 # ---- the whole job ---------------------------------------------------------------------------
 
+def denoise_recording(rec: Recording, path, log=print):
+    """(the recording with its events denoised, the DenoiseReport); refuses a window left with < 2 events."""
+    from ..method.denoise import denoise as denoise_events
+
+    events, report = denoise_events(rec.events)
+    log(report.summary())
+    if len(events) < 2:
+        raise EventDataError(f"{path}: denoising left {len(events)} event(s) of {report.n_in:,} in the window; "
+                             "run without --denoise (denoise=False) or choose a longer window")
+    return Recording(events, rec.frames, rec.meta), report
+
+
 def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str | None = None, fps: float | None = None, at=None,
                     t_start: float | None = None, t_end: float | None = None, device: str | None = None,
                     n_iters: int | None = None, seed: int = 0, overwrite: bool = False, video: bool = True,
                     progress: bool = True, time_unit: str | None = None, log=print, command: str = "",
-                    recipe: str = "kit", colour: bool = False, anchor: str = "none") -> dict:
+                    recipe: str = "kit", colour: bool = False, anchor: str = "none", denoise: bool = False) -> dict:
     """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
 
     Every check that can fail runs before training: the options, the output folder (checked,
@@ -594,6 +606,8 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
     (``meta["cfa"]``; :mod:`evinr_lite.apps.colour_job`), writing colour frames at (H/2, W/2).
     anchor: "none" (events only), "first" or "all": the recording's APS frames as anchors
     (:mod:`evinr_lite.method.anchor`); the anchor frames are not scored, run.json's "anchor" says which.
+    denoise: remove hot pixels and background activity from the window's events first
+    (:func:`evinr_lite.method.denoise.denoise`, its defaults); run.json's settings["denoise"] is the report.
     Returns the contents of run.json (with "scores" when the recording has frames).
     """
     from ..core.runtime import default_device
@@ -612,6 +626,9 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
         except RuntimeError as err:
             raise EventDataError(str(err)) from None
         rec = load_recording(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
+        denoise_report = None
+        if denoise:   # before anything reads the events: times, memory, training, the scores
+            rec, denoise_report = denoise_recording(rec, path, log)
         if anchor != "none" and rec.frames is None:   # before any training
             lo, hi = rec.meta["window"]
             raise EventDataError(f"{path}: anchor='{anchor}' needs APS frames, but the recording has none in the window "
@@ -643,6 +660,8 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
         settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
         if C_fit is not None:   # --C auto: the fit, its uncertainty and what it used
             settings["C_fit"] = C_fit.as_dict()
+        if denoise_report is not None:
+            settings["denoise"] = denoise_report.to_dict()
         if anchor != "none":   # which frames fixed the offset (not scored) and how many were scored
             settings["anchor"] = {**result.history["anchor"],
                                   "n_scored": scores["none"]["n_frames"] if scores else 0}

@@ -24,8 +24,11 @@ readout), and their order in the file is the readout's, not the scene's; countin
 ways makes the decision independent of that order. The pixel's own earlier events never
 count, so a hot pixel or a pixel's own burst cannot keep itself. With ``min_neighbours=k`` at
 least k distinct neighbouring pixels must have such an event (the STCF of Guo & Delbruck,
-2022). The result is exact (a brute-force loop over events gives the same mask; the tests
-check that, ties included) and deterministic.
+2022). With ``same_polarity=True`` only events j with p_j = p_i count; with ``window="both"``
+the condition is t_j - dt <= t_i <= t_j + dt (t_j - dt and t_j + dt in float64): neighbours
+after the event count too, which only an offline filter can do. The result is exact (a
+brute-force loop over events gives the same mask; the tests check that, ties included) and
+deterministic.
 
 Variants considered: Delbruck's original filter (2008; 8 neighbours, a per-pixel timestamp
 map, the rule above with "<"); tonic's ``Denoise`` (4 neighbours, strict ``t_i - t_j <
@@ -33,7 +36,8 @@ filter_time``, only neighbours earlier in the stream, a timestamp map that start
 ``filter_time`` so every event of the first ``filter_time`` passes); Liu et al. (2015) and
 Khodamoradi & Kastner (2018), which share timestamp cells between pixels to save memory (an
 approximation a hardware filter needs and a CPU does not); Guo & Delbruck's STCF (2022, k
-correlated neighbours, here ``min_neighbours``); learned denoisers (EDnCNN, Baldwin et al.
+correlated neighbours, here ``min_neighbours``; jAER's implementation also has
+``polaritiesMustMatch`` and an anti-causal option, here ``same_polarity`` and ``window="both"``); learned denoisers (EDnCNN, Baldwin et al.
 2020), which need training data. The kit implements the exact, order-independent rule.
 
 How it is vectorised: events are processed in time order in chunks that span less than
