@@ -32,8 +32,9 @@ is scored at the zoo's 10 ground-truth times through ``evinr_lite.evaluation.sco
 under both protocols (CLAHE on both images, and none): CLAHE-SSIM, SSIM, and MSE.
 
 Writes ``OUT.json`` (every scene's scores), ``OUT.md`` (a table per sweep: method x level, means over
-the scenes) and ``OUT_figure.png`` (``evinr_lite.viz.plot_robustness``), OUT defaulting to
-``benchmarks/robustness_results``. A hand-written interpretation at the top of an existing OUT.md,
+the scenes, then per-scene tables) and a figure (``evinr_lite.viz.plot_robustness``), OUT defaulting to
+``benchmarks/robustness_results`` (figure ``benchmarks/robustness_figure.png``; OUT's name with
+"_results" dropped, plus "_figure.png"). A hand-written interpretation at the top of an existing OUT.md,
 between the two ``<!-- interpretation -->`` markers, is kept when the file is rewritten.
 """
 from __future__ import annotations
@@ -240,7 +241,8 @@ def write_outputs(results: dict, out: str) -> list[Path]:
     from evinr_lite.viz import plot_robustness
 
     base = Path(out)
-    js, md, png = base.with_suffix(".json"), base.with_suffix(".md"), Path(f"{base}_figure.png")
+    png = base.with_name(base.name.replace("_results", "") + "_figure.png")    # robustness_figure.png
+    js, md = base.with_suffix(".json"), base.with_suffix(".md")
     write_json(js, results)
     write_text(md, "# Robustness sweeps\n\n" + kept_interpretation(md) + markdown(results) + "\n")
     fig = plot_robustness(results)

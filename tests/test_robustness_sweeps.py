@@ -106,3 +106,15 @@ def test_plot_robustness_draws_a_panel_per_sweep_and_metric_and_a_line_per_metho
 def test_plot_robustness_refuses_results_without_sweeps():
     with pytest.raises(ValueError, match="no sweeps"):
         viz.plot_robustness({"methods": ["kit"], "sweeps": {}})
+
+
+def test_outputs_are_written_and_a_hand_written_interpretation_survives_a_rerun(tiny_results, tmp_path):
+    paths = rb.write_outputs(tiny_results, str(tmp_path / "rob_results"))
+    assert [p.name for p in paths] == ["rob_results.json", "rob_results.md", "rob_figure.png"]
+    md = paths[1]
+    note = f"{rb.BEGIN}\nnoise hurts integration most\n{rb.END}"
+    md.write_text(md.read_text().replace("# Robustness sweeps\n\n", "# Robustness sweeps\n\n" + note + "\n\n"))
+    rb.write_outputs(tiny_results, str(tmp_path / "rob_results"))
+    text = md.read_text()
+    assert text.count(note) == 1 and text.index(note) < text.index("### keep")
+    assert not list(tmp_path.glob(".*partial*"))                  # written beside, renamed into place
