@@ -5,7 +5,7 @@ from .models import FrameINR
 from .solver import EvINRConfig, Reconstruction, reconstruct, split_windows
 from .tonemap import tonemap_reinhard, anchor_level, anchor_mean
 from .integration import integrate_events
-from .baselines import reconstruct_baseline, leaky_integration, highpass_filter
+from .baselines import reconstruct_baseline, leaky_integration, highpass_filter, complementary_filter
 from .coordinate import CoordinateConfig, reconstruct_coordinate
 from .colour import reconstruct_colour
 from .contrast import frame_log_changes, estimate_contrast_threshold, fit_contrast, ContrastFit
@@ -16,6 +16,7 @@ __all__ = ["EventFrames", "events_to_frames", "events_to_frames_chunked",
            "event_rate", "Siren", "SineLayer", "FrameINR", "EvINRConfig", "Reconstruction",
            "reconstruct", "split_windows", "tonemap_reinhard", "anchor_level", "anchor_mean",
            "integrate_events", "reconstruct_baseline", "leaky_integration", "highpass_filter",
+           "complementary_filter",
            "CoordinateConfig", "reconstruct_coordinate", "reconstruct_colour", "frame_log_changes",
            "estimate_contrast_threshold", "denoise", "DenoiseReport", "hot_pixel_mask",
            "remove_hot_pixels", "correlation_filter", "fit_contrast", "ContrastFit", "as_thresholds"]

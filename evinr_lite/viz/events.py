@@ -121,7 +121,7 @@ def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, siz
     ax.set_box_aspect((1.6, 1.0, 0.8))
     ax.view_init(*view)
     ax.set_title(title or f"{len(sub)} of {len(events)} events")
-    ax.legend(loc="upper left", fontsize=8, markerscale=4)
+    ax.legend(loc="upper left", fontsize=9, markerscale=4)
     return ax
 
 
@@ -159,7 +159,7 @@ def plot_event_rate(events: Events, bin_s: float, ax=None, t_range=None):
     ax.stairs(on, edges, color=ON_COLOR, label="ON")
     ax.stairs(off, edges, color=OFF_COLOR, label="OFF")
     ax.set(xlabel="time t (s)", ylabel="events / s", title=f"event rate in bins of {bin_s * 1e3:.3g} ms")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=9)
     return ax
 
 
@@ -186,7 +186,7 @@ def plot_boundaries(events: Events, boundaries: dict, ax=None, max_points: int =
         ax.vlines(b, j / m, (j + 1) / m, transform=trans, colors=f"C{j}", lw=1.0,
                   label=f"{label}: {b.size - 1} bins")
     ax.set(xlabel="time t (s)", ylabel="cumulative number of events")
-    ax.legend(fontsize=8, loc="upper left")
+    ax.legend(fontsize=9, loc="upper left")
     return ax
 
 
@@ -221,7 +221,7 @@ def show_event_frames(frames: EventFrames, indices=None, max_frames: int = 8, nc
     b = frames.boundaries
     for ax, i in zip(axes.flat, indices):
         im = ax.imshow(frames.frames[i], cmap=EVENT_FRAME_CMAP, vmin=-vmax, vmax=vmax, interpolation="nearest")
-        ax.set_title(f"bin {i}: ({b[i] * 1e3:.1f}, {b[i + 1] * 1e3:.1f}] ms\n{frames.counts[i]} events", fontsize=8)
+        ax.set_title(f"bin {i}: ({b[i] * 1e3:.1f}, {b[i + 1] * 1e3:.1f}] ms\n{frames.counts[i]} events", fontsize=9)
     for ax in axes.flat:
         ax.set_xticks([]), ax.set_yticks([])
     for ax in axes.flat[len(indices):]:

@@ -49,15 +49,15 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
             ax.set_xticks([])
             ax.set_yticks([])
             if r == 0 and times is not None:
-                ax.set_title(f"t = {float(np.asarray(times)[q]):.2f} s", fontsize=8)
+                ax.set_title(f"t = {float(np.asarray(times)[q]):.2f} s", fontsize=9)
         extra = (row_titles or {}).get(label)
-        axes[r, 0].set_ylabel(label if extra is None else f"{label}\n{extra}", fontsize=8)
+        axes[r, 0].set_ylabel(label if extra is None else f"{label}\n{extra}", fontsize=9)
     fig.subplots_adjust(wspace=0.03, hspace=0.12)
     return fig
 
 
 def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=None, symmetric: bool = False,
-                colorbar: bool = False, cell_size: float = 2.6):
+                colorbar: bool = False, cell_size: float = 2.6, colorbar_label: str | None = None):
     """Single images side by side, each titled by its key.
 
     Args:
@@ -66,6 +66,8 @@ def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=N
         symmetric: limits +-max|value| over all images (for signed maps such as errors; use a
             diverging ``cmap``).
         colorbar: one colour bar per image.
+        colorbar_label: the colour bars' label, with its unit (e.g. "log intensity", "events");
+            figures should pass one whenever ``colorbar`` is on.
 
     Returns:
         The figure.
@@ -85,11 +87,11 @@ def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=N
     axes = fig.subplots(1, n, squeeze=False)[0]
     for ax, (title, img) in zip(axes, arrays.items()):
         im = ax.imshow(img, cmap=cmap, vmin=vmin, vmax=vmax, interpolation="nearest")
-        ax.set_title(title, fontsize=8)
+        ax.set_title(title, fontsize=9)
         ax.set_xticks([])
         ax.set_yticks([])
         if colorbar:
-            fig.colorbar(im, ax=ax, fraction=0.035, pad=0.02)
+            fig.colorbar(im, ax=ax, fraction=0.035, pad=0.02, label=colorbar_label)
     return fig
 
 
@@ -103,5 +105,5 @@ def plot_histories(histories: dict, key: str = "loss", *, ax=None, xlabel: str =
         ax.semilogy(np.maximum(values, 1e-16), label=label)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(key)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=9)
     return ax

@@ -28,7 +28,7 @@ def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
             ax.bar(np.arange(len(methods)) + (k - (len(eqs) - 1) / 2) * width, vals, width, label=eq)
         ax.set_xticks(np.arange(len(methods)), methods)
         ax.set_title(f"{metric.upper()} ({better.get(metric, '')})")
-    axes[0].legend(title="equalisation", fontsize=8)
+    axes[0].legend(title="equalisation", fontsize=9)
     fig.tight_layout()
     return fig
 
@@ -65,7 +65,7 @@ def plot_ablation(rows: list[dict], metrics=("ssim_none", "ssim_clahe"), *, x=No
                      label=COLUMN_LABELS.get(m, (m,))[0])
         ax_t.bar(pos, times, 0.6, color="0.5")
         for ax in (ax_q, ax_t):
-            ax.set_xticks(pos, names, rotation=30, ha="right", fontsize=8)
+            ax.set_xticks(pos, names, rotation=30, ha="right", fontsize=9)
     else:
         x = np.asarray(x, dtype=np.float64)
         if x.shape != (len(rows),):
@@ -79,7 +79,7 @@ def plot_ablation(rows: list[dict], metrics=("ssim_none", "ssim_clahe"), *, x=No
             ax.minorticks_off()
             ax.set_xlabel(xlabel or "")
     ax_q.set(ylabel="score", title="quality (higher SSIM, lower MSE is better)")
-    ax_q.legend(fontsize=8)
+    ax_q.legend(fontsize=9)
     ax_t.set(ylabel="training time (s)", title="time on this machine")
     if title:
         fig.suptitle(title)
@@ -114,10 +114,10 @@ def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = 
         raise ValueError(f"labels must be 'front' or 'all', got {labels!r}")
     for r, ci, qi, on in zip(rows, c, q, front):
         if on or labels == "all":
-            ax.annotate(r["name"], (ci, qi), fontsize=7, xytext=(4, -3), textcoords="offset points")
+            ax.annotate(r["name"], (ci, qi), fontsize=9, xytext=(4, -3), textcoords="offset points")
     ax.set(xlabel=COLUMN_LABELS.get(cost, (cost,))[0], ylabel=COLUMN_LABELS.get(quality, (quality,))[0],
            title=title or "time against quality")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=9)
     return ax
 
 

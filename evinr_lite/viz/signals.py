@@ -65,7 +65,7 @@ def plot_signal_and_events(t, L, events, C: float | None = None, *, ax=None, pix
     plot_event_ticks(ax, te, pe)
     ax.set_xlabel("time t (s)")
     ax.set_ylabel("log intensity")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="upper right", fontsize=9)
     return ax
 
 
@@ -90,7 +90,7 @@ def plot_reconstruction_1d(t, curves: dict, truth=None, *, events=None, ax=None,
     ax.set_ylabel("log intensity")
     if title:
         ax.set_title(title)
-    ax.legend(loc="best", fontsize=8)
+    ax.legend(loc="best", fontsize=9)
     return ax
 
 
@@ -105,5 +105,5 @@ def plot_window_errors(result: dict, *, ax=None, C: float | None = None):
         ax.loglog(w, C / w, ":", color="0.5", label="C / window: the rate of one event")
     ax.set_xlabel("window length t2 - t1 (s)")
     ax.set_ylabel("mean |error of dL/dt| (1/s)")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=9)
     return ax
