@@ -1,12 +1,13 @@
 """Notebook 07's exercises (reference solutions registered with :mod:`evinr_lite.teaching.exercises` at import).
 
-- ``relative_change``: the improvement of a variant over a baseline in percent, positive = better,
-  for metrics where higher is better (SSIM, FPS) and where lower is better (MSE, time); the
-  numbers the paper quotes ("a performance gain of over 26 %") are of this kind;
+- ``time_fps_products``: Time x FPS for every row of one of the paper's tables. The product is the
+  number of frames the FPS column counts; that it is (nearly) constant within a table shows that
+  the paper's FPS is training throughput, frames delivered per second of optimisation, not an
+  inference speed;
 - ``pareto_front``: which variants are worth considering when both time and quality count: those
   that no other variant beats on one without losing on the other.
 
-The references are the library's own :func:`evinr_lite.evaluation.ablation.relative_change` and
+The references are the library's own :func:`evinr_lite.evaluation.ablation.paper_frame_counts` and
 :func:`evinr_lite.evaluation.ablation.pareto_front`.
 """
 from __future__ import annotations
@@ -14,42 +15,40 @@ from __future__ import annotations
 import numpy as np
 
 from . import exercises
-from ..evaluation.ablation import pareto_front, relative_change
+from ..evaluation.ablation import PAPER_TABLE2, PAPER_TABLE3, paper_frame_counts, pareto_front
 
-__all__ = ["relative_change", "pareto_front"]
+__all__ = ["time_fps_products", "pareto_front"]
+
+time_fps_products = paper_frame_counts
 
 
-# ---- exercise 1: relative change ---------------------------------------------------------------
+# ---- exercise 1: Time x FPS of the paper's tables -------------------------------------------------
 
-def _inputs_change(rng):
-    cases = [dict(value=0.044, baseline=0.063, higher_is_better=False),     # the paper's MSE, Base -> Base + Reg.
-             dict(value=0.658, baseline=0.542, higher_is_better=True),      # its SSIM, Base -> Full
-             dict(value=8.08, baseline=17.44, higher_is_better=False)]      # its time, Base + Reg. -> Full
-    for _ in range(3):
-        cases.append(dict(value=float(rng.uniform(0.1, 2)), baseline=float(rng.uniform(0.1, 2)),
-                          higher_is_better=bool(rng.integers(2))))
+def _inputs_products(rng):
+    cases = [dict(table=PAPER_TABLE2), dict(table=PAPER_TABLE3)]
+    rows = {f"row {k}": {"time_s": float(rng.uniform(1, 30)), "fps": float(rng.uniform(5, 80)),
+                         "ssim": float(rng.uniform(0.3, 0.7))} for k in range(4)}
+    cases.append(dict(table=rows))
     return cases
 
 
-def _no_sign_flip(value, baseline, higher_is_better):
-    return 100.0 * (value - baseline) / abs(baseline)
+def _time_over_fps(table):
+    return {name: row["time_s"] / row["fps"] for name, row in table.items()}
 
 
-def _relative_to_value(value, baseline, higher_is_better):
-    change = 100.0 * (value - baseline) / abs(value)
-    return change if higher_is_better else -change
+def _fps_over_time(table):
+    return {name: row["fps"] / row["time_s"] for name, row in table.items()}
 
 
-def _fraction(value, baseline, higher_is_better):
-    return relative_change(value, baseline, higher_is_better) / 100.0
+def _time_times_ssim(table):
+    return {name: row["time_s"] * row["ssim"] for name, row in table.items()}
 
 
 exercises.register(
-    "relative_change", relative_change, _inputs_change, rtol=1e-6,
-    hints={"for a lower-is-better metric (MSE, time) a decrease is an improvement: flip the sign when "
-           "higher_is_better is False": _no_sign_flip,
-           "divide by the baseline's value, not the new one: percent *of the baseline*": _relative_to_value,
-           "return percent (x 100), not a fraction": _fraction})
+    "time_fps_products", time_fps_products, _inputs_products, rtol=1e-9,
+    hints={"FPS is frames per second: frames = seconds x (frames / second), multiply time_s by fps": _time_over_fps,
+           "fps / time_s has units frames per second squared; the frame count is time_s * fps": _fps_over_time,
+           "use the row's 'fps' entry (the FPS column), not its quality": _time_times_ssim})
 
 
 # ---- exercise 2: Pareto front ------------------------------------------------------------------

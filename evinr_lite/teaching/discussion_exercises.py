@@ -76,6 +76,10 @@ def _inputs_render(rng):
         steps = rng.normal(0.0, 2.5 * C, (B,) + shape)
         L = np.concatenate([rng.normal(0.0, 1.0, (1,) + shape), steps]).cumsum(axis=0)
         cases.append(dict(L_boundaries=L, C=C))
+    # the threshold rule: a change of exactly C fires one event (n = trunc(change / C)). Steps of whole
+    # quarters with C = 0.25 are exact in binary floating point, so a strict "> C" test fails here
+    steps = np.array([[0.25, -0.25], [0.5, 0.0], [-0.75, 0.25], [0.25, 1.0]])
+    cases.append(dict(L_boundaries=np.concatenate([np.zeros((1, 2)), steps]).cumsum(axis=0)[:, None, :], C=0.25))
     return cases
 
 
@@ -99,9 +103,23 @@ def _reference_to_level(L_boundaries, C):
     return out
 
 
+def _floor_not_trunc(L_boundaries, C):
+    return render_counts(L_boundaries, C, np.floor)
+
+
+def _strict_threshold(L_boundaries, C):
+    """The mistake of firing only once the change *exceeds* C (``> C`` instead of ``>= C``)."""
+    def strict(x):
+        return np.sign(x) * np.maximum(np.ceil(np.abs(x)) - 1, 0)
+    return render_counts(L_boundaries, C, strict)
+
+
 exercises.register(
     "render_event_counts", render_event_counts, _inputs_render,
     hints={
+        "a change of exactly C fires one event: the rule is |change| >= C (n = trunc(change / C)), not > C":
+            _strict_threshold,
+        "OFF events round toward zero too: np.trunc(-1.5) = -1, np.floor(-1.5) = -2": _floor_not_trunc,
         "carry the remainder: compare with a reference level that moves by whole steps n * C, "
         "not with the previous boundary": _no_carry,
         "a camera fires only once the change reaches C: round toward zero (np.trunc), not to the nearest": _round_nearest,
