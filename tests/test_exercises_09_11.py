@@ -113,7 +113,8 @@ def test_hot_pixel_mask_finds_injected_hot_pixels_and_nothing_else():
 
 
 @pytest.mark.parametrize("name", ["event_rate", "estimate_contrast_threshold", "quad_bayer_channel",
-                                  "grey_event_frame", "hot_pixel_mask", "event_count_windows"])
+                                  "grey_event_frame", "hot_pixel_mask", "event_count_windows",
+                                  "anchor_first_offset", "background_activity_filter"])
 def test_references_pass_their_own_checks(name):
     assert exercises.check(name, exercises.reference(name), verbose=False)
 
@@ -131,3 +132,62 @@ def test_hot_pixel_teaching_rule_is_the_librarys_median_rule():
             events = Events.from_arrays(np.sort(rng.uniform(0, 1, n)), kw["x"], kw["y"], rng.choice([-1, 1], n), (H, W))
             np.testing.assert_array_equal(recording_exercises.hot_pixel_mask(kw["x"], kw["y"], (H, W), factor),
                                           denoise.hot_pixel_mask(events, factor=factor, rule="median"))
+
+
+# ---- notebook 09: anchor_first_offset, pinned to method/anchor.py -----------------------------
+
+def test_anchor_first_offset_is_fit_anchors_first_mode():
+    """The teaching reference gives the offset of method.anchor.fit_anchor(mode="first") (uint8 and float frames)."""
+    from evinr_lite.core.frames import Frames
+    from evinr_lite.method.anchor import fit_anchor
+    rng = np.random.default_rng(7)
+    for images in (rng.integers(0, 256, (3, 6, 9)).astype(np.uint8), rng.uniform(0, 1, (3, 6, 9))):
+        frames = Frames(images, np.array([0.1, 0.2, 0.3]))
+        L = rng.normal(-1.0, 0.7, (6, 9))
+        fit = fit_anchor(lambda t: np.broadcast_to(L, (len(t), 6, 9)), frames, "first")
+        np.testing.assert_allclose(realdata_exercises.anchor_first_offset(images[0], L), fit.values[0],
+                                   rtol=1e-6, atol=1e-6)   # fit.values are float32
+        assert np.allclose(fit.times, [0.1])
+
+
+def test_anchor_first_offset_check_catches_the_named_mistakes(capsys):
+    assert exercises.check("anchor_first_offset", realdata_exercises.anchor_first_offset)
+    _fails_with_hint(capsys, "anchor_first_offset", realdata_exercises._offset_wrong_sign, "not L(t0) - log")
+    _fails_with_hint(capsys, "anchor_first_offset", realdata_exercises._offset_no_scaling, "divide by 255")
+    _fails_with_hint(capsys, "anchor_first_offset", realdata_exercises._offset_eps_outside, "inside the log")
+    _fails_with_hint(capsys, "anchor_first_offset", realdata_exercises._offset_mean_only, "one offset per pixel")
+
+
+# ---- notebook 11: background_activity_filter, t_j <= t_i <= t_j + dt (both ends inclusive) -----------
+
+def test_background_activity_filter_is_the_librarys_correlation_filter():
+    """Pins notebook 11's pairwise reference to method.denoise.correlation_filter (8 neighbours, one
+    neighbour, any polarity, causal window), on the check's own cases and on random streams with ties."""
+    from evinr_lite import Events
+    from evinr_lite.method.denoise import correlation_filter
+    rng = np.random.default_rng(11)
+    inputs = [kw for _, kw in exercises.get("background_activity_filter").cases()]
+    for n in (50, 300):
+        t = np.sort(np.round(rng.uniform(0, 0.02, n), 4))             # whole 100 us: many equal timestamps
+        inputs.append(dict(t=t, x=rng.integers(0, 8, n), y=rng.integers(0, 6, n), dt=0.001))
+    for kw in inputs:
+        H, W = int(kw["y"].max()) + 1, int(kw["x"].max()) + 1
+        events = Events.from_arrays(kw["t"], kw["x"], kw["y"], rng.choice([-1, 1], len(kw["t"])), (H, W))
+        lib = correlation_filter(events, kw["dt"], neighbourhood=8, min_neighbours=1, same_polarity=False,
+                                 window="before")
+        np.testing.assert_array_equal(recording_exercises.background_activity_filter(**kw), lib)
+
+
+def test_background_activity_filter_check_has_the_boundary_cases(capsys):
+    assert exercises.check("background_activity_filter", recording_exercises.background_activity_filter)
+    _fails_with_hint(capsys, "background_activity_filter", recording_exercises._filter_strict_dt, "exactly dt")
+    _fails_with_hint(capsys, "background_activity_filter", recording_exercises._filter_strictly_earlier,
+                     "same timestamp counts")
+    _fails_with_hint(capsys, "background_activity_filter", recording_exercises._filter_stream_order,
+                     "not positions in the stream")
+    _fails_with_hint(capsys, "background_activity_filter", recording_exercises._filter_own_pixel, "own events")
+    _fails_with_hint(capsys, "background_activity_filter", recording_exercises._filter_four_neighbours, "diagonals")
+    # the first case really has a neighbour exactly dt earlier and a tie (else the wrong rules could pass by luck)
+    kw = exercises.get("background_activity_filter").cases()[0][1]
+    d = kw["t"][:, None] - kw["t"][None, :]
+    assert np.any(d == kw["dt"]) and np.any((d == 0) & ~np.eye(len(kw["t"]), dtype=bool))

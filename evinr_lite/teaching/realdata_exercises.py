@@ -9,15 +9,21 @@
   frames to the net event count between them, ΔL ≈ C n. The reference is the library's
   :func:`evinr_lite.method.contrast.estimate_contrast_threshold`, which notebook 11 applies to the
   reader's own recording (the exercise is notebook 09's only: one C-fit exercise in the series).
+- ``anchor_first_offset``: the per-pixel offset with which one APS frame anchors an events-only
+  reconstruction (``EvINRConfig(anchor="first")``): g = log(I0 + eps) - L(t0), I0 the first frame
+  in [0, 1] (uint8 / 255), L(t0) the network's log intensity at the frame's time before anchoring.
+  The reference re-implements :func:`evinr_lite.method.anchor.fit_anchor`'s "first" mode, and
+  ``tests/test_exercises_09_11.py`` pins the two together.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..method.anchor import FRAME_EPS
 from ..method.contrast import estimate_contrast_threshold
 from . import exercises
 
-__all__ = ["event_rate", "estimate_contrast_threshold"]
+__all__ = ["event_rate", "estimate_contrast_threshold", "anchor_first_offset"]
 
 
 def event_rate(t, bin_s):
@@ -105,4 +111,70 @@ exercises.register(
         "intercept (np.polyfit(n, ΔL, 1))":
             lambda log_changes, net_counts: float(np.polyfit(np.asarray(net_counts, float),
                                                              np.asarray(log_changes, float), 1)[0]),
+    })
+
+
+# ---- exercise 3: the per-pixel offset that one APS frame fixes ---------------------------------
+
+def anchor_first_offset(first_frame, L_t0, eps: float = FRAME_EPS) -> np.ndarray:
+    """The per-pixel offset of ``anchor="first"``: what to add to the network's L at every time.
+
+    Events fix only changes of log intensity; the first APS frame fixes the level, pixel by pixel:
+    g = log(I0 + eps) - L(t0), so that L(t0) + g is the frame's log exactly and L(t) + g carries
+    the frame forward by the network's changes.
+
+    Args:
+        first_frame: [H, W] the first APS frame, uint8 (0..255, divided by 255) or float in [0, 1].
+        L_t0: float [H, W] the network's log intensity at the frame's time, before anchoring.
+        eps: added to the intensity before the log (black pixels stay finite).
+    Returns:
+        float64 [H, W] offsets g (log units).
+    """
+    a = np.asarray(first_frame)
+    intensity = a / 255.0 if a.dtype == np.uint8 else np.clip(np.asarray(a, np.float64), 0.0, 1.0)
+    return np.log(intensity + eps) - np.asarray(L_t0, np.float64)
+
+
+def _inputs_anchor(rng):
+    cases = []
+    # uint8 frames with black (0) and saturated (255) pixels: eps keeps log finite, / 255 puts them in [0, 1]
+    img = rng.integers(0, 256, (6, 8)).astype(np.uint8)
+    img[0, 0], img[0, 1], img[5, 7] = 0, 255, 0
+    cases.append(dict(first_frame=img, L_t0=rng.normal(-1.0, 0.5, (6, 8))))
+    cases.append(dict(first_frame=rng.integers(0, 256, (4, 5)).astype(np.uint8), L_t0=np.zeros((4, 5)), eps=0.01))
+    # a float frame in [0, 1] (taken as it is) and a network far from the frame's level
+    cases.append(dict(first_frame=rng.uniform(0, 1, (5, 3)), L_t0=rng.normal(2.0, 1.0, (5, 3))))
+    return cases
+
+
+def _offset_wrong_sign(first_frame, L_t0, eps=FRAME_EPS):
+    return -anchor_first_offset(first_frame, L_t0, eps)
+
+
+def _offset_no_scaling(first_frame, L_t0, eps=FRAME_EPS):
+    return np.log(np.asarray(first_frame, np.float64) + eps) - np.asarray(L_t0, np.float64)
+
+
+def _offset_eps_outside(first_frame, L_t0, eps=FRAME_EPS):
+    a = np.asarray(first_frame)
+    intensity = a / 255.0 if a.dtype == np.uint8 else np.asarray(a, np.float64)
+    with np.errstate(divide="ignore"):
+        return np.log(intensity) + eps - np.asarray(L_t0, np.float64)
+
+
+def _offset_mean_only(first_frame, L_t0, eps=FRAME_EPS):
+    g = anchor_first_offset(first_frame, L_t0, eps)
+    return np.full_like(g, g.mean())
+
+
+exercises.register(
+    "anchor_first_offset", anchor_first_offset, _inputs_anchor, rtol=1e-6, atol=1e-9,
+    hints={
+        "the offset is what to add to the network: g = log(I0 + eps) - L(t0), not L(t0) - log(I0 + eps)":
+            _offset_wrong_sign,
+        "a uint8 frame is 0..255: divide by 255 first, so that I0 is in [0, 1] as the solver's frames are":
+            _offset_no_scaling,
+        "eps goes inside the log, log(I0 + eps): log(I0) is -inf on a black pixel": _offset_eps_outside,
+        "one offset per pixel, not one for the whole image: events never fix any pixel's level":
+            _offset_mean_only,
     })

@@ -6,7 +6,14 @@ Exercises (registered with :mod:`evinr_lite.teaching.exercises` at import):
   (count > factor x the median count of the pixels that fired; a pixel exactly at the threshold is
   not hot), the first thing to check on a recording from your own camera;
 - ``event_count_windows``: cut a recording into windows of (nearly) equal event counts, so each
-  reconstruction costs about the same and fits in memory.
+  reconstruction costs about the same and fits in memory;
+- ``background_activity_filter``: the background-activity correlation filter (Delbruck 2008) on a
+  small input, by comparing every pair of events: event i is kept when an event j at one of the 8
+  neighbouring pixels (not the pixel itself) has t_j <= t_i <= t_j + dt (both ends inclusive: a
+  neighbour exactly dt earlier counts, and so does one at the same timestamp wherever it sits in
+  the stream). The reference is the rule of :func:`evinr_lite.method.denoise.correlation_filter`
+  with ``neighbourhood=8, min_neighbours=1, same_polarity=False, window="before"`` (its defaults);
+  ``tests/test_exercises_09_11.py`` pins the two together.
 
 The contrast threshold fitted from frames (ΔL ≈ C n) is notebook 09's exercise
 (:mod:`evinr_lite.teaching.realdata_exercises`); notebook 11 applies the library's
@@ -26,7 +33,8 @@ from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from . import exercises
 
-__all__ = ["hot_pixel_mask", "event_count_windows", "windows_from_indices", "window_table"]
+__all__ = ["hot_pixel_mask", "event_count_windows", "background_activity_filter", "windows_from_indices",
+           "window_table"]
 
 
 # ---- exercise 1: a hot-pixel map from per-pixel counts ---------------------------------------
@@ -177,6 +185,101 @@ exercises.register(
         "the windows should be as equal as possible (idx[k] = floor(k N / w)), not max_events each with a "
         "short remainder":
             lambda n_events, max_events: np.append(np.arange(0, n_events, max_events, dtype=np.int64), n_events),
+    })
+
+
+# ---- exercise 3: the background-activity correlation filter ------------------------------------
+
+def background_activity_filter(t, x, y, dt: float) -> np.ndarray:
+    """Keep-mask of the background-activity filter, by comparing every pair of events (small N only).
+
+    Args:
+        t: float64 [N] seconds; x, y: int [N] columns and rows; dt: the window (s).
+    Returns:
+        bool [N]: True where some event j at a neighbouring pixel (max(|x_j - x_i|, |y_j - y_i|) = 1)
+        has t_j <= t_i <= t_j + dt (t_j + dt in float64; equal timestamps count whatever their order).
+    """
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))   # [i, j]
+    in_time = (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt)
+    return np.any((cheb == 1) & in_time, axis=1)
+
+
+def _inputs_filter(rng):
+    cases = []
+    # dyadic times and dt, so t_j + dt is exact: boundary cases
+    #   0: (1,1) at 1.0; 1: (2,1) at 1.25 = 1.0 + dt exactly -> kept by 0 (inclusive end)
+    #   2: (6,5) at 2.0 and 3: (5,5) at 2.0, 2 stored first: equal timestamps keep each other
+    #   4: (1,1) at 1.5: its own pixel fired at 1.0 (does not count); (2,1) at 1.25 is a neighbour -> kept
+    #   5: (9,9) at 3.0 and 6: (9,10) at 3.375: 0.375 > dt after it -> 6 dropped, 5 has no earlier neighbour
+    #   7: (3,3) at 4.0 and 8: (5,3) at 4.0: two columns apart, not neighbours -> both dropped
+    #   9: (7,0) at 5.0 and 10: (7,0) at 5.125: only its own pixel fired before 10 -> dropped
+    #   11: (12,12) at 6.0 and 12: (13,13) at 6.125: a diagonal neighbour -> 12 kept
+    t = np.array([1.0, 1.25, 2.0, 2.0, 1.5, 3.0, 3.375, 4.0, 4.0, 5.0, 5.125, 6.0, 6.125])
+    x = np.array([1, 2, 6, 5, 1, 9, 9, 3, 5, 7, 7, 12, 13])
+    y = np.array([1, 1, 5, 5, 1, 9, 10, 3, 3, 0, 0, 12, 13])
+    order = np.argsort(t, kind="stable")
+    cases.append(dict(t=t[order], x=x[order], y=y[order], dt=0.25))
+    # an event just after the window closes (1/1024 s past dt), one just inside, and a neighbour that comes later
+    t = np.array([0.0, 0.125 + 2 ** -10, 0.5, 0.625, 0.75])
+    cases.append(dict(t=t, x=np.array([4, 5, 0, 1, 2]), y=np.array([4, 4, 0, 1, 2]), dt=0.125))
+    # random small streams with whole-microsecond timestamps (ties happen)
+    for n, size, span, dt in ((60, 6, 0.01, 0.002), (120, 10, 0.05, 0.004)):
+        t = np.sort(np.round(rng.uniform(0, span, n), 4))
+        cases.append(dict(t=t, x=rng.integers(0, size, n), y=rng.integers(0, size, n), dt=dt))
+    return cases
+
+
+def _filter_strict_dt(t, x, y, dt):
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    return np.any((cheb == 1) & (t[None, :] <= t[:, None]) & (t[:, None] - t[None, :] < dt), axis=1)
+
+
+def _filter_strictly_earlier(t, x, y, dt):
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    return np.any((cheb == 1) & (t[None, :] < t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
+
+
+def _filter_stream_order(t, x, y, dt):
+    """Only events stored before i count (a per-pixel timestamp map updated in stream order)."""
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    n = len(t)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    before = np.arange(n)[None, :] < np.arange(n)[:, None]
+    return np.any((cheb == 1) & before & (t[:, None] <= t[None, :] + dt), axis=1)
+
+
+def _filter_own_pixel(t, x, y, dt):
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    others = ~np.eye(len(t), dtype=bool)
+    return np.any((cheb <= 1) & others & (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
+
+
+def _filter_four_neighbours(t, x, y, dt):
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    manhattan = np.abs(x[:, None] - x[None, :]) + np.abs(y[:, None] - y[None, :])
+    return np.any((manhattan == 1) & (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
+
+
+exercises.register(
+    "background_activity_filter", background_activity_filter, _inputs_filter,
+    hints={
+        "a neighbour exactly dt earlier counts: t_i <= t_j + dt (inclusive), not t_i - t_j < dt": _filter_strict_dt,
+        "a neighbour at the same timestamp counts: t_j <= t_i, not t_j < t_i": _filter_strictly_earlier,
+        "compare times, not positions in the stream: a neighbour with the same timestamp stored after the "
+        "event counts too": _filter_stream_order,
+        "the pixel's own events never count (else a hot pixel keeps itself): max(|dx|, |dy|) == 1, not <= 1":
+            _filter_own_pixel,
+        "the 8 neighbours include the diagonals: max(|dx|, |dy|) == 1, not |dx| + |dy| == 1": _filter_four_neighbours,
     })
 
 
