@@ -199,3 +199,25 @@ def test_command_reports_missing_inputs(tmp_path):
                        env={**os.environ, "EVINR_DATA": str(tmp_path / "cache")}, timeout=120)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert "python -m data_fetch get mvsec indoor_flying1" in r.stderr
+
+
+def test_denoise_anchor_and_C_auto_reach_every_task_and_change_the_settings(recordings, tmp_path):
+    """batch --denoise --anchor first --C auto: each recording's run.json records the denoise report, the
+    anchor frames (not scored) and the fitted C pair; a rerun with other options is refused, not mixed."""
+    subset = tmp_path / "two"
+    subset.mkdir()
+    for name in ("rec_camera", "rec_coffee"):
+        os.symlink(recordings / name, subset / name)
+    out = tmp_path / "out"
+    summary = run_batch([subset], out, sequential=True, n_iters=ITERS, C="auto", denoise=True, anchor="first",
+                        progress=False, log=_quiet)
+    assert [r["status"] for r in summary["recordings"]] == ["done", "done"]
+    for name in ("rec_camera", "rec_coffee"):
+        run = json.loads((out / name / "run.json").read_text())
+        assert run["denoise"] and run["anchor"]["mode"] == "first"
+        assert run["anchor"]["n_scored"] == len(run["anchor"]["frame_times_s"]) - run["anchor"]["n_anchors"]
+        assert len(run["C"]) == 2 and run["C_fit"], run["C"]                           # (C+, C-) fitted
+    with pytest.raises(EventDataError, match="anchor"):
+        run_batch([subset], out, sequential=True, n_iters=ITERS, C="auto", denoise=True, progress=False, log=_quiet)
+    with pytest.raises(EventDataError, match="anchor="):
+        run_batch([subset], tmp_path / "o2", sequential=True, anchor="last", progress=False, log=_quiet)

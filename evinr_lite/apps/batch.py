@@ -42,6 +42,7 @@ from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
 from ..io.readers import detect_format
+from ..method.anchor import ANCHOR_MODES
 from .recon_job import EQUALIZATIONS, check_run_options, run_reconstruct
 
 __all__ = ["run_batch", "resolve_inputs", "evaluate_recording", "summarize", "estimate_task_memory_mb",
@@ -214,7 +215,8 @@ def evaluate_recording(item: dict, out_dir, settings: dict) -> dict:
         run = run_reconstruct(item["path"], out, sensor_size=settings.get("sensor_size"), C=settings.get("C"),
                               fps=settings.get("fps"), t_start=t_start, t_end=t_end, device=settings.get("device"),
                               n_iters=settings.get("n_iters"), recipe=settings.get("recipe", "kit"),
-                              seed=int(settings.get("seed", 0)),
+                              seed=int(settings.get("seed", 0)), denoise=bool(settings.get("denoise", False)),
+                              anchor=settings.get("anchor", "none"),
                               overwrite=True, video=bool(settings.get("video", False)), progress=False,
                               log=lambda *a, **k: None)
     except Exception as exc:   # a bad recording is a result, not a crash of the batch
@@ -341,7 +343,11 @@ def _check_settings(out_dir: Path, settings: dict) -> None:
     path = out_dir / SETTINGS_FILE
     if path.exists():
         before = json.loads(path.read_text())
-        changed = {k: (before.get(k), v) for k, v in settings.items() if k in RESULT_SETTINGS and before.get(k) != v}
+        changed = {}
+        for k in RESULT_SETTINGS:
+            a, b = before.get(k, SETTING_DEFAULTS.get(k)), settings.get(k, SETTING_DEFAULTS.get(k))
+            if a != b:
+                changed[k] = (a, b)
         if changed:
             what = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in changed.items())
             raise EventDataError(f"{out_dir} holds results made with other settings ({what}); resuming would mix "
@@ -350,13 +356,14 @@ def _check_settings(out_dir: Path, settings: dict) -> None:
         _write_atomic(path, json.dumps(settings, indent=2) + "\n")
 
 
-RESULT_SETTINGS = ("C", "fps", "n_iters", "recipe", "seed", "sensor_size")   # settings that change the scores
+RESULT_SETTINGS = ("C", "fps", "n_iters", "recipe", "seed", "sensor_size", "denoise", "anchor")   # change the scores
+SETTING_DEFAULTS = {"denoise": False, "anchor": "none"}     # what a batch.json written before these options meant
 
 
 def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | None = None, client=None,
               sequential: bool = False, torch_threads: int = 1, C: float | None = None, fps: float | None = None,
               n_iters: int | None = None, recipe: str = "kit", seed: int = 0, device: str | None = None,
-              video: bool = False,
+              video: bool = False, denoise: bool = False, anchor: str = "none",
               sensor_size=None, cache=None, progress: bool = True, log=print) -> dict:
     """Reconstruct and score every recording of ``inputs``, one Dask task each; returns the summary.
 
@@ -371,8 +378,9 @@ def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | N
         client: an existing ``distributed.Client`` to use instead (a notebook's).
         sequential: run the tasks one after the other in this process, without Dask (a reference).
         torch_threads: torch threads per task (default 1: one per worker process).
-        C, fps, n_iters, recipe, seed, device, video, sensor_size: as for ``evinr-lite reconstruct``
-            (``video`` off by default: PNG frames and scores only).
+        C, fps, n_iters, recipe, seed, device, video, sensor_size, denoise, anchor: as for
+            ``evinr-lite reconstruct`` (``video`` off by default: PNG frames and scores only; ``C`` may be
+            a number, a pair (c_pos, c_neg) or "auto": fitted per recording from its APS frames).
     Returns:
         the summary (see :func:`summarize`), also written to ``out_dir/summary.json|csv|md``.
     """
@@ -386,13 +394,17 @@ def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | N
     if isinstance(torch_threads, bool) or not isinstance(torch_threads, (int, np.integer)) or torch_threads < 1:
         raise EventDataError(f"torch_threads= must be a whole number of at least 1, got {torch_threads!r}")
     check_run_options(C=C, fps=fps, n_iters=n_iters, seed=seed, recipe=recipe)
+    if anchor not in ANCHOR_MODES:
+        raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {anchor!r}")
     if sum(x is not None for x in (scheduler, workers, client)) + bool(sequential) > 1:
         raise EventDataError("give at most one of scheduler=, workers=, client= and sequential=True")
     items = resolve_inputs(inputs, cache=cache, log=log)
+    if isinstance(C, (tuple, list, np.ndarray)):
+        C = [float(c) for c in C]                       # as batch.json stores it, so a resume compares equal
     settings = {"C": C, "fps": fps, "n_iters": None if n_iters is None else int(n_iters), "recipe": recipe,
                 "seed": int(seed), "device": device, "video": bool(video),
                 "sensor_size": list(sensor_size) if sensor_size is not None else None,
-                "torch_threads": int(torch_threads)}
+                "torch_threads": int(torch_threads), "denoise": bool(denoise), "anchor": anchor}
     out_dir.mkdir(parents=True, exist_ok=True)
     lock = FileLock(str(out_dir / ".batch.lock"))
     try:

@@ -197,7 +197,13 @@ def build_parser() -> argparse.ArgumentParser:
                                                    "(default: one per CPU core, at most one per recording)")
     batch.add_argument("--torch-threads", type=_count, default=1, help="torch threads per task (default: 1)")
     batch.add_argument("--sensor", type=_size, help="sensor size HxW, for files that do not record it")
-    batch.add_argument("--C", type=_positive, help="contrast threshold (default: each file's, else 1)")
+    batch.add_argument("--C", type=_contrast, help="contrast threshold: a number, a pair C+,C- or auto (fitted per "
+                                                  "recording from its APS frames) (default: each file's, else 1)")
+    batch.add_argument("--denoise", action="store_true", help="remove hot pixels and background activity first "
+                                                              "(as reconstruct --denoise)")
+    batch.add_argument("--anchor", choices=("none", "first", "all"), default="none",
+                       help="use each recording's APS frames as anchors (as reconstruct --anchor; anchor frames "
+                            "are not scored)")
     batch.add_argument("--fps", type=_positive, help="frames to write per second (default: the ground-truth frame "
                                                  "times); scores are always taken at the ground-truth frames")
     batch.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
@@ -246,7 +252,7 @@ def _batch(args) -> None:
         summary = run_batch(args.inputs, args.out, scheduler=args.scheduler, workers=args.workers,
                             torch_threads=args.torch_threads, sensor_size=args.sensor, C=args.C, fps=args.fps,
                             device=args.device, n_iters=args.iters, recipe=args.recipe, seed=args.seed,
-                            video=args.video,
+                            video=args.video, denoise=args.denoise, anchor=args.anchor,
                             progress=not args.quiet)
     except KeyboardInterrupt as exc:   # finished recordings stay: the same command resumes
         exc.output_note = f"finished recordings stay in {args.out}/; run the same command again to resume"
