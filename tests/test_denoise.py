@@ -8,11 +8,11 @@ import importlib
 
 from evinr_lite.core.events import EventDataError, Events
 from evinr_lite.method import correlation_filter, hot_pixel_mask, remove_hot_pixels
-from evinr_lite.method import denoise as denoise_fn
+from evinr_lite.method.denoise import denoise as denoise_fn
 from evinr_lite.sim.scenes import MovingImageScene
 from evinr_lite.sim.simulate import add_background_noise, add_hot_pixels, simulate_scene
 
-D = importlib.import_module("evinr_lite.method.denoise")   # the module (the package's `denoise` is the function)
+D = importlib.import_module("evinr_lite.method.denoise")
 
 
 # ---- the exact rule, against a brute-force loop ------------------------------------------------

@@ -9,7 +9,9 @@ from .baselines import reconstruct_baseline, leaky_integration, highpass_filter,
 from .coordinate import CoordinateConfig, reconstruct_coordinate
 from .colour import reconstruct_colour
 from .contrast import frame_log_changes, estimate_contrast_threshold, fit_contrast, ContrastFit
-from .denoise import DenoiseReport, correlation_filter, denoise, hot_pixel_mask, remove_hot_pixels
+from .denoise import DenoiseReport, correlation_filter, hot_pixel_mask, remove_hot_pixels
+# `method.denoise` stays the module (call method.denoise.denoise(events)): re-exporting the function under the
+# module's own name would hide the module from attribute access.
 
 __all__ = ["EventFrames", "events_to_frames", "events_to_frames_chunked",
            "fixed_duration_boundaries", "equal_count_boundaries", "bisect_boundaries",
