@@ -278,17 +278,12 @@ def run_scene(z, settings, tonic, log=print) -> dict:
 
 def run_real(log=print) -> dict | None:
     """The real IJRR slider_depth chunk (no labels): what the default removes and the kit's scores, C = 1."""
-    from evinr_lite.evaluation.scoring import frames_to_score
-    from evinr_lite.io.readers import read_recording
-    from evinr_lite.io.sample_data import sample_recording_path
+    from benchmarks.quality_zoo import real_chunk
 
-    path = sample_recording_path()
-    if path is None:
-        log("real chunk: not found (shared/data/ijrr_slider_depth_chunk); skipped")
+    found = real_chunk(log)
+    if found is None:
         return None
-    rec = read_recording(path)
-    idx = frames_to_score(rec.frames.t, rec.events)
-    gt, gt_t = rec.frames.images[idx], rec.frames.t[idx]
+    rec, gt, gt_t = found
     keep, report = denoise_mask(rec.events)
     out = {"report": report.to_dict(), "rows": {}}
     for name, ev in (("none", rec.events), ("default", rec.events.take(keep))):

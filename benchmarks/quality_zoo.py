@@ -117,8 +117,9 @@ def run_zoo(scenes, methods, variants, log=print) -> dict:
     return results
 
 
-def run_real(methods, variants, log=print) -> dict | None:
-    """The IJRR slider_depth chunk beside the project, C = 1 (the paper's for IJRR); no oracle."""
+def real_chunk(log=print):
+    """(recording, scored frames [K, H, W], their times [K]) of the IJRR slider_depth chunk beside the
+    project, or None (with a note) when it is not there. Shared by the benchmarks that score on it."""
     from evinr_lite.io.readers import read_recording
     from evinr_lite.io.sample_data import sample_recording_path
 
@@ -128,8 +129,16 @@ def run_real(methods, variants, log=print) -> dict | None:
         return None
     rec = read_recording(path)
     idx = frames_to_score(rec.frames.t, rec.events)
-    gt, gt_t = rec.frames.images[idx], rec.frames.t[idx]
-    log(f"real slider_depth chunk: {len(rec.events):,} events, {len(idx)} frames")
+    return rec, rec.frames.images[idx], rec.frames.t[idx]
+
+
+def run_real(methods, variants, log=print) -> dict | None:
+    """The IJRR slider_depth chunk beside the project, C = 1 (the paper's for IJRR); no oracle."""
+    found = real_chunk(log)
+    if found is None:
+        return None
+    rec, gt, gt_t = found
+    log(f"real slider_depth chunk: {len(rec.events):,} events, {len(gt_t)} frames")
     rows, frames = {}, {}
     for m in [m for m in methods if m not in ORACLES]:
         f, seconds = run_method(m, rec.events, gt_t, 1.0, variants)
