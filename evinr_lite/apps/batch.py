@@ -42,7 +42,6 @@ from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
 from ..io.readers import detect_format
-from ..method.anchor import ANCHOR_MODES
 from .recon_job import EQUALIZATIONS, check_run_options, run_reconstruct
 
 __all__ = ["run_batch", "resolve_inputs", "evaluate_recording", "summarize", "estimate_task_memory_mb",
@@ -393,9 +392,7 @@ def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | N
         raise EventDataError(f"workers= must be a whole number of at least 1, got {workers!r}")
     if isinstance(torch_threads, bool) or not isinstance(torch_threads, (int, np.integer)) or torch_threads < 1:
         raise EventDataError(f"torch_threads= must be a whole number of at least 1, got {torch_threads!r}")
-    check_run_options(C=C, fps=fps, n_iters=n_iters, seed=seed, recipe=recipe)
-    if anchor not in ANCHOR_MODES:
-        raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {anchor!r}")
+    check_run_options(C=C, fps=fps, n_iters=n_iters, seed=seed, recipe=recipe, anchor=anchor)
     if sum(x is not None for x in (scheduler, workers, client)) + bool(sequential) > 1:
         raise EventDataError("give at most one of scheduler=, workers=, client= and sequential=True")
     items = resolve_inputs(inputs, cache=cache, log=log)

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.events import EventDataError, Events
-from ..core.frames import Frames
+from ..core.frames import GREY_WEIGHTS, Frames
 from ..core.recording import Recording
 from ..io.canonical import cfa_phase
 from ..method.colour import chroma_correlation, reconstruct_colour
@@ -34,10 +34,9 @@ from ..method.solver import EvINRConfig
 from ..method.tonemap import tonemap_reinhard
 from ..sim.quadbayer import BAYER, demosaic_events_rgb, reduce_mean
 
-__all__ = ["GREY_WEIGHTS", "check_colour_recording", "split_colour_events", "colour_frames", "ColourResult",
+__all__ = ["check_colour_recording", "split_colour_events", "colour_frames", "ColourResult",
            "reconstruct_colour_recording", "score_colour_recording"]
 
-GREY_WEIGHTS = np.array([0.2125, 0.7154, 0.0721])   # ITU-R 709, as core.frames.to_grey_uint8
 
 
 def check_colour_recording(rec: Recording) -> str:

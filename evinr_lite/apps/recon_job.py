@@ -474,7 +474,7 @@ def resolve_contrast(rec: Recording, C, path=None, log=print, *, colour: bool = 
 
 
 def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: int | None = None, seed: int = 0,
-                      time_unit=None, recipe: str = "kit") -> None:
+                      time_unit=None, recipe: str = "kit", anchor: str = "none") -> None:
     """Every option of :func:`run_reconstruct` checked before any file is read (EventDataError naming it)."""
     def finite(name, value):
         if value is None:
@@ -484,6 +484,8 @@ def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: in
         return float(value)
 
     contrast_option(C)
+    if anchor not in ANCHOR_MODES:
+        raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {anchor!r}")
     if finite("fps=", fps) is not None and not fps > 0:
         raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
     finite("t_start=", t_start)
@@ -615,9 +617,7 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
 
     t0 = time.perf_counter()
     check_run_options(C=C, fps=fps, t_start=t_start, t_end=t_end, n_iters=n_iters, seed=seed, time_unit=time_unit,
-                      recipe=recipe)
-    if anchor not in ANCHOR_MODES:
-        raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {anchor!r}")
+                      recipe=recipe, anchor=anchor)
     if anchor != "none" and colour:
         raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
     with OutputDir(out_dir, overwrite=overwrite, inputs=[path], log=log, command=command) as target:

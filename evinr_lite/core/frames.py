@@ -7,7 +7,9 @@ import numpy as np
 
 from .events import EventDataError
 
-__all__ = ["Frames", "to_grey_uint8", "to_uint8"]
+__all__ = ["Frames", "to_grey_uint8", "to_uint8", "GREY_WEIGHTS"]
+
+GREY_WEIGHTS = np.array([0.2125, 0.7154, 0.0721])   # ITU-R 709 luminance of (R, G, B): every RGB -> grey here
 
 
 @dataclass(frozen=True, eq=False)
@@ -94,7 +96,7 @@ def to_grey_uint8(img: np.ndarray, source) -> np.ndarray:
     elif img.dtype != np.uint8:
         raise EventDataError(f"{source}: images must be 8- or 16-bit grey or RGB, got dtype {img.dtype}")
     if img.ndim == 3 and img.shape[-1] in (3, 4):
-        img = img[..., :3].astype(np.float64) @ np.array([0.2125, 0.7154, 0.0721])
+        img = img[..., :3].astype(np.float64) @ GREY_WEIGHTS
     if img.ndim != 2:
         raise EventDataError(f"{source}: expected a grey or RGB image, got shape {img.shape}")
     if img.dtype != np.uint8:

@@ -29,6 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.events import EventDataError, Events
+from ..core.frames import Frames
+from .anchor import frame_log, linear_frames
 from .binning import as_thresholds
 from .integration import integrate_events
 from .offset import median_gradient_offset
@@ -221,9 +223,6 @@ DEFAULT_GAIN = 2 * math.pi   # rad/s: Scheerlinck et al.'s crossover of about 1 
 
 def _frame_logs(frames, sensor_size):
     """(times [F], log frames [F, H, W]) of APS frames, checked and sorted (log(I + eps), anchor.frame_log)."""
-    from ..core.frames import Frames
-    from .anchor import frame_log
-
     if not isinstance(frames, Frames) or len(frames) == 0:
         raise EventDataError("the complementary filter needs APS frames: pass frames= as a non-empty "
                              "evinr_lite.core.frames.Frames (e.g. recording.frames) on the events' clock")
@@ -351,8 +350,6 @@ class BaselineReconstruction:
 
     def frames_at(self, times) -> np.ndarray:
         if self.method in FRAME_BASELINES:     # in the APS frames' own intensity space
-            from .anchor import linear_frames
-
             return linear_frames(self.at(times))
         return tonemap_reinhard(self.at(times), self.params["gamma"]).astype(np.float32)
 
@@ -426,8 +423,6 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
 def _complementary_reconstruction(events, query_times, C, frames, gain, t_start, offset_solve, gamma, display_mean,
                                   extra) -> BaselineReconstruction:
     """reconstruct_baseline(method="complementary"): the filter's log intensity, in the frames' own level."""
-    from .anchor import linear_frames
-
     if extra:
         raise TypeError(f"baseline 'complementary' takes parameters ('gain',), not {sorted(extra)}")
     if offset_solve != "none":

@@ -179,7 +179,7 @@ def events_to_frames(events: Events, boundaries, C: float | tuple = 1.0) -> Even
     frames = np.zeros((B, H, W), np.float32)
     flat = frames.reshape(-1)
     if c_pos == c_neg:   # one threshold: the polarity sums times C (the float path, unchanged)
-        weights, scale = None, (C if np.ndim(C) == 0 else c_pos)
+        weights, scale = None, c_pos
     else:                # each event weighs its own polarity's threshold
         weights, scale = np.where(events.p > 0, c_pos, -c_neg), 1.0
     for i0, i1, sums in _polarity_sums(events, e, weights):
@@ -244,12 +244,11 @@ def events_to_frames_chunked(chunks, boundaries, C: float | tuple = 1.0, sensor_
     # int32 -> float32 in place, a few bins at a time (no second [B, H, W] array)
     frames = sums.view(np.float32)
     step = max(1, _GROUP_CELLS // (H * W))
-    scale = C if np.ndim(C) == 0 else c_pos
     for i in range(0, B, step):
         if split:
             frames[i:i + step] = c_pos * sums[i:i + step].astype(np.float64) - c_neg * off[i:i + step]
         else:
-            frames[i:i + step] = scale * sums[i:i + step].astype(np.float64)
+            frames[i:i + step] = c_pos * sums[i:i + step].astype(np.float64)
     return EventFrames(frames=frames, boundaries=b, counts=counts)
 
 

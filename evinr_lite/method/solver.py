@@ -616,10 +616,8 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
                          every=cfg.anchor_every, smoothing=cfg.anchor_smoothing)
         history["config"] = asdict(cfg)
         history["anchor"] = fit.summary()
-        rec = Reconstruction(q, np.zeros((0,)), np.zeros((0,)), model, windows, offsets, cfg, history, fit)
-        rec.log_intensity = rec.at(q)
-        rec.frames = linear_frames(rec.log_intensity)
-        return rec
+        L = blend_networks(model, windows, q, offsets) + fit.offset_at(q)       # = Reconstruction.at(q)
+        return Reconstruction(q, L, linear_frames(L), model, windows, offsets, cfg, history, fit)
     n_grid = min(64, 8 * len(windows))          # the anchor's times (as the paper's recipe always had them)
     if cfg.offset_solve == "median_gradient":
         n_grid = max(64, 8 * len(windows))      # a temporal median wants many frames; the anchor shares them
