@@ -255,32 +255,31 @@ def _support(t, pix, n_map, offsets, base, dt, per_neighbour, skip=None):
         idx, tt = pix[s:e], t[s:e]
         np.minimum.at(F, idx, tt)
         i0 = idx - base                              # mode="wrap": in range by the padding, and fastest
-        if skip is not None:
-            ask = ~skip[s:e]
-            if ask.any():
-                i0, tq = i0[ask], tt[ask]
-                e_max = np.take(E_views[0], i0, mode="wrap")
-                f_min = np.take(F_views[0], i0, mode="wrap")
-                for Ev, Fv in zip(E_views[1:], F_views[1:]):
-                    np.maximum(e_max, np.take(Ev, i0, mode="wrap"), out=e_max)
-                    np.minimum(f_min, np.take(Fv, i0, mode="wrap"), out=f_min)
-                out[s:e][ask] = (e_max >= tq) | (f_min <= tq)
-        elif per_neighbour:
+        if per_neighbour:
             for k, (Ev, Fv) in enumerate(zip(E_views, F_views)):
                 out[k, s:e] = (np.take(Ev, i0, mode="wrap") >= tt) | (np.take(Fv, i0, mode="wrap") <= tt)
         else:
-            # supported iff max over neighbours of E >= t  or  min over neighbours of F <= t
-            e_max = np.take(E_views[0], i0, mode="wrap")
-            f_min = np.take(F_views[0], i0, mode="wrap")
-            buf = np.empty_like(e_max)
-            for Ev, Fv in zip(E_views[1:], F_views[1:]):
-                np.maximum(e_max, np.take(Ev, i0, out=buf, mode="wrap"), out=e_max)
-                np.minimum(f_min, np.take(Fv, i0, out=buf, mode="wrap"), out=f_min)
-            out[s:e] = (e_max >= tt) | (f_min <= tt)
+            ask = slice(None) if skip is None else ~skip[s:e]
+            i0, tq = i0[ask], tt[ask]
+            if tq.size:
+                e_max, f_min = _nearest(E_views, F_views, i0)
+                out[s:e][ask] = (e_max >= tq) | (f_min <= tq)
         F[idx] = np.inf
         np.maximum.at(E, idx, tt + dt)
         s = e
     return out
+
+
+def _nearest(E_views, F_views, i0):
+    """(max over neighbours of E, min over neighbours of F) at sensor cells ``i0``: an event at t is
+    supported iff the first >= t (a neighbour fired before, within dt) or the second <= t (in its chunk)."""
+    e_max = np.take(E_views[0], i0, mode="wrap")
+    f_min = np.take(F_views[0], i0, mode="wrap")
+    buf = np.empty_like(e_max)
+    for Ev, Fv in zip(E_views[1:], F_views[1:]):
+        np.maximum(e_max, np.take(Ev, i0, out=buf, mode="wrap"), out=e_max)
+        np.minimum(f_min, np.take(Fv, i0, out=buf, mode="wrap"), out=f_min)
+    return e_max, f_min
 
 
 # ---- both, with a report ------------------------------------------------------------------
