@@ -71,24 +71,12 @@ def _events_from_message(msg) -> tuple[int, int, np.ndarray]:
 def debayer(raw: np.ndarray, cfa: str) -> np.ndarray:
     """A raw 2 x 2 Bayer mosaic uint8 [H, W] (filter ``cfa``, e.g. "RGGB") -> colour uint8 [H, W, 3].
 
-    Bilinear: every photosite keeps its own value in its own channel; a missing channel is the mean
-    of that channel's nearest photosites (the 2 or 4 neighbours: weights 1 2 1 / 2 4 2 / 1 2 1).
+    Bilinear (:func:`evinr_lite.sim.quadbayer.debayer_bilinear`), rounded back to 8 bits.
     """
-    from scipy import ndimage
+    from evinr_lite.sim.quadbayer import debayer_bilinear
 
-    from evinr_lite.sim.quadbayer import BAYER, cfa_pattern
-
-    raw = np.asarray(raw)
-    pattern = cfa_pattern(raw.shape, CFA_NAMES[cfa], block=BAYER)
-    kernel = np.array([[1.0, 2.0, 1.0], [2.0, 4.0, 2.0], [1.0, 2.0, 1.0]])
-    values = raw.astype(np.float64)
-    out = []
-    for c in range(3):
-        mask = (pattern == c).astype(np.float64)
-        num = ndimage.convolve(values * mask, kernel, mode="mirror")
-        den = ndimage.convolve(mask, kernel, mode="mirror")
-        out.append(np.where(mask > 0, values, num / den))
-    return np.clip(np.round(np.stack(out, axis=-1)), 0, 255).astype(np.uint8)
+    rgb = debayer_bilinear(raw, CFA_NAMES[cfa])
+    return np.clip(np.round(rgb), 0, 255).astype(np.uint8)
 
 
 def decode_image(msg, source: str = "image", *, colour: bool = False, cfa: str | None = None) -> np.ndarray:

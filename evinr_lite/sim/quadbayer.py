@@ -61,6 +61,7 @@ from .scenes import MovingImageScene
 
 __all__ = ["CHANNELS", "QUAD_BAYER", "BAYER", "TILE_COLOURS", "period", "photosites_per_window", "cfa_tile",
            "cfa_channel", "cfa_pattern", "mosaic", "demosaic_grey", "demosaic_rgb", "demosaic_rgb_full",
+           "debayer_bilinear",
            "effective_thresholds", "demosaic_events", "demosaic_events_rgb", "QuadBayerScene",
            "simulate_colour_video", "reduce_mean", "mosaic_display", "checker_amplitude"]
 
@@ -230,6 +231,25 @@ def demosaic_rgb_full(raw, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
         num = ndimage.uniform_filter(np.asarray(raw, np.float64) * mask, size=size, mode="mirror")
         den = ndimage.uniform_filter(np.broadcast_to(mask, raw.shape).astype(np.float64), size=size, mode="mirror")
         out.append(num / den)
+    return np.stack(out, axis=-1)
+
+
+def debayer_bilinear(raw, phase=(0, 0)) -> np.ndarray:
+    """A standard 2 x 2 Bayer mosaic [H, W] -> colour [H, W, 3] (R, G, B), bilinear, float64.
+
+    Every photosite keeps its own value in its own channel; a missing channel is the weighted mean
+    of that channel's nearest photosites (kernel 1 2 1 / 2 4 2 / 1 2 1: the 2 or 4 neighbours), as a
+    camera driver's debayered topic (DAVIS346 colour, CED). ``phase``: the filter's phase (cfa_tile).
+    """
+    values = np.asarray(raw, np.float64)
+    pattern = cfa_pattern(values.shape, phase, block=BAYER)
+    kernel = np.array([[1.0, 2.0, 1.0], [2.0, 4.0, 2.0], [1.0, 2.0, 1.0]])
+    out = []
+    for c in range(3):
+        mask = (pattern == c).astype(np.float64)
+        num = ndimage.convolve(values * mask, kernel, mode="mirror")
+        den = ndimage.convolve(mask, kernel, mode="mirror")
+        out.append(np.where(mask > 0, values, num / den))
     return np.stack(out, axis=-1)
 
 
