@@ -21,7 +21,7 @@ from skimage.metrics import structural_similarity
 
 from ..core.frames import to_uint8
 
-__all__ = ["mse", "ssim", "equalize", "score_frames", "protocol_description", "PROTOCOLS",
+__all__ = ["mse", "ssim", "equalize", "score_pairs", "score_frames", "protocol_description", "PROTOCOLS",
            "METRIC_PROTOCOL", "SSIM_PROTOCOL", "EQUALIZATIONS", "CLAHE_CLIP_LIMIT", "CLAHE_TILES"]
 
 EQUALIZATIONS = ("none", "global", "clahe")
@@ -100,6 +100,31 @@ def equalize(img, method: str = "none") -> np.ndarray:
     return out.astype(np.float64) / 255.0
 
 
+def score_pairs(pred, gt, equalization: str = "none") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per-frame MSE and SSIM of matched frame pairs, after the same equalisation of both.
+
+    The one scoring loop: :func:`score_frames` averages it, and
+    :func:`evinr_lite.evaluation.scoring.score_sequence` runs it on timestamp-matched frames (and
+    LPIPS on the equalised stacks it returns).
+
+    Args:
+        pred, gt: [F, H, W] each, in [0, 1] (or uint8), pair i is (pred[i], gt[i]).
+        equalization: "none", "global" or "clahe" (:func:`equalize`).
+
+    Returns:
+        (pred_eq, gt_eq, mse, ssim): the equalised stacks float64 [F, H, W] in [0, 1], and the
+        per-frame scores float64 [F].
+    """
+    if len(pred) == 0 or len(pred) != len(gt):
+        raise ValueError(f"need one or more matched frame pairs, got {len(pred)} predictions and {len(gt)} "
+                         "ground-truth frames; pass stacks [F, H, W] of the same length F >= 1")
+    pred_eq = np.stack([equalize(a, equalization) for a in pred])
+    gt_eq = np.stack([equalize(b, equalization) for b in gt])
+    m = np.array([mse(a, b) for a, b in zip(pred_eq, gt_eq)])
+    s = np.array([ssim(a, b) for a, b in zip(pred_eq, gt_eq)])
+    return pred_eq, gt_eq, m, s
+
+
 def score_frames(pred, gt, equalization: str = "none") -> dict:
     """Mean MSE and SSIM over frames [F, H, W] (both in [0, 1]) after the same equalisation of both.
 
@@ -112,8 +137,6 @@ def score_frames(pred, gt, equalization: str = "none") -> dict:
     pred, gt = np.asarray(pred), np.asarray(gt)
     if pred.shape != gt.shape or pred.ndim != 3:
         raise ValueError(f"expected two [F, H, W] stacks of the same shape, got {pred.shape} and {gt.shape}")
-    p = [equalize(a, equalization) for a in pred]
-    g = [equalize(b, equalization) for b in gt]
-    return {"mse": float(np.mean([mse(a, b) for a, b in zip(p, g)])),
-            "ssim": float(np.mean([ssim(a, b) for a, b in zip(p, g)])),
-            "n_frames": len(p), "protocol": f"equalization={equalization}: " + protocol_description(equalization)}
+    _, _, m, s = score_pairs(pred, gt, equalization)
+    return {"mse": float(np.mean(m)), "ssim": float(np.mean(s)),
+            "n_frames": len(m), "protocol": f"equalization={equalization}: " + protocol_description(equalization)}

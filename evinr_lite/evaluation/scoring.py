@@ -23,7 +23,7 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 from ..method.baselines import BASELINES, reconstruct_baseline
-from .metrics import equalize, mse, protocol_description, ssim
+from .metrics import protocol_description, score_pairs
 
 __all__ = ["frames_to_score", "match_frames", "score_sequence", "pool", "evaluate", "results_table",
            "resolve_lpips", "measure_inference_fps", "METHODS"]
@@ -131,10 +131,7 @@ def score_sequence(pred_frames, pred_times, gt_frames, gt_times, equalization: s
     if p_idx.size == 0:
         raise ValueError(f"no ground-truth frame has a prediction within {tol} s; query the reconstruction at "
                          "the ground-truth timestamps (rec.frames_at(gt_times)) on the same clock")
-    P = np.stack([equalize(f, equalization) for f in pred[p_idx]])
-    G = np.stack([equalize(f, equalization) for f in gt[g_idx]])
-    m = np.array([mse(a, b) for a, b in zip(P, G)])
-    s = np.array([ssim(a, b) for a, b in zip(P, G)])
+    P, G, m, s = score_pairs(pred[p_idx], gt[g_idx], equalization)
     model, note = resolve_lpips(lpips_model)
     lp = None
     if model is not None:
