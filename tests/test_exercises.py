@@ -329,3 +329,24 @@ def test_stub_banners_quote_what_the_check_prints(notebook, capsys):
     for line, name in quoted:
         assert exercises.check(name, exercises.reference(name))
         assert capsys.readouterr().out.strip() == line
+
+
+def test_registry_is_filled_by_the_teaching_face_with_plain_imports():
+    """Issue 23 item 4: no registry of module-name strings; the face imports every registering module,
+    and ``teaching.__all__`` lists only names it holds."""
+    import ast
+    from pathlib import Path
+
+    import evinr_lite.teaching as teaching
+
+    assert all(hasattr(teaching, n) for n in teaching.__all__)
+    source = Path(exercises.__file__).read_text()
+    assert "import_module" not in source and "REFERENCE_MODULES" not in source
+    folder = Path(teaching.__file__).parent
+    registering = {p.stem for p in folder.glob("*.py")
+                   if p.stem not in ("__init__", "exercises") and "exercises." in p.read_text()}
+    imported = {a.name for node in ast.walk(ast.parse((folder / "__init__.py").read_text()))
+                if isinstance(node, ast.ImportFrom) for a in node.names}
+    assert registering and registering <= imported, registering - imported
+    # every notebook's exercise is known without importing its module by hand
+    assert {"integrate_events_1d", "crossfade_weights"} <= set(exercises.names())

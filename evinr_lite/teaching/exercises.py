@@ -46,7 +46,6 @@ effects (one optimiser step, say), ``register(..., observe=...)`` says what to c
 from __future__ import annotations
 
 import copy
-import importlib
 import inspect
 import traceback
 import warnings
@@ -59,13 +58,6 @@ __all__ = [
     "Exercise", "ExerciseWarning", "register", "exercise", "get", "names", "reference",
     "check", "use", "solution_or_reference", "show_reference",
 ]
-
-# Modules that register reference solutions at import; imported on the first lookup of an
-# unknown name, so ``check`` works without the notebook importing them first.
-REFERENCE_MODULES = ["evinr_lite.teaching." + name for name in (
-    "pde1d", "events2d", "coordinate_exercises", "frame_exercises", "training_exercises", "accel_exercises",
-    "ablation_exercises",
-    "discussion_exercises", "realdata_exercises", "aed_exercises", "recording_exercises")]
 
 SEED = 0
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
@@ -140,13 +132,11 @@ def exercise(name: str, make_inputs: Callable, **kwargs) -> Callable:
 
 
 def get(name: str) -> Exercise:
-    """The registered exercise ``name`` (KeyError listing the known names otherwise)."""
-    if name not in _REGISTRY:
-        for module in REFERENCE_MODULES:
-            try:
-                importlib.import_module(module)
-            except ImportError:  # pragma: no cover - a broken optional module must not hide the KeyError
-                pass
+    """The registered exercise ``name`` (KeyError listing the known names otherwise).
+
+    The registry is filled when :mod:`evinr_lite.teaching` is imported (its face imports every
+    module that registers exercises), which any import of this module does first.
+    """
     if name not in _REGISTRY:
         raise KeyError(f"no exercise named {name!r}; known exercises: {', '.join(names()) or 'none'}")
     return _REGISTRY[name]
