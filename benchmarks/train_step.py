@@ -30,7 +30,7 @@ except ImportError:  # run as a script
     from common import alternate, devices, matmul_peak_gflops, parser, report, row
 
 from evinr_lite.method.models import FrameINR  # noqa: E402
-from evinr_lite.method.solver import _Bins, make_adam, step_losses  # noqa: E402
+from evinr_lite.method.training import _Bins, make_adam, step_losses  # noqa: E402
 
 
 def step_flops(n_models: int, bins: int, hidden: int, layers: int, pixels: int) -> float:

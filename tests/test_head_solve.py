@@ -9,7 +9,8 @@ from evinr_lite import EvINRConfig, make_scene, reconstruct, simulate_scene
 from evinr_lite.method.head_solve import laplacian_eigenvalues, solve_head
 from evinr_lite.method.models import FrameINR
 from evinr_lite.method.offset import median_gradient_offset, poisson_integrate
-from evinr_lite.method.solver import _Bins, alignment_offsets, step_losses
+from evinr_lite.method.solver import alignment_offsets
+from evinr_lite.method.training import _Bins, step_losses
 
 
 def _differences(n):

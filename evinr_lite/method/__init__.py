@@ -2,7 +2,9 @@
 from .binning import (EventFrames, events_to_frames, events_to_frames_chunked, fixed_duration_boundaries, equal_count_boundaries, bisect_boundaries, event_rate, as_thresholds)
 from .siren import Siren, SineLayer
 from .models import FrameINR
-from .solver import EvINRConfig, Reconstruction, reconstruct, split_windows
+from .config import EvINRConfig
+from .ensemble import split_windows
+from .solver import Reconstruction, reconstruct
 from .tonemap import tonemap_reinhard, anchor_level, anchor_mean
 from .integration import integrate_events
 from .baselines import reconstruct_baseline, leaky_integration, highpass_filter, complementary_filter

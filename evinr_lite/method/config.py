@@ -1,0 +1,268 @@
+"""The solver's settings: :class:`EvINRConfig`, every field checked on construction, and its named recipes.
+
+    cfg = EvINRConfig()                 # the kit's default (chosen on the scene zoo and the real chunk)
+    cfg = EvINRConfig.paper()           # the paper's recipe exactly (Sec. 3-4)
+    cfg = EvINRConfig(C=0.2, tau=2.0)   # any field overridden; a bad value raises EventDataError
+
+Times are seconds; C is in log units per event.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..core.events import EventDataError
+from .anchor import ANCHOR_MODES
+from .binning import as_thresholds
+
+__all__ = ["EvINRConfig"]
+
+
+@dataclass
+class EvINRConfig:
+    """Every setting of the frame-based solver.
+
+    Three named recipes (``benchmarks/quality_zoo.py`` compares them in one run):
+
+    - ``EvINRConfig()``: the kit's default, chosen on the mean of the scene zoo (nine seeded scenes,
+      ``evinr_lite.sim.zoo``) and the real slider_depth chunk, never on one scene;
+    - ``EvINRConfig.paper()``: the paper's recipe exactly (Sec. 3-4);
+    - ``EvINRConfig.v0_1()``: the kit's earlier default (the paper's plus first_omega_0 = 10 and
+      head_lr_scale = 30, tuned on the demo scene alone); notebooks 03-11 train it.
+
+    The kit's default departs from the paper in these fields. Zoo means (CLAHE-SSIM / SSIM / MSE; wall
+    time per scene, 2 CPU cores shared with other jobs):
+    ``python benchmarks/quality_zoo.py``: kit 0.555 / 0.583 / 0.030 in 1.6 s, paper 0.320 / 0.402 /
+    0.051 in 92 s, v0.1 0.499 / 0.527 / 0.042 in 69 s, integration 0.425 / 0.513 / 0.042, high-pass
+    filter 0.464 / 0.507 / 0.047.
+
+    - head_solve=True, n_iters=0, coarse_to_fine=False: the output layer is solved in closed form
+      for the SIREN's initial hidden layers. Training the hidden layers first (60 Adam steps) changed
+      the zoo means by less than 0.002 at 4x the time, so no Adam step is taken.
+    - temporal_loss="difference": the closed form fits the exact integral form; the mid-point
+      derivative is a first-order approximation.
+    - offset_solve="median_gradient": the per-pixel offset that events never fix is solved
+      explicitly instead of drifting under the regularizer (the ghost).
+    - lam=0.01 instead of 0.05: with the exact head, less smoothing wins on the zoo (quick zoo,
+      CLAHE-SSIM mean: 0.293 at lam 1, 0.403 at 0.2, 0.482 at 0.05, 0.528 at 0.01). On the real chunk,
+      lam from 0.003 to 1 moves CLAHE-SSIM only between 0.256 and 0.272.
+    - hidden_features=256: the same zoo scores as 512 (within 0.002) at a quarter of the solve's
+      d^2 work.
+    - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
+      2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
+      (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
+      quick zoo (1.5-2.25 s scenes) the mean CLAHE-SSIM drops from 0.528 to 0.522.
+
+    Events and bins:
+        C: contrast threshold (log units per event; paper: 1 for IJRR/HQF, 0.25 for AED), or a pair
+            (c_pos, c_neg): ON events weigh +c_pos, OFF events -c_neg (real sensors differ; fit both
+            from APS frames with :func:`evinr_lite.method.contrast.fit_contrast`).
+        bin_duration: final event-frame length in seconds (paper: 1/32 s).
+        min_bins: at least this many final fixed-duration bins per network window (shorter bins
+            in short windows; 0: bin_duration alone decides, as in the paper).
+        binning: "fixed" (paper: fixed-duration bins) or "equal_count" (the reference code).
+        events_per_bin: final events per bin for "equal_count". The reference code fixes the number
+            of bins instead (50, then 100 after one bisection at n_iters / 2, over the whole window):
+            emulate it with events_per_bin = n_events // 100 and c2f_iters = (n_iters // 2,)
+            (``ablation.recipe_variants`` does).
+    Losses:
+        temporal_loss: "derivative" (paper, Eq. 5-6: dF/dt at bin mid-points times bin length) or
+            "difference" (F(b_{i+1}) - F(b_i) at bin boundaries: exact integral form).
+        regularizer: "tikhonov" (paper, Eq. 9), "tv" (reference code) or "none".
+        lam: weight lambda of the regularizer (paper: 0.05; finite differences in pixel units).
+    Network (SIREN):
+        hidden_features, hidden_layers: width and depth (paper: 512, 3).
+        omega_0: frequency factor of the hidden layers (SIREN's default 30).
+        first_omega_0: frequency factor of the first layer, which sets how fast F can vary in time
+            (not in the paper; the reference code uses 10 everywhere). With 30, the network fits
+            dF/dt at the bin mid-points while wandering between them, so integrated changes are
+            wrong (notebook 01 shows the same in 1-D); 10 keeps F smooth at the scale of a bin.
+            Each network maps its own window to [-1, 1], so shorter ensemble windows allow faster
+            wiggles per second: with short windows prefer temporal_loss="difference" (notebook 06).
+    Optimisation:
+        n_iters: iterations (paper: 300). lr, lr_decay, lr_decay_every: Adam with lr x lr_decay
+            every lr_decay_every iterations (paper: 1e-4, 0.95, 10).
+        head_lr_scale: learning-rate factor for the H*W output layer. Not in the paper: the public
+            reference code multiplies the head's output by omega_0, which under Adam makes the head
+            learn omega_0 times faster. We keep SIREN's small initial output and scale the head's
+            learning rate instead (default 30 = omega_0); with 1, 300 iterations at lr 1e-4 leave
+            the frames far from converged (see benchmarks/solver_quality.py).
+        coarse_to_fine: bisect the bins at ``c2f_iters`` (paper: 3 stages, at 100 and 200).
+    Ensembling:
+        tau: longest window per network in seconds (paper: 5); None for one network.
+        overlap: seconds shared by neighbouring windows (used to align and cross-fade them).
+    Beyond the paper:
+        head_solve: after the Adam iterations (if any), set the H*W output layer to the exact optimum
+            of the loss for the hidden layers (a linear least-squares problem solved in closed form,
+            :mod:`evinr_lite.method.head_solve`; needs regularizer "tikhonov" or "none").
+        offset_solve: how the per-pixel offset that events cannot fix is chosen: "none" (left to the
+            regularizer, as in the paper) or "median_gradient" (:mod:`evinr_lite.method.offset`:
+            the offset that makes the temporal median of each pixel's gradient zero).
+        anchor: APS frames as anchors (:mod:`evinr_lite.method.anchor`; pass ``frames=`` to
+            :func:`reconstruct`): "none" (events only, the default), "first" (the first frame in the
+            window sets the per-pixel offset) or "all" (every ``anchor_every``-th frame is a soft
+            constraint on a slowly varying per-pixel offset; the others are held out for scoring).
+            Anchored output is the frames' linear intensity, clip(exp(L) - 1/255, 0, 1), instead of
+            the tone map; offset_solve and display_mean are then unused.
+        anchor_every: with anchor "all", frames 0, k, 2k, ... of the window are anchors (k >= 1;
+            default 2: every other frame is held out for scoring).
+        anchor_smoothing: with anchor "all", the time scale s (seconds, >= 0) over which the offset
+            may drift between anchors: 0 passes through every anchor frame, large s fits one
+            least-squares offset per pixel.
+    Output:
+        gamma: tone-mapping exponent (paper: 0.6). display_mean: the tone-mapped value that the
+            mean log intensity is anchored to (see the module docstring).
+    Runtime:
+        seed: seeds the initialisation. device: "cpu", "cuda" or None (GPU when present).
+        progress: show a progress bar (terminal or notebook).
+    """
+
+    C: float | tuple = 1.0
+    bin_duration: float = 1 / 32
+    min_bins: int = 64
+    binning: str = "fixed"
+    events_per_bin: int = 100
+    temporal_loss: str = "difference"
+    regularizer: str = "tikhonov"
+    lam: float = 0.01
+    hidden_features: int = 256
+    hidden_layers: int = 3
+    omega_0: float = 30.0
+    first_omega_0: float | None = 10.0
+    n_iters: int = 0
+    lr: float = 1e-4
+    lr_decay: float = 0.95
+    lr_decay_every: int = 10
+    head_lr_scale: float = 30.0
+    coarse_to_fine: bool = False
+    c2f_iters: tuple = (100, 200)
+    tau: float | None = 5.0
+    overlap: float = 0.5
+    gamma: float = 0.6
+    display_mean: float = 0.5
+    head_solve: bool = True
+    offset_solve: str = "median_gradient"
+    anchor: str = "none"
+    anchor_every: int = 2
+    anchor_smoothing: float = 0.03
+    seed: int = 0
+    device: str | None = None
+    progress: bool = True
+
+    def __post_init__(self):
+        # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
+        choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
+                   "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient")}
+        for name, allowed in choices.items():
+            if getattr(self, name) not in allowed:
+                raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+        if self.head_solve and self.regularizer == "tv":
+            raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
+                                 "pass head_solve=False to train the head with Adam")
+        if self.anchor not in ANCHOR_MODES:
+            raise EventDataError(f"anchor must be one of {ANCHOR_MODES}, got {self.anchor!r}")
+        if isinstance(self.anchor_every, bool) or not isinstance(self.anchor_every, (int, np.integer)) or \
+                self.anchor_every < 1:
+            raise EventDataError(f"anchor_every must be a whole number >= 1, got {self.anchor_every!r}")
+        self.anchor_every = int(self.anchor_every)
+        if isinstance(self.anchor_smoothing, bool) or not isinstance(self.anchor_smoothing, (int, float, np.integer, np.floating)) \
+                or not (math.isfinite(self.anchor_smoothing) and self.anchor_smoothing >= 0):
+            raise EventDataError(f"anchor_smoothing must be a finite number of seconds >= 0, got {self.anchor_smoothing!r}")
+        self.anchor_smoothing = float(self.anchor_smoothing)
+
+        def number(name, value, *, integer=False):
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or (
+                    integer and not float(value).is_integer()) or not math.isfinite(value):
+                raise EventDataError(f"{name} must be a finite {'whole ' if integer else ''}number, got {value!r}")
+            return int(value) if integer else float(value)
+
+        if isinstance(self.C, (tuple, list, np.ndarray)):   # (c_pos, c_neg), checked by the one parser of C
+            self.C = as_thresholds(self.C, "C")
+        elif not number("C", self.C) > 0:
+            raise EventDataError(f"C must be positive (or a pair (c_pos, c_neg) of positive numbers), got {self.C}")
+        for name in ("bin_duration", "lr", "gamma", "omega_0", "head_lr_scale"):
+            if not number(name, getattr(self, name)) > 0:
+                raise EventDataError(f"{name} must be positive, got {getattr(self, name)}")
+        if self.first_omega_0 is not None and not number("first_omega_0", self.first_omega_0) > 0:
+            raise EventDataError(f"first_omega_0 must be positive (or None), got {self.first_omega_0}")
+        for name, low in (("n_iters", 0 if self.head_solve else 1), ("min_bins", 0), ("hidden_features", 1), ("hidden_layers", 0), ("lr_decay_every", 1),
+                          ("events_per_bin", 1)):
+            if number(name, getattr(self, name), integer=True) < low:
+                raise EventDataError(f"{name} must be at least {low}, got {getattr(self, name)}")
+            setattr(self, name, int(getattr(self, name)))
+        if not number("lam", self.lam) >= 0:
+            raise EventDataError(f"lam must be zero or positive, got {self.lam}")
+        if not 0 < number("lr_decay", self.lr_decay) <= 1:
+            raise EventDataError(f"lr_decay must be in (0, 1], got {self.lr_decay}")
+        if not 0 < number("display_mean", self.display_mean) < 1:
+            raise EventDataError(f"display_mean must be in (0, 1), got {self.display_mean}")
+        if self.tau is not None and not number("tau", self.tau) > number("overlap", self.overlap) >= 0:
+            raise EventDataError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
+        for name in ("head_solve", "coarse_to_fine", "progress"):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise EventDataError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2**63:
+            raise EventDataError(f"seed must be a whole number in [0, 2**63), got {self.seed!r}")
+        if self.device is not None and not (isinstance(self.device, str) and
+                                            re.fullmatch(r"cpu|mps|cuda(:\d+)?", self.device)):
+            raise EventDataError(f"device must be 'cpu', 'cuda', 'cuda:N', 'mps' or None (a GPU when present), "
+                                 f"got {self.device!r}")
+        self.c2f_iters = tuple(number("c2f_iters", i, integer=True) for i in self.c2f_iters)
+        if self.coarse_to_fine:
+            if any(i < 1 for i in self.c2f_iters) or list(self.c2f_iters) != sorted(set(self.c2f_iters)):
+                raise EventDataError(f"c2f_iters must be increasing iterations >= 1, got {self.c2f_iters}")
+            late = [i for i in self.c2f_iters if i >= self.n_iters]
+            if late:   # a warning, not an error: fast-mode notebooks shorten n_iters under the default stages
+                import warnings
+
+                fix = (f"c2f_iters=({self.n_iters // 3}, {2 * self.n_iters // 3})" if self.n_iters >= 3
+                       else "coarse_to_fine=False")
+                warnings.warn(f"c2f_iters {late} are not inside the run of n_iters={self.n_iters} iterations: those "
+                              f"bisections never happen, so the final bins are coarser than bin_duration; pass {fix}",
+                              stacklevel=3)
+
+    @classmethod
+    def paper(cls, **overrides) -> "EvINRConfig":
+        """The paper's recipe exactly (Sec. 3-4): SIREN 3 x 512 with omega_0 = 30 in every layer, the
+        derivative loss (Eq. 5-6) on 1/32 s bins, Tikhonov with lambda 0.05, Adam lr 1e-4 x 0.95 every
+        10 iterations for 300 iterations, coarse-to-fine at 100 and 200, 5 s sub-sequences; one
+        learning rate for every layer; no head or offset solve."""
+        return cls(**{"C": 1.0, "bin_duration": 1 / 32, "binning": "fixed", "temporal_loss": "derivative",
+                      "min_bins": 0, "regularizer": "tikhonov", "lam": 0.05, "hidden_features": 512, "hidden_layers": 3,
+                      "omega_0": 30.0, "first_omega_0": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
+                      "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
+                      "tau": 5.0, "overlap": 0.5, "gamma": 0.6, "head_solve": False, "offset_solve": "none",
+                      **overrides})
+
+    @classmethod
+    def v0_1(cls, **overrides) -> "EvINRConfig":
+        """The kit's default of version 0.1 (before the scene zoo): the paper's recipe with
+        first_omega_0 = 10 and head_lr_scale = 30, tuned on the demo scene alone. Kept so that
+        benchmarks compare today's default with it in the same run."""
+        return cls.paper(**{"first_omega_0": 10.0, "head_lr_scale": 30.0, **overrides})
+
+    @classmethod
+    def base(cls, **overrides) -> "EvINRConfig":
+        """The paper's ablation 'Base': no spatial regularization, no coarse-to-fine."""
+        return cls.v0_1(**{"regularizer": "none", "coarse_to_fine": False, **overrides})
+
+    @classmethod
+    def reference_code(cls, **overrides) -> "EvINRConfig":
+        """The public reference code's choices where they differ from the paper (as far as this
+        solver expresses them): anisotropic TV, equal-count bins, a boundary-difference temporal
+        term (evaluated at the boundaries, without the code's half-bin shift), omega_0 = 10.
+
+        Its bin count depends on the data (the code uses 100 bins over the window, 50 before one
+        bisection at n_iters / 2): pass ``events_per_bin=n_events // 100, c2f_iters=(n_iters // 2,)``.
+        Not expressible here: AdamW at a fixed lr 3e-4 for 1000 steps, the extra regularizer terms,
+        the sigmoid tone mapping."""
+        return cls.paper(**{"regularizer": "tv", "binning": "equal_count", "temporal_loss": "difference",
+                            "omega_0": 10.0, "first_omega_0": 10.0, "head_lr_scale": 10.0, **overrides})
+
+    @property
+    def n_bisections(self) -> int:
+        """How many times the bins are halved during training."""
+        return len(self.c2f_iters) if self.coarse_to_fine else 0
