@@ -1,0 +1,157 @@
+"""The README and docs/ hold together: every relative link resolves, the README's example runs, and the
+zoo figures quoted in the docs are those of the committed results (benchmarks/zoo_results.json)."""
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "benchmarks" / "README.md"]
+
+_FENCE = re.compile(r"^(```|~~~)")
+_LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
+_CODE_SPAN = re.compile(r"`+[^`]*`+")
+
+
+def _prose_lines(text: str):
+    """(line number, line) outside fenced code blocks."""
+    fenced = False
+    for i, line in enumerate(text.splitlines(), 1):
+        if _FENCE.match(line.strip()):
+            fenced = not fenced
+            continue
+        if not fenced:
+            yield i, line
+
+
+def github_slug(heading: str) -> str:
+    """GitHub's anchor for a heading: lower case, markup and punctuation dropped, spaces -> '-'."""
+    text = re.sub(r"!?\[([^\]]*)\]\([^)]*\)", r"\1", heading)      # a link keeps its text
+    text = text.strip().lower().replace("`", "")
+    text = re.sub(r"[^\w\- ]", "", text)                           # keeps letters, digits, _ and -
+    return text.replace(" ", "-")
+
+
+def anchors(path: Path) -> set[str]:
+    """Every heading anchor of a markdown file, numbered as GitHub numbers repeats (-1, -2, ...)."""
+    seen: dict[str, int] = {}
+    out = set()
+    for _, line in _prose_lines(path.read_text(encoding="utf-8")):
+        m = re.match(r"^(#{1,6})\s+(.*?)\s*#*\s*$", line)
+        if not m:
+            continue
+        slug = github_slug(m.group(2))
+        n = seen.get(slug, 0)
+        seen[slug] = n + 1
+        out.add(slug if n == 0 else f"{slug}-{n}")
+    return out
+
+
+def relative_links(path: Path):
+    """(line number, target) of every relative link in a markdown file (code spans and blocks skipped)."""
+    for i, line in _prose_lines(path.read_text(encoding="utf-8")):
+        for m in _LINK.finditer(_CODE_SPAN.sub("", line)):
+            target = m.group(1)
+            if re.match(r"^[a-z][a-z0-9+.-]*:", target, re.I):    # http:, https:, mailto:
+                continue
+            yield i, target
+
+
+def broken_links(path: Path) -> list[str]:
+    problems = []
+    for line, target in relative_links(path):
+        file_part, _, anchor = target.partition("#")
+        dest = (path.parent / file_part).resolve() if file_part else path
+        where = f"{path.relative_to(ROOT)}:{line}: [{target}]"
+        if not dest.exists():
+            problems.append(f"{where}: {dest.relative_to(ROOT) if dest.is_relative_to(ROOT) else dest} does not exist")
+        elif anchor and dest.suffix == ".md" and anchor not in anchors(dest):
+            problems.append(f"{where}: no heading '#{anchor}' in {dest.relative_to(ROOT)}")
+    return problems
+
+
+@pytest.mark.parametrize("path", DOCS, ids=lambda p: str(p.relative_to(ROOT)))
+def test_every_relative_link_resolves(path):
+    assert path.exists()
+    problems = broken_links(path)
+    assert not problems, "broken links (fix the target or the heading):\n" + "\n".join(problems)
+
+
+def test_the_link_checker_catches_a_missing_file_and_a_missing_anchor(tmp_path, monkeypatch):
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    (tmp_path / "other.md").write_text("# Other page\n\n## The `--denoise` option: what it does\n")
+    page = tmp_path / "page.md"
+    page.write_text("# Page\n\n## Two  words\n\n[ok](other.md#the---denoise-option-what-it-does) [ok](#page)"
+                    " [ok](#two--words) [gone](missing.md) [bad](other.md#nope) [web](https://example.org/x)\n"
+                    "```\n[in code](missing_too.md)\n```\n`[span](missing_span.md)`\n")
+    problems = broken_links(page)
+    assert len(problems) == 2, problems
+    assert "missing.md does not exist" in problems[0] and "no heading '#nope'" in problems[1]
+
+
+def test_github_slugs():
+    assert github_slug("Set up and run: two commands") == "set-up-and-run-two-commands"
+    assert github_slug("`demo`: the main job (no download)") == "demo-the-main-job-no-download"
+    assert github_slug("Defaults: the kit's recipe and the paper's") == "defaults-the-kits-recipe-and-the-papers"
+    assert github_slug("`--anchor`: APS frames as anchors") == "--anchor-aps-frames-as-anchors"
+
+
+def test_the_readme_keeps_its_sections_and_length():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    heads = anchors(ROOT / "README.md")
+    for section in ("set-up-and-run-two-commands", "run-the-tests", "how-the-data-flows", "conventions",
+                    "where-next", "figures"):
+        assert section in heads, f"README.md lost its section #{section}"
+    assert len(text.splitlines()) <= 200, "README.md is meant to be read in five minutes: move detail to docs/"
+
+
+def _zoo():
+    d = json.loads((ROOT / "benchmarks" / "zoo_results.json").read_text())
+    zoo = [s for name, s in d["scenes"].items() if name != "real_slider_chunk"]
+    return d, zoo
+
+
+def test_the_zoo_means_in_docs_defaults_are_the_committed_results():
+    d, zoo = _zoo()
+    text = (ROOT / "docs" / "defaults.md").read_text(encoding="utf-8")
+    checked = 0
+    for method in d["methods"]:
+        m = re.search(rf"^\| {re.escape(method)}\b[^|]*\|([^\n]*)$", text, re.M)
+        assert m, f"docs/defaults.md has no row for {method}"
+        cells = [c.strip() for c in m.group(1).strip(" |").split("|")]
+        rows = [s["rows"][method] for s in zoo]
+        want = [f"{np.mean([r['ssim_clahe'] for r in rows]):.3f}", f"{np.mean([r['ssim_none'] for r in rows]):.3f}",
+                f"{np.mean([r['mse_none'] for r in rows]):.4f}"]
+        assert cells[:3] == want, f"docs/defaults.md's {method} row {cells[:3]} != zoo_results.json {want}"
+        real = d["scenes"]["real_slider_chunk"]["rows"].get(method)
+        if real is not None:
+            assert cells[4:6] == [f"{real['ssim_clahe']:.3f}", f"{real['ssim_none']:.3f}"], method
+        checked += 1
+    assert checked == len(d["methods"]) >= 5
+
+
+def test_the_zoo_table_in_benchmarks_readme_is_the_committed_results():
+    d, zoo = _zoo()
+    text = (ROOT / "benchmarks" / "README.md").read_text(encoding="utf-8")
+    for name, scene in d["scenes"].items():
+        want = [f"{scene['rows'][m]['ssim_clahe']:.3f} / {scene['rows'][m]['ssim_none']:.3f}"
+                if m in scene["rows"] else "-" for m in d["methods"]]
+        assert f"| {name} | " + " | ".join(want) + " |" in text, f"benchmarks/README.md: the {name} row is stale"
+
+
+def test_the_readme_python_example_runs():
+    """The six lines under 'Six lines of Python', as printed (the comments state what they give)."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Six lines of Python", 1)[1]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    assert len(code.strip().splitlines()) == 6
+    scope: dict = {}
+    exec(compile(code, "README.md", "exec"), scope)
+    rec = scope["rec"]
+    assert rec.frames.shape == (10, 120, 160) and 0 <= rec.frames.min() and rec.frames.max() <= 1
+    assert rec.frames_at([0.5, 0.51]).shape == (2, 120, 160)
