@@ -237,3 +237,24 @@ def test_result_is_an_events_container():
     ev = simulate_video(np.random.default_rng(0).normal(size=(5, 3, 4)), np.arange(5.0), C=0.3)
     assert isinstance(ev, Events) and ev.sensor_size == (3, 4)
     assert ev.x.max() < 4 and ev.y.max() < 3
+
+
+def test_threshold_drift_scales_steps_and_zero_drift_changes_nothing():
+    from evinr_lite.sim.scenes import MovingImageScene
+
+    sc = MovingImageScene("camera", (30, 40), 2.0)
+    base = simulate_scene(sc, C=0.2, seed=0)
+    same = simulate_scene(sc, C=0.2, seed=0, threshold_drift=0.0)
+    np.testing.assert_array_equal(base.t, same.t)
+    ev = simulate_scene(sc, C=0.2, seed=0, threshold_drift=0.5)
+    # each event moved the reference by the threshold in force (0.75x at the start .. 1.25x at the end):
+    # summed per pixel, the steps reproduce the change of L to within one (largest) step
+    scale = 1 + 0.5 * (ev.t / 2.0 - 0.5)
+    steps = np.bincount(ev.y * 40 + ev.x, weights=ev.p * 0.2 * scale, minlength=1200).reshape(30, 40)
+    err = sc.log_intensity(2.0) - sc.log_intensity(0.0) - steps
+    assert np.abs(err).max() < 0.2 * 1.25 + 0.02
+    # and the nominal threshold alone would be off: later events are bigger steps
+    nominal = np.bincount(ev.y * 40 + ev.x, weights=ev.p * 0.2, minlength=1200).reshape(30, 40)
+    assert np.abs(sc.log_intensity(2.0) - sc.log_intensity(0.0) - nominal).max() > np.abs(err).max()
+    with pytest.raises(EventDataError, match="threshold_drift"):
+        simulate_scene(sc, C=0.2, threshold_drift=2.5)

@@ -72,3 +72,75 @@ def test_zoo_is_documented_and_simulates():
     assert zoo.effective_C(z) == pytest.approx(0.2)
     with pytest.raises(EventDataError, match="no zoo scene"):
         zoo.get("nope")
+
+
+# ---- issue 21: the zoo grows (long scenes, ON-only hot pixels, drifting thresholds, light-dependent noise)
+
+def test_oscillating_scene_is_bounded_and_periodic():
+    from evinr_lite.sim.scenes import OscillatingScene
+
+    s = OscillatingScene("camera", (24, 32), 8.0, path=((10.0, 4.0, 2.0, 0.0),), rotation=(0.05, 4.0))
+    np.testing.assert_allclose(s.log_intensity(0.0), s.log_intensity(4.0), atol=1e-9)    # both periods divide 4 s
+    assert np.abs(s.log_intensity(1.0) - s.log_intensity(0.0)).max() > 0.3                # it does move
+    o = s.offset(np.linspace(0, 8, 401))
+    assert np.abs(o[:, 0]).max() <= 10.0 + 1e-9 and np.abs(o[:, 1]).max() <= 4.0 + 1e-9
+    # the fastest pixel never outruns max_speed (it sets the simulator's sampling)
+    t = np.linspace(0, 8, 2001)
+    speed = np.hypot(*np.diff(s.offset(t), axis=0).T) / np.diff(t)
+    assert speed.max() <= s.max_speed
+    with pytest.raises(EventDataError, match="path"):
+        OscillatingScene("camera", (24, 32), 2.0, path=((1.0, 1.0, 0.0, 0.0),))
+
+
+def test_on_only_hot_pixels_keep_pixels_and_times():
+    ev = Events.from_arrays([0.0, 2.0], [0, 1], [0, 0], [1, -1], (8, 10))
+    mixed, hot = add_hot_pixels(ev, 5, 100.0, seed=3)
+    on, hot_on = add_hot_pixels(ev, 5, 100.0, seed=3, on_only=True)
+    np.testing.assert_array_equal(hot, hot_on)
+    np.testing.assert_array_equal(mixed.t, on.t)
+    flat = on.y.astype(np.int64) * 10 + on.x
+    assert np.all(on.p[np.isin(flat, hot)] == 1) and np.any(mixed.p[np.isin(flat, hot)] == -1)
+
+
+def test_light_noise_grows_where_it_is_dark():
+    from evinr_lite.sim.simulate import add_light_noise
+
+    class HalfDark:                        # left half at full scale, right half at 1/10 of it
+        sensor_size = (20, 40)
+
+        def log_intensity(self, t):
+            L = np.zeros((20, 40))
+            L[:, 20:] = np.log(0.1)
+            return L
+
+    ev = Events.from_arrays([0.0, 10.0], [0, 1], [0, 0], [1, -1], (20, 40))
+    out, added = add_light_noise(ev, HalfDark(), 2.0, seed=1, return_labels=True)
+    x = out.x[added]
+    n_bright, n_dark = np.sum(x < 20), np.sum(x >= 20)
+    assert n_bright == pytest.approx(20 * 20 * 2.0 * 10, rel=0.1)          # Poisson(rate x area x span)
+    assert n_dark / n_bright == pytest.approx(10.0, rel=0.1)              # x 1 / intensity
+    again = add_light_noise(ev, HalfDark(), 2.0, seed=1)
+    np.testing.assert_array_equal(again.t, out.t)
+    with pytest.raises(EventDataError, match="sensor_size"):
+        add_light_noise(Events.from_arrays([0.0, 1.0], [0, 1], [0, 0], [1, -1], (8, 10)), HalfDark(), 1.0)
+
+
+def test_zoo_long_scenes_are_marked_and_new_faults_are_there():
+    long = [z for z in zoo.ZOO if z.long]
+    assert {z.name for z in long} >= {"long_pan_20s", "long_ijrr_60s"}
+    assert max(z.duration for z in long) >= 60 and min(z.duration for z in long) >= 20
+    assert all(not z.long for z in zoo.default_scenes()) and len(zoo.default_scenes(long=True)) == len(zoo.ZOO)
+    assert any(z.hot_on_only for z in zoo.ZOO) and any(z.threshold_drift for z in zoo.ZOO)
+    assert any(z.dark_noise_hz for z in zoo.ZOO)
+    assert zoo.get("long_pan_20s").n_scored == 40 and zoo.get("camera_translate").n_scored == zoo.N_SCORED
+
+
+def test_zoo_dark_scene_gets_noisier_as_light_falls():
+    z = zoo.quick(zoo.get("dark_falling"))
+    scene, events, times, gt = zoo.simulate(z)
+    assert gt[-1].mean() < gt[0].mean() / 4                               # the light falls
+    from dataclasses import replace
+
+    clean = zoo.simulate(replace(z, dark_noise_hz=0.0))[1]
+    noise = len(events) - len(clean)
+    assert noise > 0

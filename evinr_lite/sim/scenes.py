@@ -22,7 +22,7 @@ from scipy import ndimage
 from ..core.events import EventDataError, check_sensor_size
 from ..core.frames import Frames
 
-__all__ = ["Scene", "MovingImageScene", "MovingBarScene", "VaryingSpeedScene", "WarpedImageScene",
+__all__ = ["Scene", "MovingImageScene", "OscillatingScene", "MovingBarScene", "VaryingSpeedScene", "WarpedImageScene",
            "ObjectOverBackgroundScene", "LightingScene", "make_scene", "IMAGE_NAMES", "SCENE_NAMES"]
 
 # scikit-image sample images that ship with the package (no download needed).
@@ -204,6 +204,58 @@ class MovingImageScene(Scene):
         c, s = c[:, None, None], s[:, None, None]
         cols = self._centre[1] + k * (c * dx + s * dy)       # R(-theta) applied to (dx, dy)
         rows = self._centre[0] + k * (-s * dx + c * dy)
+        L = ndimage.map_coordinates(self._coeffs, [rows.ravel(), cols.ravel()], order=self.order,
+                                    mode="mirror", prefilter=False)
+        return L.reshape(t.size, *self.sensor_size)
+
+
+class OscillatingScene(MovingImageScene):
+    """A natural image swinging back and forth: bounded motion that can last minutes.
+
+    The image offset (x, y) in sensor pixels is a sum of sinusoids,
+    ``o(t) = sum_i a_i sin(2 pi t / T_i + phi_i)`` over ``path`` = ((ax, ay, T, phi), ...), and the
+    image turns by ``rotation[0] sin(2 pi t / rotation[1])`` rad about the sensor centre. One slow
+    component is a slider or a panning camera going to and fro (long recordings stay on the image);
+    several fast ones are a hand-held camera's shake. Intensity and sampling as
+    :class:`MovingImageScene`.
+
+    Args:
+        image, sensor_size, duration, scale, blur, intensity_range, order: as :class:`MovingImageScene`.
+        path: ((ax px, ay px, period s, phase rad), ...), at least one component, periods > 0.
+        rotation: (amplitude rad, period s); (0, 1) for none.
+    """
+
+    def __init__(self, image="camera", sensor_size=(120, 160), duration=2.0, *, path=((30.0, 10.0, 4.0, 0.0),),
+                 rotation=(0.0, 1.0), scale=None, blur=0.75, intensity_range=(0.05, 1.0), order=3):
+        super().__init__(image, sensor_size, duration, velocity=(0.0, 0.0), rotation=0.0, zoom=0.0, scale=scale,
+                         blur=blur, intensity_range=intensity_range, order=order)
+        self.path = np.asarray(path, dtype=np.float64).reshape(-1, 4)
+        self.rot_amp, self.rot_period = (float(v) for v in rotation)
+        if self.path.shape[0] < 1 or not np.all(np.isfinite(self.path)) or np.any(self.path[:, 2] <= 0):
+            raise EventDataError(f"path must be ((ax, ay, period > 0, phase), ...) in px, s, rad; got {path!r}")
+        if not (np.isfinite(self.rot_amp) and np.isfinite(self.rot_period) and self.rot_period > 0):
+            raise EventDataError(f"rotation must be (amplitude rad, period s > 0), got {rotation!r}")
+
+    def offset(self, t) -> np.ndarray:
+        """Image offset (x, y) in sensor pixels at times t [T]: float64 [T, 2]."""
+        t = np.atleast_1d(np.asarray(t, dtype=np.float64))
+        a, T, phi = self.path[:, :2], self.path[:, 2], self.path[:, 3]
+        return np.sin(2 * np.pi * t[:, None] / T[None] + phi[None]) @ a
+
+    @property
+    def max_speed(self) -> float:
+        radius = np.hypot(*self.sensor_size) / 2 + np.abs(self.path[:, :2]).sum()
+        v = np.sum(2 * np.pi * np.hypot(self.path[:, 0], self.path[:, 1]) / self.path[:, 2])
+        return float(v + 2 * np.pi * abs(self.rot_amp) / self.rot_period * radius)
+
+    def _log_intensity(self, t: np.ndarray) -> np.ndarray:
+        o = self.offset(t)
+        theta = self.rot_amp * np.sin(2 * np.pi * t / self.rot_period)
+        c, s = np.cos(theta)[:, None, None], np.sin(theta)[:, None, None]
+        dx = self._x[None] - o[:, 0, None, None]
+        dy = self._y[None] - o[:, 1, None, None]
+        cols = self._centre[1] + self.scale * (c * dx + s * dy)
+        rows = self._centre[0] + self.scale * (-s * dx + c * dy)
         L = ndimage.map_coordinates(self._coeffs, [rows.ravel(), cols.ravel()], order=self.order,
                                     mode="mirror", prefilter=False)
         return L.reshape(t.size, *self.sensor_size)

@@ -27,6 +27,8 @@ Non-idealities (all optional, all seeded):
   for a dropped event (the change is consumed, not reported), so the integrated events fall
   short of ``L`` by the dropped steps. (v2e instead holds the reference and reports the change
   late.) Noise events are emitted events too: they start a refractory period.
+- ``threshold_drift`` (:func:`simulate_scene`): every threshold scaled by a factor linear in time,
+  nominal at mid-span (a sensor warming up); the reference moves by the step in force.
 - ``noise_rate`` (Hz per pixel): background events, an independent Poisson process per pixel
   with uniform times in ``[t[0], t[-1]]`` and polarity +1 or -1 with probability 1/2.
   They do not move the reference level.
@@ -46,7 +48,7 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 
-__all__ = ["simulate_events_1d", "pixel_events", "add_background_noise", "add_hot_pixels", "simulate_video", "simulate_scene", "sample_thresholds",
+__all__ = ["simulate_events_1d", "pixel_events", "add_background_noise", "add_hot_pixels", "add_light_noise", "simulate_video", "simulate_scene", "sample_thresholds",
            "MIN_THRESHOLD_FRACTION", "MAX_PX_PER_SAMPLE"]
 
 MIN_THRESHOLD_FRACTION = 0.1   # mismatched thresholds are clipped below at this x nominal
@@ -126,7 +128,8 @@ def _expand(pixels: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndar
     return rep, j
 
 
-def _crossings(t: np.ndarray, frames: Iterable[np.ndarray], C_pos: np.ndarray, C_neg: np.ndarray):
+def _crossings(t: np.ndarray, frames: Iterable[np.ndarray], C_pos: np.ndarray, C_neg: np.ndarray,
+               scale: np.ndarray | None = None):
     """All threshold crossings of per-pixel signals sampled at times ``t``.
 
     Args:
@@ -134,6 +137,9 @@ def _crossings(t: np.ndarray, frames: Iterable[np.ndarray], C_pos: np.ndarray, C
         frames: T arrays [P] of log intensity, one per sample time (consumed one at a time,
             so a long video never needs to be in memory at once).
         C_pos, C_neg: float64 [P] thresholds.
+        scale: float64 [T] or None: threshold drift, the thresholds during interval (t[k-1], t[k]]
+            are ``scale[k] * C_pos`` and ``scale[k] * C_neg`` (the reference then moves by the step
+            in force when the event fired, so the events still sum exactly to the change crossed).
 
     Returns:
         t_ev float64 [N] (linear interpolation), pix int64 [N], p int8 [N],
@@ -152,6 +158,16 @@ def _crossings(t: np.ndarray, frames: Iterable[np.ndarray], C_pos: np.ndarray, C
         if L_next.shape != L_init.shape:
             raise EventDataError(f"sample {k} has {L_next.size} pixels but sample 0 has {L_init.size}")
         d = L_next - ref
+        if scale is not None:
+            cp, cn = scale[k] * C_pos, scale[k] * C_neg
+            up, down = np.floor(d / cp), np.floor(-d / cn)
+            parts = _drifting_parts(t, k, L_prev, L_next, ref, up, down, cp, cn)
+            L_prev = L_next
+            if parts:
+                t_ev, rep, p, level = (np.concatenate(c) for c in zip(*parts))
+                order = np.argsort(t_ev, kind="stable")
+                out.append((t_ev[order], rep[order], p[order], level[order], np.full(rep.size, k, np.int64)))
+            continue
         up = np.floor(d / C_pos)
         down = np.floor(-d / C_neg)
         parts = []
@@ -181,6 +197,24 @@ def _crossings(t: np.ndarray, frames: Iterable[np.ndarray], C_pos: np.ndarray, C
         e = np.zeros(0)
         return e, e.astype(np.int64), e.astype(np.int8), e, e.astype(np.int64)
     return tuple(np.concatenate(c) for c in zip(*out))
+
+
+def _drifting_parts(t, k, L_prev, L_next, ref, up, down, cp, cn) -> list:
+    """One sample interval of :func:`_crossings` with thresholds ``cp``/``cn`` [P] in force there;
+    ``ref`` [P] moves in place by the steps taken (levels are ref + j * step, so they chain exactly)."""
+    parts = []
+    for sign, steps, C in ((1, up, cp), (-1, down, cn)):
+        pixels = np.flatnonzero(steps > 0)
+        if pixels.size == 0:
+            continue
+        counts = steps[pixels].astype(np.int64)
+        rep, j = _expand(pixels, counts)
+        level = ref[rep] + sign * j * C[rep]
+        ref[pixels] += sign * counts * C[pixels]
+        a, b = L_prev[rep], L_next[rep]
+        frac = np.clip((level - a) / (b - a), 0.0, 1.0)
+        parts.append((t[k - 1] + frac * (t[k] - t[k - 1]), rep, np.full(rep.size, sign, np.int8), level))
+    return parts
 
 
 def _refine(L: Callable, n_pixels: int, t: np.ndarray, pix, p, level, k) -> np.ndarray:
@@ -247,7 +281,7 @@ def _refractory_keep(t_ev: np.ndarray, pix: np.ndarray, refractory: float) -> np
 
 
 def _simulate_samples(t, frames, n_pixels, C_pos, C_neg, threshold_sigma, refractory, noise_rate, rng,
-                      L_callable=None):
+                      L_callable=None, threshold_drift: float = 0.0):
     """Shared core of the 1-D and 2-D simulators.
 
     Args:
@@ -255,12 +289,21 @@ def _simulate_samples(t, frames, n_pixels, C_pos, C_neg, threshold_sigma, refrac
         n_pixels: P. C_pos, C_neg: nominal thresholds. threshold_sigma, refractory (s),
         noise_rate (Hz per pixel): see the module docstring. rng: np.random.Generator.
         L_callable: if given, crossings are refined by bisection on it (see :func:`_refine`).
+        threshold_drift: relative change of every threshold over [t[0], t[-1]], linear in time:
+            thresholds x (1 + threshold_drift * ((t - t[0]) / (t[-1] - t[0]) - 1/2)), so the
+            nominal values hold at mid-recording (0: no drift).
 
     Returns:
         t_ev float64 [N] sorted, pix int64 [N] (flat pixel index), p int8 [N].
     """
     C_pos_pix, C_neg_pix = sample_thresholds(n_pixels, C_pos, C_neg, threshold_sigma, rng)
-    t_ev, pix, p, level, k = _crossings(t, frames, C_pos_pix, C_neg_pix)
+    scale = None
+    if threshold_drift:
+        scale = 1.0 + threshold_drift * ((t - t[0]) / (t[-1] - t[0]) - 0.5)
+        if np.any(scale < MIN_THRESHOLD_FRACTION):
+            raise EventDataError(f"threshold_drift {threshold_drift} takes the thresholds below "
+                                 f"{MIN_THRESHOLD_FRACTION} x nominal; use |threshold_drift| < 1.8")
+    t_ev, pix, p, level, k = _crossings(t, frames, C_pos_pix, C_neg_pix, scale)
     if L_callable is not None and t_ev.size:
         t_ev = _refine(L_callable, n_pixels, t, pix, p, level, k)
     if noise_rate > 0:
@@ -353,12 +396,14 @@ def _check_video(log_frames, t) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _video_events(t, frames: Iterable[np.ndarray], sensor_size, C, C_pos, C_neg, threshold_sigma,
-                  refractory, noise_rate, seed) -> Events:
+                  refractory, noise_rate, seed, threshold_drift=0.0) -> Events:
     C_pos, C_neg = _check_thresholds(C, C_pos, C_neg)
     _check_nonnegative(threshold_sigma=threshold_sigma, refractory=refractory, noise_rate=noise_rate)
+    if not (np.isscalar(threshold_drift) and np.isfinite(threshold_drift)):
+        raise EventDataError(f"threshold_drift must be a finite relative change, got {threshold_drift!r}")
     H, W = sensor_size
     t_ev, pix, p = _simulate_samples(t, frames, H * W, C_pos, C_neg, threshold_sigma, refractory,
-                                     noise_rate, _as_rng(seed))
+                                     noise_rate, _as_rng(seed), threshold_drift=float(threshold_drift))
     y, x = np.divmod(pix, W)
     return Events(t_ev, x.astype(np.int32), y.astype(np.int32), p, (H, W))
 
@@ -405,7 +450,9 @@ def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, *
             ``scene.max_speed / MAX_PX_PER_SAMPLE`` so the image moves at most 0.5 px between
             samples (at least 100 Hz), which keeps the linear interpolation between samples accurate.
         C: contrast threshold; ``**kwargs`` go on to :func:`simulate_video` (C_pos, C_neg,
-            threshold_sigma, refractory, noise_rate, seed).
+            threshold_sigma, refractory, noise_rate, seed), and ``threshold_drift``: the relative
+            change of every threshold over [t_start, t_end], linear in time, nominal at mid-span
+            (e.g. 0.3: from 0.85x to 1.15x, as a sensor warming up; default 0).
 
     Returns:
         Events on ``scene.sensor_size``. Frames are rendered in chunks, never all at once.
@@ -419,11 +466,13 @@ def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, *
         raise EventDataError(f"sample_rate must be a positive number of samples per second, got {sample_rate!r}")
     n = max(2, int(np.ceil((t_end - t_start) * sample_rate - 1e-9)) + 1)
     t = np.linspace(t_start, t_end, n)
-    unknown = set(kwargs) - {"C_pos", "C_neg", "threshold_sigma", "refractory", "noise_rate", "seed"}
+    unknown = set(kwargs) - {"C_pos", "C_neg", "threshold_sigma", "refractory", "noise_rate", "seed",
+                             "threshold_drift"}
     if unknown:
-        raise TypeError(f"simulate_scene got unexpected arguments {sorted(unknown)}; "
-                        "it accepts C_pos, C_neg, threshold_sigma, refractory, noise_rate, seed")
-    opts = dict(C_pos=None, C_neg=None, threshold_sigma=0.0, refractory=0.0, noise_rate=0.0, seed=0)
+        raise TypeError(f"simulate_scene got unexpected arguments {sorted(unknown)}; it accepts C_pos, C_neg, "
+                        "threshold_sigma, refractory, noise_rate, seed, threshold_drift")
+    opts = dict(C_pos=None, C_neg=None, threshold_sigma=0.0, refractory=0.0, noise_rate=0.0, seed=0,
+                threshold_drift=0.0)
     opts.update(kwargs)
     return _video_events(t, _scene_frames(scene, t), tuple(scene.sensor_size), C, **opts)
 
@@ -473,12 +522,15 @@ def _merge(events: Events, noise: Events, return_labels: bool):
 
 
 def add_hot_pixels(events: Events, n_pixels: int, rate_hz: float, seed=0, t_start: float | None = None,
-                   t_end: float | None = None, *, return_labels: bool = False):
+                   t_end: float | None = None, *, return_labels: bool = False, on_only: bool = False):
     """The events plus ``n_pixels`` hot pixels, each firing a Poisson process of ``rate_hz`` events
     per second over [t_start, t_end] (default: the events' span), nearly all of one polarity (90 %,
     the pixel's own sign), as a stuck or leaky DVS pixel does.
 
     Args:
+        on_only: every hot-pixel event is ON (+1), as a leaky pixel's reset does on real DVS
+            sensors: integrated, each hot pixel then climbs without bound. The same random draws
+            are made either way, so the pixels and times do not change with this flag.
         return_labels: also return ``added``, bool [N_out], True for the hot-pixel events this call
             added (the events the input already had at those pixels stay False).
 
@@ -500,8 +552,62 @@ def add_hot_pixels(events: Events, n_pixels: int, rate_hz: float, seed=0, t_star
     pix = np.repeat(hot, counts)
     t = t0 + (t1 - t0) * rng.random(pix.size)
     p = np.repeat(sign, counts) * np.where(rng.random(pix.size) < 0.9, 1, -1)
+    if on_only:
+        p = np.ones_like(p)
     noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
     if return_labels:
         merged, added = _merge(events, noise, True)
         return merged, hot, added
     return _merge(events, noise, False), hot
+
+
+def add_light_noise(events: Events, scene, rate_hz: float, seed=0, t_start: float | None = None,
+                    t_end: float | None = None, *, max_gain: float = 30.0, n_frames_per_s: float = 20.0,
+                    return_labels: bool = False):
+    """The events plus background activity that grows as light falls: at pixel x and time t, a Poisson
+    process of ``rate_hz * min(1 / I(t, x), max_gain)`` events per second (I = exp(L) the scene's
+    intensity, 1 = full scale), polarity +1 or -1 with probability 1/2. DVS leak and shot noise rise in
+    the dark, so a dimming scene gets noisier exactly where and when it is darkest.
+
+    Drawn by thinning: candidates at the top rate ``rate_hz * max_gain``, each kept with probability
+    gain(t, x) / max_gain, with I read from the scene rendered ``n_frames_per_s`` times a second
+    (nearest frame; light changes slowly next to events).
+
+    Args:
+        scene: the :class:`~evinr_lite.sim.scenes.Scene` the events came from (sensor size must match).
+        rate_hz: events per pixel per second at full scale (I = 1). seed: int or np.random.Generator.
+        return_labels: also return ``added``, bool [N_out], True for the events this call added.
+
+    Returns:
+        The merged events (stable merge), with ``return_labels`` ``(events, added)``.
+    """
+    _check_nonnegative(rate_hz=rate_hz)
+    if not (np.isscalar(max_gain) and np.isfinite(max_gain) and max_gain >= 1):
+        raise EventDataError(f"max_gain must be a number >= 1 (the noise's largest factor), got {max_gain!r}")
+    if tuple(scene.sensor_size) != tuple(events.sensor_size):
+        raise EventDataError(f"scene sensor_size {tuple(scene.sensor_size)} != events' {tuple(events.sensor_size)}")
+    rng = _as_rng(seed)
+    t0 = events.t[0] if t_start is None else float(t_start)
+    t1 = events.t[-1] if t_end is None else float(t_end)
+    if not t1 > t0:
+        raise EventDataError(f"noise span [{t0}, {t1}] s is empty; give t_end > t_start")
+    H, W = events.sensor_size
+    counts = rng.poisson(rate_hz * max_gain * (t1 - t0), size=H * W)
+    pix = np.repeat(np.arange(H * W), counts)
+    t = t0 + (t1 - t0) * rng.random(pix.size)
+    n_frames = max(2, int(np.ceil((t1 - t0) * n_frames_per_s)) + 1)
+    ft = np.linspace(t0, t1, n_frames)
+    k = np.clip(np.rint((t - t0) / (t1 - t0) * (n_frames - 1)).astype(np.int64), 0, n_frames - 1)
+    gain = np.empty(pix.size)
+    order = np.argsort(k, kind="stable")
+    bounds = np.searchsorted(k[order], np.arange(n_frames + 1))
+    for i in range(n_frames):                       # one frame at a time: bounded memory on long scenes
+        sel = order[bounds[i]:bounds[i + 1]]
+        if sel.size:
+            L = np.asarray(scene.log_intensity(ft[i]), dtype=np.float64).ravel()
+            gain[sel] = np.minimum(np.exp(-L[pix[sel]]), max_gain)
+    keep = rng.random(pix.size) * max_gain < gain
+    pix, t = pix[keep], t[keep]
+    p = np.where(rng.random(pix.size) < 0.5, -1, 1)
+    noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
+    return _merge(events, noise, return_labels)

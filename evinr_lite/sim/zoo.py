@@ -9,7 +9,11 @@ Together the scenes vary texture (five natural images and one low-texture scene)
 (translation, rotation + zoom, shear and perspective, non-uniform speed, a static camera with an
 object moving over a static background), light (a global change and vignetting), the sensor
 (background activity, hot pixels, C+ != C-, threshold mismatch, a refractory period), size
-(120x160 to 180x240) and length (2-3 s). ``benchmarks/quality_zoo.py`` scores every method on
+(120x160 to 180x240) and length (2-3 s; 8 s for the drifting thresholds; 20 s and 60 s for the two
+``long`` recordings, which only the zoo's ``--long`` mode runs). Sensor faults that users' recordings
+bring: C+ != C- with one nominal C given, ON-only hot pixels, thresholds drifting over the recording,
+background activity growing as light falls. Motion also includes bounded to-and-fro pans (a slider)
+and hand-held shake (:class:`~evinr_lite.sim.scenes.OscillatingScene`). ``benchmarks/quality_zoo.py`` scores every method on
 them; the kit's defaults were chosen on their mean, never on one scene.
 """
 from __future__ import annotations
@@ -19,9 +23,9 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from . import scenes as sc
-from .simulate import add_background_noise, add_hot_pixels, simulate_scene
+from .simulate import add_background_noise, add_hot_pixels, add_light_noise, simulate_scene
 
-__all__ = ["ZooScene", "ZOO", "N_SCORED", "quick", "simulate", "effective_C", "get"]
+__all__ = ["ZooScene", "ZOO", "N_SCORED", "quick", "simulate", "effective_C", "get", "default_scenes"]
 
 N_SCORED = 10   # ground-truth times scored per scene, evenly spread over [0.1, 0.95] of the duration
 
@@ -43,12 +47,22 @@ class ZooScene:
     noise_hz: float = 0.0                # background activity per pixel
     hot_pixels: int = 0                  # stuck pixels firing hot_hz each
     hot_hz: float = 50.0
+    hot_on_only: bool = False            # hot pixels fire ON events only (they integrate into a climb)
+    threshold_drift: float = 0.0         # relative change of the thresholds over the recording (nominal mid-way)
+    dark_noise_hz: float = 0.0           # background activity x 1/intensity (grows as light falls)
+    long: bool = False                   # a long recording: only in the zoo's --long mode
     seed: int = 0
     tags: tuple = field(default_factory=tuple)
 
     @property
     def noise_free(self) -> bool:
-        return self.noise_hz == 0 and self.hot_pixels == 0 and self.threshold_sigma == 0
+        return (self.noise_hz == 0 and self.hot_pixels == 0 and self.threshold_sigma == 0
+                and self.dark_noise_hz == 0 and self.threshold_drift == 0)
+
+    @property
+    def n_scored(self) -> int:
+        """Ground-truth times scored: N_SCORED, or 2 per second on long scenes (so each quarter holds many)."""
+        return max(N_SCORED, int(round(2 * self.duration)))
 
 
 ZOO = [
@@ -82,6 +96,33 @@ ZOO = [
     ZooScene("camera_240x180", "camera at 180x240 (the paper's DAVIS240 size), 2 s: the timing target; clean",
              lambda s, d: sc.MovingImageScene("camera", s, d, velocity=(25.0, 10.0), rotation=0.1, zoom=0.1),
              size=(180, 240)),
+    ZooScene("unequal_onhot", "rocket, pan + zoom at 150x200, 3 s: C+ 0.26, C- 0.18 given as C 0.22, 30 ON-only hot pixels",
+             lambda s, d: sc.MovingImageScene("rocket", s, d, velocity=(-16.0, 6.0), rotation=-0.06, zoom=0.08),
+             size=(150, 200), duration=3.0, C=0.22, C_pos=0.26, C_neg=0.18, threshold_sigma=0.03, noise_hz=0.2,
+             hot_pixels=30, hot_hz=40.0, hot_on_only=True, seed=3),
+    ZooScene("drift_clock", "clock panned to and fro (slider), 8 s: thresholds drift from 0.8x to 1.2x, 3 % mismatch",
+             lambda s, d: sc.OscillatingScene("clock", s, d, path=((28.0, 6.0, 5.0, 0.0),), rotation=(0.04, 7.0)),
+             duration=8.0, threshold_sigma=0.03, threshold_drift=0.4, seed=4),
+    ZooScene("dark_falling", "coins while the light falls 7x over 3 s; background activity grows as 1/intensity",
+             lambda s, d: sc.LightingScene(sc.MovingImageScene("coins", s, d, velocity=(14.0, -9.0), rotation=0.12,
+                                                               zoom=0.0, blur=1.0, intensity_range=(0.02, 0.35)),
+                                           global_change=-2.0, vignette=-0.3),
+             duration=3.0, threshold_sigma=0.04, dark_noise_hz=0.05, seed=5),
+    ZooScene("text_shake", "printed text (binary strokes) under hand-held shake: three fast sinusoids; clean sensor",
+             lambda s, d: sc.OscillatingScene("text", s, d, path=((6.0, 3.0, 0.9, 0.0), (3.0, 5.0, 0.55, 1.0),
+                                                                  (2.0, 2.0, 0.23, 2.0)), rotation=(0.03, 0.7))),
+    ZooScene("long_pan_20s", "astronaut on a slider going to and fro, 20 s at 180x240: C+ 0.25, C- 0.20 given as "
+             "0.225, 20 ON-only hot pixels, 0.3 Hz background",
+             lambda s, d: sc.OscillatingScene("astronaut", s, d, path=((40.0, 8.0, 10.0, 0.0), (5.0, 4.0, 3.3, 1.0)),
+                                              rotation=(0.05, 13.0)),
+             size=(180, 240), duration=20.0, C=0.225, C_pos=0.25, C_neg=0.20, threshold_sigma=0.03, noise_hz=0.3,
+             hot_pixels=20, hot_hz=30.0, hot_on_only=True, long=True, seed=6),
+    ZooScene("long_ijrr_60s", "gravel panned for 60 s at 180x240, ~IJRR event rate: C+ 0.22, C- 0.18, drift 0.3, "
+             "ON-only hot pixels, 0.1 Hz background, 0.5 ms refractory",
+             lambda s, d: sc.OscillatingScene("gravel", s, d, path=((50.0, 10.0, 12.0, 0.0), (6.0, 8.0, 4.1, 2.0)),
+                                              rotation=(0.06, 17.0)),
+             size=(180, 240), duration=60.0, C=0.2, C_pos=0.22, C_neg=0.18, threshold_sigma=0.05, refractory=5e-4,
+             threshold_drift=0.3, noise_hz=0.1, hot_pixels=20, hot_hz=30.0, hot_on_only=True, long=True, seed=7),
 ]
 
 
@@ -96,14 +137,19 @@ def simulate(z: ZooScene):
     """(scene, events, gt times [10], gt intensity frames [10, H, W] in (0, 1])."""
     scene = z.build(z.size, z.duration)
     kw = {} if z.C_pos is None else {"C_pos": z.C_pos, "C_neg": z.C_neg}
+    if z.threshold_drift:
+        kw["threshold_drift"] = z.threshold_drift
     events = simulate_scene(scene, 0.0, z.duration, C=z.C, threshold_sigma=z.threshold_sigma,
                             refractory=z.refractory, seed=z.seed, **kw)
     rng = np.random.default_rng(z.seed + 100)
     if z.noise_hz > 0:
         events = add_background_noise(events, z.noise_hz, seed=rng, t_start=0.0, t_end=z.duration)
     if z.hot_pixels:
-        events, _ = add_hot_pixels(events, z.hot_pixels, z.hot_hz, seed=rng, t_start=0.0, t_end=z.duration)
-    times = np.linspace(0.1 * z.duration, 0.95 * z.duration, N_SCORED)
+        events, _ = add_hot_pixels(events, z.hot_pixels, z.hot_hz, seed=rng, t_start=0.0, t_end=z.duration,
+                                   on_only=z.hot_on_only)
+    if z.dark_noise_hz > 0:
+        events = add_light_noise(events, scene, z.dark_noise_hz, seed=rng, t_start=0.0, t_end=z.duration)
+    times = np.linspace(0.1 * z.duration, 0.95 * z.duration, z.n_scored)
     return scene, events, times, scene.intensity(times).astype(np.float32)
 
 
@@ -112,6 +158,11 @@ def effective_C(z: ZooScene) -> float:
     return z.C if z.C_pos is None else 0.5 * (z.C_pos + z.C_neg)
 
 
+
+
+def default_scenes(long: bool = False) -> list:
+    """The scenes a zoo run scores: every scene, or (``long=False``) all but the long recordings."""
+    return [z for z in ZOO if long or not z.long]
 
 
 def get(name: str) -> ZooScene:
