@@ -36,6 +36,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from evinr_lite.core.frames import Frames, to_uint8  # noqa: E402
+from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
 from evinr_lite.method import EvINRConfig, reconstruct, reconstruct_baseline  # noqa: E402
 from evinr_lite.method.baselines import DEFAULT_GAIN  # noqa: E402
@@ -50,7 +51,7 @@ METHODS = ("events_only", "first", "all", "cf_first", "cf_anchors", "cf_every_fr
 def score(frames, times, gt, sel) -> dict:
     """{eq: SSIM} on the frames ``sel`` (indices) only."""
     return {eq: score_sequence(frames[sel], times[sel], gt[sel], times[sel], eq, lpips_model=False)["ssim"]
-            for eq in ("none", "clahe")}
+            for eq in SCORE_PROTOCOLS}
 
 
 def run_scene(events, frames: Frames, gt, C: float, smoothing, gains=(), log=print) -> dict:
@@ -114,10 +115,10 @@ def verdicts(results: dict) -> list[str]:
     for name, res in results.items():
         r = res["rows"]
         for cf in ["cf_first", "cf_every_frame"] + [m for m in r if m.startswith("cf_first (gain")]:
-            wins = [f"{p}/{eq}" for p in ("linear", "tonemapped") for eq in ("none", "clahe")
+            wins = [f"{p}/{eq}" for p in ("linear", "tonemapped") for eq in SCORE_PROTOCOLS
                     if r["first"][p][eq] > r[cf][p][eq]]
             out.append(f"{name}: first beats {cf} in {len(wins)} of 4 (output/equalisation): {', '.join(wins) or '-'}")
-        wins = [f"{p}/{eq}" for p in ("linear", "tonemapped") for eq in ("none", "clahe")
+        wins = [f"{p}/{eq}" for p in ("linear", "tonemapped") for eq in SCORE_PROTOCOLS
                 if r["all"][p][eq] > r["cf_anchors"][p][eq]]
         out.append(f"{name}: all beats cf_anchors in {len(wins)} of 4: {', '.join(wins) or '-'}")
     return out

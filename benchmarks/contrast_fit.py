@@ -19,6 +19,7 @@ import numpy as np
 
 from evinr_lite.core.events import EventDataError
 from evinr_lite.core.frames import Frames
+from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS
 from evinr_lite.method.contrast import fit_contrast
 from evinr_lite.sim import zoo
 
@@ -82,7 +83,7 @@ def reconstruct_asymmetric(quick: bool, rate: float) -> None:
         for label, C in (("mean C", zoo.effective_C(z)), ("true pair", (z.C_pos, z.C_neg)), ("fitted pair", fit.C)):
             rec = reconstruct(events, times, EvINRConfig(C=C, progress=False))
             s = {eq: score_sequence(rec.frames, times, gt, times, equalization=eq, lpips_model=False)
-                 for eq in ("none", "clahe")}
+                 for eq in SCORE_PROTOCOLS}
             print(f"{z.name:<20} {label:<12} C = {np.round(C, 3)}: SSIM {s['none']['ssim']:.3f}, CLAHE-SSIM "
                   f"{s['clahe']['ssim']:.3f}, MSE {s['none']['mse']:.4f}", flush=True)
 

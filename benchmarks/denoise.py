@@ -36,6 +36,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from evinr_lite.core.events import Events  # noqa: E402
+from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.method.denoise import DEFAULT_DT, correlation_filter, denoise_mask, hot_pixel_mask  # noqa: E402
 from evinr_lite.sim import zoo  # noqa: E402
 from evinr_lite.sim.simulate import add_background_noise, add_hot_pixels, simulate_scene  # noqa: E402
@@ -263,7 +264,7 @@ def run_scene(z, settings, tonic, log=print) -> dict:
         log(f"    {name:<22s} signal kept {r['signal_kept']:.3f}  bg removed {r['background_removed'] or 0:.3f}  "
             f"hot removed {r['hot_removed'] or 0:.3f}  CLAHE-SSIM {r['ssim_clahe']:.4f}  SSIM {r['ssim_none']:.4f}")
     for name, r in rows.items():
-        for eq in ("clahe", "none"):
+        for eq in SCORE_PROTOCOLS:
             r[f"gain_{eq}"] = r[f"ssim_{eq}"] / rows["none"][f"ssim_{eq}"]
     out = {"doc": z.doc, "size": list(z.size), "duration_s": z.duration, "counts": counts, "rows": rows}
     if tonic is not None:
@@ -288,7 +289,7 @@ def run_real(log=print) -> dict | None:
     out = {"report": report.to_dict(), "rows": {}}
     for name, ev in (("none", rec.events), ("default", rec.events.take(keep))):
         out["rows"][name] = reconstruct_score(ev, gt_t, gt, 1.0)
-    for eq in ("clahe", "none"):
+    for eq in SCORE_PROTOCOLS:
         out[f"gain_{eq}"] = out["rows"]["default"][f"ssim_{eq}"] / out["rows"]["none"][f"ssim_{eq}"]
     log(f"real slider chunk: {report.summary()}; CLAHE-SSIM {out['rows']['none']['ssim_clahe']:.4f} -> "
         f"{out['rows']['default']['ssim_clahe']:.4f}, SSIM {out['rows']['none']['ssim_none']:.4f} -> "

@@ -34,7 +34,7 @@ except ImportError:  # run as a script
     from common import devices, parser, report, row, sync
 
 from evinr_lite import make_scene, simulate_scene, tonemap_reinhard  # noqa: E402
-from evinr_lite.evaluation.metrics import score_frames  # noqa: E402
+from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS, score_frames  # noqa: E402
 from evinr_lite.method import solver  # noqa: E402
 from evinr_lite.method.solver import EvINRConfig, reconstruct  # noqa: E402
 
@@ -80,7 +80,7 @@ def run(quick: bool = False, device: str | None = None, reference: bool = True, 
             train = min(rec.history["train_time_s"], again.history["train_time_s"])
         else:
             train = rec.history["train_time_s"]
-        scores = {eq: score_frames(rec.frames, gt, eq) for eq in ("none", "clahe")}
+        scores = {eq: score_frames(rec.frames, gt, eq) for eq in SCORE_PROTOCOLS}
         quality = (f"MSE {scores['none']['mse']:.4f} SSIM {scores['none']['ssim']:.3f} | CLAHE: MSE "
                    f"{scores['clahe']['mse']:.4f} SSIM {scores['clahe']['ssim']:.3f}")
         log(f"end to end [{dev}]: reconstruct {wall:.1f} s (training {train:.1f} s, {iters} iterations, "

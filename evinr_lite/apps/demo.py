@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from ..method.integration import integrate_events
-from ..evaluation.metrics import score_frames
+from ..evaluation.metrics import SCORE_PROTOCOLS, score_frames
 from ..io.output import atomic_output_dir, save_json, save_png
 from ..sim.scenes import make_scene
 from ..sim.simulate import simulate_scene
@@ -115,7 +115,7 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
             rows.append(frames)
             row_labels.append(ROW_LABELS[folder])
             results[name] = {"folder": folder, "time_s": seconds}
-            for eq in ("none", "clahe"):
+            for eq in SCORE_PROTOCOLS:
                 s = score_frames(frames, gt, eq)
                 results[name].update({f"mse_{eq}": s["mse"], f"ssim_{eq}": s["ssim"]})
         column_labels = [f"t = {t:.2f} s" for t in t_query]

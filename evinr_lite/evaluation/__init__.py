@@ -1,8 +1,8 @@
 """Scores: metrics, LPIPS, the one scoring path, ablation tables, event enhancement."""
-from .metrics import mse, ssim, equalize, score_frames, protocol_description
+from .metrics import mse, ssim, equalize, score_pairs, score_frames, protocol_description, SCORE_PROTOCOLS
 from .scoring import (evaluate, results_table, score_sequence, match_frames, pool, frames_to_score, measure_inference_fps)
 from . import ablation, enhance, lpips
 
-__all__ = ["mse", "ssim", "equalize", "score_frames", "protocol_description", "evaluate",
-           "results_table", "score_sequence", "match_frames", "pool", "frames_to_score",
+__all__ = ["mse", "ssim", "equalize", "score_pairs", "score_frames", "protocol_description", "SCORE_PROTOCOLS",
+           "evaluate", "results_table", "score_sequence", "match_frames", "pool", "frames_to_score",
            "measure_inference_fps", "ablation", "enhance", "lpips"]

@@ -43,6 +43,7 @@ from ..core.runtime import default_device
 from ..method.integration import integrate_events
 from ..method.solver import EvINRConfig, reconstruct
 from ..method.tonemap import anchor_mean, tonemap_reinhard
+from .metrics import SCORE_PROTOCOLS
 from .scoring import measure_inference_fps, score_sequence
 
 __all__ = ["PAPER_TABLE2", "PAPER_TABLE3", "COLUMN_LABELS",
@@ -199,7 +200,7 @@ def _protocol(n_frames: int, equalizations, repeats: int, n_inference: int, devi
 
 
 def run_variants(events: Events, gt_frames, gt_times, variants: dict, *, t_start: float | None = None,
-                 t_end: float | None = None, equalizations=("none", "clahe"), repeats: int = 1,
+                 t_end: float | None = None, equalizations=SCORE_PROTOCOLS, repeats: int = 1,
                  n_inference: int = 64, cache: dict | None = None, log=None) -> list[dict]:
     """Reconstruct at ``gt_times`` with every variant and score against ``gt_frames``.
 
@@ -209,7 +210,7 @@ def run_variants(events: Events, gt_frames, gt_times, variants: dict, *, t_start
         gt_times: [Q] their timestamps (seconds, the events' clock).
         variants: ``{name: EvINRConfig or method(events, times) -> frames [Q, H, W]}``.
         t_start, t_end: span to reconstruct (seconds; see :func:`reconstruct`).
-        equalizations: the scoring protocols (metrics.EQUALIZATIONS).
+        equalizations: the scoring protocols (default metrics.SCORE_PROTOCOLS; any of metrics.EQUALIZATIONS).
         repeats: runs per variant; the fastest training time is kept (results are identical: seeded).
         n_inference: query times for the inference-FPS measurement.
         cache: a dict shared between calls: a config already run on the same events, ground truth,

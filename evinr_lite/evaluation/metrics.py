@@ -22,9 +22,13 @@ from skimage.metrics import structural_similarity
 from ..core.frames import to_uint8
 
 __all__ = ["mse", "ssim", "equalize", "score_pairs", "score_frames", "protocol_description", "PROTOCOLS",
-           "METRIC_PROTOCOL", "SSIM_PROTOCOL", "EQUALIZATIONS", "CLAHE_CLIP_LIMIT", "CLAHE_TILES"]
+           "SCORE_PROTOCOLS", "METRIC_PROTOCOL", "SSIM_PROTOCOL", "EQUALIZATIONS", "CLAHE_CLIP_LIMIT", "CLAHE_TILES"]
 
-EQUALIZATIONS = ("none", "global", "clahe")
+EQUALIZATIONS = ("none", "global", "clahe")   # every equalisation equalize() knows
+# The protocols every result of the kit is reported under (run folders, batch summaries, the demo, the
+# benchmarks, ablations): no equalisation, and CLAHE (the EvINR paper's). One constant, so that a
+# table never silently drops one of the two.
+SCORE_PROTOCOLS = ("none", "clahe")
 CLAHE_CLIP_LIMIT = 2.0
 CLAHE_TILES = (8, 8)
 

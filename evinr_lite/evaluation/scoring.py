@@ -23,7 +23,7 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 from ..method.baselines import BASELINES, reconstruct_baseline
-from .metrics import protocol_description, score_pairs
+from .metrics import SCORE_PROTOCOLS, protocol_description, score_pairs
 
 __all__ = ["frames_to_score", "match_frames", "score_sequence", "pool", "evaluate", "results_table",
            "resolve_lpips", "measure_inference_fps", "METHODS"]
@@ -176,7 +176,7 @@ def pool(rows) -> dict:
 
 
 def evaluate(events: Events, gt_frames, gt_times=None, methods=("evinr", "integration", "hf"), config=None,
-             equalizations=("none", "clahe"), lpips_model=None, baseline_params=None, *,
+             equalizations=SCORE_PROTOCOLS, lpips_model=None, baseline_params=None, *,
              tol: float = 1e-3, sequence: str = "", keep_frames: bool = False) -> list[dict]:
     """Reconstruct at the ground-truth timestamps with each method and score every equalisation.
 
