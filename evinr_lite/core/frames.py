@@ -77,7 +77,9 @@ class Frames:
 
 
 def to_uint8(img) -> np.ndarray:
-    """A grey image in [0, 1] (clipped) as uint8 ``round(255 * x)``; uint8 input is returned as is."""
+    """Images in [0, 1] (clipped) as uint8 ``round(255 * x)``, element by element, any shape (an image
+    [H, W], a stack [F, H, W] or colour [..., 3]); uint8 input is returned as is. The one conversion
+    used by scoring (equalisation) and export."""
     img = np.asarray(img)
     if img.dtype == np.uint8:
         return img

@@ -13,18 +13,19 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from ..core.frames import to_uint8 as metrics_to_uint8
+from ..core.frames import to_uint8
 from .output import save_png
 
 __all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv"]
 
 
-def to_uint8(frames) -> np.ndarray:
-    """[F, H, W] or [F, H, W, 3] floats in [0, 1] (clipped) or uint8 -> uint8 of the same shape."""
+def _stack_uint8(frames) -> np.ndarray:
+    """[F, H, W] or [F, H, W, 3] floats in [0, 1] (clipped) or uint8 -> uint8 of the same shape
+    (:func:`~evinr_lite.core.frames.to_uint8`, after checking that it is a stack of frames)."""
     frames = np.asarray(frames)
     if not (frames.ndim == 3 or (frames.ndim == 4 and frames.shape[-1] == 3)):
         raise ValueError(f"frames must have shape [F, H, W] (grey) or [F, H, W, 3] (colour), got {frames.shape}")
-    return metrics_to_uint8(frames)
+    return to_uint8(frames)
 
 
 def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
@@ -33,7 +34,7 @@ def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
-    for i, img in enumerate(to_uint8(frames)):
+    for i, img in enumerate(_stack_uint8(frames)):
         paths.append(folder / f"{prefix}{i:05d}.png")
         save_png(paths[-1], img)
     return paths
@@ -44,7 +45,7 @@ def save_gif(path, frames, fps: float) -> Path:
     resolution, at most 50 per second), looping."""
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps}")
-    images = [Image.fromarray(img) for img in to_uint8(frames)]
+    images = [Image.fromarray(img) for img in _stack_uint8(frames)]
     delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
     images[0].save(path, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
     return Path(path)
@@ -60,7 +61,7 @@ def save_mp4(path, frames, fps: float) -> Path:
 
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps}")
-    frames = to_uint8(frames)
+    frames = _stack_uint8(frames)
     colour = frames.ndim == 4
     F, H, W = frames.shape[:3]
     frames = np.pad(frames, ((0, 0), (0, H % 2), (0, W % 2)) + (((0, 0),) if colour else ()))
