@@ -164,45 +164,36 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    """Run the command; 0 ok, 2 bad input, 1 internal error (``--debug`` shows the traceback), 128 + n after signal n."""
-    import signal
-    import traceback
+    """Run the command; 0 ok, 2 bad input, 1 internal error (``--debug`` shows the traceback), 128 + n after signal n.
 
+    The guard is evinr-lite's (:func:`evinr_lite.core.guard.run_guarded`): signals handled from the
+    first line, a closed stdout pipe harmless, a deleted current folder refused."""
+    from evinr_lite.core.guard import run_guarded   # standard library only
+
+    owns_process = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
-    try:
-        args = build_parser().parse_args([str(a) for a in argv])
-    except SystemExit as exc:
-        return exc.code if isinstance(exc.code, int) else EXIT_ERROR
-    log = logging.getLogger("data_fetch")
-    if not log.handlers:
-        handler = logging.StreamHandler()
-        handler.setFormatter(logging.Formatter("%(message)s"))
-        log.addHandler(handler)
-        log.propagate = False
-    log.setLevel(logging.WARNING if getattr(args, "quiet", False) else logging.INFO)
-    from evinr_lite.core.events import InputError
-    from evinr_lite.io.output import Interrupted, termination_signals
+    seen = {}
 
-    try:
-        with termination_signals():
-            return args.func(args)
-    except KeyboardInterrupt as exc:
-        signum = exc.signum if isinstance(exc, Interrupted) else signal.SIGINT
-        print(f"data_fetch: interrupted by {signal.Signals(signum).name}; nothing half-written was kept: run the same "
-              "command again to resume", file=sys.stderr)
-        return 128 + int(signum)
-    except (DataFetchError, InputError, OSError) as err:
-        text = f"{err.filename}: {err.strerror}" if isinstance(err, OSError) and err.strerror and err.filename else err
-        print(f"data_fetch: error: {text}", file=sys.stderr)
-        return EXIT_ERROR
-    except Exception as err:
-        if args.debug:
-            traceback.print_exc()
-        else:
-            print(f"data_fetch: internal error: {type(err).__name__}: {err}\n  This is a bug in data_fetch, not a "
-                  f"problem with your input. Rerun with --debug to see the traceback:\n  python -m data_fetch --debug "
-                  f"{' '.join(argv)}", file=sys.stderr)
-        return EXIT_INTERNAL
+    def body() -> int:
+        args = build_parser().parse_args([str(a) for a in argv])
+        seen["args"] = args
+        log = logging.getLogger("data_fetch")
+        if not log.handlers:
+            handler = logging.StreamHandler()
+            handler.setFormatter(logging.Formatter("%(message)s"))
+            log.addHandler(handler)
+            log.propagate = False
+        log.setLevel(logging.WARNING if getattr(args, "quiet", False) else logging.INFO)
+        return args.func(args)
+
+    def describe(err) -> str:
+        return f"{err.filename}: {err.strerror}" if isinstance(err, OSError) and err.strerror and err.filename \
+            else str(err)
+
+    return run_guarded("data_fetch", body, argv, expected=(DataFetchError,), describe=describe,
+                       interrupted_note=lambda exc: "nothing half-written was kept: run the same command again "
+                                                    "to resume",
+                       debug=lambda: getattr(seen.get("args"), "debug", False), owns_process=owns_process)
 
 
 if __name__ == "__main__":

@@ -20,12 +20,32 @@ Subpackages, in layers (a module imports only its own layer or lower ones; the t
 
 Data flow: file -> Events -> event frames -> solver -> log intensity -> tone map -> metrics / export.
 """
-from .core import EventDataError, Events, Frames, Recording, default_device, fast_mode, pick
-from .evaluation import evaluate, results_table
-from .io import read_recording
-from .method import (EvINRConfig, Reconstruction, events_to_frames, fixed_duration_boundaries, integrate_events,
-                     reconstruct, reconstruct_baseline, tonemap_reinhard)
-from .sim import make_scene, simulate_events_1d, simulate_scene, simulate_video
+# Names are imported when first used (PEP 562), so that `import evinr_lite` and the command's
+# start-up stay light (no numpy or torch): the command handles Ctrl-C from its first line, and
+# `evinr-lite info` never imports torch.
+_LAZY = {"core": ("EventDataError", "Events", "Frames", "Recording", "default_device", "fast_mode", "pick"),
+         "evaluation": ("evaluate", "results_table"),
+         "io": ("read_recording",),
+         "method": ("EvINRConfig", "Reconstruction", "events_to_frames", "fixed_duration_boundaries",
+                    "integrate_events", "reconstruct", "reconstruct_baseline", "tonemap_reinhard"),
+         "sim": ("make_scene", "simulate_events_1d", "simulate_scene", "simulate_video")}
+_HOME = {name: sub for sub, names in _LAZY.items() for name in names}
+
+
+def __getattr__(name):
+    import importlib
+
+    if name in _HOME:
+        value = getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if name in ("core", "io", "sim", "method", "evaluation", "viz", "teaching", "apps"):
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_HOME))
 
 __all__ = ["Events", "EventDataError", "Frames", "Recording", "read_recording", "make_scene", "simulate_scene",
            "simulate_video", "simulate_events_1d", "EvINRConfig", "reconstruct", "Reconstruction",

@@ -144,11 +144,13 @@ def test_memory_is_estimated_before_allocating(capsys, npy_file, tmp_path, argv,
 
 
 def test_a_tiny_bin_duration_is_refused_by_the_estimate(npy_file):
-    from evinr_lite.apps.recon_job import check_memory, load_recording
+    from evinr_lite.apps.recon_job import load_recording
+    from evinr_lite.method.memory import check_memory
 
     rec = load_recording(npy_file, sensor_size=(H, W))
+    lo, hi = rec.meta["window"]
     with pytest.raises(EventDataError, match="bin_duration"):
-        check_memory(rec, np.array([0.1]), EvINRConfig(bin_duration=1e-9, tau=None))
+        check_memory(rec.events.sensor_size, lo, hi, len(rec.events), 1, EvINRConfig(bin_duration=1e-9, tau=None))
 
 
 # ---- 4. time units ------------------------------------------------------------------------------------
@@ -412,7 +414,7 @@ def test_both_polarity_encodings(tmp_path, fmt, encoding):
 # ---- 7. the guard: an internal error is named as one, --debug shows the traceback ----------------------
 
 def test_an_internal_error_says_so_and_debug_shows_the_traceback(capsys, rec_dir, monkeypatch):
-    import evinr_lite.apps.recon_job as job
+    import evinr_lite.apps.describe as job   # what `info` runs (no torch)
 
     monkeypatch.setattr(job, "describe_recording", lambda rec: 1 / 0)
     code, out, err = run(capsys, "info", rec_dir)

@@ -108,13 +108,13 @@ def test_at_files(capsys, rec_dir, tmp_path, monkeypatch, case):
 @pytest.mark.parametrize("text,expected", [("0.1 0.12", [0.1, 0.12]), (" 0.12 , 0.1 ", [0.1, 0.12]),
                                            ("0.1,0.1", [0.1, 0.1]), ("1e-1", [0.1])])
 def test_at_text_forms_are_read_correctly(text, expected):
-    from evinr_lite.apps.recon_job import _parse_times
+    from evinr_lite.apps.options import parse_times as _parse_times
 
     np.testing.assert_allclose(_parse_times(text), expected)
 
 
 def test_at_file_with_crlf_is_read_correctly(rec_dir, tmp_path):
-    from evinr_lite.apps.recon_job import _parse_times
+    from evinr_lite.apps.options import parse_times as _parse_times
 
     (tmp_path / "t.txt").write_bytes(b"0.05\r\n0.1\r\n\r\n0.15\r\n")
     np.testing.assert_allclose(_parse_times(str(tmp_path / "t.txt")), [0.05, 0.1, 0.15])
@@ -962,7 +962,7 @@ def test_argparse_errors_in_the_commands_style(capsys, tmp_path, monkeypatch, ar
     (lambda: EventDataError("sensor_size=(H, W) is wrong"), 2, "--sensor HxW is wrong"),
 ])
 def test_the_guard_sorts_exceptions(capsys, rec_dir, monkeypatch, exc, code, text):
-    import evinr_lite.apps.recon_job as job
+    import evinr_lite.apps.describe as job   # what `info` runs (no torch)
 
     def boom(rec):
         raise exc()

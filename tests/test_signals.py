@@ -17,7 +17,7 @@ import pytest
 
 from evinr_lite.apps.cli import main
 from evinr_lite.io import output
-from evinr_lite.io.output import OutputDir, OutputError, check_output_path
+from evinr_lite.io.output import OutputDir, OutputError, check_output_path, mark_partial
 from evinr_lite.sim.recordings import write_example_recording
 
 FAST = ["--iters", "3", "--quiet", "--no-video"]
@@ -152,6 +152,7 @@ def test_a_kill_between_the_renames_is_repaired_by_the_next_run(capsys, recordin
     (aside / "mine.txt").write_text("the old result")
     partial = tmp_path / ".out.partial-4242-fedcba9876543210"
     (partial / "frames").mkdir(parents=True)
+    mark_partial(partial)                                               # made by evinr-lite: its marker inside
     (tmp_path / ".out.lock").write_text('{"pid": 4242}')
     code, out, err = run(capsys, "reconstruct", recording, "--out", tmp_path / "out", *FAST)
     assert code == 2 and "already exists" in err                     # the old result is back, so refused

@@ -1,6 +1,14 @@
 """The command line, the demo and the reconstruct job (they never import viz or teaching)."""
-from .cli import main
-from .demo import run_demo
-from .recon_job import run_reconstruct
+from .cli import main   # light: the command's guard starts before anything heavy is imported
+
+_HOME = {"run_demo": "demo", "run_reconstruct": "recon_job"}
+
+
+def __getattr__(name):
+    import importlib
+
+    if name in _HOME:
+        return getattr(importlib.import_module(f".{_HOME[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = ["main", "run_demo", "run_reconstruct"]

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
 import sys
 
@@ -216,27 +217,36 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _info(args) -> None:
-    from .recon_job import describe_recording, format_info, read_any
+    from .describe import describe_recording, format_info, read_any   # no torch: info needs none
 
     rec = read_any(args.recording, sensor_size=args.sensor, time_unit=args.time_unit)
     info = describe_recording(rec)
     print(json.dumps(info, indent=2) if args.json else format_info(info))
 
 
+def _run_options(args):
+    """The RunOptions of reconstruct's or batch's flags: the one place a flag is matched to its option."""
+    from .options import RunOptions
+
+    video = not args.no_video if hasattr(args, "no_video") else args.video   # reconstruct writes video by default
+    return RunOptions(sensor_size=args.sensor, C=args.C, fps=args.fps, at=getattr(args, "at", None),
+                      t_start=getattr(args, "start", None), t_end=getattr(args, "end", None),
+                      time_unit=getattr(args, "time_unit", None), device=args.device, recipe=args.recipe,
+                      n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
+                      colour=getattr(args, "colour", False), video=video, progress=not args.quiet)
+
+
 def _reconstruct(args) -> None:
     from .recon_job import run_reconstruct
 
-    run_reconstruct(args.recording, args.out, anchor=args.anchor, denoise=args.denoise,
-                    sensor_size=args.sensor, C=args.C, fps=args.fps, at=args.at,
-                    t_start=args.start, t_end=args.end, device=args.device, n_iters=args.iters, seed=args.seed,
-                    recipe=args.recipe, overwrite=args.overwrite, video=not args.no_video, progress=not args.quiet,
-                    time_unit=args.time_unit, command=" ".join(["evinr-lite", *sys.argv[1:]]), colour=args.colour)
+    run_reconstruct(args.recording, args.out, _run_options(args), overwrite=args.overwrite,
+                    command=" ".join(["evinr-lite", *sys.argv[1:]]))
 
 
 def _demo(args) -> None:
     from .demo import run_demo
     from ..io.output import check_output_path
-    from .recon_job import recipe_config
+    from ..method.recipes import recipe_config
 
     check_output_path(args.out, overwrite=args.overwrite)   # say so before training, not after
     config = recipe_config(args.recipe, args.iters, C=args.C, seed=args.seed)
@@ -249,11 +259,8 @@ def _batch(args) -> None:
     from ..core.events import EventDataError
 
     try:
-        summary = run_batch(args.inputs, args.out, scheduler=args.scheduler, workers=args.workers,
-                            torch_threads=args.torch_threads, sensor_size=args.sensor, C=args.C, fps=args.fps,
-                            device=args.device, n_iters=args.iters, recipe=args.recipe, seed=args.seed,
-                            video=args.video, denoise=args.denoise, anchor=args.anchor,
-                            progress=not args.quiet)
+        summary = run_batch(args.inputs, args.out, _run_options(args), scheduler=args.scheduler,
+                            workers=args.workers, torch_threads=args.torch_threads)
     except KeyboardInterrupt as exc:   # finished recordings stay: the same command resumes
         exc.output_note = f"finished recordings stay in {args.out}/; run the same command again to resume"
         raise
@@ -293,66 +300,58 @@ def _show_note(message, category, filename, lineno, file=None, line=None):
     print(f"evinr-lite: note: {_message(Warning(str(message)))}", file=sys.stderr)
 
 
-def _out_of_memory(exc: BaseException) -> bool:
-    if isinstance(exc, MemoryError):
-        return True
+def _out_of_memory(exc: BaseException) -> str | None:
+    """The message for an exception that means memory ran out, else None."""
     torch = sys.modules.get("torch")
     oom = getattr(torch, "OutOfMemoryError", None) if torch is not None else None
-    return (oom is not None and isinstance(exc, oom)) or (isinstance(exc, RuntimeError) and
-                                                          "out of memory" in str(exc).lower())
+    if isinstance(exc, MemoryError) or (oom is not None and isinstance(exc, oom)) or \
+            (isinstance(exc, RuntimeError) and "out of memory" in str(exc).lower()):
+        return ("ran out of memory (the estimate made before training was too low); shorten the window with "
+                "--start/--end or ask for fewer frames with --fps/--at")
+    return None
 
 
 def main(argv=None) -> int:
     """Run the command; returns the exit status (0 ok, 2 bad input, 1 internal error, 128 + n after signal n).
 
-    One guard around every command: a known input problem prints ``evinr-lite: error: ...``
-    (status 2); anything else prints ``evinr-lite: internal error: ...`` with the command to rerun
-    with ``--debug``, which shows the traceback (status 1). SIGTERM and SIGHUP are handled as
-    Ctrl-C: the run stops, cleans up and says what happened to the output folder.
+    The one guard of every command (:func:`evinr_lite.core.guard.run_guarded`, shared with
+    ``python -m data_fetch``), in force from this function's first line, before anything heavy is
+    imported: a known input problem prints ``evinr-lite: error: ...`` (status 2); anything else
+    prints ``evinr-lite: internal error: ...`` with the command to rerun with ``--debug``, which
+    shows the traceback (status 1). SIGINT, SIGTERM and SIGHUP stop the run, which cleans up and
+    says what happened to the output folder; a closed stdout pipe does not change the result.
     """
-    import signal
-    import traceback
-    import warnings
-    from pathlib import Path
+    from ..core.guard import run_guarded   # standard library only
 
+    owns_process = argv is None            # the command itself, not a call from Python
     argv = list(sys.argv[1:] if argv is None else argv)
-    try:
-        args = build_parser().parse_args([str(a) for a in argv])
-    except SystemExit as exc:   # --help (0) or a bad option (2, already printed)
-        return exc.code if isinstance(exc.code, int) else EXIT_ERROR
-    from ..core.events import InputError
-    from ..io.output import Interrupted, termination_signals
+    seen = {}
 
-    commands = {"info": _info, "reconstruct": _reconstruct, "demo": _demo, "batch": _batch}
-    out = getattr(args, "out", None)
-    existed = out is not None and Path(out).exists()
-    try:
-        with termination_signals(), warnings.catch_warnings():
+    def body() -> int:
+        import warnings
+        from pathlib import Path
+
+        args = build_parser().parse_args([str(a) for a in argv])
+        seen["args"] = args
+        out = getattr(args, "out", None)
+        try:
+            seen["existed"] = out is not None and os.path.lexists(out)
+        except (OSError, ValueError):
+            seen["existed"] = False
+        commands = {"info": _info, "reconstruct": _reconstruct, "demo": _demo, "batch": _batch}
+        with warnings.catch_warnings():
             warnings.simplefilter("default")
             warnings.showwarning = _show_note
             commands[args.command](args)
-    except KeyboardInterrupt as exc:
-        signum = exc.signum if isinstance(exc, Interrupted) else signal.SIGINT
+        return 0
+
+    def interrupted_note(exc):
         note = getattr(exc, "output_note", None)
+        out = getattr(seen.get("args"), "out", None)
         if note is None and out is not None:
-            note = f"the existing {out} was left as it was" if existed else f"{out} was not written"
-        where = f"; {note}" if note else ""
-        print(f"\nevinr-lite: interrupted by {signal.Signals(signum).name}{where} (partial results are deleted)",
-              file=sys.stderr)
-        return 128 + int(signum)
-    except (InputError, OSError) as exc:
-        print(f"evinr-lite: error: {_message(exc)}", file=sys.stderr)
-        return EXIT_ERROR
-    except Exception as exc:
-        if _out_of_memory(exc):
-            print("evinr-lite: error: ran out of memory (the estimate made before training was too low); shorten "
-                  "the window with --start/--end or ask for fewer frames with --fps/--at", file=sys.stderr)
-            return EXIT_ERROR
-        if getattr(args, "debug", False):
-            traceback.print_exc()
-        else:
-            print(f"evinr-lite: internal error: {type(exc).__name__}: {exc}\n"
-                  f"  This is a bug in evinr-lite, not a problem with your input. Rerun with --debug to see the "
-                  f"traceback and include it in a report:\n  evinr-lite --debug {' '.join(argv)}", file=sys.stderr)
-        return EXIT_INTERNAL
-    return 0
+            note = f"the existing {out} was left as it was" if seen.get("existed") else f"{out} was not written"
+        return note
+
+    return run_guarded("evinr-lite", body, argv, describe=_message, interrupted_note=interrupted_note,
+                       out_of_memory=_out_of_memory, debug=lambda: getattr(seen.get("args"), "debug", False),
+                       owns_process=owns_process)

@@ -21,18 +21,14 @@ import numpy as np
 
 import math
 
+from .guard import InputError   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
+
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
            "TimeUnitWarning", "resolve_time_unit", "check_time_span", "MAX_SPAN_S"]
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 LARGE_T = 1e5  # seconds; clocks whose first timestamp is at least this large get a whole-second t_origin
-
-
-class InputError(ValueError):
-    """A bad input the user can fix (a file, a path, a setting); the message names the problem and the fix.
-
-    The command line prints it as ``evinr-lite: error: ...`` and exits with status 2."""
 
 
 class EventDataError(InputError):

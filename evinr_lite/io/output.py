@@ -36,12 +36,13 @@ import numpy as np
 from PIL import Image
 
 from ..core.events import InputError
+from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, termination_signals  # re-exported
 
 __all__ = ["atomic_output_dir", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
            "termination_signals", "signals_deferred", "save_png", "save_json", "first_existing",
-           "TERMINATION_SIGNALS"]
+           "TERMINATION_SIGNALS", "PARTIAL_MARKER", "mark_partial", "remove_stale_partials", "remove_lock_file",
+           "resolve_path"]
 
-TERMINATION_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))
 _TEMP_ROOM = len(".partial-4194304-") + 16 + 1   # bytes a temporary name adds to the folder's name
 
 
@@ -53,76 +54,22 @@ class OutputExistsError(OutputError, FileExistsError):
     """The output folder exists and ``overwrite`` is False."""
 
 
-class Interrupted(KeyboardInterrupt):
-    """SIGINT, SIGTERM or SIGHUP arrived; ``signum`` says which (the exit status is 128 + signum)."""
-
-    def __init__(self, signum: int = signal.SIGINT):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = int(signum)
-
-
-def _raise_interrupted(signum, frame):
-    raise Interrupted(signum)
-
-
-@contextmanager
-def termination_signals():
-    """Inside the block SIGTERM and SIGHUP raise :class:`Interrupted` like Ctrl-C (SIGINT) does, so
-    cleanup runs for all three. SIGINT is left alone when it is ignored (a background job)."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {}
-    for sig in TERMINATION_SIGNALS:
-        current = signal.getsignal(sig)
-        if sig == signal.SIGINT and current in (signal.SIG_IGN, None):
-            continue
-        previous[sig] = current
-        signal.signal(sig, _raise_interrupted)
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-
-
-@contextmanager
-def signals_deferred():
-    """Hold back SIGINT, SIGTERM and SIGHUP inside the block; one that arrives is acted on when the
-    block ends (its handler runs then, or its default action). Only the main thread can do this
-    (Python runs signal handlers there); elsewhere the block runs unprotected."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    pending, previous = [], {}
-    for sig in TERMINATION_SIGNALS:
-        handler = signal.getsignal(sig)
-        if handler in (signal.SIG_IGN, None):
-            continue
-        previous[sig] = handler
-        signal.signal(sig, lambda signum, frame: pending.append(signum))
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-        if pending:
-            handler = previous[pending[0]]
-            if callable(handler):
-                handler(pending[0], None)        # e.g. raises KeyboardInterrupt / Interrupted
-            elif handler == signal.SIG_DFL:
-                os.kill(os.getpid(), pending[0])  # the default action, now that the block is done
-
-
 def first_existing(path: Path) -> Path:
     """``path`` or its nearest existing ancestor: where a folder that does not exist yet would be created."""
     while not os.path.lexists(path) and path != path.parent:
         path = path.parent
     return path
+
+
+def resolve_path(path, what: str = "the path") -> Path:
+    """``Path(path).resolve()``, with a symbolic-link loop or an unreadable link as an OutputError naming
+    the path (Python raises RuntimeError or OSError there, which would read as an internal error)."""
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError) as err:
+        raise OutputError(f"{what} {str(path)!r} cannot be followed: it goes through a loop of symbolic links "
+                          f"or a link that cannot be read ({err}); fix or remove the link, or choose another "
+                          "path") from None
 
 
 def _inside(a: Path, b: Path) -> bool:
@@ -144,12 +91,12 @@ def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:
     out = Path(os.path.abspath(given))
     if out == out.parent or not out.name:
         raise OutputError(f"out_dir={str(given)!r} is the root of the file system; choose a folder to create, e.g. out_dir=rec")
-    real = out.parent.resolve() / out.name
+    real = resolve_path(out.parent, "out_dir=") / out.name
     for source in inputs:
         if source is None:
             continue
-        source = Path(source).expanduser().resolve()
-        if _inside(source, real.resolve() if out.is_symlink() else real):
+        source = resolve_path(Path(source).expanduser(), "the input")
+        if _inside(source, resolve_path(real, "out_dir=") if out.is_symlink() else real):
             what = "is the input recording" if source == real else f"contains the input recording {source}"
             raise OutputError(f"the output folder {given} {what}; writing there would replace the input; "
                               "choose another out_dir=")
@@ -184,6 +131,51 @@ def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:
                           f"{name_max} per name and {_TEMP_ROOM} are needed for a temporary name beside it: choose "
                           f"a name of at most {name_max - _TEMP_ROOM} bytes as out_dir=")
     return out
+
+
+PARTIAL_MARKER = ".evinr-partial"   # inside every staging folder this package makes: recovery removes only those
+
+
+def mark_partial(folder: Path, command: str = "") -> None:
+    """Mark a staging folder as this package's own (so that recovery may delete it, and nothing else)."""
+    (Path(folder) / PARTIAL_MARKER).write_text(json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
+                                                            "command": command}) + "\n")
+
+
+def remove_stale_partials(parent, name: str = "*", *, log=None) -> list[Path]:
+    """Remove ``.<name>.partial-*`` folders in ``parent`` that runs of this package left behind.
+
+    Only folders that carry :data:`PARTIAL_MARKER` (or are empty: a run killed right after creating
+    one) are removed; a folder of the same pattern without the marker is someone else's and is left
+    as it is, with a note. The caller must hold the lock that proves those runs have ended.
+    Returns the folders removed.
+    """
+    log = log or (lambda message: None)
+    removed = []
+    for stale in sorted(Path(parent).glob(f".{name}.partial-*")):
+        if stale.is_symlink() or not stale.is_dir():
+            continue
+        try:
+            ours = (stale / PARTIAL_MARKER).is_file() or not any(stale.iterdir())
+        except OSError:
+            ours = False
+        if not ours:
+            log(f"note: left {stale} as it is: it looks like an unfinished result but carries no "
+                f"{PARTIAL_MARKER} marker, so this package did not make it; delete it yourself if it is not needed")
+            continue
+        pid = stale.name.rsplit(".partial-", 1)[1].split("-")[0]
+        shutil.rmtree(stale, ignore_errors=True)
+        removed.append(stale)
+        log(f"note: removed {stale.name}, an unfinished result of an earlier run (process {pid}) that was killed")
+    return removed
+
+
+def remove_lock_file(path) -> None:
+    """Delete a lock file this process holds or failed to fill (never leaves an empty lock behind)."""
+    try:
+        Path(path).unlink(missing_ok=True)
+    except OSError:
+        pass
 
 
 class OutputDir:
@@ -229,6 +221,7 @@ class OutputDir:
                 os.ftruncate(fd, 0)
                 os.write(fd, info)
 
+            existed = os.path.lexists(self._lock_path)
             try:
                 lock = FileLock(self._lock_path, timeout=0, on_acquired=write_holder)
                 lock.acquire()
@@ -236,7 +229,9 @@ class OutputDir:
                 self._remove_created_parents()
                 raise OutputError(f"the output folder {self.given} is being written by another run "
                                   f"({self._holder()}); wait for it to finish or choose another out_dir=") from None
-            except OSError as err:
+            except OSError as err:   # e.g. no space left while writing the holder: no empty lock is left
+                if not existed:
+                    remove_lock_file(self._lock_path)
                 self._remove_created_parents()
                 raise OutputError(f"cannot lock the output folder {self.given} ({err.strerror}: {self._lock_path}); "
                                   "choose an out_dir= in a folder you can write") from None
@@ -253,6 +248,11 @@ class OutputDir:
                     raise OutputError(f"cannot write the output folder {self.given} ({err.strerror}); choose an "
                                       "out_dir= in a folder you can write") from None
                 self.staging = tmp
+                try:
+                    mark_partial(tmp, self.command)
+                except OSError as err:
+                    raise OutputError(f"cannot write the output folder {self.given} ({err.strerror}); choose an "
+                                      "out_dir= in a folder you can write") from None
                 self.state = "staged"
         except BaseException:
             self._cleanup()
@@ -305,11 +305,7 @@ class OutputDir:
             else:
                 shutil.rmtree(old, ignore_errors=True)
                 self.log(f"note: removed {old.name}, an old result left aside by a replacement that was killed")
-        for stale in sorted(parent.glob(f".{name}.partial-*")):
-            pid = stale.name.rsplit(".partial-", 1)[1].split("-")[0]   # the lock proves that run has ended
-            shutil.rmtree(stale, ignore_errors=True)
-            self.log(f"note: removed {stale.name}, an unfinished result of an earlier run "
-                     f"(process {pid}) that was killed")
+        remove_stale_partials(parent, name, log=self.log)   # the lock proves that their runs have ended
 
     # ---- closing -------------------------------------------------------------------------------
     def commit(self) -> Path:
@@ -324,6 +320,7 @@ class OutputDir:
                                       "written: choose another out_dir=")
                 aside = self.path.parent / f".{self.path.name}.old-{os.getpid()}-{secrets.token_hex(8)}"
                 os.rename(self.path, aside)
+            (self.staging / PARTIAL_MARKER).unlink(missing_ok=True)   # a finished result carries no marker
             os.rename(self.staging, self.path)
             self.state = "committed"
             self.staging = None
@@ -350,7 +347,7 @@ class OutputDir:
     def _release(self):
         if self._lock is not None:
             try:
-                self._lock_path.unlink(missing_ok=True)   # while held: waiters see an unlinked inode and retry
+                remove_lock_file(self._lock_path)   # while held: waiters see an unlinked inode and retry
             finally:
                 self._lock.release()
                 self._lock = None
