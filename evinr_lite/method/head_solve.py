@@ -48,6 +48,36 @@ def _weights(B: int, T: int, sensor_size, lam: float) -> tuple[float, float]:
     return cx, cy
 
 
+# Frequency columns (or weight rows) per chunk of the solve: the float64 work arrays stay a few MB
+# whatever the sensor, while each BLAS call is still large enough to run at full speed.
+_CHUNK_CELLS = 1 << 21
+
+
+def _dct_rows(X: np.ndarray, sensor_size, inverse: bool = False) -> None:
+    """Orthonormal 2-D DCT-II (or its inverse) of every row of X [d, H*W] float32, in place, a
+    few rows at a time in float64 (no second d x H x W array; only the stored result is rounded)."""
+    H, W = sensor_size
+    transform = scipy.fft.idctn if inverse else scipy.fft.dctn
+    rows = max(1, _CHUNK_CELLS // max(H * W, 1))
+    for r0 in range(0, X.shape[0], rows):
+        r1 = min(X.shape[0], r0 + rows)
+        X[r0:r1] = transform(X[r0:r1].reshape(r1 - r0, H, W).astype(np.float64), type=2, norm="ortho", axes=(1, 2),
+                             workers=-1).reshape(r1 - r0, H * W)
+
+
+def _solve_frequencies(X: np.ndarray, V: np.ndarray, lam_: np.ndarray, mu: np.ndarray) -> None:
+    """X [d, P] (the DCT of A^T E, float32) <- V (Lambda + mu_p)^-1 V^T X[:, p] for every frequency
+    p, in place, in float64 over chunks of columns (V can be large where G is ill-conditioned, so
+    the products are not rounded to float32 before the division)."""
+    d, P = X.shape
+    cols = max(1, _CHUNK_CELLS // max(d, 1))
+    for c0 in range(0, P, cols):
+        c1 = min(P, c0 + cols)
+        Y = V.T @ X[:, c0:c1].astype(np.float64)
+        Y /= lam_[:, None] + mu[None, c0:c1]
+        X[:, c0:c1] = V @ Y
+
+
 @torch.no_grad()
 def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temporal_loss: str = "difference",
                regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7) -> dict:
@@ -60,6 +90,12 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
         regularizer: "tikhonov" or "none" (TV has no closed form; train it with Adam instead).
         lam: the regularizer's weight, as in the training loss.
         ridge: relative ridge added to both Gram matrices (numerical safety; 1e-7 of their trace / d).
+
+    Memory: the d x H*W right-hand side is formed, transformed and solved in place in float32 (in
+    the head's own storage on a CPU), the DCT a few rows and the frequencies a few columns at a
+    time in float64; so the solve needs about one head (d * H * W * 4 bytes) beyond the model and
+    the event frames, not five float64 copies of it (tests/test_head_solve.py pins the result to a
+    dense float64 solve).
 
     Returns:
         {"seconds": time taken, "temporal": temporal loss after the solve (mean over bins, pixels, networks)}.
@@ -91,22 +127,36 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
     mean_h = reg_h.mean(dim=1, keepdim=True)                             # [N, 1, d]
     Hc = (reg_h - mean_h).double().cpu().numpy()
     A64 = A.double().cpu().numpy()
-    rhs = torch.bmm(A.transpose(1, 2).float(), E.float()).double().cpu().numpy()   # [N, d, P] = A^T E
+    # A^T E [N, d, P] goes straight into the head's storage when it lives in CPU float32 memory,
+    # else into one float32 buffer that is copied to the device at the end
+    in_place = device.type == "cpu" and dtype == torch.float32 and model.head_weight.is_contiguous()
+    target = model.head_weight.data if in_place else torch.empty((N, d, P), dtype=torch.float32)
+    for n in range(N):
+        if in_place:
+            torch.mm(A[n].transpose(0, 1).float(), E[n].float(), out=target[n])
+        else:
+            target[n].copy_(torch.mm(A[n].transpose(0, 1).float(), E[n].float()).cpu())
+    weights = target.numpy()
     cx, cy = _weights(B, T, (H, W), lam if regularizer == "tikhonov" else 0.0)
     mu = laplacian_eigenvalues((H, W), cx, cy).ravel()                  # [P]
-    weights = np.empty((N, d, P), dtype=np.float32)
     for n in range(N):
         S = A64[n].T @ A64[n]
         G = Hc[n].T @ Hc[n]
         eps_s = ridge * max(np.trace(S) / d, 1e-30)
         eps_g = ridge * max(np.trace(G) / d, 1e-30)
         lam_, V = scipy.linalg.eigh(S + eps_s * np.eye(d), G + eps_g * np.eye(d))   # S V = G V diag(lam_)
-        R = scipy.fft.dctn(rhs[n].reshape(d, H, W), type=2, norm="ortho", axes=(1, 2), workers=-1).reshape(d, P)
-        X = V @ ((V.T @ R) / (lam_[:, None] + mu[None, :]))             # every spatial frequency at once
-        weights[n] = scipy.fft.idctn(X.reshape(d, H, W), type=2, norm="ortho", axes=(1, 2),
-                                     workers=-1).reshape(d, P)
-    Wt = torch.as_tensor(weights, device=device, dtype=dtype)
-    model.head_weight.copy_(Wt)
+        _dct_rows(weights[n], (H, W))                                   # R = DCT(A^T E), per row
+        _solve_frequencies(weights[n], V, lam_, mu)                     # every spatial frequency
+        _dct_rows(weights[n], (H, W), inverse=True)
+    if not in_place:
+        model.head_weight.copy_(target.to(device=device, dtype=dtype))
+    Wt = model.head_weight
     model.head_bias.copy_(-torch.bmm(mean_h.to(dtype), Wt))                # zero mean over time at every pixel
-    temporal = float(((torch.bmm(A.to(dtype), Wt) - E) ** 2).mean())
-    return {"seconds": time.perf_counter() - t0, "temporal": temporal}
+    # the temporal loss |A W - E|^2, a few bins at a time (no [N, B, P] residual)
+    total, step = 0.0, max(1, _CHUNK_CELLS // max(P, 1))
+    for n in range(N):
+        for b0 in range(0, B, step):
+            r = torch.mm(A[n, b0:b0 + step].to(dtype), Wt[n])
+            r -= E[n, b0:b0 + step]
+            total += float(torch.linalg.vector_norm(r).double() ** 2)
+    return {"seconds": time.perf_counter() - t0, "temporal": total / (N * B * P)}

@@ -24,11 +24,22 @@ from torch import nn
 
 from ..core.events import check_sensor_size
 
-__all__ = ["FrameINR"]
+__all__ = ["FrameINR", "network_seed"]
 
 
-def _uniform(shape, bound, generator):
-    return (torch.rand(shape, generator=generator) * 2 - 1) * bound
+def _uniform(shape, bound, generator, out=None):
+    """U(-bound, bound) of ``shape``, drawn into ``out`` when given (in place: no temporaries, which
+    matters for the d x H*W head at HD sizes); the same values either way."""
+    out = torch.empty(shape) if out is None else out
+    torch.rand(shape, generator=generator, out=out)
+    return out.mul_(2).sub_(1).mul_(bound)
+
+
+def network_seed(seed: int, k: int) -> int:
+    """The seed of network k of an ensemble seeded with ``seed``: ``seed`` itself for k = 0, so a
+    one-network model is initialised as before; each network's own seed makes network k the same
+    whether it is built alone (streaming, one window at a time) or inside an N-network model."""
+    return (int(seed) + int(k) * 0x9E3779B97F4A7C15) % 2**63
 
 
 class FrameINR(nn.Module):
@@ -41,13 +52,19 @@ class FrameINR(nn.Module):
         hidden_layers: hidden-to-hidden sine layers (paper: 3).
         omega_0: frequency factor of the hidden layers (SIREN: 30; the reference code uses 10).
         first_omega_0: frequency factor of the first layer (None: omega_0).
-        seed: seeds the initialisation (SIREN's, per network).
+        seed: seeds the initialisation (SIREN's, per network: network k draws from
+            :func:`network_seed` (seed, first_index + k)).
+        first_index: the ensemble index of the first network held here, so that a model of one
+            window (streaming) is initialised exactly as that window's network of the whole ensemble.
+        init_head: False leaves the H*W output layer at zero instead of drawing it (for a head that
+            will be solved in closed form before use: saves d x H*W random draws, ~1 GB at 1280x720).
 
     Shapes: ``forward(t)`` with t [N, T] seconds -> F [N, T, H, W].
     """
 
     def __init__(self, sensor_size, windows, hidden_features: int = 512, hidden_layers: int = 3,
-                 omega_0: float = 30.0, first_omega_0: float | None = None, seed: int = 0):
+                 omega_0: float = 30.0, first_omega_0: float | None = None, seed: int = 0, *,
+                 first_index: int = 0, init_head: bool = True):
         super().__init__()
         H, W = check_sensor_size(sensor_size)
         windows = torch.as_tensor(windows, dtype=torch.float64).reshape(-1, 2)
@@ -58,20 +75,27 @@ class FrameINR(nn.Module):
         self.omega_0 = float(omega_0)
         self.first_omega_0 = float(omega_0 if first_omega_0 is None else first_omega_0)
         self.register_buffer("windows", windows)
-        g = torch.Generator().manual_seed(int(seed))
         d = int(hidden_features)
-
-        def bias(n_in, n_out):  # PyTorch's default Linear bias
-            return nn.Parameter(_uniform((N, 1, n_out), 1 / math.sqrt(n_in), g))
-
-        self.weights = nn.ParameterList([nn.Parameter(_uniform((N, 1, d), 1.0, g))])  # first layer: U(-1/in, 1/in), in = 1
-        self.biases = nn.ParameterList([bias(1, d)])
         hidden_bound = math.sqrt(6 / d) / self.omega_0
-        for _ in range(int(hidden_layers)):
-            self.weights.append(nn.Parameter(_uniform((N, d, d), hidden_bound, g)))
-            self.biases.append(bias(d, d))
-        self.head_weight = nn.Parameter(_uniform((N, d, H * W), hidden_bound, g))
-        self.head_bias = nn.Parameter(_uniform((N, 1, H * W), 1 / math.sqrt(d), g))
+        # (name, shape per network, bound) in SIREN's drawing order; biases as PyTorch's Linear
+        layout = [("w0", (1, d), 1.0), ("b0", (1, d), 1.0)]   # first layer: U(-1/in, 1/in), in = 1
+        for i in range(1, int(hidden_layers) + 1):
+            layout += [(f"w{i}", (d, d), hidden_bound), (f"b{i}", (1, d), 1 / math.sqrt(d))]
+        layout += [("head_w", (d, H * W), hidden_bound), ("head_b", (1, H * W), 1 / math.sqrt(d))]
+        values = {name: torch.empty((N, *shape)) for name, shape, _ in layout}
+        for k in range(N):   # network k from its own generator (network_seed), drawn straight into place
+            g = torch.Generator().manual_seed(network_seed(seed, int(first_index) + k))
+            for name, shape, bound in layout:
+                if name.startswith("head") and not init_head:
+                    continue
+                _uniform((1, *shape), bound, g, out=values[name][k:k + 1])
+        if not init_head:   # to be solved in closed form: zeros (never read before the solve)
+            values["head_w"].zero_()
+            values["head_b"].zero_()
+        self.weights = nn.ParameterList([nn.Parameter(values[f"w{i}"]) for i in range(int(hidden_layers) + 1)])
+        self.biases = nn.ParameterList([nn.Parameter(values[f"b{i}"]) for i in range(int(hidden_layers) + 1)])
+        self.head_weight = nn.Parameter(values["head_w"])
+        self.head_bias = nn.Parameter(values["head_b"])
 
     # ---- time mapping -------------------------------------------------------------------
     def normalize_time(self, t: torch.Tensor) -> torch.Tensor:
@@ -126,7 +150,7 @@ class FrameINR(nn.Module):
         k = k % self.n_models
         d = self.weights[0].shape[-1]
         single = FrameINR(self.sensor_size, self.windows[k:k + 1].cpu(), d, len(self.weights) - 1,
-                          self.omega_0, self.first_omega_0)
+                          self.omega_0, self.first_omega_0, init_head=False)
         single.load_state_dict({name: v[k:k + 1].clone() for name, v in self.state_dict().items()})
         return single.to(self.head_weight.device)
 
