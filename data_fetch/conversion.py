@@ -77,18 +77,15 @@ def _kind(path: Path) -> str:
 
 
 def check_writable_folder(folder: Path, what: str) -> None:
-    """Refuse (DataFetchError) a folder that cannot be created or written, before any download or conversion."""
-    import os
+    """Refuse (DataFetchError) a folder that cannot be created or written, before any download or conversion
+    (:func:`evinr_lite.io.output.check_writable`, with data_fetch's fix and error class)."""
+    from evinr_lite.io.output import OutputError, check_writable
 
-    from evinr_lite.io.output import first_existing
-
-    anchor = first_existing(folder)
-    if not anchor.is_dir():
-        raise DataFetchError(f"the {what} {folder} cannot be created: {anchor} is a file, not a folder; set "
-                             "EVINR_DATA to a folder (or choose another --out)")
-    if not os.access(anchor, os.W_OK | os.X_OK):
-        raise DataFetchError(f"the {what} {folder} cannot be written: no permission to write in {anchor}; set "
-                             "EVINR_DATA to a folder you can write (or choose another --out)")
+    try:
+        check_writable(folder, f"the {what} {folder}", "set EVINR_DATA to a folder you can write (or choose another "
+                       "--out)")
+    except OutputError as err:
+        raise DataFetchError(str(err)) from None
 
 
 def check_settings(*, C=None, sensor_size=None, eval_window=None, time_unit=None) -> None:

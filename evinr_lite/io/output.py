@@ -39,7 +39,7 @@ from ..core.events import InputError
 from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, termination_signals  # re-exported
 
 __all__ = ["atomic_output_dir", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
-           "termination_signals", "signals_deferred", "save_png", "save_json", "first_existing",
+           "termination_signals", "signals_deferred", "save_png", "save_json", "first_existing", "check_writable",
            "TERMINATION_SIGNALS", "PARTIAL_MARKER", "mark_partial", "remove_stale_partials", "remove_lock_file",
            "resolve_path"]
 
@@ -59,6 +59,30 @@ def first_existing(path: Path) -> Path:
     while not os.path.lexists(path) and path != path.parent:
         path = path.parent
     return path
+
+
+def check_writable(folder, what: str, fix: str) -> Path:
+    """Refuse, before any work, a folder that cannot be created or written: its nearest existing ancestor
+    must be a folder this process may write in. The one such check (``data_fetch`` uses it too).
+
+    Args:
+        folder: the folder (it need not exist yet).
+        what: how the message names it, e.g. "the output folder rec".
+        fix: what to do instead; ends the message.
+
+    Returns:
+        The nearest existing ancestor (``folder`` itself when it exists).
+
+    Raises:
+        OutputError: "cannot create <what>: <ancestor> is a file, not a folder; <fix>" or
+        "cannot write <what>: no permission to write in <ancestor>; <fix>".
+    """
+    anchor = first_existing(Path(folder))
+    if not anchor.is_dir():
+        raise OutputError(f"cannot create {what}: {anchor} is a file, not a folder; {fix}")
+    if not os.access(anchor, os.W_OK | os.X_OK):
+        raise OutputError(f"cannot write {what}: no permission to write in {anchor}; {fix}")
+    return anchor
 
 
 def resolve_path(path, what: str = "the path") -> Path:
@@ -114,13 +138,8 @@ def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:
     if out.exists() and _inside(Path.cwd().resolve(), real):
         raise OutputError(f"the output folder {given} is the current folder (or contains it); replacing it would "
                           "delete the folder you are working in: choose a new folder, e.g. out_dir=rec")
-    anchor = first_existing(out.parent)
-    if not anchor.is_dir():
-        raise OutputError(f"cannot create the output folder {given}: {anchor} is a file, not a folder; choose "
-                          "another out_dir=")
-    if not os.access(anchor, os.W_OK | os.X_OK):
-        raise OutputError(f"cannot write the output folder {given}: no permission to write in {anchor}; choose an "
-                          "out_dir= in a folder you can write")
+    anchor = check_writable(out.parent, f"the output folder {given}",
+                            "choose another out_dir=, in a folder you can write")
     try:
         name_max = os.pathconf(anchor, "PC_NAME_MAX")
     except (OSError, ValueError):
