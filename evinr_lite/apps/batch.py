@@ -42,19 +42,68 @@ from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
 from ..io.readers import detect_format
-from .recon_job import EQUALIZATIONS, check_run_options, run_reconstruct
+from .options import BATCH_FIELDS, RunOptions
+from .recon_job import EQUALIZATIONS, run_reconstruct
 
 __all__ = ["run_batch", "resolve_inputs", "evaluate_recording", "summarize", "estimate_task_memory_mb",
-           "RECORDING_SUFFIXES"]
+           "RECORDING_SUFFIXES", "input_identity", "result_state", "result_settings", "check_batch_out",
+           "check_scheduler_address", "OWNER_MARKER"]
 
 RECORDING_SUFFIXES = (".h5", ".hdf5", ".txt", ".npy", ".aedat4", ".raw", ".dat")  # files taken from a folder
-SETTINGS_FILE = "batch.json"           # the settings a DIR was made with; a rerun must use the same
+SETTINGS_FILE = "batch.json"           # the settings a DIR was made with (a rerun must use the same) and its recordings
+OWNER_MARKER = ".evinr-batch.json"     # inside each DIR/<name>/ a batch wrote: the input's identity and the settings
+LOCK_FILE = ".batch.lock"
+SUMMARY_FILES = ("summary.json", "summary.csv", "summary.md")
+SCHEDULER_ADDRESS = re.compile(r"^((tcp|tls|inproc|ucx|ws|wss)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.\-]+)(:\d{1,5})?/?$")
 DATASET_NAME = re.compile(r"^([a-z][a-z0-9_]*)(?::([A-Za-z0-9_.\-]+))?$")
 KILLED_NOTE = ("its worker died on every try (killed, or out of memory: see the memory one task needs in "
                "the README's batch section)")
 
 
 # ---- inputs ----------------------------------------------------------------------------------
+
+def _real_path(path) -> Path:
+    """The absolute path with every symbolic link followed; a loop is an EventDataError naming it."""
+    try:
+        return Path(os.path.abspath(Path(path).expanduser())).resolve()
+    except (RuntimeError, OSError) as err:
+        raise EventDataError(f"{path}: cannot be followed (a loop of symbolic links, or a link that cannot be "
+                             f"read: {err}); fix the link or pass the recording's real path") from None
+
+
+def _file_key(path) -> tuple:
+    """What makes two paths the same recording: the device and inode of the file or folder."""
+    try:
+        st = os.stat(path)
+        return (st.st_dev, st.st_ino)
+    except OSError:
+        return (str(path),)
+
+
+def input_identity(path) -> dict:
+    """The identity of an input by which results are resumed: its real path, size and modification
+    time (for a folder, those of every file in it), as {"path", "fingerprint"}. A different file
+    under the same name, or the same file changed since, has another fingerprint."""
+    import hashlib
+
+    real = _real_path(path)
+    h = hashlib.sha256()
+    try:
+        if real.is_dir():
+            for root, dirs, files in os.walk(real):
+                dirs.sort()
+                for name in sorted(files):
+                    f = Path(root) / name
+                    st = f.stat()
+                    h.update(f"{f.relative_to(real)}\0{st.st_size}\0{st.st_mtime_ns}\n".encode())
+        else:
+            st = real.stat()
+            h.update(f"{st.st_size}\0{st.st_mtime_ns}".encode())
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read ({err.strerror or err}); check the path and its "
+                             "permissions") from None
+    return {"path": str(real), "fingerprint": h.hexdigest()[:32]}
+
 
 def _is_recording_dir(path: Path) -> bool:
     try:
@@ -104,7 +153,7 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
     for spec in inputs:
         path = Path(spec)
         if path.exists():
-            path = path.resolve()
+            path = _real_path(path)
             if path.is_dir() and not _is_recording_dir(path):
                 found = []
                 for child in sorted(path.iterdir()):
@@ -127,15 +176,18 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
             raise EventDataError(f"{spec}: no such recording or folder, and not a data_fetch name "
                                  "(dataset or dataset:sequence, e.g. ijrr:slider_depth); check the path")
     unique, seen = [], set()
-    for item in items:                      # the same file named twice runs once
-        if item["path"] not in seen:
-            seen.add(item["path"])
+    for item in items:                      # the same recording named twice (any path to it) runs once
+        item["path"] = str(_real_path(item["path"]))
+        key = _file_key(item["path"])
+        if key not in seen:
+            seen.add(key)
             unique.append(item)
     counts = {}
     for item in unique:
         counts[item["name"]] = counts.get(item["name"], 0) + 1
     names = set()
-    for item in unique:                     # two recordings called the same: prefix their dataset
+    # labels depend on the recordings, not on the order they were given in: assigned in path order
+    for item in sorted(unique, key=lambda i: i["path"]):
         name = item["name"] if counts[item["name"]] == 1 else f"{item['dataset']}-{item['name']}"
         base, k = name, 2
         while name in names:
@@ -180,11 +232,42 @@ def _row(item: dict, run: dict, status: str, seconds: float | None) -> dict:
     return row
 
 
-def _finished(out: Path) -> dict | None:
+def _read_json(path: Path):
+    """A JSON file's contents, None when it is missing or damaged (not readable as a JSON object)."""
     try:
-        return json.loads((out / "run.json").read_text())
-    except (FileNotFoundError, json.JSONDecodeError):
+        value = json.loads(path.read_text())
+    except (FileNotFoundError, NotADirectoryError, json.JSONDecodeError, UnicodeDecodeError):
         return None
+    return value if isinstance(value, dict) else None
+
+
+def result_state(folder: Path, item: dict, settings: dict, claimed: bool = False) -> tuple[str, dict | None]:
+    """Whether ``folder`` (DIR/<name>) may be written for ``item``, and whether it is already done.
+
+    Returns (state, run.json): "absent" (nothing there), "finished" (this batch's result for this
+    very input, same identity and result settings), "stale" (this batch's, but for another input or
+    other settings, or unfinished: it is reconstructed again) or "foreign" (not provably written by
+    this batch: never touched). Proof of ownership is the OWNER_MARKER inside, or a claim in
+    batch.json together with a run.json that names this input (a task killed between its commit and
+    its marker).
+    """
+    if not os.path.lexists(folder):
+        return "absent", None
+    if folder.is_symlink() or not folder.is_dir():
+        return "foreign", None
+    marker = _read_json(folder / OWNER_MARKER)
+    run = _read_json(folder / "run.json")
+    if marker is None:
+        if claimed and run is not None and run.get("input") == item["path"]:
+            return "stale", None
+        return "foreign", None
+    same = marker.get("input") == item.get("identity") and marker.get("settings") == result_settings(settings)
+    return ("finished", run) if same and run is not None else ("stale", None)
+
+
+def result_settings(settings: dict) -> dict:
+    """The settings that change a result (RESULT_SETTINGS, defaults filled in), as JSON stores them."""
+    return json.loads(json.dumps({k: settings.get(k, SETTING_DEFAULTS.get(k)) for k in RESULT_SETTINGS}))
 
 
 def evaluate_recording(item: dict, out_dir, settings: dict) -> dict:
@@ -200,9 +283,15 @@ def evaluate_recording(item: dict, out_dir, settings: dict) -> dict:
         stop the batch.
     """
     out = Path(out_dir) / item["name"]
-    done = _finished(out)
-    if done is not None:
+    if "identity" not in item:
+        item = {**item, "identity": input_identity(item["path"])}
+    state, done = result_state(out, item, settings, claimed=bool(item.get("claimed")))
+    if state == "finished":
         return _row(item, done, "skipped", None)
+    if state == "foreign":   # appeared since the batch checked: never replaced
+        return {"name": item["name"], "dataset": item["dataset"], "input": item["path"], "status": "failed",
+                "error": f"{out} exists and was not written by this batch; it was left as it is (move it away "
+                         "or choose another --out)", "time_s": None}
     import torch
 
     threads_before = torch.get_num_threads()
@@ -211,13 +300,12 @@ def evaluate_recording(item: dict, out_dir, settings: dict) -> dict:
     t0 = time.perf_counter()
     try:
         t_start, t_end = _eval_window(item["path"])
-        run = run_reconstruct(item["path"], out, sensor_size=settings.get("sensor_size"), C=settings.get("C"),
-                              fps=settings.get("fps"), t_start=t_start, t_end=t_end, device=settings.get("device"),
-                              n_iters=settings.get("n_iters"), recipe=settings.get("recipe", "kit"),
-                              seed=int(settings.get("seed", 0)), denoise=bool(settings.get("denoise", False)),
-                              anchor=settings.get("anchor", "none"),
-                              overwrite=True, video=bool(settings.get("video", False)), progress=False,
+        options = RunOptions.from_settings({"video": False, **settings}, t_start=t_start, t_end=t_end, progress=False)
+        run = run_reconstruct(item["path"], out, options,
+                              overwrite=state == "stale",   # only a folder this batch proved its own
                               log=lambda *a, **k: None)
+        _write_atomic(out / OWNER_MARKER, json.dumps({"input": item["identity"],
+                                                      "settings": result_settings(settings)}, indent=2) + "\n")
     except Exception as exc:   # a bad recording is a result, not a crash of the batch
         return {"name": item["name"], "dataset": item["dataset"], "input": item["path"], "status": "failed",
                 "error": f"{type(exc).__name__}: {exc}", "time_s": time.perf_counter() - t0}
@@ -316,54 +404,128 @@ def estimate_task_memory_mb(sensor_size, duration_s: float, n_events: int, *, n_
 
     The process itself (PROCESS_MIB: Python, torch, the libraries, a reader and the scoring), the
     events in memory (17 bytes each: t float64, x and y int32, p int8; twice while they are read),
-    and the reconstruction as :func:`evinr_lite.apps.recon_job.estimate_memory` counts it (each
-    network's weights, gradients and Adam moments with its H*W head, one network per ``tau``
-    seconds; the event bins; the ``n_frames`` queried frames) for ``config`` (default: the paper's).
+    and the reconstruction as :func:`evinr_lite.method.memory.estimate_memory` counts it (each
+    network's weights, gradients and Adam moments with its H*W head, one network per window of
+    ``tau`` seconds; the event bins; the ``n_frames`` queried frames) for ``config`` (default: the kit's).
     """
-    from ..core.events import Events
-    from ..core.recording import Recording
-    from ..method.solver import EvINRConfig
-    from .recon_job import estimate_memory
+    from ..method.config import EvINRConfig
+    from ..method.memory import estimate_memory
 
-    rec = Recording(Events.empty(tuple(int(v) for v in sensor_size)), None, {"window": (0.0, float(duration_s))})
-    solver = estimate_memory(rec, np.zeros(max(int(n_frames), 1)), config or EvINRConfig(progress=False))["total"]
+    size = tuple(int(v) for v in sensor_size)
+    solver = estimate_memory(size, 0.0, float(duration_s), int(n_events), max(int(n_frames), 1),
+                             config or EvINRConfig(progress=False))["total"]
     return PROCESS_MIB + (2 * 17 * n_events + solver) / 1024.0 ** 2
 
 
 # ---- the whole batch -------------------------------------------------------------------------
 
-def _clean_partials(out_dir: Path) -> None:
-    """Temporary folders that a killed task left behind (``.<name>.partial-*``)."""
-    for tmp in out_dir.glob(".*.partial-*"):
-        shutil.rmtree(tmp, ignore_errors=True)
+def _clean_partials(out_dir: Path, log=None) -> None:
+    """Temporary folders that killed tasks left behind (``.<name>.partial-*`` carrying the package's marker)."""
+    from ..io.output import remove_stale_partials
+
+    remove_stale_partials(out_dir, log=log)
 
 
-def _check_settings(out_dir: Path, settings: dict) -> None:
+def _load_settings(out_dir: Path) -> dict | None:
+    """batch.json of ``out_dir`` (None when there is none); a damaged one is an EventDataError with the fix."""
     path = out_dir / SETTINGS_FILE
-    if path.exists():
+    if not os.path.lexists(path):
+        return None
+    try:
         before = json.loads(path.read_text())
-        changed = {}
-        for k in RESULT_SETTINGS:
-            a, b = before.get(k, SETTING_DEFAULTS.get(k)), settings.get(k, SETTING_DEFAULTS.get(k))
-            if a != b:
-                changed[k] = (a, b)
-        if changed:
-            what = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in changed.items())
-            raise EventDataError(f"{out_dir} holds results made with other settings ({what}); resuming would mix "
-                                 "them: choose another out_dir= or delete that folder")
-    else:
-        _write_atomic(path, json.dumps(settings, indent=2) + "\n")
+        if not isinstance(before, dict):
+            raise ValueError(f"a JSON {type(before).__name__}, not an object")
+        if not isinstance(before.get("recordings", {}), dict):
+            raise ValueError("its 'recordings' is not an object")
+    except (OSError, ValueError) as err:
+        raise EventDataError(f"{path} is damaged ({err}); it records which results in {out_dir} this batch wrote, "
+                             f"so nothing there is touched: delete {out_dir} (or only {path.name}, to start the "
+                             "batch over) or choose another out_dir=") from None
+    return before
+
+
+def _remove_quietly(path: Path) -> None:
+    try:
+        Path(path).unlink(missing_ok=True)
+    except OSError:
+        pass
+
+
+def _rmdir_quietly(path: Path) -> None:
+    try:
+        Path(path).rmdir()
+    except OSError:
+        pass
+
+
+def _check_settings(out_dir: Path, settings: dict, before: dict | None) -> None:
+    if before is None:
+        return
+    changed = {}
+    for k in RESULT_SETTINGS:
+        a, b = before.get(k, SETTING_DEFAULTS.get(k)), settings.get(k, SETTING_DEFAULTS.get(k))
+        if a != b:
+            changed[k] = (a, b)
+    if changed:
+        what = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in changed.items())
+        raise EventDataError(f"{out_dir} holds results made with other settings ({what}); resuming would mix "
+                             "them: choose another out_dir= or delete that folder")
+
+
+def _inside(a: Path, b: Path) -> bool:
+    return a == b or b in a.parents
+
+
+def check_batch_out(out_dir, inputs, items) -> Path:
+    """The batch ownership rule, checked before any work; returns ``out_dir``'s real path.
+
+    ``out_dir`` may be new, an empty folder, or a folder this batch made (it holds batch.json). It
+    may not be, or lie inside, an input folder, nor contain an input. Raises EventDataError with the
+    fix otherwise.
+    """
+    given = Path(out_dir)
+    real = _real_path(given)
+    folders = {_real_path(spec) for spec in inputs if isinstance(spec, (str, os.PathLike)) and Path(spec).is_dir()}
+    folders |= {Path(i["path"]) for i in items if Path(i["path"]).is_dir()}
+    for folder in sorted(folders):
+        if _inside(real, folder):
+            raise EventDataError(f"out_dir={str(given)!r} is, or lies inside, the input folder {folder}; batch "
+                                 "never writes among its inputs: choose an out_dir= outside it")
+    for i in items:
+        if _inside(Path(i["path"]), real):
+            raise EventDataError(f"out_dir={str(given)!r} contains the input {i['path']}; batch never writes "
+                                 "among its inputs: choose an out_dir= that holds no input")
+    if os.path.lexists(real) and not real.is_dir():
+        raise EventDataError(f"out_dir={str(given)!r} exists and is not a folder; choose another out_dir=")
+    if real.is_dir() and not os.path.lexists(real / SETTINGS_FILE):
+        try:
+            others = sorted(p.name for p in real.iterdir() if p.name != LOCK_FILE)
+        except OSError as err:
+            raise EventDataError(f"out_dir={str(given)!r} cannot be read ({err.strerror}); choose another "
+                                 "out_dir=") from None
+        if others:
+            shown = ", ".join(others[:5]) + (", ..." if len(others) > 5 else "")
+            raise EventDataError(f"out_dir={str(given)!r} already holds files that evinr-lite batch did not write "
+                                 f"({shown}; no {SETTINGS_FILE}); batch writes only into a new or empty folder, or "
+                                 "one it made: choose another out_dir=")
+    return real
+
+
+def check_scheduler_address(address: str) -> str:
+    """A Dask scheduler address (``tcp://host:8786``, ``host:8786``), else an EventDataError with an example."""
+    if not isinstance(address, str) or not SCHEDULER_ADDRESS.match(address.strip()):
+        raise EventDataError(f"scheduler={address!r} is not a Dask scheduler address; give one like "
+                             "tcp://host:8786 (the address `dask scheduler` prints)")
+    return address.strip()
 
 
 RESULT_SETTINGS = ("C", "fps", "n_iters", "recipe", "seed", "sensor_size", "denoise", "anchor")   # change the scores
 SETTING_DEFAULTS = {"denoise": False, "anchor": "none"}     # what a batch.json written before these options meant
 
 
-def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | None = None, client=None,
-              sequential: bool = False, torch_threads: int = 1, C: float | None = None, fps: float | None = None,
-              n_iters: int | None = None, recipe: str = "kit", seed: int = 0, device: str | None = None,
-              video: bool = False, denoise: bool = False, anchor: str = "none",
-              sensor_size=None, cache=None, progress: bool = True, log=print) -> dict:
+def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: str | None = None,
+              workers: int | None = None, client=None, sequential: bool = False, torch_threads: int = 1,
+              cache=None, log=print, **fields) -> dict:
     """Reconstruct and score every recording of ``inputs``, one Dask task each; returns the summary.
 
     Args:
@@ -377,48 +539,93 @@ def run_batch(inputs, out_dir, *, scheduler: str | None = None, workers: int | N
         client: an existing ``distributed.Client`` to use instead (a notebook's).
         sequential: run the tasks one after the other in this process, without Dask (a reference).
         torch_threads: torch threads per task (default 1: one per worker process).
-        C, fps, n_iters, recipe, seed, device, video, sensor_size, denoise, anchor: as for
-            ``evinr-lite reconstruct`` (``video`` off by default: PNG frames and scores only; ``C`` may be
-            a number, a pair (c_pos, c_neg) or "auto": fitted per recording from its APS frames).
+        options: a :class:`~evinr_lite.apps.options.RunOptions`, or its fields as keywords (the
+            keywords replace fields of ``options``): C, fps, n_iters, recipe, seed, device, video,
+            sensor_size, denoise, anchor as for ``evinr-lite reconstruct`` (``video`` off by default:
+            PNG frames and scores only; ``C`` may be a number, a pair (c_pos, c_neg) or "auto":
+            fitted per recording from its APS frames), progress (the batch's progress bar).
     Returns:
         the summary (see :func:`summarize`), also written to ``out_dir/summary.json|csv|md``.
     """
     from filelock import FileLock, Timeout
 
     out_dir = Path(out_dir)
-    if n_iters is not None and n_iters < 1:
-        raise EventDataError(f"n_iters= must be at least 1 (or None: the recipe's own), got {n_iters}")
+    # every option checked, once; a batch writes no video unless asked
+    options = RunOptions.of(options, **fields) if options is not None else RunOptions(**{"video": False, **fields})
+    options.check_batch()
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1):
         raise EventDataError(f"workers= must be a whole number of at least 1, got {workers!r}")
     if isinstance(torch_threads, bool) or not isinstance(torch_threads, (int, np.integer)) or torch_threads < 1:
         raise EventDataError(f"torch_threads= must be a whole number of at least 1, got {torch_threads!r}")
-    check_run_options(C=C, fps=fps, n_iters=n_iters, seed=seed, recipe=recipe, anchor=anchor)
     if sum(x is not None for x in (scheduler, workers, client)) + bool(sequential) > 1:
         raise EventDataError("give at most one of scheduler=, workers=, client= and sequential=True")
     items = resolve_inputs(inputs, cache=cache, log=log)
-    if isinstance(C, (tuple, list, np.ndarray)):
-        C = [float(c) for c in C]                       # as batch.json stores it, so a resume compares equal
-    settings = {"C": C, "fps": fps, "n_iters": None if n_iters is None else int(n_iters), "recipe": recipe,
-                "seed": int(seed), "device": device, "video": bool(video),
-                "sensor_size": list(sensor_size) if sensor_size is not None else None,
-                "torch_threads": int(torch_threads), "denoise": bool(denoise), "anchor": anchor}
-    out_dir.mkdir(parents=True, exist_ok=True)
-    lock = FileLock(str(out_dir / ".batch.lock"))
+    # as batch.json stores them (pairs and sizes as lists), so a resume compares equal
+    settings = {**options.to_dict(BATCH_FIELDS), "torch_threads": int(torch_threads)}
+    if scheduler is not None:
+        scheduler = check_scheduler_address(scheduler)
+    for item in items:
+        item["identity"] = input_identity(item["path"])
+    real = check_batch_out(out_dir, inputs, items)          # the ownership rule, before anything is written
+    created_out = not os.path.lexists(real)
+    try:
+        real.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise EventDataError(f"cannot create out_dir={str(out_dir)!r} ({err.strerror}); choose an out_dir= in a "
+                             "folder you can write") from None
+    lock_path = real / LOCK_FILE
+    lock_existed = os.path.lexists(lock_path)
+    lock = FileLock(str(lock_path))
     try:
         lock.acquire(timeout=0)
     except Timeout:
         raise EventDataError(f"another batch is writing into {out_dir}; wait for it or choose another out_dir=") from None
+    except OSError as err:   # e.g. no space left: no empty lock file and no empty folder stay behind
+        if not lock_existed:
+            _remove_quietly(lock_path)
+        if created_out:
+            _rmdir_quietly(real)
+        raise EventDataError(f"cannot lock out_dir={str(out_dir)!r} ({err.strerror}); choose an out_dir= in a "
+                             "folder you can write") from None
+    created_settings = False
     try:
-        _check_settings(out_dir, settings)
-        _clean_partials(out_dir)
-        rows = _run(items, out_dir, settings, scheduler=scheduler, workers=workers, client=client,
-                    sequential=sequential, progress=progress, log=log)
-        _clean_partials(out_dir)
+        before = _load_settings(real)
+        check_batch_out(out_dir, inputs, items)             # again, under the lock
+        _check_settings(real, settings, before)
+        claimed = dict((before or {}).get("recordings", {}))
+        foreign = []
+        for item in items:
+            item["claimed"] = item["name"] in claimed
+            state, _ = result_state(real / item["name"], item, settings, claimed=item["claimed"])
+            if state == "foreign":
+                foreign.append(str(real / item["name"]))
+        if foreign:
+            raise EventDataError(f"{', '.join(foreign)} exist(s) in out_dir= but were not written by this batch (no "
+                                 f"{OWNER_MARKER} inside, not listed in {SETTINGS_FILE}); batch never replaces what it "
+                                 "did not write: move them away or choose another out_dir=")
+        for item in items:                                 # claimed before any task runs
+            claimed[item["name"]] = item["path"]
+            item["claimed"] = True
+        created_settings = before is None
+        _write_atomic(real / SETTINGS_FILE, json.dumps({**(before or {}), **settings, "owner": "evinr-lite batch",
+                                                        "recordings": claimed}, indent=2) + "\n")
+        _clean_partials(real, log)
+        rows = _run(items, real, settings, scheduler=scheduler, workers=workers, client=client,
+                    sequential=sequential, progress=options.progress, log=log)
+        _clean_partials(real, log)
         summary = summarize(rows, settings)
         for name, text in _summary_files(summary).items():
-            _write_atomic(out_dir / name, text)
+            _write_atomic(real / name, text)
+    except BaseException:
+        # nothing was done (e.g. the scheduler could not be reached): leave no batch.json that blocks a rerun
+        if created_settings and not any((real / i["name"]).exists() for i in items):
+            _remove_quietly(real / SETTINGS_FILE)
+        raise
     finally:
+        _remove_quietly(lock_path)        # while held: no .batch.lock stays behind
         lock.release()
+        if created_out:
+            _rmdir_quietly(real)          # only when empty: a batch that did nothing leaves nothing
     done = sum(r["status"] in ("done", "unscored") for r in rows)
     skipped = sum(r["status"].startswith("skipped") for r in rows)
     log(f"batch: {done} recording(s) run, {skipped} already finished, {len(summary['failed'])} failed; "
@@ -437,10 +644,13 @@ def _run(items, out_dir: Path, settings: dict, *, scheduler, workers, client, se
     rows = []
     todo = []
     for item in items:                       # finished recordings are read back, not scheduled
-        done = _finished(out_dir / item["name"])
-        if done is not None:
+        state, done = result_state(out_dir / item["name"], item, settings, claimed=item.get("claimed", False))
+        if state == "finished":
             rows.append(_row(item, done, "skipped", None))
         else:
+            if state == "stale":
+                log(f"batch: {item['name']}: the result there was made from another input or with other settings "
+                    f"(or is unfinished); it is reconstructed again")
             todo.append(item)
     if not todo:
         return rows
@@ -454,7 +664,12 @@ def _run(items, out_dir: Path, settings: dict, *, scheduler, workers, client, se
     cluster = own_client = bar = None
     try:
         if client is None and scheduler is not None:
-            client = own_client = Client(scheduler)
+            try:
+                client = own_client = Client(scheduler, timeout="20s")
+            except (OSError, ValueError, TypeError) as err:
+                raise EventDataError(f"cannot reach the Dask scheduler at {scheduler} ({type(err).__name__}: {err}); "
+                                     "check that it is running and the address (tcp://host:port), or leave "
+                                     "--scheduler out to use this machine") from None
             log(f"batch: scheduler {scheduler}, {len(client.scheduler_info().get('workers', {}))} worker(s)")
         elif client is None:
             n = workers or max(1, min(os.cpu_count() or 1, len(todo)))
