@@ -14,11 +14,13 @@ def _fails_with_hint(capsys, name, wrong, words):
     assert words in out, out
 
 
-# ---- notebook 09: event_rate, bins [b_k, b_{k+1}) -----------------------------------------------
+# ---- notebook 09: event_rate, bins (b_k, b_{k+1}] (the library's rule) -----------------------------
 
 def _rate_by_edges(t, bin_s, side):
+    """Counts by ``searchsorted(edges, t, side) - 1``; side 'left' is the rule (b_k, b_{k+1}]."""
     t = np.asarray(t, dtype=np.float64)
-    n_bins = max(int(np.floor((t[-1] - t[0]) / bin_s)) + 1, 1)
+    span = (t[-1] - t[0]) / bin_s
+    n_bins = max(int(np.ceil(span)), 1) if side == "left" else int(np.floor(span)) + 1
     edges = t[0] + np.arange(n_bins + 1) * bin_s
     k = np.clip(np.searchsorted(edges, t, side=side) - 1, 0, n_bins - 1)
     return t[0] + (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
@@ -26,16 +28,34 @@ def _rate_by_edges(t, bin_s, side):
 
 def test_event_rate_check_has_events_on_bin_edges(capsys):
     assert exercises.check("event_rate", realdata_exercises.event_rate)
-    assert exercises.check("event_rate", lambda t, bin_s: _rate_by_edges(t, bin_s, "right"))   # [b_k, b_{k+1})
-    _fails_with_hint(capsys, "event_rate", lambda t, bin_s: _rate_by_edges(t, bin_s, "left"), "side='right'")
-    ceil_rule = lambda t, bin_s: (realdata_exercises.event_rate(t, bin_s)[0],  # noqa: E731
-                                  realdata_exercises._rate_edges_to_lower_bin(t, bin_s)[1])
-    _fails_with_hint(capsys, "event_rate", ceil_rule, "belongs to bin k")
-    # the boundary cases really put events on edges (else the wrong rules would pass by luck)
-    cases = exercises.get("event_rate").cases()
+    assert exercises.check("event_rate", lambda t, bin_s: _rate_by_edges(t, bin_s, "left"))    # (b_k, b_{k+1}]
+    _fails_with_hint(capsys, "event_rate", lambda t, bin_s: _rate_by_edges(t, bin_s, "right"), "side='left'")
+    _fails_with_hint(capsys, "event_rate", realdata_exercises._rate_edges_to_later_bin, "belongs to bin k - 1")
+    # the first event sits on edge b_0: a rule that drops it (no clip at 0) fails too
+    def drops_first(t, bin_s):
+        centers, rate = realdata_exercises.event_rate(t, bin_s)
+        k = np.ceil((np.asarray(t) - t[0]) / bin_s).astype(int) - 1
+        return centers, np.bincount(k[k >= 0], minlength=len(centers)) / bin_s
+    assert not exercises.check("event_rate", drops_first, verbose=False)
+    # the boundary cases really put events on edges, ties and empty bins (else wrong rules pass by luck)
+    cases = [kw for _, kw in exercises.get("event_rate").cases()]
     on_edge = [np.any(np.isclose(((kw["t"] - kw["t"][0]) / kw["bin_s"]) % 1, 0) & (kw["t"] > kw["t"][0]))
-               for _, kw in cases]
+               for kw in cases]
     assert sum(on_edge) >= 2
+    assert any(np.unique(kw["t"]).size < kw["t"].size for kw in cases)                     # ties
+    assert any(np.any(realdata_exercises.event_rate(**kw)[1] == 0) for kw in cases)        # an empty bin
+
+
+def test_teaching_and_library_event_rate_agree_on_edges():
+    """One bin-edge rule: the teaching reference and method.binning.event_rate count events exactly on
+    edges in the same (earlier) bin."""
+    from evinr_lite.core.events import Events
+    from evinr_lite.method.binning import event_rate as library_event_rate
+    t = np.array([1.0, 1.125, 1.25, 1.25, 1.3, 1.5, 1.625, 2.0])
+    events = Events.from_arrays(t, np.zeros(t.size, int), np.zeros(t.size, int), np.ones(t.size, int), (1, 1))
+    edges, on, off = library_event_rate(events, 0.125)
+    _, rate = realdata_exercises.event_rate(t, 0.125)
+    np.testing.assert_allclose(rate * 0.125, (on + off) * np.diff(edges))
 
 
 def test_contrast_threshold_exercise_is_registered_by_notebook_09s_module(capsys):

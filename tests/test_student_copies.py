@@ -93,14 +93,32 @@ def test_student_lines_appear_and_instructor_cells_are_left_out():
     nb = {"cells": [
         _code("def f(x):\n    ### STUDENT: # TODO: return twice x\n    ### STUDENT: result = ...\n"
               "    ### BEGIN SOLUTION\n    result = 2 * x\n    ### END SOLUTION\n    return result\n", cell_id="ex"),
-        {"cell_type": "markdown", "id": "ans", "metadata": {"tags": ["instructor"]}, "source": ["**Answer.** 4\n"]},
         {"cell_type": "markdown", "id": "q", "metadata": {"tags": ["predict"]}, "source": ["**Predict.** f(2)?\n"]},
+        {"cell_type": "markdown", "id": "ans", "metadata": {"tags": ["instructor"]}, "source": ["**Answer.** 4, twice 2.\n"]},
+        {"cell_type": "markdown", "id": "note", "metadata": {"tags": ["instructor"]}, "source": ["Note: go slowly.\n"]},
     ], "metadata": {}, "nbformat": 4, "nbformat_minor": 5}
     student = msc.student_copy(nb, "01_x.ipynb")
     sources = ["".join(c["source"]) for c in student["cells"]]
     assert sources[1] == ("def f(x):\n    # TODO: return twice x\n    result = ...\n"
                           "    raise NotImplementedError\n    return result\n")
-    assert [c["id"] for c in student["cells"][1:]] == ["ex", "q"]          # the answer is instructor-only
+    assert [c["id"] for c in student["cells"][1:]] == ["ex", "q", "ans"]   # the note is instructor-only
+    answer = student["cells"][3]
+    assert answer["metadata"]["jupyter"]["source_hidden"] is True          # collapsed in Jupyter
+    assert answer["metadata"]["tags"] == ["answer"]
+    text = "".join(answer["source"])
+    assert text.startswith("<details>") and "4, twice 2." in text and "</details>" in text   # closed elsewhere
+    assert "**Answer.**" not in text
     ns = {}
     exec("".join(nb["cells"][0]["source"]), ns)                           # instructor copy: STUDENT lines are comments
     assert ns["f"](2) == 4
+
+
+def test_every_answer_in_the_notebooks_reaches_the_student_copy_hidden():
+    """Issue 24 section 4: explanations are kept for students, behind a collapsed cell."""
+    for path in sorted(msc.SOURCE_DIR.glob(msc.PATTERN)):
+        nb = json.loads(path.read_text())
+        answers = [c["id"] for c in nb["cells"] if msc.is_answer(c)]
+        student = msc.student_copy(nb, path.name)
+        kept = {c["id"]: c for c in student["cells"] if "answer" in c["metadata"].get("tags", [])}
+        assert list(kept) == answers, path.name
+        assert all(c["metadata"]["jupyter"]["source_hidden"] for c in kept.values())

@@ -3,8 +3,9 @@
 - ``event_rate``: events per second in fixed bins, the first look at any recording. The reference
   below is the teaching version (times only, one rate); it re-implements, on purpose, the
   library's :func:`evinr_lite.method.binning.event_rate` (ON and OFF rates of an ``Events``),
-  and ``tests/test_realdata.py`` pins the two together. Bins are half-open, [b_k, b_{k+1}): an
-  event exactly on an edge belongs to the later bin, and the check has such events.
+  and ``tests/test_realdata.py`` pins the two together. Bins follow the kit's one rule,
+  (b_k, b_{k+1}] (bin 0 also holds an event at b_0), as every binning of the library does: an event
+  exactly on an edge belongs to the earlier bin, and the check has such events.
 - ``estimate_contrast_threshold``: the least-squares C relating the log-intensity change of APS
   frames to the net event count between them, ΔL ≈ C n. The reference is the library's
   :func:`evinr_lite.method.contrast.estimate_contrast_threshold`, which notebook 11 applies to the
@@ -35,12 +36,14 @@ def event_rate(t, bin_s):
 
     Returns:
         (centers, rate): float64 [B] bin centres (s) and events per second in each bin, with bins
-        [t0 + k * bin_s, t0 + (k + 1) * bin_s) starting at t0 = t[0] and covering every event
-        (an event exactly on an edge counts in the later bin).
+        (t0 + k * bin_s, t0 + (k + 1) * bin_s] starting at t0 = t[0] (bin 0 also holds the events at
+        t0) and B = ceil((t[-1] - t0) / bin_s), at least 1, so that every event is counted once: an
+        event exactly on an edge counts in the earlier bin, the kit's one rule.
     """
     t = np.asarray(t, dtype=np.float64)
-    n_bins = max(int(np.floor((t[-1] - t[0]) / bin_s)) + 1, 1)
-    counts = np.bincount(np.minimum(((t - t[0]) / bin_s).astype(np.int64), n_bins - 1), minlength=n_bins)
+    n_bins = max(int(np.ceil((t[-1] - t[0]) / bin_s)), 1)
+    k = np.clip(np.ceil((t - t[0]) / bin_s).astype(np.int64) - 1, 0, n_bins - 1)
+    counts = np.bincount(k, minlength=n_bins)
     centers = t[0] + (np.arange(n_bins) + 0.5) * bin_s
     return centers, counts / bin_s
 
@@ -53,18 +56,22 @@ def _inputs_rate(rng):
         t = np.sort(rng.uniform(0.0, span, n)) + rng.uniform(0, 3)
         cases.append(dict(t=t, bin_s=bin_s))
     # events exactly on bin edges (dyadic times, so t - t0 and the edges are exact in float64): the
-    # rule [b_k, b_{k+1}) puts each in the later bin; a (b_k, b_{k+1}] rule or searchsorted(side="left")
-    # moves them one bin down. The last event sits on an edge too, and gets a bin of its own.
+    # rule (b_k, b_{k+1}] puts each in the earlier bin; a [b_k, b_{k+1}) rule (floor, or
+    # searchsorted(side="right")) moves them one bin up and adds a bin for a last event on an edge.
+    # Ties: several events at one time; the first event (t0) sits on edge b_0 and belongs to bin 0.
     cases.append(dict(t=np.array([1.0, 1.125, 1.25, 1.25, 1.3, 1.5, 1.625, 2.0]), bin_s=0.125))
     cases.append(dict(t=np.array([0.5, 0.5, 0.75, 1.0, 1.0, 1.0, 1.5]), bin_s=0.25))
+    # an empty bin in the middle, and a single event (one bin)
+    cases.append(dict(t=np.array([0.0, 0.25, 1.0]), bin_s=0.25))
+    cases.append(dict(t=np.array([3.0]), bin_s=0.5))
     return cases
 
 
-def _rate_edges_to_lower_bin(t, bin_s):
-    """The mistake: bins (b_k, b_{k+1}] (ceil - 1, or searchsorted(edges, t, side="left") - 1)."""
+def _rate_edges_to_later_bin(t, bin_s):
+    """The mistake: bins [b_k, b_{k+1}) (floor, or searchsorted(edges, t, side="right") - 1)."""
     t = np.asarray(t, dtype=np.float64)
     n_bins = max(int(np.floor((t[-1] - t[0]) / bin_s)) + 1, 1)
-    k = np.clip(np.ceil((t - t[0]) / bin_s).astype(np.int64) - 1, 0, n_bins - 1)
+    k = np.minimum(((t - t[0]) / bin_s).astype(np.int64), n_bins - 1)
     counts = np.bincount(k, minlength=n_bins)
     return t[0] + (np.arange(n_bins) + 0.5) * bin_s, counts / bin_s
 
@@ -75,9 +82,10 @@ exercises.register(
            lambda t, bin_s: (event_rate(t, bin_s)[0], event_rate(t, bin_s)[1] * bin_s),
            "return the bin centres, not the left edges":
            lambda t, bin_s: (event_rate(t, bin_s)[0] - bin_s / 2, event_rate(t, bin_s)[1]),
-           "an event exactly on a bin edge t0 + k bin_s belongs to bin k (bins are [b_k, b_{k+1})): use "
-           "floor((t - t0) / bin_s), or searchsorted(edges, t, side='right') - 1, not ceil - 1 or side='left'":
-           _rate_edges_to_lower_bin})
+           "an event exactly on a bin edge t0 + k bin_s belongs to bin k - 1 (bins are (b_k, b_{k+1}], the "
+           "library's rule; bin 0 also holds t0): use ceil((t - t0) / bin_s) - 1 clipped at 0, or "
+           "searchsorted(edges, t, side='left') - 1, not floor or side='right'":
+           _rate_edges_to_later_bin})
 
 
 def _inputs_threshold(rng):
