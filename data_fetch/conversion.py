@@ -147,7 +147,7 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
 
     check_settings(C=C, sensor_size=sensor_size, eval_window=eval_window, time_unit=time_unit)
     if cfa is not _UNSET:
-        from evinr_lite.io.canonical import check_cfa
+        from evinr_lite.core.cfa import check_cfa
 
         cfa = check_cfa(cfa, DataFetchError)
     raw = Path(raw).expanduser()

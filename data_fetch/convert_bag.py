@@ -25,7 +25,7 @@ import numpy as np
 from evinr_lite.core.events import LARGE_T, EventDataError
 from evinr_lite.io.text import NS
 from evinr_lite.core.frames import to_grey_uint8 as _to_grey_uint8
-from evinr_lite.io.canonical import CFA_NAMES, check_cfa
+from evinr_lite.core.cfa import CFA_NAMES, check_cfa
 
 from .canonical import CanonicalWriter
 from .errors import ConversionError

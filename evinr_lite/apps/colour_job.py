@@ -25,14 +25,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.cfa import BAYER, cfa_phase
 from ..core.events import EventDataError, Events
 from ..core.frames import GREY_WEIGHTS, Frames
 from ..core.recording import Recording
-from ..io.canonical import cfa_phase
 from ..method.colour import chroma_correlation, reconstruct_colour
 from ..method.solver import EvINRConfig
 from ..method.tonemap import tonemap_reinhard
-from ..sim.quadbayer import BAYER, demosaic_events_rgb, reduce_mean
+from ..sim.quadbayer import demosaic_events_rgb, reduce_mean
 
 __all__ = ["check_colour_recording", "split_colour_events", "colour_frames", "ColourResult",
            "reconstruct_colour_recording", "score_colour_recording"]

@@ -55,6 +55,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.cfa import CFA_NAMES, cfa_phase, check_cfa  # the colour filter's one home (names kept here)
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames, to_grey_uint8
 
@@ -82,31 +83,6 @@ COMPRESSION = dict(compression="gzip", compression_opts=4, shuffle=True)
 DTYPES = {"t": np.float64, "x": np.uint16, "y": np.uint16, "p": np.int8}
 log = logging.getLogger("evinr_lite")
 EVENT_FIELDS = ("t", "x", "y", "p")
-# 2 x 2 Bayer filters by the colours of photosites (0, 0), (0, 1), (1, 0), (1, 1) -> phase (dy, dx) of
-# the RGGB tile (evinr_lite.sim.quadbayer's convention, block = 1)
-CFA_NAMES = {"RGGB": (0, 0), "GRBG": (0, 1), "GBRG": (1, 0), "BGGR": (1, 1)}
-
-
-def check_cfa(cfa, error=EventDataError) -> str | None:
-    """A colour filter name checked (None = mono): one of :data:`CFA_NAMES`, upper-cased."""
-    if cfa is None:
-        return None
-    name = str(cfa).upper() if isinstance(cfa, str) else None
-    if name not in CFA_NAMES:
-        raise error(f"cfa must be one of {', '.join(CFA_NAMES)} (the colours of the photosites (0, 0), (0, 1), "
-                    f"(1, 0), (1, 1)) or None for a mono sensor; got {cfa!r}")
-    return name
-
-
-def cfa_phase(cfa) -> tuple[int, int]:
-    """(dy, dx) of a 2 x 2 Bayer filter name in the RGGB tile: "RGGB" (0, 0), "GRBG" (0, 1), "GBRG"
-    (1, 0), "BGGR" (1, 1); the ``phase`` of :mod:`evinr_lite.sim.quadbayer` with ``block=1``."""
-    name = check_cfa(cfa)
-    if name is None:
-        raise EventDataError("cfa_phase needs a colour filter name (RGGB, GRBG, GBRG, BGGR), got None (mono)")
-    return CFA_NAMES[name]
-
-
 def is_canonical(path) -> bool:
     """True when ``path`` is an HDF5 file in the canonical layout (any version)."""
     import h5py

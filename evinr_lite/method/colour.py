@@ -5,7 +5,7 @@
     rec.frames            # [Q, h, w, 3] in [0, 1]
 
 Each channel is solved on its own (:func:`evinr_lite.method.solver.reconstruct`) with its own effective
-threshold (C / 4, C / 8, C / 4 for Quad Bayer, :func:`evinr_lite.sim.quadbayer.effective_thresholds`).
+threshold (C / 4, C / 8, C / 4 for Quad Bayer, :func:`evinr_lite.core.cfa.effective_thresholds`).
 
 The white balance is not in the events. Events give changes of log intensity only; each channel's
 constant offset is unknown, and a colour cast *is* a difference of channel offsets. ``reconstruct``
@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.cfa import CHANNELS, QUAD_BAYER, effective_thresholds
 from ..core.events import EventDataError, Events
-from ..sim.quadbayer import CHANNELS, QUAD_BAYER, effective_thresholds
 from .solver import EvINRConfig, reconstruct
 from .tonemap import tonemap_reinhard
 

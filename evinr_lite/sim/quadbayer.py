@@ -1,5 +1,7 @@
 """Quad Bayer colour sensors (the ALPIX-Eiger of the paper's AED dataset, Sec. 3.4): the colour
 filter, mosaicing, colour events, and demosaicing of frames and events to grey and to colour.
+The filter's helpers (tile, channel of a photosite, pattern, names, thresholds) live in
+:mod:`evinr_lite.core.cfa` and are importable from here too.
 
 The colour filter array (CFA)
     A Quad Bayer sensor repeats a 4 x 4 tile of 2 x 2 same-colour blocks (``block = 2``)::
@@ -56,6 +58,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
+from ..core.cfa import (BAYER, CHANNELS, QUAD_BAYER, TILE_COLOURS, cfa_channel, cfa_pattern, cfa_tile,  # noqa: F401
+                        check_block, check_phase, effective_thresholds, period, photosites_per_window)
 from ..core.events import EventDataError, Events, check_sensor_size
 from .scenes import MovingImageScene
 
@@ -64,72 +68,6 @@ __all__ = ["CHANNELS", "QUAD_BAYER", "BAYER", "TILE_COLOURS", "period", "photosi
            "debayer_bilinear",
            "effective_thresholds", "demosaic_events", "demosaic_events_rgb", "QuadBayerScene",
            "simulate_colour_video", "reduce_mean", "mosaic_display", "checker_amplitude"]
-
-CHANNELS = ("R", "G", "B")
-QUAD_BAYER = 2          # block size: 2 x 2 same-colour photosites
-BAYER = 1               # plain Bayer: every photosite its own block
-TILE_COLOURS = np.array([[0, 1], [1, 2]], dtype=np.int8)   # R G / G B, one entry per block
-
-
-# ---- the colour filter -------------------------------------------------------------------
-
-def _check_block(block) -> int:
-    if isinstance(block, (bool, np.bool_)) or not isinstance(block, (int, np.integer)) or block < 1:
-        raise EventDataError(f"block must be a positive int (2 = Quad Bayer, 1 = plain Bayer), got {block!r}")
-    return int(block)
-
-
-def _check_phase(phase, block: int) -> tuple[int, int]:
-    try:
-        dy, dx = (int(v) for v in phase)
-    except (TypeError, ValueError):
-        raise EventDataError(f"phase must be (dy, dx), two ints (row, column offset in the tile), got {phase!r}") from None
-    if not np.allclose(np.asarray(phase, dtype=np.float64), (dy, dx)):
-        raise EventDataError(f"phase must hold whole numbers (row, column offset in the tile), got {phase!r}")
-    P = 2 * block
-    return dy % P, dx % P
-
-
-def period(block: int = QUAD_BAYER) -> int:
-    """P = 2 * block: the side of the CFA tile and of one reduced (grey) pixel, in photosites."""
-    return 2 * _check_block(block)
-
-
-def photosites_per_window(block: int = QUAD_BAYER) -> dict:
-    """Photosites of each colour in one P x P window: {"R": b^2, "G": 2 b^2, "B": b^2, "grey": 4 b^2}."""
-    b2 = _check_block(block) ** 2
-    return {"R": b2, "G": 2 * b2, "B": b2, "grey": 4 * b2}
-
-
-def cfa_tile(block: int = QUAD_BAYER, phase=(0, 0)) -> np.ndarray:
-    """The tile as the sensor sees it from its photosite (0, 0): int8 [P, P] of channel indices."""
-    block = _check_block(block)
-    dy, dx = _check_phase(phase, block)
-    P = 2 * block
-    y, x = np.mgrid[0:P, 0:P]
-    return cfa_channel(y, x, (dy, dx), block).astype(np.int8)
-
-
-def cfa_channel(y, x, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
-    """Colour channel (0 R, 1 G, 2 B) of the photosites at rows ``y`` and columns ``x``.
-
-    ``TILE[(y + dy) % P, (x + dx) % P]``: the block row is ``((y + dy) % P) // block``, the block
-    column likewise, and the block colour is R G / G B. ``y`` and ``x`` are int arrays of one shape
-    (broadcast); returns int64 of that shape.
-    """
-    block = _check_block(block)
-    dy, dx = _check_phase(phase, block)
-    P = 2 * block
-    y = np.asarray(y, dtype=np.int64)
-    x = np.asarray(x, dtype=np.int64)
-    return TILE_COLOURS[((y + dy) % P) // block, ((x + dx) % P) // block].astype(np.int64)
-
-
-def cfa_pattern(sensor_size, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
-    """Channel of every photosite of a sensor (H, W): int8 [H, W] (indexed [y, x])."""
-    H, W = check_sensor_size(sensor_size)
-    y, x = np.mgrid[0:H, 0:W]
-    return cfa_channel(y, x, phase, block).astype(np.int8)
 
 
 def mosaic(rgb, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
@@ -255,17 +193,6 @@ def debayer_bilinear(raw, phase=(0, 0)) -> np.ndarray:
 
 # ---- demosaicing events ------------------------------------------------------------------
 
-def effective_thresholds(C: float, block: int = QUAD_BAYER) -> dict:
-    """Log-intensity step carried by one demosaiced event: C / (photosites per window).
-
-    Returns {"grey": C / n, "R": C / n_R, "G": C / n_G, "B": C / n_B}; for Quad Bayer
-    C/16, C/4, C/8, C/4. (See the module docstring for why.)
-    """
-    if not (np.isscalar(C) and np.isfinite(C) and C > 0):
-        raise EventDataError(f"C must be a positive contrast threshold (log units), got {C!r}")
-    return {name: float(C) / n for name, n in photosites_per_window(block).items()}
-
-
 def _check_events(events: Events, block: int) -> tuple[int, int, int]:
     if not isinstance(events, Events):
         raise EventDataError(f"expected an Events stream on the raw (mosaic) sensor, got {type(events).__name__}")
@@ -353,8 +280,8 @@ class QuadBayerScene:
 
     def __init__(self, image="coffee", sensor_size=(64, 96), duration=1.0, *, phase=(0, 0),
                  block: int = QUAD_BAYER, intensity_range=(0.05, 1.0), **motion):
-        self.block = _check_block(block)
-        self.phase = _check_phase(phase, self.block)
+        self.block = check_block(block)
+        self.phase = check_phase(phase, self.block)
         P = 2 * self.block
         H, W = check_sensor_size(sensor_size)
         if H % P or W % P:
