@@ -4,19 +4,10 @@ The filter's helpers (tile, channel of a photosite, pattern, names, thresholds) 
 :mod:`evinr_lite.core.cfa` and are importable from here too.
 
 The colour filter array (CFA)
-    A Quad Bayer sensor repeats a 4 x 4 tile of 2 x 2 same-colour blocks (``block = 2``)::
-
-        R R G G
-        R R G G
-        G G B B
-        G G B B
-
-    A plain Bayer sensor is the same with ``block = 1`` (the 2 x 2 tile R G / G B). The period is
-    ``P = 2 * block``. ``phase = (dy, dx)`` says where the sensor's photosite (row 0, column 0)
-    sits in the tile: the photosite at row y, column x has colour
-    ``TILE[(y + dy) % P, (x + dx) % P]``. A sensor whose top-left block is blue has phase (2, 2);
-    cropping one row off the top of a phase-(0, 0) sensor gives phase (1, 0). Channels are
-    numbered 0 = R, 1 = G, 2 = B.
+    The tile (:mod:`evinr_lite.core.cfa`): 2 x 2 same-colour blocks R / G / G / B (``block = 2`` for
+    Quad Bayer, ``block = 1`` for plain Bayer), period ``P = 2 * block``, and ``phase = (dy, dx)``,
+    where the sensor's photosite (row 0, column 0) sits in the tile. A sensor whose top-left block
+    is blue has phase (2, 2); cropping one row off the top of a phase-(0, 0) sensor gives phase (1, 0).
 
 The reduced grid (the paper's demosaicing to grey)
     Every P x P window aligned on the sensor grid (rows P*i .. P*i + P - 1, columns P*j ..) holds
