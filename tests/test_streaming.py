@@ -1,0 +1,132 @@
+"""Streaming reconstruction (method/streaming.py) against the whole-sequence solve (method/solver.py).
+
+What streaming must keep: one window gives the identical result; over several windows the networks,
+their alignment and the cross-fade are the same, so streaming differs from the whole-sequence solve
+by exactly one offset image (taken from the first window instead of the whole span); each window
+reads only its own events; a run stopped after any window resumes to the same frames.
+"""
+import numpy as np
+import pytest
+import torch
+
+from evinr_lite import EvINRConfig, make_scene, simulate_scene
+from evinr_lite.core.events import EventDataError
+from evinr_lite.evaluation.scoring import score_sequence
+from evinr_lite.io.source import MemorySource
+from evinr_lite.method.models import FrameINR
+from evinr_lite.method.solver import reconstruct
+from evinr_lite.method.streaming import StreamState, stream_reconstruct
+from evinr_lite.method.tonemap import tonemap_reinhard
+
+SIZE = (24, 32)
+
+
+@pytest.fixture(scope="module")
+def scene_events():
+    scene = make_scene("camera", sensor_size=SIZE, duration=3.0)
+    return scene, simulate_scene(scene, 0.0, 3.0, C=0.2, seed=0)
+
+
+def _config(**kw):
+    return EvINRConfig(C=0.2, hidden_features=64, progress=False, **kw)
+
+
+def _collect(parts):
+    parts = list(parts)
+    idx = np.concatenate([p.indices for p in parts])
+    return (idx, np.concatenate([p.log_intensity for p in parts]), np.concatenate([p.frames for p in parts]), parts)
+
+
+class _CountingSource(MemorySource):
+    """A source that records every window it is asked for."""
+
+    def __init__(self, events):
+        super().__init__(events)
+        self.asked = []
+
+    def _read_window(self, t0, t1):
+        self.asked.append((t0, t1))
+        return super()._read_window(t0, t1)
+
+
+def test_one_window_is_identical_to_the_whole_sequence_solve(scene_events):
+    _, events = scene_events
+    q = np.linspace(0.05, 2.95, 12)
+    cfg = _config()                                   # tau 5 s: the 3 s span is one window
+    whole = reconstruct(events, q, cfg, t_start=0.0, t_end=3.0)
+    idx, L, frames, parts = _collect(stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0))
+    assert len(parts) == 1 and np.array_equal(idx, np.arange(len(q)))
+    np.testing.assert_array_equal(L, whole.log_intensity)
+    np.testing.assert_array_equal(frames, whole.frames)
+
+
+def test_many_windows_differ_from_the_whole_sequence_solve_by_one_offset_image(scene_events):
+    scene, events = scene_events
+    q = np.linspace(0.05, 2.95, 40)                   # some inside the overlaps, where networks are cross-faded
+    cfg = _config(tau=1.0, overlap=0.25)              # 4 windows
+    whole = reconstruct(events, q, cfg, t_start=0.0, t_end=3.0)
+    assert len(whole.windows) == 4
+    source = _CountingSource(events)
+    idx, L, frames, parts = _collect(stream_reconstruct(source, q, cfg, t_start=0.0, t_end=3.0))
+    assert len(parts) == 4 and np.array_equal(idx, np.arange(len(q)))
+    assert np.all(np.diff(idx) > 0)                   # handed out in time order, each time once
+    # same networks, alignment and cross-fade: the difference is one image, the same at every time
+    diff = L - whole.log_intensity
+    spread = np.abs(diff - diff.mean(axis=0)).max()
+    assert spread < 1e-3 * np.abs(whole.log_intensity).max(), spread
+    # and that image (first window's offset vs the whole span's) stays small next to the content
+    assert np.abs(diff.mean(axis=0) - diff.mean()).mean() < 0.25 * whole.log_intensity.std()
+    # quality against the truth: within 0.02 CLAHE-SSIM of the whole-sequence solve
+    gt = tonemap_reinhard(np.stack([scene.log_intensity(t) for t in q])).astype(np.float32)
+    s_whole = score_sequence(whole.frames, q, gt, q, "clahe", lpips_model=False)["ssim"]
+    s_stream = score_sequence(frames, q, gt, q, "clahe", lpips_model=False)["ssim"]
+    assert s_stream > s_whole - 0.02, (s_stream, s_whole)
+    # each window read only its own events (never the whole recording)
+    assert len(source.asked) == 4
+    assert all(t1 - t0 <= cfg.tau + 1e-6 for t0, t1 in source.asked)
+
+
+def test_a_stopped_run_resumes_to_the_same_frames(scene_events, tmp_path):
+    _, events = scene_events
+    q = np.linspace(0.05, 2.95, 25)
+    cfg = _config(tau=1.0, overlap=0.25)
+    _, L_full, _, _ = _collect(stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0))
+    saved = []
+
+    def save(part, state):
+        state.save(tmp_path / "state.npz")
+        saved.append(part)
+
+    stream = stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0, on_window=save)
+    next(stream), next(stream)                        # two windows done, then the run is "killed"
+    stream.close()
+    state = StreamState.load(tmp_path / "state.npz")
+    assert state.next_window == 2
+    idx, L, _, _ = _collect(stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0, state=state))
+    done = np.concatenate([p.indices for p in saved])
+    np.testing.assert_array_equal(np.concatenate([done, idx]), np.arange(len(q)))
+    np.testing.assert_array_equal(np.concatenate([np.concatenate([p.log_intensity for p in saved]), L]), L_full)
+    # a state from another plan of windows is refused, not silently mixed in
+    with pytest.raises(EventDataError, match="another plan"):
+        next(stream_reconstruct(events, q, _config(tau=1.5, overlap=0.25), t_start=0.0, t_end=3.0, state=state))
+
+
+def test_network_k_alone_is_network_k_of_the_ensemble():
+    windows = [[0.0, 1.0], [0.75, 2.0], [1.75, 3.0]]
+    ensemble = FrameINR(SIZE, windows, 32, 2, 30.0, 10.0, seed=5)
+    alone = FrameINR(SIZE, windows[2:], 32, 2, 30.0, 10.0, seed=5, first_index=2)
+    for name, value in alone.state_dict().items():
+        assert torch.equal(value, ensemble.state_dict()[name][2:3]), name
+    first = FrameINR(SIZE, windows[:1], 32, 2, 30.0, 10.0, seed=5)      # network 0 keeps the old seeding
+    assert torch.equal(first.weights[1], ensemble.weights[1][:1])
+    assert not torch.equal(ensemble.weights[1][0], ensemble.weights[1][1])
+
+
+def test_bad_requests_are_refused_before_any_training(scene_events):
+    _, events = scene_events
+    with pytest.raises(EventDataError, match="anchored"):
+        next(stream_reconstruct(events, [0.5], _config(anchor="first")))
+    with pytest.raises(EventDataError, match="sorted"):
+        next(stream_reconstruct(events, [0.6, 0.5], _config()))
+    with pytest.raises(EventDataError, match="outside"):
+        next(stream_reconstruct(events, [5.0], _config(), t_start=0.0, t_end=3.0))
