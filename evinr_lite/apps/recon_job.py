@@ -16,31 +16,31 @@ first event on an absolute clock, else 0), as ``describe_recording`` prints them
 from __future__ import annotations
 
 import math
-import os
 import time
 from pathlib import Path
 
 import numpy as np
 
-from ..core.events import TIME_UNITS, EventDataError
+from ..core.events import EventDataError
 from ..core.frames import Frames
 from ..core.recording import Recording
 from ..io.readers import detect_format, read_recording
 from .describe import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,  # noqa: F401
                        TIME_UNIT_FORMATS, describe_recording, format_info, read_any)
 from ..evaluation.scoring import score_sequence
-from ..method.binning import as_thresholds
-from ..method.contrast import fit_contrast
-from ..method.solver import EvINRConfig, Reconstruction, reconstruct
-from ..method.anchor import ANCHOR_MODES, held_out
+from ..method.anchor import held_out
+from ..method.config import EvINRConfig
+from ..method.memory import check_memory, check_times_memory
+from ..method.recipes import (DEFAULT_C, RECIPES, contrast_option, format_contrast, recipe_config,  # noqa: F401
+                              resolve_contrast)
+from ..method.solver import Reconstruction, reconstruct
+from .options import RunOptions, check_run_options, parse_times  # noqa: F401
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
-           "check_run_options", "contrast_option", "resolve_contrast", "format_contrast", "estimate_memory", "check_memory", "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS", "RECIPES",
-           "recipe_config"]
+           "DEFAULT_FPS", "DEFAULT_C", "EQUALIZATIONS"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
-DEFAULT_C = 1.0         # the paper's contrast threshold for DAVIS recordings (IJRR, HQF)
 EQUALIZATIONS = ("none", "clahe")   # scored without equalisation, and with CLAHE (the paper's)
 
 
@@ -80,34 +80,12 @@ def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_en
 
 # ---- times and reconstruction ----------------------------------------------------------------
 
-def _parse_times(at) -> np.ndarray:
-    """Seconds from an array, a list, '0.1,0.2' text, or a file with one time per line."""
-    if isinstance(at, (str, Path)) and Path(at).is_file():
-        try:
-            text = Path(at).read_bytes().decode("utf-8-sig")
-        except UnicodeDecodeError as err:
-            raise EventDataError(f"{at}: not UTF-8 text (byte {err.start}); save the times as plain text, one number "
-                                 "of seconds per line") from None
-        at = [tok for line in text.splitlines() if line.strip() and not line.lstrip().startswith("#")
-              for tok in line.replace(",", " ").split()[-1:]]
-    elif isinstance(at, str):
-        at = [tok for tok in at.replace(",", " ").split()]
-    try:
-        times = np.atleast_1d(np.asarray(at, dtype=np.float64))
-    except ValueError:
-        raise EventDataError(f"could not read times from at={at!r}; give seconds separated by commas "
-                             "(e.g. 0.5,0.75,1.0) or a file with one time per line") from None
-    if times.size == 0 or not np.all(np.isfinite(times)):
-        raise EventDataError("at=: give at least one finite time in seconds")
-    return np.sort(times)
-
-
 def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[np.ndarray, str]:
     """The times to reconstruct and where they come from.
 
     Args:
         fps: frames per second over the window (the first half a frame period after its start).
-        at: explicit times (array, '0.1,0.2' text, or a file with one time per line).
+        at: explicit times (array, '0.1,0.2' text, or a file: :func:`~evinr_lite.apps.options.parse_times`).
         Neither: the ground-truth frame times when the recording has frames, else DEFAULT_FPS.
     Returns:
         (times float64 [Q] seconds, a short description of the choice).
@@ -116,7 +94,7 @@ def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[
         raise EventDataError("give either fps= or at=, not both")
     lo, hi = rec.meta["window"]
     if at is not None:
-        times = _parse_times(at)
+        times = parse_times(at)
         outside = times[(times < lo) | (times > hi)]
         if outside.size:
             raise EventDataError(f"requested time {outside[0]} s is outside the reconstructed window "
@@ -130,14 +108,7 @@ def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[
     if not (math.isfinite(fps) and fps > 0):
         raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
     n = int(math.floor((hi - lo) * fps))
-    H, W = rec.events.sensor_size
-    need, free = n * 40.0, _available_bytes("cpu")   # the times alone, before np.arange allocates them (check_memory
-    # then counts the frames)
-    if need > 0.8 * free:
-        raise EventDataError(f"{n:,} frames at {fps:g} per second over [{lo:.6f}, {hi:.6f}] s: this reconstruction "
-                             f"needs about {need / 2**30:,.1f} GiB of memory but about {free / 2**30:,.1f} GiB is free: "
-                             f"most of it for {n:,} output frames of {H}x{W} pixels; ask for fewer frames with fps= or "
-                             "at=, or shorten the window with t_start=/t_end=")
+    check_times_memory(n, rec.events.sensor_size, f"{n:,} frames at {fps:g} per second over [{lo:.6f}, {hi:.6f}] s")
     times = lo + (np.arange(n) + 0.5) / fps if n >= 1 else np.array([0.5 * (lo + hi)])
     return times, f"{len(times)} frames at {fps:g} per second"
 
@@ -299,184 +270,6 @@ def _jsonable(obj):
 
 # ---- the whole job ---------------------------------------------------------------------------
 
-RECIPES = {"kit": EvINRConfig, "paper": EvINRConfig.paper, "v0_1": EvINRConfig.v0_1}
-
-
-def recipe_config(recipe: str = "kit", n_iters: int | None = None, **fields) -> EvINRConfig:
-    """The EvINRConfig of a named recipe: "kit" (``EvINRConfig()``, the default), "paper" (the paper's
-    recipe exactly) or "v0_1" (the kit's default before the scene zoo).
-
-    ``n_iters`` None keeps the recipe's own (kit: no Adam iteration, the output layer solved in closed
-    form; paper: 300). Given, it sets the Adam iterations; for the recipes with coarse-to-fine the two
-    bisections move to n_iters / 3 and 2 n_iters / 3 (the paper's 100 and 200 of 300).
-    """
-    if recipe not in RECIPES:
-        raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {recipe!r}")
-    make = RECIPES[recipe]
-    if n_iters is not None:
-        fields["n_iters"] = int(n_iters)
-        if make().coarse_to_fine:
-            c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
-            fields.update(c2f_iters=c2f, coarse_to_fine=bool(c2f))
-    return make(**fields)
-
-
-def contrast_option(C):
-    """run_reconstruct's ``C=`` checked: None (the file's, else DEFAULT_C), a positive number, a pair
-    (c_pos, c_neg) of positive numbers, or "auto" (fitted from the APS frames: :func:`resolve_contrast`).
-    Returns None, "auto", a float or a (c_pos, c_neg) tuple; EventDataError naming C= otherwise."""
-    if C is None or (isinstance(C, str) and C == "auto"):
-        return C
-    if isinstance(C, (tuple, list, np.ndarray)):
-        return as_thresholds(C, "C=")
-    if isinstance(C, bool) or not isinstance(C, (int, float, np.integer, np.floating)) or not math.isfinite(C):
-        raise EventDataError(f"C= must be a finite number, a pair (c_pos, c_neg) or 'auto', got {C!r}")
-    if not C > 0:
-        raise EventDataError(f"C= must be positive (a contrast threshold in log units), got {C}")
-    return float(C)
-
-
-def format_contrast(C) -> str:
-    """'0.2' for one threshold, 'C+ 0.22 / C- 0.18' for a pair."""
-    return f"{C:g}" if np.ndim(C) == 0 else f"C+ {C[0]:.4g} / C- {C[1]:.4g}"
-
-
-def resolve_contrast(rec: Recording, C, path=None, log=print, *, colour: bool = False):
-    """(C for EvINRConfig, where it came from, the ContrastFit or None) for a checked ``C=`` option.
-
-    "auto" fits C+ and C- from the recording's APS frames in the window
-    (:func:`evinr_lite.method.contrast.fit_contrast`) and logs the fit with its uncertainty; None
-    takes the file's C, else DEFAULT_C. Raises EventDataError when "auto" finds no frames or too
-    few usable ones (the message says to pass a number instead).
-    """
-    fit = None
-    if C == "auto":
-        lo, hi = rec.meta["window"]
-        if rec.frames is None or len(rec.frames) < 2:
-            n = 0 if rec.frames is None else len(rec.frames)
-            raise EventDataError(f"{path}: C='auto' fits C from the recording's APS frames, but the window "
-                                 f"[{lo:.6f}, {hi:.6f}] s holds {n} frame(s) (2 or more needed); pass a number instead "
-                                 "(e.g. C=0.2), or widen the window with t_start=/t_end=")
-        try:
-            fit = fit_contrast(rec.frames, rec.events)
-        except EventDataError as err:
-            raise EventDataError(f"{path}: C='auto' could not fit C from the frames in [{lo:.6f}, {hi:.6f}] s: "
-                                 f"{err}") from None
-        log(f"C from the APS frames: {fit}")
-        C, source = fit.C, "fitted from the APS frames (auto)"
-    elif C is not None:
-        source = "given"
-    else:
-        source = "from the file" if rec.meta.get("C") else "default (pass C=)"
-        C = float(rec.meta.get("C") or DEFAULT_C)
-    if colour and np.ndim(C) != 0:
-        raise EventDataError("colour reconstruction takes one C (the photosites' threshold), not a pair or 'auto'; "
-                             "pass a number (e.g. C=0.2)")
-    return C, source, fit
-
-
-def check_run_options(*, C=None, fps=None, t_start=None, t_end=None, n_iters: int | None = None, seed: int = 0,
-                      time_unit=None, recipe: str = "kit", anchor: str = "none") -> None:
-    """Every option of :func:`run_reconstruct` checked before any file is read (EventDataError naming it)."""
-    def finite(name, value):
-        if value is None:
-            return None
-        if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
-            raise EventDataError(f"{name} must be a finite number, got {value!r}")
-        return float(value)
-
-    contrast_option(C)
-    if anchor not in ANCHOR_MODES:
-        raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {anchor!r}")
-    if finite("fps=", fps) is not None and not fps > 0:
-        raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
-    finite("t_start=", t_start)
-    finite("t_end=", t_end)
-    if t_start is not None and t_end is not None and not t_end > t_start:
-        raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end= must exceed t_start=")
-    if n_iters is not None and (isinstance(n_iters, bool) or not isinstance(n_iters, (int, np.integer)) or n_iters < 1):
-        raise EventDataError(f"n_iters= must be a whole number of at least 1 (or None: the recipe's own), got {n_iters!r}")
-    if recipe not in RECIPES:
-        raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {recipe!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**63:
-        raise EventDataError(f"seed must be a whole number in [0, 2**63), got {seed!r}")
-    if time_unit is not None and time_unit not in TIME_UNITS:
-        raise EventDataError(f"time_unit= must be one of {', '.join(TIME_UNITS)}, got {time_unit!r}")
-
-
-def _available_bytes(device: str) -> int:
-    """Memory free for the run: the GPU's free memory on cuda, else the system's available memory."""
-    if device.startswith("cuda"):
-        import torch
-
-        return int(torch.cuda.mem_get_info()[0])
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    try:
-        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return 1 << 62
-
-
-def estimate_memory(rec: Recording, times, config: EvINRConfig) -> dict:
-    """Bytes a reconstruction will need, by part, before anything is allocated.
-
-    Parts: ``networks`` (each window's SIREN with its H*W head: weights, gradients and Adam's two
-    moments, float32), ``bins`` (the event frames and the loss terms over them), ``frames`` (the
-    queried log intensities and tone-mapped frames). An estimate (within a factor of about 2).
-    """
-    lo, hi = rec.meta["window"]
-    span = max(float(hi) - float(lo), 0.0)
-    H, W = rec.events.sensor_size
-    pixels = float(H) * float(W)
-    if config.tau is None or span <= config.tau:
-        n_windows = 1
-    else:
-        n_windows = math.ceil((span - config.overlap) / (config.tau - config.overlap))
-    hidden = config.hidden_features
-    params = 2 * hidden + config.hidden_layers * (hidden * hidden + hidden) + (hidden + 1) * pixels
-    if config.binning == "fixed":
-        n_bins = math.ceil(span / config.bin_duration)
-    else:
-        n_bins = math.ceil(len(rec.events) / config.events_per_bin)
-    n_bins = max(n_bins, 1)
-    parts = {"networks": 16.0 * params * n_windows, "bins": 3 * 4.0 * n_bins * pixels,
-             "frames": 2 * 16.0 * len(np.atleast_1d(times)) * pixels}
-    return {"total": sum(parts.values()), "parts": parts, "n_windows": n_windows, "n_bins": n_bins,
-            "n_frames": len(np.atleast_1d(times)), "span_s": span}
-
-
-def check_memory(rec: Recording, times, config: EvINRConfig, device: str = "cpu", *, fraction: float = 0.8) -> dict:
-    """Refuse (EventDataError) a reconstruction whose :func:`estimate_memory` exceeds ``fraction`` of
-    the free memory, naming the estimate and the parameter to change. Returns the estimate."""
-    est = estimate_memory(rec, times, config)
-    free = _available_bytes(device)
-    if est["total"] <= fraction * free:
-        return est
-    gib = lambda b: f"{b / 2**30:,.1f} GiB"  # noqa: E731
-    H, W = rec.events.sensor_size
-    lo, hi = rec.meta["window"]
-    worst = max(est["parts"], key=est["parts"].get)
-    ev_lo, ev_hi = (float(rec.events.t[0]), float(rec.events.t[-1])) if len(rec.events) else (lo, hi)
-    fix = {
-        "networks": (f"{est['n_windows']:,} network(s) with a head of {H}x{W} pixels (windows of tau = {config.tau} s "
-                     f"over {est['span_s']:.6g} s); shorten the window with t_start=/t_end= (the events cover "
-                     f"[{ev_lo:.6f}, {ev_hi:.6f}] s) or check the sensor size (sensor_size=(H, W))"),
-        "bins": (f"{est['n_bins']:,} event bins of {H}x{W} pixels ({est['span_s']:.6g} s in bins of "
-                 f"{config.bin_duration:g} s); shorten the window with t_start=/t_end= (the events cover "
-                 f"[{ev_lo:.6f}, {ev_hi:.6f}] s) or use a longer bin_duration"),
-        "frames": (f"{est['n_frames']:,} output frames of {H}x{W} pixels; ask for fewer frames with fps= or at=, "
-                   "or shorten the window with t_start=/t_end="),
-    }[worst]
-    raise EventDataError(f"this reconstruction needs about {gib(est['total'])} of memory but about {gib(free)} is "
-                         f"free on {device}: most of it for {fix}")
-
-
 # ---- the whole job ---------------------------------------------------------------------------
 
 def denoise_recording(rec: Recording, path, log=print):
@@ -491,45 +284,39 @@ def denoise_recording(rec: Recording, path, log=print):
     return Recording(events, rec.frames, rec.meta), report
 
 
-def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str | None = None, fps: float | None = None, at=None,
-                    t_start: float | None = None, t_end: float | None = None, device: str | None = None,
-                    n_iters: int | None = None, seed: int = 0, overwrite: bool = False, video: bool = True,
-                    progress: bool = True, time_unit: str | None = None, log=print, command: str = "",
-                    recipe: str = "kit", colour: bool = False, anchor: str = "none", denoise: bool = False) -> dict:
+def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwrite: bool = False, log=print,
+                    command: str = "", **fields) -> dict:
     """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
+
+    The run's options are a :class:`~evinr_lite.apps.options.RunOptions` (``options``), or its
+    fields given as keywords (``C=0.2, fps=30, ...``), or both (the keywords replace fields of
+    ``options``): sensor_size, C ("auto" fits C+ and C- from the APS frames, recorded in run.json
+    as "C_fit"; None: the file's, else DEFAULT_C), fps / at, t_start / t_end, time_unit, device,
+    recipe / n_iters / seed, anchor (APS frames as anchors, not scored; run.json's "anchor" says
+    which), denoise (run.json's settings["denoise"] is the report), colour (one EvINR per channel
+    of the colour filter, frames at (H/2, W/2)), video, progress.
 
     Every check that can fail runs before training: the options, the output folder (checked,
     locked for the whole run against a second run, a staging folder created beside it), the
     device, the file, its format, the sensor size, the window, the times and the memory needed.
-    C: the contrast threshold; a pair (c_pos, c_neg) for ON and OFF events; "auto" fits C+ and C-
-    from the APS frames in the window (logged with its uncertainty, recorded in run.json as
-    "C_fit"); None takes the file's (canonical files store it), else DEFAULT_C = 1
-    (the paper's for DAVIS data). time_unit: the unit of integer or text timestamps ('s', 'ms',
-    'us', 'ns'; None: the reader's detection). ``command`` is recorded in the lock so a second run
-    can name this one. colour: reconstruct in colour from a recording with a colour filter
-    (``meta["cfa"]``; :mod:`evinr_lite.apps.colour_job`), writing colour frames at (H/2, W/2).
-    anchor: "none" (events only), "first" or "all": the recording's APS frames as anchors
-    (:mod:`evinr_lite.method.anchor`); the anchor frames are not scored, run.json's "anchor" says which.
-    denoise: remove hot pixels and background activity from the window's events first
-    (:func:`evinr_lite.method.denoise.denoise`, its defaults); run.json's settings["denoise"] is the report.
-    Returns the contents of run.json (with "scores" when the recording has frames).
+    ``overwrite`` replaces ``out_dir``; ``command`` is recorded in the lock so a second run can
+    name this one. Returns the contents of run.json (with "scores" when the recording has frames).
     """
     from ..core.runtime import default_device
     from ..io.output import OutputDir
 
     t0 = time.perf_counter()
-    check_run_options(C=C, fps=fps, t_start=t_start, t_end=t_end, n_iters=n_iters, seed=seed, time_unit=time_unit,
-                      recipe=recipe, anchor=anchor)
-    if anchor != "none" and colour:
-        raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
+    options = RunOptions.of(options, **fields)   # every option checked, once, before anything is touched
+    anchor, colour = options.anchor, options.colour
     with OutputDir(out_dir, overwrite=overwrite, inputs=[path], log=log, command=command) as target:
         try:
-            device_name = str(default_device(device))
+            device_name = str(default_device(options.device))
         except RuntimeError as err:
             raise EventDataError(str(err)) from None
-        rec = load_recording(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
+        rec = load_recording(path, sensor_size=options.sensor_size, t_start=options.t_start, t_end=options.t_end,
+                             time_unit=options.time_unit)
         denoise_report = None
-        if denoise:   # before anything reads the events: times, memory, training, the scores
+        if options.denoise:   # before anything reads the events: times, memory, training, the scores
             rec, denoise_report = denoise_recording(rec, path, log)
         if anchor != "none" and rec.frames is None:   # before any training
             lo, hi = rec.meta["window"]
@@ -540,16 +327,17 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
             from .colour_job import check_colour_recording
 
             check_colour_recording(rec)
-        times, source = choose_times(rec, fps=fps, at=at)
-        C, C_source, C_fit = resolve_contrast(rec, contrast_option(C), path, log, colour=colour)
-        config = recipe_config(recipe, n_iters, C=C, seed=seed, device=device, progress=progress, anchor=anchor)
-        check_memory(rec, times, config, device_name)
+        times, source = choose_times(rec, fps=options.fps, at=options.at)
+        C, C_source, C_fit = resolve_contrast(rec, options.C, path, log, colour=colour)
+        config = options.config(C)
         lo, hi = rec.meta["window"]
         H, W = rec.events.sensor_size
+        check_memory((H, W), lo, hi, len(rec.events), len(times), config, device_name,
+                     events_span=(float(rec.events.t[0]), float(rec.events.t[-1])))
         log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
             + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
             + f" in {time.perf_counter() - t0:.1f} s")
-        log(f"reconstructing {source} with EvINR ({recipe} recipe, C = {format_contrast(C)} {C_source}, {config.n_iters} Adam "
+        log(f"reconstructing {source} with EvINR ({options.recipe} recipe, C = {format_contrast(C)} {C_source}, {config.n_iters} Adam "
             f"iterations{' + the closed-form output layer' if config.head_solve else ''}, {device_name})")
         if colour:   # one EvINR per channel of the colour filter (apps/colour_job.py)
             from .colour_job import reconstruct_colour_recording, score_colour_recording
@@ -559,7 +347,7 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
         else:
             result = reconstruct_recording(rec, times, config)
             scores = score_recording(result, rec.frames)
-        settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": seed}
+        settings = {"C": C, "C_source": C_source, "times_source": source, "device": device_name, "seed": options.seed}
         if C_fit is not None:   # --C auto: the fit, its uncertainty and what it used
             settings["C_fit"] = C_fit.as_dict()
         if denoise_report is not None:
@@ -570,7 +358,7 @@ def run_reconstruct(path, out_dir, *, sensor_size=None, C: float | tuple | str |
         if colour:
             settings["colour"] = {"cfa": result.history["cfa"], "thresholds": result.history["thresholds"],
                                   "grid": list(result.frames.shape[1:3]), **(colour_scores or {})}
-        run = export_reconstruction(target, rec, result, scores, settings=settings, video=video, log=log)
+        run = export_reconstruction(target, rec, result, scores, settings=settings, video=options.video, log=log)
     seconds = time.perf_counter() - t0
     out_dir = target.given
     line = (f"wrote {len(times)} frames to {out_dir}/ in {seconds:.1f} s "

@@ -181,8 +181,8 @@ class EvINRConfig:
 
         if isinstance(self.C, (tuple, list, np.ndarray)):   # (c_pos, c_neg), checked by the one parser of C
             self.C = as_thresholds(self.C, "C")
-        elif not number("C", self.C) > 0:
-            raise EventDataError(f"C must be positive (or a pair (c_pos, c_neg) of positive numbers), got {self.C}")
+        else:                                               # one number, kept as given
+            as_thresholds(self.C, "C")
         for name in ("bin_duration", "lr", "gamma", "omega_0", "head_lr_scale"):
             if not number(name, getattr(self, name)) > 0:
                 raise EventDataError(f"{name} must be positive, got {getattr(self, name)}")

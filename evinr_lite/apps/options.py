@@ -1,0 +1,240 @@
+"""The options of a run, spelled once: :class:`RunOptions` for ``evinr-lite reconstruct`` / ``batch``,
+:func:`~evinr_lite.apps.recon_job.run_reconstruct` and :func:`~evinr_lite.apps.batch.run_batch`, and
+:func:`parse_times`, the one reader of a list of times (``--at``).
+
+    options = RunOptions(C=0.2, fps=30, t_start=1.0, t_end=2.5)   # every option checked here, once
+    run_reconstruct("rec.h5", "out", options)                      # or run_reconstruct("rec.h5", "out", C=0.2, ...)
+    options.config(C)                                              # the EvINRConfig of its recipe
+
+Times are seconds on the recording's clock; sensor sizes (H, W).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..core.events import TIME_UNITS, EventDataError
+from ..method.anchor import ANCHOR_MODES
+from ..method.config import EvINRConfig
+from ..method.recipes import RECIPES, contrast_option, recipe_config
+
+__all__ = ["RunOptions", "parse_times", "check_run_options", "BATCH_FIELDS"]
+
+# the options a batch takes (each recording's window and times are its own), as batch.json stores them
+BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor")
+MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
+_INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
+
+
+def _time_tokens(text: str) -> list[str]:
+    """The time tokens of a text: lines (blank ones and '#' comments skipped), each split at commas
+    and white space. The table evinr-lite writes (timestamps.txt: `index time` lines with indexes
+    0, 1, 2, ...) gives its time column: recognised by its header comment, or by two or more lines
+    whose first fields count 0, 1, 2, ...; any other text gives every number in it."""
+    lines = text.splitlines()
+    header = any(line.lstrip().startswith("# frame index") for line in lines)
+    data = [line for line in lines if line.strip() and not line.lstrip().startswith("#")]
+    rows = [_INDEX_TIME.fullmatch(line) for line in data]
+    if data and all(rows) and [int(r.group(1)) for r in rows] == list(range(len(rows))) and \
+            (header or len(rows) >= 2):
+        return [r.group(2) for r in rows]
+    return [tok for line in data for tok in line.replace(",", " ").split()]
+
+
+def _times_file(at) -> Path | None:
+    """``at`` as the path of a file of times, or None when it is a list written out in text."""
+    if isinstance(at, Path):
+        if not at.exists():
+            raise EventDataError(f"at={str(at)!r}: no such file of times; check the path")
+    elif not isinstance(at, str) or not at.strip() or len(at) > MAX_PATH_CHARS or "\n" in at:
+        return None
+    try:
+        path = Path(at)
+        is_dir, is_file = path.is_dir(), path.is_file()
+    except (OSError, ValueError):   # not a possible file name (too long, a NUL byte): a list
+        return None
+    if is_dir:
+        raise EventDataError(f"at={str(at)!r} is a folder; give a file with the times (seconds, one per line or "
+                             "separated by commas) or the times themselves (e.g. 0.5,0.75,1.0)")
+    return path if is_file else None
+
+
+def parse_times(at) -> np.ndarray:
+    """Sorted float64 [Q] seconds from an array, a list, text ('0.1,0.2' or '0.1 0.2') or a text file.
+
+    The one reader of ``--at``: a file and the command line give the same times for the same text
+    (``0.1, 0.2, 0.3, 0.4`` is four times on one line of a file as on the command line; a file may
+    also hold one time per line, '#' comments, or evinr-lite's own timestamps.txt). Text longer
+    than 255 characters is never taken for a file name.
+
+    Raises:
+        EventDataError: text that is not numbers, a file that is not UTF-8 text, a folder, no time,
+            or a time that is not finite.
+    """
+    path = _times_file(at)
+    if path is not None:
+        try:
+            text = path.read_bytes().decode("utf-8-sig")
+        except UnicodeDecodeError as err:
+            raise EventDataError(f"{at}: not UTF-8 text (byte {err.start}); save the times as plain text, one number "
+                                 "of seconds per line") from None
+        at = _time_tokens(text)
+    elif isinstance(at, str):
+        at = _time_tokens(at)
+    try:
+        times = np.atleast_1d(np.asarray(at, dtype=np.float64))
+    except (ValueError, TypeError):
+        raise EventDataError(f"could not read times from at={at!r}; give seconds separated by commas "
+                             "(e.g. 0.5,0.75,1.0) or a file with one time per line") from None
+    if times.ndim != 1:
+        raise EventDataError(f"at= must be a flat list of seconds, got an array of shape {times.shape}")
+    if times.size == 0 or not np.all(np.isfinite(times)):
+        raise EventDataError("at=: give at least one finite time in seconds")
+    return np.sort(times)
+
+
+def _finite(name: str, value) -> float | None:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
+        raise EventDataError(f"{name} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _flag(name: str, value) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise EventDataError(f"{name}= must be True or False, got {value!r}")
+    return bool(value)
+
+
+@dataclass(frozen=True, eq=False)
+class RunOptions:
+    """Every option of one reconstruction run, checked on construction (EventDataError naming it).
+
+    Attributes:
+        sensor_size: (H, W) for formats that do not record it; else checked against the file's.
+        C: the contrast threshold: None (the file's, else :data:`~evinr_lite.method.recipes.DEFAULT_C`),
+            a positive number, a pair (c_pos, c_neg), or "auto" (fitted from the APS frames).
+        fps: frames per second over the window; at: explicit times (see :func:`parse_times`; kept
+            as the parsed float64 [Q] seconds). Neither: the ground-truth frame times, else 30 per second.
+        t_start, t_end: the window, seconds on the recording's clock (None: the events' first / last).
+        time_unit: the unit of integer or text timestamps ('s', 'ms', 'us', 'ns'; None: detected).
+        device: "cpu", "cuda" or None (a GPU when present; checked when the run starts).
+        recipe: "kit", "paper" or "v0_1" (:mod:`evinr_lite.method.recipes`); n_iters: its Adam
+            iterations (None: the recipe's own); seed: seeds the networks.
+        anchor: "none", "first" or "all" (:mod:`evinr_lite.method.anchor`); denoise: denoise the
+            window's events first; colour: one EvINR per colour channel (not with an anchor).
+        video: also write MP4 / GIF; progress: show a progress bar.
+    """
+
+    sensor_size: tuple | None = None
+    C: float | tuple | str | None = None
+    fps: float | None = None
+    at: np.ndarray | None = None
+    t_start: float | None = None
+    t_end: float | None = None
+    time_unit: str | None = None
+    device: str | None = None
+    recipe: str = "kit"
+    n_iters: int | None = None
+    seed: int = 0
+    anchor: str = "none"
+    denoise: bool = False
+    colour: bool = False
+    video: bool = True
+    progress: bool = True
+
+    def __post_init__(self):
+        checked = {"C": contrast_option(self.C)}
+        if self.anchor not in ANCHOR_MODES:
+            raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {self.anchor!r}")
+        if self.fps is not None and self.at is not None:
+            raise EventDataError("give either fps= or at=, not both")
+        if _finite("fps=", self.fps) is not None and not self.fps > 0:
+            raise EventDataError(f"fps= must be a positive number of frames per second, got {self.fps}")
+        checked.update(fps=_finite("fps=", self.fps), t_start=_finite("t_start=", self.t_start),
+                       t_end=_finite("t_end=", self.t_end))
+        if self.t_start is not None and self.t_end is not None and not self.t_end > self.t_start:
+            raise EventDataError(f"time window [{self.t_start}, {self.t_end}) is empty or reversed; t_end= must "
+                                 "exceed t_start=")
+        if self.at is not None:
+            times = parse_times(self.at)
+            times.flags.writeable = False
+            checked["at"] = times
+        if self.n_iters is not None and (isinstance(self.n_iters, bool) or
+                                         not isinstance(self.n_iters, (int, np.integer)) or self.n_iters < 1):
+            raise EventDataError(f"n_iters= must be a whole number of at least 1 (or None: the recipe's own), "
+                                 f"got {self.n_iters!r}")
+        if self.recipe not in RECIPES:
+            raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {self.recipe!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2**63:
+            raise EventDataError(f"seed must be a whole number in [0, 2**63), got {self.seed!r}")
+        if self.time_unit is not None and self.time_unit not in TIME_UNITS:
+            raise EventDataError(f"time_unit= must be one of {', '.join(TIME_UNITS)}, got {self.time_unit!r}")
+        if self.device is not None and not isinstance(self.device, str):
+            raise EventDataError(f"device= must be 'cpu', 'cuda' or None (a GPU when present), got {self.device!r}")
+        if self.sensor_size is not None:
+            size = tuple(self.sensor_size) if isinstance(self.sensor_size, (tuple, list, np.ndarray)) else ()
+            if len(size) != 2 or not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) and v > 0
+                                         for v in size):
+                raise EventDataError(f"sensor_size=(H, W) must be two positive whole numbers, got {self.sensor_size!r}")
+            checked["sensor_size"] = (int(size[0]), int(size[1]))
+        for name in ("denoise", "colour", "video", "progress"):
+            checked[name] = _flag(name, getattr(self, name))
+        if self.anchor != "none" and checked["colour"]:
+            raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
+        if self.n_iters is not None:
+            checked["n_iters"] = int(self.n_iters)
+        checked["seed"] = int(self.seed)
+        for name, value in checked.items():   # normalised values (a frozen dataclass: set once, here)
+            object.__setattr__(self, name, value)
+
+    @classmethod
+    def of(cls, options: "RunOptions | None" = None, **fields) -> "RunOptions":
+        """``options`` with ``fields`` replaced (checked again), or new options from ``fields``."""
+        if options is None:
+            return cls(**fields)
+        if not isinstance(options, cls):
+            raise EventDataError(f"options= must be a RunOptions, got {type(options).__name__}")
+        return dataclasses.replace(options, **fields) if fields else options
+
+    @classmethod
+    def from_settings(cls, settings: dict, **fields) -> "RunOptions":
+        """The options of a batch's settings (batch.json: BATCH_FIELDS, missing ones at their
+        defaults; other keys ignored), with ``fields`` added."""
+        return cls(**{k: settings[k] for k in BATCH_FIELDS if settings.get(k) is not None}, **fields)
+
+    def check_batch(self) -> "RunOptions":
+        """These options, refused (EventDataError) if they set one that a batch does not take."""
+        own = [name for name in ("at", "t_start", "t_end", "time_unit") if getattr(self, name) is not None]
+        own += ["colour"] if self.colour else []
+        if own:
+            raise EventDataError(f"a batch reconstructs each recording's own evaluation window at its frame times: "
+                                 f"{', '.join(n + '=' for n in own)} cannot apply; leave them out")
+        return self
+
+    def config(self, C) -> EvINRConfig:
+        """The EvINRConfig of this run's recipe with the resolved threshold ``C`` (a number or a pair)."""
+        return recipe_config(self.recipe, self.n_iters, C=C, seed=self.seed, device=self.device,
+                             progress=self.progress, anchor=self.anchor)
+
+    def to_dict(self, names=None) -> dict:
+        """JSON-ready values of the named fields (all by default): pairs and sizes as lists."""
+        names = [f.name for f in dataclasses.fields(self)] if names is None else names
+        out = {}
+        for name in names:
+            value = getattr(self, name)
+            out[name] = value.tolist() if isinstance(value, np.ndarray) else \
+                list(value) if isinstance(value, tuple) else value
+        return out
+
+
+def check_run_options(**fields) -> RunOptions:
+    """Every option of :func:`~evinr_lite.apps.recon_job.run_reconstruct` checked before any file is
+    read: :class:`RunOptions` (EventDataError naming the option)."""
+    return RunOptions(**fields)
