@@ -1,0 +1,191 @@
+"""One RunOptions for the command line, run_reconstruct and run_batch; one --at parser; recipes and the
+memory estimate in method (issue 23 items 1 and 3, issue 25's "parsing differs by entry point")."""
+import json
+
+import numpy as np
+import pytest
+
+from evinr_lite import EventDataError
+from evinr_lite.apps.cli import build_parser, main
+from evinr_lite.apps.options import BATCH_FIELDS, RunOptions, parse_times
+from evinr_lite.io.export import save_timestamps
+from evinr_lite.method.config import EvINRConfig
+from evinr_lite.method.ensemble import split_windows
+from evinr_lite.method.memory import check_memory, estimate_memory
+from evinr_lite.method.recipes import DEFAULT_C, contrast_option, recipe_config
+from evinr_lite.sim.recordings import write_example_recording
+
+FAST = ["--no-video", "--quiet"]
+
+
+@pytest.fixture(scope="module")
+def example(tmp_path_factory):
+    return write_example_recording(tmp_path_factory.mktemp("opt") / "rec", sensor_size=(24, 32), duration=0.3,
+                                   C=0.25, frame_rate=20.0, seed=0)
+
+
+# ---- one parser of time lists ----------------------------------------------------------------------
+
+def test_a_list_on_one_line_of_a_file_gives_the_same_times_as_the_text(tmp_path):
+    text = "0.1, 0.2, 0.3, 0.4"
+    path = tmp_path / "times.txt"
+    path.write_text(text + "\n")
+    from_file, from_text = parse_times(str(path)), parse_times(text)
+    assert from_file.tolist() == from_text.tolist() == [0.1, 0.2, 0.3, 0.4]
+    assert parse_times(path).tolist() == from_file.tolist()            # a Path, too
+    # one time per line, comments and a CRLF file: the same times
+    path.write_bytes(b"# times\r\n0.4\r\n0.1\r\n\r\n0.3, 0.2\r\n")
+    assert parse_times(str(path)).tolist() == from_text.tolist()
+
+
+def test_a_long_list_is_never_taken_for_a_file_name():
+    times = np.round(np.linspace(0.001, 0.299, 60), 6)
+    text = ",".join(f"{t:.6f}" for t in times)
+    assert len(text) > 255
+    assert parse_times(text).tolist() == times.tolist()
+    assert RunOptions(at=text).at.tolist() == times.tolist()
+
+
+def test_timestamps_txt_written_by_the_kit_reads_back_as_its_times(tmp_path):
+    times = np.array([0.05, 0.1, 0.15])
+    save_timestamps(tmp_path / "timestamps.txt", times)
+    assert parse_times(str(tmp_path / "timestamps.txt")).tolist() == pytest.approx(times.tolist())
+    one = tmp_path / "one.txt"
+    save_timestamps(one, times[:1])                  # one frame: the header says it is index + time
+    assert parse_times(str(one)).tolist() == pytest.approx([0.05])
+    # the same `index time` text from the command line gives the same times
+    assert parse_times((tmp_path / "timestamps.txt").read_text()).tolist() == pytest.approx(times.tolist())
+
+
+@pytest.mark.parametrize("bad,pattern", [("", "at least one"), ("  ", "at least one"), ("0.1;0.2", "could not read"),
+                                         ("nan", "finite"), ([[0.1, 0.2]], "flat list")])
+def test_bad_time_lists_are_refused_with_the_fix(bad, pattern):
+    with pytest.raises(EventDataError, match=pattern):
+        parse_times(bad)
+
+
+def test_a_folder_is_not_a_file_of_times(tmp_path):
+    with pytest.raises(EventDataError, match="folder"):
+        parse_times(str(tmp_path))
+    with pytest.raises(EventDataError, match="no such file"):
+        parse_times(tmp_path / "missing.txt")
+
+
+def test_the_command_line_reads_a_file_and_a_list_alike(capsys, example, tmp_path):
+    path = tmp_path / "times.txt"
+    path.write_text("0.1, 0.15, 0.2, 0.25\n")
+    runs = {}
+    for name, at in (("file", str(path)), ("list", "0.1,0.15,0.2,0.25")):
+        assert main(["reconstruct", str(example), "--out", str(tmp_path / name), "--at", at, *FAST]) == 0
+        runs[name] = json.loads((tmp_path / name / "run.json").read_text())
+    capsys.readouterr()
+    assert runs["file"]["times_s"] == runs["list"]["times_s"] == [0.1, 0.15, 0.2, 0.25]
+    assert runs["file"]["n_frames_written"] == 4
+
+
+# ---- RunOptions ---------------------------------------------------------------------------------------
+
+def test_options_are_normalised_once():
+    o = RunOptions(C=[0.22, 0.18], fps=30, sensor_size=np.array([24, 32]), n_iters=np.int64(5), seed=np.int32(3))
+    assert o.C == (0.22, 0.18) and o.fps == 30.0 and o.sensor_size == (24, 32)
+    assert type(o.n_iters) is int and type(o.seed) is int
+    assert RunOptions(at="0.3,0.1").at.tolist() == [0.1, 0.3]
+    with pytest.raises(ValueError):
+        RunOptions(at="0.1").at[0] = 5.0                    # the parsed times are read-only
+    with pytest.raises(AttributeError):
+        o.fps = 1.0                                         # frozen: checked values stay checked
+
+
+@pytest.mark.parametrize("fields,name", [
+    ({"C": 0}, "C"), ({"C": "0.2"}, "C="), ({"C": (0.2, -1)}, "C"), ({"fps": 0}, "fps="), ({"fps": np.nan}, "fps="),
+    ({"fps": 2, "at": "0.1"}, "fps= or at="), ({"t_start": 1.0, "t_end": 1.0}, "t_end="), ({"t_start": np.inf}, "t_start="),
+    ({"n_iters": 0}, "n_iters="), ({"n_iters": 2.5}, "n_iters="), ({"recipe": "Paper"}, "recipe="),
+    ({"seed": -1}, "seed"), ({"seed": True}, "seed"), ({"time_unit": "sec"}, "time_unit="), ({"anchor": "some"}, "anchor="),
+    ({"sensor_size": (0, 5)}, "sensor_size="), ({"sensor_size": (2.5, 4)}, "sensor_size="), ({"video": "yes"}, "video="),
+    ({"colour": True, "anchor": "all"}, "colour"), ({"device": 0}, "device="),
+])
+def test_every_bad_option_is_refused_naming_it(fields, name):
+    with pytest.raises(EventDataError, match=name.replace("(", r"\(")):
+        RunOptions(**fields)
+
+
+def test_of_replaces_fields_and_checks_them_again():
+    base = RunOptions(C=0.2, fps=10)
+    assert RunOptions.of(base) is base
+    assert RunOptions.of(base, seed=4).seed == 4 and RunOptions.of(base, seed=4).C == 0.2
+    with pytest.raises(EventDataError, match="fps="):
+        RunOptions.of(base, fps=-1)
+    with pytest.raises(EventDataError, match="RunOptions"):
+        RunOptions.of({"C": 0.2})
+
+
+def test_batch_settings_round_trip_and_batch_only_options():
+    o = RunOptions(C=(0.22, 0.18), sensor_size=(24, 32), recipe="paper", n_iters=6, seed=2, denoise=True, video=False)
+    settings = json.loads(json.dumps({**o.to_dict(BATCH_FIELDS), "torch_threads": 1}))   # as batch.json holds it
+    back = RunOptions.from_settings(settings, t_start=0.1)
+    assert back.to_dict(BATCH_FIELDS) == o.to_dict(BATCH_FIELDS) and back.t_start == 0.1
+    assert o.check_batch() is o
+    for fields in ({"at": "0.1"}, {"t_end": 1.0}, {"time_unit": "us"}, {"colour": True}):
+        with pytest.raises(EventDataError, match="batch"):
+            RunOptions(**fields).check_batch()
+
+
+def test_options_give_the_recipes_config():
+    cfg = RunOptions(recipe="paper", n_iters=90, seed=5, progress=False, anchor="first").config(0.3)
+    assert cfg.C == 0.3 and cfg.n_iters == 90 and cfg.c2f_iters == (30, 60) and cfg.seed == 5
+    assert cfg.anchor == "first" and not cfg.progress and cfg.first_omega_0 is None   # the paper's recipe
+    assert recipe_config("kit", C=0.2) == EvINRConfig(C=0.2)
+
+
+def test_the_command_line_maps_each_flag_to_its_option(monkeypatch, tmp_path):
+    import evinr_lite.apps.recon_job as job
+
+    seen = {}
+    monkeypatch.setattr(job, "run_reconstruct", lambda path, out, options, **kw: seen.update(options=options, **kw))
+    argv = ["reconstruct", "rec", "--out", str(tmp_path / "o"), "--sensor", "24x32", "--C", "0.22,0.18", "--at", "0.2,0.1",
+            "--start", "0.05", "--end", "0.3", "--time-unit", "us", "--device", "cpu", "--recipe", "v0_1", "--iters", "7",
+            "--seed", "9", "--anchor", "first", "--denoise", "--no-video", "--quiet", "--overwrite"]
+    assert main(argv) == 0
+    o = seen["options"]
+    assert (o.sensor_size, o.C, o.at.tolist(), o.t_start, o.t_end, o.time_unit, o.device, o.recipe, o.n_iters, o.seed,
+            o.anchor, o.denoise, o.colour, o.video, o.progress) == \
+        ((24, 32), (0.22, 0.18), [0.1, 0.2], 0.05, 0.3, "us", "cpu", "v0_1", 7, 9, "first", True, False, False, False)
+    assert seen["overwrite"] is True
+    defaults = build_parser().parse_args(["reconstruct", "rec", "--out", "o"])
+    assert defaults.recipe == RunOptions().recipe and defaults.seed == RunOptions().seed
+
+
+# ---- method: the default C and the memory estimate -------------------------------------------------
+
+def test_default_C_is_the_configs():
+    assert DEFAULT_C == EvINRConfig().C
+    assert contrast_option(None) is None and contrast_option("auto") == "auto" and contrast_option(1) == 1.0
+
+
+@pytest.mark.parametrize("span", [0.2, 4.9, 5.0, 5.1, 9.6, 23.0, 101.0])
+def test_the_estimate_counts_the_solvers_own_windows(span):
+    cfg = EvINRConfig(progress=False)
+    est = estimate_memory((24, 32), 1.0, 1.0 + span, 1000, 10, cfg)
+    assert est["n_windows"] == len(split_windows(1.0, 1.0 + span, cfg.tau, cfg.overlap))
+    assert est["total"] == sum(est["parts"].values())
+
+
+def test_the_estimate_grows_with_what_it_counts():
+    cfg = EvINRConfig(progress=False)
+    base = estimate_memory((24, 32), 0.0, 1.0, 1000, 10, cfg)["total"]
+    assert estimate_memory((48, 64), 0.0, 1.0, 1000, 10, cfg)["total"] > base
+    assert estimate_memory((24, 32), 0.0, 1.0, 1000, 100, cfg)["total"] > base
+    assert estimate_memory((24, 32), 0.0, 20.0, 1000, 10, cfg)["total"] > base
+    eq = EvINRConfig(binning="equal_count", progress=False)
+    assert estimate_memory((24, 32), 0.0, 1.0, 10**7, 10, eq)["n_bins"] > estimate_memory((24, 32), 0.0, 1.0, 10**4, 10, eq)["n_bins"]
+    with pytest.raises(EventDataError, match="output frames"):
+        check_memory((24, 32), 0.0, 1.0, 1000, 10**12, cfg)
+
+
+def test_batch_task_estimate_takes_plain_arguments():
+    from evinr_lite.apps.batch import PROCESS_MIB, estimate_task_memory_mb
+
+    cfg = EvINRConfig(binning="equal_count", progress=False)
+    mb = estimate_task_memory_mb((24, 32), 2.0, 10**6, n_frames=5, config=cfg)
+    solver = estimate_memory((24, 32), 0.0, 2.0, 10**6, 5, cfg)["total"]
+    assert mb == pytest.approx(PROCESS_MIB + (2 * 17 * 10**6 + solver) / 2**20)
