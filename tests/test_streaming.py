@@ -1,9 +1,9 @@
 """Streaming reconstruction (method/streaming.py) against the whole-sequence solve (method/solver.py).
 
 What streaming must keep: one window gives the identical result; over several windows the networks,
-their alignment and the cross-fade are the same, so streaming differs from the whole-sequence solve
-by exactly one offset image (taken from the first window instead of the whole span); each window
-reads only its own events; a run stopped after any window resumes to the same frames.
+their alignment, the cross-fade, the offset image and the level are the same (offset_from="span"),
+or differ by exactly one offset image taken from the first window (offset_from="first_window");
+each window reads only its own events; a run stopped after any window resumes to the same frames.
 """
 import numpy as np
 import pytest
@@ -49,66 +49,100 @@ class _CountingSource(MemorySource):
         return super()._read_window(t0, t1)
 
 
-def test_one_window_is_identical_to_the_whole_sequence_solve(scene_events):
+@pytest.mark.parametrize("offset_from", ["span", "first_window"])
+def test_one_window_is_identical_to_the_whole_sequence_solve(scene_events, offset_from):
     _, events = scene_events
     q = np.linspace(0.05, 2.95, 12)
     cfg = _config()                                   # tau 5 s: the 3 s span is one window
     whole = reconstruct(events, q, cfg, t_start=0.0, t_end=3.0)
-    idx, L, frames, parts = _collect(stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0))
-    assert len(parts) == 1 and np.array_equal(idx, np.arange(len(q)))
+    idx, L, frames, parts = _collect(stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0,
+                                                        offset_from=offset_from))
+    assert np.array_equal(idx, np.arange(len(q)))
     np.testing.assert_array_equal(L, whole.log_intensity)
     np.testing.assert_array_equal(frames, whole.frames)
 
 
-def test_many_windows_differ_from_the_whole_sequence_solve_by_one_offset_image(scene_events):
-    scene, events = scene_events
+def test_many_windows_give_the_whole_sequence_result(scene_events, tmp_path):
+    _, events = scene_events
     q = np.linspace(0.05, 2.95, 40)                   # some inside the overlaps, where networks are cross-faded
     cfg = _config(tau=1.0, overlap=0.25)              # 4 windows
     whole = reconstruct(events, q, cfg, t_start=0.0, t_end=3.0)
     assert len(whole.windows) == 4
     source = _CountingSource(events)
-    idx, L, frames, parts = _collect(stream_reconstruct(source, q, cfg, t_start=0.0, t_end=3.0))
-    assert len(parts) == 4 and np.array_equal(idx, np.arange(len(q)))
-    assert np.all(np.diff(idx) > 0)                   # handed out in time order, each time once
-    # same networks, alignment and cross-fade: the difference is one image, the same at every time
+    idx, L, frames, parts = _collect(stream_reconstruct(source, q, cfg, t_start=0.0, t_end=3.0, workdir=tmp_path))
+    assert np.array_equal(idx, np.arange(len(q)))
+    # same networks, alignment, cross-fade, offset image and level: equal up to float32 rounding
+    np.testing.assert_allclose(L, whole.log_intensity, rtol=0, atol=1e-4 * np.abs(whole.log_intensity).max())
+    np.testing.assert_allclose(frames, whole.frames, rtol=0, atol=1e-4)
+    # each window read only its own events (never the whole recording)
+    assert len(source.asked) == 4
+    assert all(t1 - t0 <= cfg.tau + 1e-6 for t0, t1 in source.asked)
+    assert (tmp_path / "log_intensity.f32").stat().st_size == len(q) * SIZE[0] * SIZE[1] * 4   # the spill
+
+
+def test_first_window_offset_differs_from_the_whole_sequence_solve_by_one_image(scene_events):
+    scene, events = scene_events
+    q = np.linspace(0.05, 2.95, 40)
+    cfg = _config(tau=1.0, overlap=0.25)
+    whole = reconstruct(events, q, cfg, t_start=0.0, t_end=3.0)
+    parts = []
+    for part in stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0, offset_from="first_window"):
+        parts.append(part)                            # each window's frames are final as it finishes
+        assert part.window[0] == len(parts) - 1
+    idx, L, frames, _ = _collect(parts)
+    assert np.array_equal(idx, np.arange(len(q)))
     diff = L - whole.log_intensity
     spread = np.abs(diff - diff.mean(axis=0)).max()
     assert spread < 1e-3 * np.abs(whole.log_intensity).max(), spread
-    # and that image (first window's offset vs the whole span's) stays small next to the content
-    assert np.abs(diff.mean(axis=0) - diff.mean()).mean() < 0.25 * whole.log_intensity.std()
     # quality against the truth: within 0.02 CLAHE-SSIM of the whole-sequence solve
     gt = tonemap_reinhard(np.stack([scene.log_intensity(t) for t in q])).astype(np.float32)
     s_whole = score_sequence(whole.frames, q, gt, q, "clahe", lpips_model=False)["ssim"]
     s_stream = score_sequence(frames, q, gt, q, "clahe", lpips_model=False)["ssim"]
     assert s_stream > s_whole - 0.02, (s_stream, s_whole)
-    # each window read only its own events (never the whole recording)
-    assert len(source.asked) == 4
-    assert all(t1 - t0 <= cfg.tau + 1e-6 for t0, t1 in source.asked)
 
 
-def test_a_stopped_run_resumes_to_the_same_frames(scene_events, tmp_path):
+@pytest.mark.parametrize("offset_from", ["span", "first_window"])
+def test_a_stopped_run_resumes_to_the_same_frames(scene_events, tmp_path, offset_from):
     _, events = scene_events
     q = np.linspace(0.05, 2.95, 25)
     cfg = _config(tau=1.0, overlap=0.25)
-    _, L_full, _, _ = _collect(stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0))
-    saved = []
-
-    def save(part, state):
-        state.save(tmp_path / "state.npz")
-        saved.append(part)
-
-    stream = stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0, on_window=save)
-    next(stream), next(stream)                        # two windows done, then the run is "killed"
-    stream.close()
+    run = dict(t_start=0.0, t_end=3.0, offset_from=offset_from)
+    _, L_full, _, _ = _collect(stream_reconstruct(events, q, cfg, **run))
+    states = []
+    stream = stream_reconstruct(events, q, cfg, **run, workdir=tmp_path / "work",
+                                on_state=lambda s: (s.save(tmp_path / "state.npz"), states.append(s.next_window)))
+    handed = []
+    if offset_from == "span":                         # nothing is handed out before the last window: stop in between
+        stream = iter(stream_reconstruct(events, q, cfg, **run, workdir=tmp_path / "work",
+                                         on_state=lambda s: (s.save(tmp_path / "state.npz"),
+                                                             states.append(s.next_window),
+                                                             _stop_after(s, 2))))
+        with pytest.raises(_Stop):
+            next(stream)
+    else:
+        handed += [next(stream), next(stream), next(stream)]
+        stream.close()                                # "killed" after handing out three windows
     state = StreamState.load(tmp_path / "state.npz")
-    assert state.next_window == 2
-    idx, L, _, _ = _collect(stream_reconstruct(events, q, cfg, t_start=0.0, t_end=3.0, state=state))
-    done = np.concatenate([p.indices for p in saved])
-    np.testing.assert_array_equal(np.concatenate([done, idx]), np.arange(len(q)))
-    np.testing.assert_array_equal(np.concatenate([np.concatenate([p.log_intensity for p in saved]), L]), L_full)
+    assert state.next_window == 2 and states[-1] == 2
+    idx, L, _, _ = _collect(stream_reconstruct(events, q, cfg, **run, workdir=tmp_path / "work", state=state))
+    if offset_from == "span":
+        np.testing.assert_array_equal(idx, np.arange(len(q)))
+        np.testing.assert_array_equal(L, L_full)
+    else:                                             # the windows after the saved state come again, the same
+        np.testing.assert_array_equal(L, L_full[idx])
+        assert idx[0] == handed[2].indices[0] and idx[-1] == len(q) - 1
     # a state from another plan of windows is refused, not silently mixed in
     with pytest.raises(EventDataError, match="another plan"):
-        next(stream_reconstruct(events, q, _config(tau=1.5, overlap=0.25), t_start=0.0, t_end=3.0, state=state))
+        next(stream_reconstruct(events, q, _config(tau=1.5, overlap=0.25), **run, state=state))
+
+
+class _Stop(Exception):
+    pass
+
+
+def _stop_after(state, k):
+    if state.next_window == k:
+        raise _Stop
 
 
 def test_network_k_alone_is_network_k_of_the_ensemble():
@@ -126,6 +160,8 @@ def test_bad_requests_are_refused_before_any_training(scene_events):
     _, events = scene_events
     with pytest.raises(EventDataError, match="anchored"):
         next(stream_reconstruct(events, [0.5], _config(anchor="first")))
+    with pytest.raises(EventDataError, match="offset_from"):
+        next(stream_reconstruct(events, [0.5], _config(), offset_from="middle"))
     with pytest.raises(EventDataError, match="sorted"):
         next(stream_reconstruct(events, [0.6, 0.5], _config()))
     with pytest.raises(EventDataError, match="outside"):

@@ -47,25 +47,30 @@ from .tonemap import anchor_level, tonemap_reinhard
 from .training import train_frame_inr
 
 __all__ = ["stream_reconstruct", "StreamPart", "StreamState", "train_window", "network_at", "chain_offset",
-           "alignment_times", "first_window_offset", "offset_grid", "PREDICT_CELLS", "N_ALIGN_SAMPLES"]
+           "alignment_times", "first_window_offset", "offset_grid", "span_offset", "OFFSET_FROM", "PREDICT_CELLS", "N_ALIGN_SAMPLES"]
 
 PREDICT_CELLS = 1 << 24     # frames x pixels per prediction batch (64 MB of float32), whatever the sensor
 N_ALIGN_SAMPLES = 8         # times at which neighbouring networks are compared (as ensemble.alignment_offsets)
 _EDGE = 1e-9                # seconds: a time this close to a window belongs to it (as ensemble.blend_weights)
+OFFSET_FROM = ("span", "first_window")
 
 
 @dataclass
 class StreamPart:
-    """The frames one window finished: times float64 [Q_k] (s), log_intensity and frames float32
-    [Q_k, H, W] (anchored log intensity; tone-mapped in [0, 1]), ``indices`` int64 [Q_k] their
-    positions in the query times, ``window`` (index, t_lo, t_hi) and the window's training history."""
+    """Finished frames: times float64 [Q_k] (s), ``indices`` int64 [Q_k] their positions in the query
+    times, log_intensity and frames float32 [Q_k, H, W] (anchored log intensity; tone-mapped in
+    [0, 1]), ``window`` (index, t_lo, t_hi) of the window that finished them (None for the final
+    pass of ``offset_from="span"``) and ``history`` (training so far: train_time_s, n_windows, per window)."""
 
     times: np.ndarray
     indices: np.ndarray
     log_intensity: np.ndarray
     frames: np.ndarray
-    window: tuple
+    window: tuple | None
     history: dict = field(repr=False)
+
+
+_ARRAYS = ("align", "offset", "samples", "q_pending", "q_sum", "g_pending", "g_sum", "grid", "windows")
 
 
 @dataclass
@@ -73,42 +78,65 @@ class StreamState:
     """What window k hands to window k + 1: images, never a network (so a run can resume).
 
     Attributes:
-        next_window: index of the next window to train.
+        next_window: index of the next window to train. windows: float64 [N, 2] the plan.
         align: float32 [H, W] the last network's alignment offset (the chain of overlap means).
-        offset: float32 [H, W] offset image + level from the first window (None before it).
-        samples: float32 [S, H, W] the last network at the alignment times shared with the next
-            one (None for the last window).
-        pending: int64 [M] query indices that wait for the next network; pending_sum float32
-            [M, H, W] their blend so far.
-        train_time_s: training seconds so far. windows: float64 [N, 2] the plan (checked on resume).
+        offset: float32 [H, W] offset image + level (``offset_from="first_window"``: set by window 0;
+            "span": None until every window is done).
+        samples: float32 [S, H, W] the last network at the alignment times shared with the next one.
+        q_pending, g_pending: int64 query / grid indices waiting for the next network, with their
+            blends so far q_sum, g_sum float32 [M, H, W].
+        grid: float32 [G_done, H, W] the finished frames of the offset grid (mode "span").
+        n_spilled: query frames written to the spill file (mode "span"). train_time_s: seconds so far.
+        windows_log: per-window records (events, bins, seconds).
     """
 
     next_window: int
-    align: np.ndarray
-    offset: np.ndarray | None
-    samples: np.ndarray | None
-    pending: np.ndarray
-    pending_sum: np.ndarray
-    train_time_s: float
     windows: np.ndarray
+    align: np.ndarray
+    offset: np.ndarray | None = None
+    samples: np.ndarray | None = None
+    q_pending: np.ndarray | None = None
+    q_sum: np.ndarray | None = None
+    g_pending: np.ndarray | None = None
+    g_sum: np.ndarray | None = None
+    grid: np.ndarray | None = None
+    n_spilled: int = 0
+    train_time_s: float = 0.0
+    windows_log: list = field(default_factory=list)
+
+    @classmethod
+    def start(cls, windows: np.ndarray, sensor_size) -> "StreamState":
+        H, W = sensor_size
+        none, empty = np.zeros(0, np.int64), np.zeros((0, H, W), np.float32)
+        return cls(0, windows, np.zeros((H, W), np.float32), q_pending=none, q_sum=empty, g_pending=none,
+                   g_sum=empty.copy(), grid=empty.copy())
 
     def save(self, path) -> None:
         """Write to ``path`` (.npz), beside and then renamed into place (never half-written)."""
+        import json
+
         path = Path(path)
         tmp = path.with_name(f".{path.name}.partial")
-        arrays = {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+        arrays = {k: np.asarray(getattr(self, k)) for k in _ARRAYS if getattr(self, k) is not None}
+        scalars = {"next_window": self.next_window, "n_spilled": self.n_spilled, "train_time_s": self.train_time_s,
+                   "windows_log": self.windows_log}
         with open(tmp, "wb") as f:
-            np.savez(f, **{k: np.asarray(v) for k, v in arrays.items()})
+            np.savez(f, scalars=np.array(json.dumps(scalars)), **arrays)
         tmp.replace(path)
 
     @classmethod
     def load(cls, path) -> "StreamState":
+        import json
+
         with np.load(path) as z:
-            get = {k: z[k] for k in z.files}
-        return cls(next_window=int(get["next_window"]), align=get["align"], offset=get.get("offset"),
-                   samples=get.get("samples"), pending=get["pending"].astype(np.int64),
-                   pending_sum=get["pending_sum"], train_time_s=float(get["train_time_s"]),
-                   windows=get["windows"])
+            arrays = {k: z[k] for k in z.files}
+        scalars = json.loads(str(arrays.pop("scalars")))
+        return cls(**{k: arrays.get(k) for k in _ARRAYS}, **scalars)
+
+
+def _spill_path(workdir) -> Path:
+    return Path(workdir) / "log_intensity.f32"
+
 
 
 def offset_grid(t_start: float, t_end: float, n_windows: int, config: EvINRConfig) -> np.ndarray:
@@ -170,14 +198,18 @@ def first_window_offset(model: FrameINR, window, config: EvINRConfig) -> np.ndar
     return offset
 
 
-def _check(source, query_times, config, t_start, t_end):
+def _check(source, query_times, config, t_start, t_end, offset_from):
     cfg = config or EvINRConfig()
+    if not isinstance(cfg, EvINRConfig):
+        raise EventDataError(f"config must be an EvINRConfig, got {type(cfg).__name__}")
     if cfg.anchor != "none":
         raise EventDataError(f"streaming does not take anchored configs (anchor={cfg.anchor!r}): the APS frames fit "
                              "the offset over the whole span; use reconstruct(...) for them")
+    if offset_from not in OFFSET_FROM:
+        raise EventDataError(f"offset_from must be one of {OFFSET_FROM}, got {offset_from!r}")
     q = np.atleast_1d(np.asarray(query_times, dtype=np.float64))
-    if q.size == 0 or not np.all(np.isfinite(q)):
-        raise EventDataError("query_times must be a non-empty array of finite seconds")
+    if q.ndim != 1 or q.size == 0 or not np.all(np.isfinite(q)):
+        raise EventDataError("query_times must be a non-empty 1-D array of finite seconds")
     if np.any(np.diff(q) < 0):
         raise EventDataError("query_times must be sorted (increasing seconds) for streaming; pass np.sort(times)")
     first, last = source.t_span
@@ -190,9 +222,9 @@ def _check(source, query_times, config, t_start, t_end):
 
 
 def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *, t_start: float | None = None,
-                       t_end: float | None = None, state: StreamState | None = None, on_window=None,
-                       progress: bool | None = None):
-    """Reconstruct window after window, yielding each window's finished frames (:class:`StreamPart`).
+                       t_end: float | None = None, offset_from: str = "span", workdir=None,
+                       state: StreamState | None = None, on_state=None, progress: bool | None = None):
+    """Reconstruct window after window; yield the finished frames (:class:`StreamPart`) in time order.
 
     Args:
         source: a :class:`~evinr_lite.io.source.RecordingSource` (``open_recording(path)``), or a
@@ -200,80 +232,178 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
         query_times: float64 [Q] sorted seconds inside [t_start, t_end].
         config: EvINRConfig (the kit's default when None); anchored configs are refused.
         t_start, t_end: the span (default: the source's events, widened to the query times).
-        state: a :class:`StreamState` saved by ``on_window`` to resume from (its plan must match).
-        on_window: called as on_window(part, state) after each window, once its frames are final
-            (the place to write them and save the state).
+        offset_from: where the offset image and the level come from. "span" (default): from the
+            whole-sequence solve's grid over the whole span, so the result is that of
+            :func:`~evinr_lite.method.solver.reconstruct` up to float rounding; each window's log
+            intensities are written to a spill file in ``workdir`` as it finishes, and the frames
+            are handed out in one final pass (about 4 bytes x H x W per query time on disk).
+            "first_window": from the grid over the first window; each window's frames are final
+            (and handed out) as soon as it finishes; identical when the span is one window.
+        workdir: folder for the spill file (mode "span"; default: a temporary folder, removed at the
+            end). To resume, pass the same folder and the saved ``state``.
+        state: a :class:`StreamState` saved by ``on_state`` to resume from (its plan must match).
+        on_state: called as on_state(state) after each window, once what it finished is handed out
+            or spilled (the place to save the state for a resume).
         progress: a tqdm bar counting windows with an ETA (default: ``config.progress``).
 
-    Memory: one network, its window's events and bins, and a bounded batch of predictions (plus the
-    frames of one overlap), whatever the recording's length.
+    Memory: one network, its window's events and bins, a bounded batch of predictions, the frames
+    of one overlap, and the offset grid (64 frames, 8 per window beyond 8 windows), whatever the
+    recording's length.
     """
+    import tempfile
+
     from ..io.source import as_source
-    from tqdm.auto import tqdm
 
     source = as_source(source)
-    cfg, q, t_start, t_end = _check(source, query_times, config, t_start, t_end)
+    cfg, q, t_start, t_end = _check(source, query_times, config, t_start, t_end, offset_from)
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
-    N = len(windows)
-    H, W = source.sensor_size
     if state is None:
-        state = StreamState(0, np.zeros((H, W), np.float32), None, None, np.zeros(0, np.int64),
-                            np.zeros((0, H, W), np.float32), 0.0, windows)
+        state = StreamState.start(windows, source.sensor_size)
     elif state.windows.shape != windows.shape or not np.allclose(state.windows, windows, rtol=0, atol=1e-9):
         raise EventDataError("the saved streaming state belongs to another plan of windows (another span, tau or "
                              "overlap); start again without it")
+    grid = offset_grid(t_start, t_end, len(windows), cfg) if offset_from == "span" else np.zeros(0)
+    if offset_from == "first_window":
+        for part, _ in _windows(source, q, grid, cfg, state, None, on_state, progress):
+            yield part
+        return
+    with tempfile.TemporaryDirectory(prefix="evinr-stream-") if workdir is None else _nothing(workdir) as folder:
+        spill = _spill_path(folder)
+        for _, state in _windows(source, q, grid, cfg, state, spill, on_state, progress):
+            pass
+        offset = span_offset(state.grid, cfg)
+        yield from _final_pass(spill, q, offset, cfg, source.sensor_size, _history(state))
+
+
+class _nothing:
+    """A context manager that hands out a folder it does not own."""
+
+    def __init__(self, folder):
+        self.folder = Path(folder)
+
+    def __enter__(self):
+        self.folder.mkdir(parents=True, exist_ok=True)
+        return self.folder
+
+    def __exit__(self, *exc):
+        return False
+
+
+def span_offset(grid_frames: np.ndarray, config: EvINRConfig) -> np.ndarray:
+    """The offset image + level [H, W] float32 from the aligned log intensities on the whole span's
+    grid [G, H, W], by the steps and float32 order of the whole-sequence solve."""
+    H, W = grid_frames.shape[1:]
+    offset = np.zeros((H, W), np.float32)
+    if config.offset_solve == "median_gradient":
+        offset += median_gradient_offset(grid_frames).astype(np.float32)
+    shifted = grid_frames + offset
+    offset += np.float32(anchor_level(config.gamma, config.display_mean) - float(shifted.mean()))
+    return offset
+
+
+def _history(state: StreamState) -> dict:
+    return {"train_time_s": state.train_time_s, "n_windows": len(state.windows), "windows": list(state.windows_log)}
+
+
+def _windows(source, q, grid, cfg, state, spill, on_state, progress):
+    """Train, align and blend window after window from ``state``; yield (StreamPart, state) in mode
+    "first_window" (spill None), else append the finished log intensities to ``spill`` and yield
+    (None, state) (once at least, so the caller always gets the last state)."""
+    from tqdm.auto import tqdm
+
+    windows = state.windows
+    N = len(windows)
     quiet = dataclasses.replace(cfg, progress=False)   # one bar for the windows, none per window
     show = cfg.progress if progress is None else progress
+    if spill is not None:   # resume: drop frames spilled after the state was saved
+        P = int(np.prod(source.sensor_size))
+        with open(spill, "ab") as f:
+            f.truncate(state.n_spilled * P * 4)
     bar = tqdm(total=N, initial=state.next_window, desc="EvINR windows", unit="window", disable=not show)
+    if state.next_window >= N:
+        yield None, state
     try:
         for k in range(state.next_window, N):
             lo, hi = windows[k]
-            end = np.nextafter(hi, np.inf)      # the last window's end is inclusive (as reconstruct's span)
-            events = source.events(lo, end)
+            events = source.events(lo, np.nextafter(hi, np.inf))   # the last window's end is inclusive
             if len(events) < 2:
                 raise EventDataError(f"window {k} [{lo:.6f}, {hi:.6f}] s holds {len(events)} event(s); EvINR needs "
                                      "events in every window: choose a span with events throughout or a longer tau")
             t0 = time.perf_counter()
             model, history = train_window(events, windows, k, quiet)
+            n_events = len(events)
             del events
             align = state.align if k == 0 else chain_offset(state.align, state.samples, model,
-                                                            alignment_times(windows, k))
-            offset = first_window_offset(model, windows[0], cfg) if k == 0 else state.offset
-            total = align + offset if k else offset.copy()    # k = 0: align is zero
-            part = _blend_window(model, windows, k, q, total, state)
+                                                            alignment_times(windows, k)).astype(np.float32)
+            if spill is None:
+                offset = first_window_offset(model, windows[0], cfg) if k == 0 else state.offset
+                total = offset.copy() if k == 0 else align + offset      # k = 0: align is zero
+            else:
+                offset, total = None, align
+            q_idx, q_L, q_pending, q_sum = _blend_window(model, windows, k, q, total, state.q_pending, state.q_sum)
+            g_idx, g_L, g_pending, g_sum = _blend_window(model, windows, k, grid, total, state.g_pending, state.g_sum)
             samples = network_at(model, alignment_times(windows, k + 1)) if k + 1 < N else None
             del model
-            history["window_s"] = time.perf_counter() - t0
-            state = StreamState(k + 1, align.astype(np.float32), offset, samples, part.pop("pending"),
-                                part.pop("pending_sum"), state.train_time_s + history["train_time_s"], windows)
-            L = part["L"]
-            out = StreamPart(q[part["idx"]], part["idx"], L, tonemap_reinhard(L, cfg.gamma).astype(np.float32),
-                             (k, float(lo), float(hi)), history)
-            if on_window is not None:
-                on_window(out, state)
+            log = {"window": k, "t_s": [float(lo), float(hi)], "n_events": n_events,
+                   "final_bins": history.get("final_bins"), "train_time_s": history["train_time_s"],
+                   "seconds": time.perf_counter() - t0}
+            new = StreamState(k + 1, windows, align, offset, samples, q_pending, q_sum, g_pending, g_sum,
+                              np.concatenate([state.grid, g_L]) if g_L.size else state.grid,
+                              state.n_spilled, state.train_time_s + history["train_time_s"],
+                              state.windows_log + [log])
+            part = None
+            if spill is None:
+                part = StreamPart(q[q_idx], q_idx, q_L, tonemap_reinhard(q_L, cfg.gamma).astype(np.float32),
+                                  (k, float(lo), float(hi)), _history(new))
+            else:
+                with open(spill, "ab") as f:
+                    np.ascontiguousarray(q_L, np.float32).tofile(f)
+                new.n_spilled += len(q_idx)
+            state = new
             bar.update(1)
-            yield out
+            yield part, state                          # handed out (or spilled) before the state is saved
+            if on_state is not None:
+                on_state(state)
     finally:
         bar.close()
 
 
-def _blend_window(model, windows, k, q, total_offset, state) -> dict:
-    """Network k's share of the cross-fade at the query times inside its window: the finished
-    times' log intensities, and the times still waiting for network k + 1 with their partial sums."""
-    lo, hi = windows[k]
-    a, b = np.searchsorted(q, lo - _EDGE, "left"), np.searchsorted(q, hi + _EDGE, "right")
-    idx = np.arange(a, b, dtype=np.int64)
+def _final_pass(spill, q, offset, cfg, sensor_size, history):
+    """The spilled log intensities plus the offset, tone-mapped, a bounded batch at a time."""
+    H, W = sensor_size
+    P = H * W
+    step = max(1, PREDICT_CELLS // P)
+    with open(spill, "rb") as f:
+        for i0 in range(0, len(q), step):
+            n = min(step, len(q) - i0)
+            L = np.fromfile(f, np.float32, n * P).reshape(n, H, W)
+            if L.shape[0] != n:
+                raise EventDataError(f"the spill file {spill} is short ({i0 + L.shape[0]} of {len(q)} frames); "
+                                     "it was changed while the run was stopped: start again without resuming")
+            L += offset
+            idx = np.arange(i0, i0 + n, dtype=np.int64)
+            yield StreamPart(q[idx], idx, L, tonemap_reinhard(L, cfg.gamma).astype(np.float32), None, history)
+
+
+def _blend_window(model, windows, k, times, total_offset, pending, pending_sum):
+    """Network k's share of the cross-fade at the ``times`` inside its window.
+
+    Returns (finished indices, their log intensities, indices waiting for network k + 1, their
+    partial sums). ``pending`` / ``pending_sum``: the times network k - 1 left waiting."""
     H, W = model.sensor_size
+    lo, hi = windows[k]
+    a, b = np.searchsorted(times, lo - _EDGE, "left"), np.searchsorted(times, hi + _EDGE, "right")
+    idx = np.arange(a, b, dtype=np.int64)
     if idx.size == 0:
-        return {"idx": idx, "L": np.zeros((0, H, W), np.float32), "pending": idx,
-                "pending_sum": np.zeros((0, H, W), np.float32)}
-    w = blend_weights(windows, q[idx])                 # [N, Q_k]: the whole plan's weights
-    L = network_at(model, q[idx])
+        none = np.zeros(0, np.int64)
+        return none, np.zeros((0, H, W), np.float32), none, np.zeros((0, H, W), np.float32)
+    w = blend_weights(windows, times[idx])             # [N, Q_k]: the whole plan's weights
+    L = network_at(model, times[idx])
     L += total_offset
     if len(windows) > 1:                               # the cross-fade; one window: weight 1 everywhere
         L *= w[k].astype(np.float32)[:, None, None]
-        if state.pending.size:                         # the predecessor's share of the shared times
-            where = np.searchsorted(idx, state.pending)
-            L[where] += state.pending_sum
+        if pending.size:                               # the predecessor's share of the shared times
+            L[np.searchsorted(idx, pending)] += pending_sum
     waiting = w[k + 1] > 0 if k + 1 < len(windows) else np.zeros(idx.size, bool)
-    return {"idx": idx[~waiting], "L": L[~waiting], "pending": idx[waiting], "pending_sum": L[waiting]}
+    return idx[~waiting], L[~waiting], idx[waiting], L[waiting]
+
