@@ -41,7 +41,7 @@ import numpy as np
 from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
-from ..io.readers import detect_format
+from ..io.formats import RECORDING_SUFFIXES, detect_format, is_recording_folder  # formats: io.formats
 from .options import BATCH_FIELDS, RunOptions
 from .recon_job import EQUALIZATIONS, run_reconstruct
 
@@ -49,7 +49,6 @@ __all__ = ["run_batch", "resolve_inputs", "evaluate_recording", "summarize", "es
            "RECORDING_SUFFIXES", "input_identity", "result_state", "result_settings", "check_batch_out",
            "check_scheduler_address", "OWNER_MARKER"]
 
-RECORDING_SUFFIXES = (".h5", ".hdf5", ".txt", ".npy", ".aedat4", ".raw", ".dat")  # files taken from a folder
 SETTINGS_FILE = "batch.json"           # the settings a DIR was made with (a rerun must use the same) and its recordings
 OWNER_MARKER = ".evinr-batch.json"     # inside each DIR/<name>/ a batch wrote: the input's identity and the settings
 LOCK_FILE = ".batch.lock"
@@ -106,11 +105,7 @@ def input_identity(path) -> dict:
 
 
 def _is_recording_dir(path: Path) -> bool:
-    try:
-        detect_format(path)
-        return True
-    except EventDataError:
-        return False
+    return is_recording_folder(path)
 
 
 def _from_cache(spec: str, cache: Path) -> list[dict]:

@@ -24,9 +24,8 @@ import numpy as np
 from ..core.events import EventDataError
 from ..core.frames import Frames
 from ..core.recording import Recording
-from ..io.readers import detect_format, read_recording
-from .describe import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,  # noqa: F401
-                       TIME_UNIT_FORMATS, describe_recording, format_info, read_any)
+from ..io.load import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,  # noqa: F401
+                       TIME_UNIT_FORMATS, describe_recording, format_info, load_recording, read_any)
 from ..evaluation.scoring import score_sequence
 from ..method.anchor import held_out
 from ..method.config import EvINRConfig
@@ -42,40 +41,6 @@ __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "c
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 EQUALIZATIONS = ("none", "clahe")   # scored without equalisation, and with CLAHE (the paper's)
-
-
-# ---- load ------------------------------------------------------------------------------------
-
-def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None,
-                   time_unit: str | None = None) -> Recording:
-    """Read a recording (any supported format) restricted to the window [t_start, t_end).
-
-    Args:
-        path, sensor_size, time_unit: see :func:`read_any`.
-        t_start, t_end: seconds on the recording's clock; None: from the first / to the last event.
-    Returns:
-        Recording whose events lie in the window and whose frames lie in [start, end], the span
-        to reconstruct, stored as ``meta["window"]`` = (start, end) seconds.
-    Raises:
-        EventDataError: missing file, unknown format, wrong sensor size, empty window (each
-            message says what to do).
-    """
-    for name, value in (("t_start", t_start), ("t_end", t_end)):
-        if value is not None and not math.isfinite(value):
-            raise EventDataError(f"{name}= must be a finite number of seconds, got {value}")
-    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
-    events, frames = rec.events, rec.frames
-    if rec.meta["format"] not in READER_WINDOW_FORMATS:
-        events = events.slice_time(t_start, t_end)
-    if len(events) < 2:
-        raise EventDataError(f"{path}: only {len(events)} event(s) in the window [{t_start}, {t_end}) s; "
-                             "choose a longer window (see `evinr-lite info` for the time span)")
-    start = float(events.t[0]) if t_start is None else float(t_start)
-    end = float(events.t[-1]) if t_end is None else float(t_end)
-    if frames is not None:  # only frames the events can reach: inside [start, end]
-        keep = (frames.t >= start) & (frames.t <= end)
-        frames = Frames(frames.images[keep], frames.t[keep], frames.t_origin) if keep.any() else None
-    return Recording(events, frames, {**rec.meta, "window": (start, end)})
 
 
 # ---- times and reconstruction ----------------------------------------------------------------
@@ -149,7 +114,8 @@ def score_recording(result: Reconstruction, gt: Frames | None) -> dict | None:
 
     The trained network is queried at the frames' own timestamps, so the scores do not depend on
     which times were exported. Frames used as anchors (``result.anchor_times``) are not scored.
-    Returns None when no other frame lies in the reconstructed span.
+    Returns None when no other frame lies in the reconstructed span. ``per_frame_index`` counts in
+    ``gt`` as given (the frames export writes to ``gt/``), anchors included.
     """
     if gt is None or not len(gt):
         return None
@@ -157,11 +123,15 @@ def score_recording(result: Reconstruction, gt: Frames | None) -> dict | None:
     keep = (gt.t >= lo) & (gt.t <= hi) & held_out(gt.t, getattr(result, "anchor_times", ()))
     if not keep.any():
         return None
+    index = np.flatnonzero(keep)
     gt = Frames(gt.images[keep], gt.t[keep], gt.t_origin)
     if tuple(gt.size) != tuple(result.frames.shape[1:]):
         raise EventDataError(f"ground-truth frames are {gt.size} but the events' sensor is "
                              f"{tuple(result.frames.shape[1:])} (H, W); they cannot be compared")
-    return score_predictions(result.frames_at(gt.t), gt.t, gt)
+    scores = score_predictions(result.frames_at(gt.t), gt.t, gt)
+    for s in scores.values():   # indices into the frames given (those written to gt/), not into the scored subset
+        s["per_frame_index"] = index[np.asarray(s["per_frame_index"], dtype=np.int64)].tolist()
+    return scores
 
 
 # ---- export ----------------------------------------------------------------------------------

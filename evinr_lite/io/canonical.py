@@ -58,6 +58,8 @@ import numpy as np
 from ..core.cfa import CFA_NAMES, cfa_phase, check_cfa  # the colour filter's one home (names kept here)
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames, to_grey_uint8
+from .notes import note
+from .source import RecordingSource
 
 __all__ = [
     "CanonicalWriter",
@@ -74,6 +76,8 @@ __all__ = [
     "CFA_NAMES",
     "check_cfa",
     "cfa_phase",
+    "CanonicalSource",
+    "META_TYPES",
 ]
 
 FORMAT_NAME = "evinr-lite canonical"
@@ -132,6 +136,8 @@ def _open(path):
         missing = [f"events/{k}" for k in EVENT_FIELDS if f"events/{k}" not in f]
         if missing:
             raise EventDataError(f"{path}: missing datasets {missing}; the file is incomplete: convert it again")
+        _check_datasets(f, path, [f"events/{k}" for k in EVENT_FIELDS] + ["events/t_index", "frames/t",
+                                                                           "frames/images", "frames/rgb"])
         n = f["events/t"].shape
         bad = [k for k in EVENT_FIELDS if f[f"events/{k}"].shape != n or len(n) != 1]
         if bad:
@@ -144,6 +150,48 @@ def _open(path):
         f.close()
         raise _damaged(path, err) from None
     return f
+
+
+def _check_datasets(f, path, names) -> None:
+    """Each of ``names`` present in the file must be a numeric dataset (not a group, not text)."""
+    import h5py
+
+    for name in names:
+        node = f.get(name)
+        if node is None:
+            continue
+        if not isinstance(node, h5py.Dataset):
+            raise EventDataError(f"{path}: {name} is a {type(node).__name__.lower()}, not a dataset; the file is "
+                                 "damaged or was not written by data_fetch: convert it again")
+        if node.dtype.kind not in "iuf":
+            raise EventDataError(f"{path}: {name} holds {node.dtype} values, not numbers; the file is damaged: "
+                                 "convert it again")
+
+
+# Values of meta_json that the kit reads, with their type check and what they must be; other keys are free.
+META_TYPES = {
+    "C": (lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0,
+          "a positive number (the contrast threshold)"),
+    "eval_window": (lambda v: v is None or (isinstance(v, list) and len(v) == 2 and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v) and v[0] < v[1]),
+                    "null or [start, end], two numbers of seconds with start < end"),
+    "calib": (lambda v: isinstance(v, (dict, list)), "an object or a list of numbers"),
+    "cfa": (lambda v: v is None or (isinstance(v, str) and v.upper() in CFA_NAMES), f"null or one of {list(CFA_NAMES)}"),
+    "frame_times_repaired": (lambda v: isinstance(v, list) and all(isinstance(x, int) for x in v),
+                             "a list of frame indices"),
+    "frames_sorted": (lambda v: isinstance(v, bool), "true or false"),
+    "t_origin": (lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v),
+                 "a finite number of seconds"),
+    "time_unit": (lambda v: v in ("s", "ms", "us", "ns"), "one of 's', 'ms', 'us', 'ns'"),
+}
+
+
+def _check_meta(meta: dict, path) -> None:
+    """The keys of meta_json that the kit reads must have their type (see :data:`META_TYPES`)."""
+    for key, (valid, expected) in META_TYPES.items():
+        if key in meta and not valid(meta[key]):
+            raise EventDataError(f"{path}: meta_json[{key!r}] is {meta[key]!r}, but it must be {expected}; repair "
+                                 f"it (h5py.File(path, 'r+').attrs['meta_json']) or convert the file again")
 
 
 def _attr(value):
@@ -165,6 +213,7 @@ def _info_from(f, path) -> dict:
         raise EventDataError(f"{path}: the attribute meta_json is not JSON ({err}); convert the file again") from None
     if not isinstance(info["meta"], dict):
         raise EventDataError(f"{path}: the attribute meta_json is not a JSON object; convert the file again")
+    _check_meta(info["meta"], path)
     if "sensor_size" not in f.attrs:
         raise EventDataError(f"{path}: no attribute sensor_size (H, W); the file is incomplete: convert it again")
     size = np.asarray(f.attrs["sensor_size"]).ravel()
@@ -214,22 +263,49 @@ def canonical_info(path) -> dict:
             raise _damaged(path, err) from None
 
 
+def _time_index(f, n: int):
+    """(t_index, stride) when ``events/t_index`` is usable: a float dataset of ceil(n / stride) finite,
+    non-decreasing values with a positive whole ``stride``; else None (the caller bisects events/t)."""
+    import h5py
+
+    ds = f.get("events/t_index")
+    if not isinstance(ds, h5py.Dataset) or ds.ndim != 1 or ds.dtype.kind != "f":
+        return None
+    try:
+        stride = int(np.asarray(ds.attrs.get("stride")).reshape(()))
+    except (TypeError, ValueError):
+        return None
+    if stride <= 0 or ds.shape[0] != -(-n // stride):
+        return None
+    index = ds[()]
+    if not np.all(np.isfinite(index)) or np.any(np.diff(index) < 0):
+        return None
+    return index, stride
+
+
 def find_time_index(f, value: float, side: str = "left") -> int:
     """First event index i with t[i] >= value (side 'left') or t[i] > value ('right').
 
-    Uses ``events/t_index`` (one float per chunk) and then reads a single chunk of ``events/t``;
-    files without the index fall back to a binary search reading one element at a time.
+    Uses ``events/t_index`` (one float per chunk: t_index[k] = t[k * stride]) and then reads a single
+    chunk of ``events/t``. The index is not trusted blindly: it must be well-formed, and the entries
+    that bracket the answer must equal the timestamps they index (checked on the chunk read, plus one
+    element); a damaged or missing index falls back to a binary search on ``events/t`` reading one
+    element at a time (the same answer, slower), with a logged warning.
     """
     ts = f["events/t"]
     n = ts.shape[0]
-    if "events/t_index" in f:
-        index = f["events/t_index"][()]
-        stride = int(f["events/t_index"].attrs["stride"])
+    found = _time_index(f, n) if n else None
+    if found is not None:
+        index, stride = found
         k = int(np.searchsorted(index, value, side=side))
-        if k == 0:
-            return 0
-        lo, hi = (k - 1) * stride, min(k * stride, n)
-        return lo + int(np.searchsorted(ts[lo:hi], value, side=side))
+        lo, hi = max(k - 1, 0) * stride, min(max(k, 1) * stride, n)
+        chunk = ts[lo:hi]
+        ok = chunk[0] == index[max(k - 1, 0)] and (hi >= n or float(ts[hi]) == index[hi // stride])
+        if ok:   # t[lo] < value <= t[hi] (left side): the answer lies in this chunk
+            return 0 if k == 0 else lo + int(np.searchsorted(chunk, value, side=side))
+    if n and "events/t_index" in f:
+        log.warning("%s: events/t_index does not match events/t (the index is damaged); finding the window by "
+                    "binary search on events/t instead (convert the file again to repair the index)", f.filename)
     lo, hi = 0, n
     while lo < hi:
         mid = (lo + hi) // 2
@@ -272,27 +348,51 @@ def _read_open(f, path, t_start, t_end, frames):
         raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
                              f"{span} (relative to t_origin = {origin}); choose a window inside that range")
     events = _events(f, lo, hi, sensor_size, origin, path)
-    gt = None
-    if frames and "frames/t" in f and f["frames/t"].shape[0]:
-        ft = f["frames/t"][()]
-        a = 0 if t_start is None else int(np.searchsorted(ft, t_start, side="left"))
-        b = len(ft) if t_end is None else int(np.searchsorted(ft, t_end, side="left"))
-        if b > a:
-            if "frames/images" not in f or f["frames/images"].shape[0] != len(ft):
-                raise EventDataError(f"{path}: frames/t and frames/images do not match; the file is damaged: convert "
-                                     "it again")
-            try:
-                gt = Frames(f["frames/images"][a:b], ft[a:b], origin)
-            except EventDataError as err:
-                raise EventDataError(f"{path}: {err}") from None
-            if "frames/rgb" in f:
-                rgb = f["frames/rgb"]
-                if rgb.shape != (len(ft), *f["frames/images"].shape[1:], 3) or rgb.dtype != np.uint8:
-                    raise EventDataError(f"{path}: frames/rgb is {rgb.dtype} {rgb.shape}, expected uint8 "
-                                         f"{(len(ft), *f['frames/images'].shape[1:], 3)} like frames/images; the "
-                                         "file is damaged: convert it again")
-                info["frames_rgb"], info["frames_rgb_t"] = rgb[a:b], gt.t.copy()
+    gt = _frames(f, path, origin, t_start, t_end, info) if frames and "frames/t" in f else None
     return info, lo, hi, events, gt
+
+
+def _frames(f, path, origin: float, t_start, t_end, info: dict):
+    """The frames with t_start <= t < t_end (None when there are none), in time order: frames/t out of
+    order is sorted with a note (meta["read_notes"]); frames/rgb, when present, goes to info["frames_rgb"]."""
+    ft = f["frames/t"][()]
+    if ft.ndim != 1 or not np.all(np.isfinite(ft)):
+        raise EventDataError(f"{path}: frames/t must be finite seconds, one per frame (got shape {ft.shape}); the "
+                             "file is damaged: convert it again")
+    if not len(ft):
+        return None
+    if "frames/images" not in f or f["frames/images"].shape[0] != len(ft):
+        raise EventDataError(f"{path}: frames/t and frames/images do not match; the file is damaged: convert "
+                             "it again")
+    order = None
+    if np.any(np.diff(ft) < 0):
+        order = np.argsort(ft, kind="stable")
+        ft = ft[order]
+        note(info, f"{path}: frames/t is not in time order; the frames are read sorted by their timestamps")
+    a = 0 if t_start is None else int(np.searchsorted(ft, t_start, side="left"))
+    b = len(ft) if t_end is None else int(np.searchsorted(ft, t_end, side="left"))
+    if b <= a:
+        return None
+
+    def take(ds):   # rows a:b of the time order (h5py reads increasing indices only)
+        if order is None:
+            return ds[a:b]
+        wanted = order[a:b]
+        rows = np.unique(wanted)
+        return ds[rows][np.searchsorted(rows, wanted)]
+
+    try:
+        gt = Frames(take(f["frames/images"]), ft[a:b], origin)
+    except EventDataError as err:
+        raise EventDataError(f"{path}: {err}") from None
+    if "frames/rgb" in f:
+        rgb = f["frames/rgb"]
+        if rgb.shape != (len(ft), *f["frames/images"].shape[1:], 3) or rgb.dtype != np.uint8:
+            raise EventDataError(f"{path}: frames/rgb is {rgb.dtype} {rgb.shape}, expected uint8 "
+                                 f"{(len(ft), *f['frames/images'].shape[1:], 3)} like frames/images; the "
+                                 "file is damaged: convert it again")
+        info["frames_rgb"], info["frames_rgb_t"] = take(rgb), gt.t.copy()
+    return gt
 
 
 def read_canonical(path, t_start: float | None = None, t_end: float | None = None, *,
@@ -322,10 +422,62 @@ def read_canonical(path, t_start: float | None = None, t_end: float | None = Non
             raise
         except (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError) as err:
             raise _damaged(path, err) from None
+    return Recording(events, gt, _recording_meta(info, path, (lo, hi)))
+
+
+def _recording_meta(info: dict, path, event_slice) -> dict:
+    """Recording.meta of a canonical file: its attributes, then meta_json, then what the reader adds."""
     meta = {"format": "canonical", "frames_rgb": None, "frames_rgb_t": None,
-            **{k: v for k, v in info.items() if k not in ("format", "meta")}, **info["meta"], "event_slice": (lo, hi)}
-    meta["path"] = str(path)
-    return Recording(events, gt, meta)
+            **{k: v for k, v in info.items() if k not in ("format", "meta")}, **info["meta"]}
+    meta.update(path=str(path), event_slice=event_slice)
+    if info.get("read_notes"):
+        meta["read_notes"] = list(info["read_notes"])
+    return meta
+
+
+class CanonicalSource(RecordingSource):
+    """Windows of a canonical file: each found through the (checked) time index, only its events read.
+
+    Holds the file open (use as a context manager or call :meth:`close`). ``t_span`` and ``n_events``
+    come from the stored events (first and last timestamp, dataset length), the frames are read once.
+    """
+
+    def __init__(self, path, *, frames: bool = True):
+        path = Path(path)
+        self._f = _open(path)
+        try:
+            info = _info_from(self._f, path)
+            ts = self._f["events/t"]
+            n = ts.shape[0]
+            self.t_span = (float(ts[0]), float(ts[n - 1])) if n else (0.0, 0.0)
+            gt = _frames(self._f, path, float(info["t_origin"]), None, None, info) if frames and "frames/t" in self._f \
+                else None
+        except BaseException as err:
+            self.close()
+            if isinstance(err, (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError)):
+                raise _damaged(path, err) from None
+            raise
+        self.path, self.format, self.frames, self.n_events = path, "canonical", gt, int(n)
+        self.sensor_size, self.t_origin = info["sensor_size"], float(info["t_origin"])
+        self.meta = _recording_meta(info, path, (0, int(n)))
+
+    def _read_window(self, t0: float, t1: float) -> Events:
+        try:
+            lo, hi = _window(self._f, self.path, t0, t1)
+            return _events(self._f, lo, hi, self.sensor_size, self.t_origin, self.path)
+        except EventDataError:
+            raise
+        except (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError) as err:
+            raise _damaged(self.path, err) from None
+
+    def load(self, t_start=None, t_end=None):
+        """As :func:`read_canonical` (the frames' colour version included)."""
+        return read_canonical(self.path, t_start, t_end)
+
+    def close(self) -> None:
+        f, self._f = getattr(self, "_f", None), None
+        if f is not None:
+            f.close()
 
 
 def iter_canonical_events(path, t_start: float | None = None, t_end: float | None = None, *,

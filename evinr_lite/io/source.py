@@ -7,7 +7,7 @@ allows it (memory-mapped .npy, canonical and HQF h5, AEDAT4 and Prophesee packet
 in seconds on the recording's clock: the same clock as ``Events.t`` and ``Frames.t`` that
 :func:`~evinr_lite.io.read_recording` returns (relative to ``t_origin``).
 
-    source = open_recording("shared/data/ijrr_slider_depth_chunk")
+    source = open_recording("shared/data/ijrr_slider_depth_chunk")     # evinr_lite.io.open_recording
     t0, t1 = source.t_span
     for start in np.arange(t0, t1, 0.05):
         window = source.events(start, start + 0.05)     # Events with start <= t < start + 0.05
@@ -24,7 +24,7 @@ from ..core.events import EventDataError, Events, InputError
 from ..core.frames import Frames
 from ..core.recording import Recording
 
-__all__ = ["RecordingSource", "MemorySource", "open_recording", "as_source", "check_window"]
+__all__ = ["RecordingSource", "MemorySource", "as_source", "check_window"]
 
 
 def check_window(t0, t1, what: str = "window") -> tuple[float, float]:
@@ -163,28 +163,6 @@ def as_source(obj) -> RecordingSource:
         return MemorySource(obj)
     if isinstance(obj, (str, Path)):
         raise InputError(f"as_source takes a Recording or Events in memory, got the path {obj!r}; "
-                         "use open_recording(path) for a file or folder")
+                         "use evinr_lite.io.open_recording(path) for a file or folder")
     raise InputError(f"as_source takes a Recording or Events, got {type(obj).__name__}; read a file with "
-                     "open_recording(path), or build Events(t, x, y, p, sensor_size)")
-
-
-def open_recording(path, **reader_options) -> RecordingSource:
-    """Open a recording (any format :func:`~evinr_lite.io.detect_format` knows) for reading window by window.
-
-    ``reader_options`` are those of the format's reader (``sensor_size=``, ``time_unit=``, ...). Formats
-    that can read a window without the rest (memory-mapped .npy, canonical and HQF h5, AEDAT4 and
-    Prophesee packets) do so; the others (text, IJRR and EVREAL folders) are read once and sliced.
-    """
-    from .readers import detect_format, read_recording
-
-    kind = detect_format(path)
-    opener = _WINDOWED.get(kind)
-    if opener is not None:
-        return opener(Path(path), **reader_options)
-    recording = read_recording(path, **reader_options)
-    return MemorySource(recording.events, recording.frames, recording.meta, path=path,
-                        format=recording.meta.get("format", kind))
-
-
-_WINDOWED: dict = {}   # format name -> opener(path, **options) of a source that reads only its windows
-
+                     "evinr_lite.io.open_recording(path), or build Events(t, x, y, p, sensor_size)")

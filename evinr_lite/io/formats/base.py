@@ -1,0 +1,243 @@
+"""What every format module declares (:class:`FileFormat`), and the checks the readers share.
+
+A format module (``npy.py``, ``txt.py``, ``ijrr.py``, ...) defines its reader and one
+``FORMAT = FileFormat(...)`` (or ``FORMATS = (...)``) that says how to recognise the format and what
+its reader accepts. :mod:`.registry` collects them; detection, ``read_recording``,
+``SUPPORTED_FORMATS`` and the capability tables are derived from these declarations.
+"""
+from __future__ import annotations
+
+import json
+import stat
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ...core.events import EventDataError, Events, check_time_span, relative_seconds, resolve_time_unit
+from ..text import read_text_bytes
+
+__all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
+           "json_file", "size_value", "plain_attr", "check_declared_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted"]
+
+
+@dataclass(frozen=True)
+class FileFormat:
+    """One recording format, as its module declares it.
+
+    Attributes:
+        name: the format's name (``detect_format``'s answer, ``meta["format"]``).
+        description: one phrase for the list of supported formats.
+        reader: ``reader(path, **options) -> Recording``.
+        folder: True for a folder format (IJRR, EVREAL), False for a single file.
+        suffixes: file name endings taken as this format when a folder of recordings is scanned (lower case).
+        sniff: ``sniff(path, head) -> bool``: the content is this format (``head``: the file's first
+            64 bytes; None for a folder). Formats are tried in the registry's order.
+        by_suffix: also taken by its suffix alone when no format's content matched (text files).
+        needs_sensor_size: the file may not record the sensor size (then ``sensor_size=`` is needed).
+        takes_sensor_size: the reader accepts ``sensor_size=`` (to supply or check it).
+        time_unit: the unit the format fixes for its timestamps ('us', 's'), or None when the reader
+            takes ``time_unit=`` (the file does not say).
+        windowed: the reader takes ``t_start=`` / ``t_end=`` and reads only that window from disk.
+        open_source: ``open_source(path, **options) -> RecordingSource`` that reads only each window
+            (None: the recording is read once and sliced in memory).
+        options: the reader's other keyword options (for messages and the command line).
+        priority: formats are tried by ascending priority (a more specific format first: the
+            canonical h5 before the generic HQF h5; text, recognised by its suffix, last).
+    """
+
+    name: str
+    description: str
+    reader: Callable
+    folder: bool = False
+    suffixes: tuple[str, ...] = ()
+    sniff: Callable | None = None
+    by_suffix: bool = False
+    needs_sensor_size: bool = False
+    takes_sensor_size: bool = False
+    time_unit: str | None = None
+    windowed: bool = False
+    open_source: Callable | None = None
+    options: tuple[str, ...] = field(default=())
+    priority: int = 50
+
+
+# ---- checks shared by the readers -----------------------------------------------------------
+
+def existing(path, kind: str = "file") -> Path:
+    """``path`` as a Path when it is an existing non-empty regular file (``kind='file'``) or a folder."""
+    path = Path(path)
+    if not path.exists():
+        raise EventDataError(f"no such {kind}: {path}; check the path")
+    mode = path.stat().st_mode
+    if kind == "folder" and not stat.S_ISDIR(mode):
+        raise EventDataError(f"{path} is not a folder; pass the recording's folder")
+    if kind == "file" and stat.S_ISDIR(mode):
+        raise EventDataError(f"{path} is a folder, not a file; pass the file")
+    if kind == "file" and not stat.S_ISREG(mode):
+        raise EventDataError(f"{path} is not a regular file (a FIFO, pipe or device); save the data to a file first")
+    if kind == "file" and path.stat().st_size == 0:
+        raise EventDataError(f"{path} is empty")
+    return path
+
+
+def load_npy(path: Path, *, mmap: bool = False):
+    """np.load of one plain array (memory-mapped when ``mmap``), every failure an EventDataError naming the file."""
+    try:   # memory-mapped first: a damaged header that claims more data than the file holds fails, not allocates
+        array = np.load(path, allow_pickle=False, mmap_mode="r")
+        return array if mmap or not isinstance(array, np.memmap) else np.array(array)
+    except Exception as err:   # numpy raises ValueError, SyntaxError, TokenError, OSError, ... on a damaged header
+        raise EventDataError(f"{path}: not a readable numeric .npy array ({type(err).__name__}: {err}); the file is "
+                             "damaged or incomplete, or not saved with np.save(path, array)") from None
+
+
+def to_seconds(source, t, time_unit):
+    """Timestamps in their unit (detected when time_unit is 'auto'/None) -> (seconds relative to origin,
+    origin, unit), the span checked for plausibility."""
+    unit = resolve_time_unit(t, time_unit, source)
+    t, origin = relative_seconds(t, unit)
+    check_time_span(t, source, unit)
+    return t, origin, unit
+
+
+def build_events(source, t, x, y, p, sensor_size, *, polarity, t_origin=0.0, sort=False) -> Events:
+    """Events.from_arrays with the file named in any error message."""
+    try:
+        return Events.from_arrays(t, x, y, p, sensor_size, polarity=polarity, sort=sort, t_origin=t_origin)
+    except EventDataError as err:
+        raise EventDataError(f"{source}: {err}") from None
+
+
+def size_hint(x, y) -> str:
+    """The smallest sensor the coordinates fit, as a hint for a message asking for the sensor size."""
+    if len(x) == 0:
+        return ""
+    return (f"; the events span x (column) 0..{int(np.max(x))} and y (row) 0..{int(np.max(y))}, "
+            f"so the smallest sensor that fits is ({int(np.max(y)) + 1}, {int(np.max(x)) + 1}), "
+            "but use the camera's real size, e.g. (180, 240) for a DAVIS240C")
+
+
+def sensor_from_header(path, header, sensor_size):
+    """Reconcile a `W H` header (given as (H, W)) with a sensor_size argument."""
+    if header is None or sensor_size is None:
+        return sensor_size if header is None else header
+    if tuple(int(v) for v in sensor_size) != header:
+        H, W = header
+        raise EventDataError(
+            f"{path}: the header line `{W} {H}` (width first) means sensor_size (H, W) = {header}, "
+            f"but sensor_size={tuple(sensor_size)} was passed; pass sensor_size={header} or leave it out"
+        )
+    return header
+
+
+def check_declared_size(path, declared, sensor_size, where: str):
+    """The file's (H, W), or an error when a different sensor_size was asked for."""
+    if sensor_size is not None and tuple(int(v) for v in sensor_size) != declared:
+        H, W = declared
+        raise EventDataError(f"{path}: the {where} says the sensor is (H, W) = {declared} ({H}x{W}), but sensor "
+                             f"size {tuple(int(v) for v in sensor_size)} was given; leave the sensor size out "
+                             "(the file's is used) or pass the file's")
+    return declared
+
+
+def json_file(path: Path) -> dict:
+    """A JSON object from a file, or an EventDataError naming the file."""
+    try:
+        data = json.loads(read_text_bytes(path, "JSON file").decode("utf-8"))
+    except UnicodeDecodeError as err:
+        raise EventDataError(f"{path}: not UTF-8 text ({err}); save it as UTF-8 JSON") from None
+    except json.JSONDecodeError as err:
+        raise EventDataError(f"{path}: not valid JSON ({err}); expected e.g. {{\"sensor_resolution\": [H, W]}}") from None
+    if not isinstance(data, dict):
+        raise EventDataError(f"{path}: expected a JSON object such as {{\"sensor_resolution\": [H, W]}}, "
+                             f"got {type(data).__name__}")
+    return data
+
+
+def size_value(source, value, name) -> tuple[int, int]:
+    """A stored (H, W) -> two positive ints, or an EventDataError naming where it came from."""
+    try:
+        a = np.asarray(value).ravel()
+        if a.size != 2 or a.dtype.kind not in "iuf" or not np.all(np.isfinite(a)) or np.any(a != np.round(a)) \
+                or np.any(a <= 0) or np.any(a > 1 << 20):
+            raise ValueError
+        return int(a[0]), int(a[1])
+    except (ValueError, TypeError):
+        raise EventDataError(f"{source}: {name} must be (H, W), two positive whole numbers; got {value!r}") from None
+
+
+def plain_attr(value):
+    """An HDF5 attribute as a plain value (bytes decoded)."""
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    return value
+
+
+def check_reader_window(t_start, t_end) -> None:
+    """Refuse a non-finite or reversed ``[t_start, t_end)`` before any reading."""
+    import math
+
+    for name, value in (("t_start", t_start), ("t_end", t_end)):
+        if value is not None and (not isinstance(value, (int, float, np.integer, np.floating))
+                                  or not math.isfinite(value)):
+            raise EventDataError(f"{name}= must be a finite number of seconds, got {value!r}")
+    if t_start is not None and t_end is not None and t_end <= t_start:
+        raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
+
+
+class Clock:
+    """File timestamps (in ``unit``, integer or float) <-> float64 seconds relative to a whole-second origin.
+
+    The origin is that of :func:`~evinr_lite.core.events.relative_seconds` for a recording whose
+    earliest timestamp is ``first`` (its whole seconds on an absolute clock, else 0): reading a window
+    through a Clock gives the same seconds as reading the whole file and slicing it. Integer
+    timestamps are shifted in integer arithmetic before the division, so nothing is lost.
+    """
+
+    def __init__(self, first, unit: str, integer: bool):
+        from ...core.events import LARGE_T, TIME_UNITS, auto_origin
+
+        self.unit, self.integer = unit, integer
+        self.per_s = round(1 / TIME_UNITS[unit])
+        if integer:
+            first = int(first)
+            self.origin_units = (first // self.per_s) * self.per_s if abs(first) >= LARGE_T * self.per_s else 0
+            self.origin = float(self.origin_units // self.per_s)
+        else:
+            self.origin = auto_origin(float(first) / self.per_s)
+
+    def seconds(self, raw) -> np.ndarray:
+        """File timestamps -> float64 seconds relative to the origin."""
+        raw = np.asarray(raw)
+        if self.integer:
+            return (raw.astype(np.int64) - self.origin_units) / self.per_s
+        return raw.astype(np.float64) / self.per_s - self.origin
+
+
+def bisect_seconds(column, clock: Clock, value: float, lo: int, hi: int) -> int:
+    """First index in [lo, hi) whose time (in seconds, through ``clock``) is >= ``value``, reading
+    single elements of ``column`` (an on-disk dataset or memory map: O(log N) reads, not N)."""
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if float(clock.seconds(column[mid])) < value:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+def probe_sorted(column, source, n_probe: int = 1025) -> None:
+    """Refuse a timestamp column that is evidently not sorted, from about ``n_probe`` evenly spaced
+    elements (a window is found by bisection, which needs sorted times); a full read checks them all."""
+    n = column.shape[0]
+    if n < 2:
+        return
+    idx = np.unique(np.linspace(0, n - 1, min(n, n_probe)).astype(np.int64))
+    values = np.array([column[int(i)] for i in idx])
+    down = np.flatnonzero(np.diff(values) < 0)
+    if down.size:
+        a, b = int(idx[down[0]]), int(idx[down[0] + 1])
+        raise EventDataError(f"{source}: the timestamps are not sorted (t[{a}] = {values[down[0]]!r} > t[{b}] = "
+                             f"{values[down[0] + 1]!r}), so a time window cannot be found without reading "
+                             "everything; read the whole file with sort=True, or sort it and save it again")

@@ -1,0 +1,221 @@
+"""An HQF-style HDF5 file (the layout of the HQF / EVREAL h5 releases and of event_utils).
+
+Layout: events/xs, events/ys (int), events/ts (float64 s, sorted), events/ps (bool, 0/1 or -1/+1);
+images/image%09d (uint8) with attrs 'timestamp' (and 'event_idx'); root attr 'sensor_resolution'
+(H, W). A window is found by bisection on events/ts on disk and only its slice is read.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...core.events import TIME_UNITS, EventDataError, Events, check_time_span, resolve_time_unit
+from ...core.frames import Frames, to_grey_uint8
+from ...core.recording import Recording
+from ..source import RecordingSource
+from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, existing, plain_attr,
+                   probe_sorted, size_value)
+
+__all__ = ["read_h5", "HqfSource", "FORMAT"]
+
+EVENT_NAMES = ("events/xs", "events/ys", "events/ts", "events/ps")
+H5_ERRORS = (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError)
+
+
+def _damaged(path, err) -> EventDataError:
+    return EventDataError(f"{path}: the HDF5 file is damaged or incomplete ({type(err).__name__}: {err}); copy or "
+                          "convert it again")
+
+
+def _open_file(path):
+    import h5py
+
+    try:
+        return h5py.File(path, "r")
+    except OSError as err:
+        raise _damaged(path, err) from None
+
+
+class _Layout:
+    """The checked layout of an open HQF file: sensor size, event count, clock, time unit."""
+
+    def __init__(self, f, path, time_unit):
+        import h5py
+
+        self.f, self.path = f, path
+        missing = [n for n in EVENT_NAMES if n not in f or not isinstance(f[n], h5py.Dataset)]
+        if missing:
+            raise EventDataError(f"{path}: missing datasets {missing} (or groups where datasets belong); expected "
+                                 f"the HQF layout {list(EVENT_NAMES)}, each a 1-D dataset")
+        if "sensor_resolution" not in f.attrs:
+            raise EventDataError(f"{path}: no root attribute 'sensor_resolution' (H, W); add it, e.g. "
+                                 "h5py.File(path, 'r+').attrs['sensor_resolution'] = (H, W)")
+        self.sensor_size = size_value(path, f.attrs["sensor_resolution"], "the attribute sensor_resolution")
+        ts = self.ts = f["events/ts"]
+        n = self.n = ts.shape[0] if ts.ndim == 1 else -1
+        if any(f[name].shape != (n,) for name in EVENT_NAMES):
+            raise EventDataError(f"{path}: {EVENT_NAMES} must be 1-D with the same length, got "
+                                 f"{[f[name].shape for name in EVENT_NAMES]}")
+        for name in EVENT_NAMES:
+            if f[name].dtype.kind not in "iufb":
+                raise EventDataError(f"{path}: {name} must be numeric, got dtype {f[name].dtype}")
+        self.unit = resolve_time_unit(ts.dtype.kind if n else "f", time_unit, f"{path}: events/ts")
+        per_s = 1.0 / TIME_UNITS[self.unit]
+        if n and not (math.isfinite(float(ts[0])) and math.isfinite(float(ts[n - 1]))):
+            raise EventDataError(f"{path}: events/ts holds non-finite timestamps; the file is damaged")
+        if n and ts.dtype.kind == "f" and ts.dtype.itemsize < 8:   # float32 on an absolute clock rounds to minutes
+            step = float(np.spacing(np.abs(np.asarray([ts[0], ts[n - 1]], dtype=ts.dtype)).max())) / per_s
+            if step > 1e-6:
+                raise EventDataError(f"{path}: events/ts is {ts.dtype}, which at these values resolves only "
+                                     f"{step:.3g} s; the timestamps were rounded when the file was written: write "
+                                     "them as float64 (or integer microseconds)")
+        self.clock = Clock(ts[0] if n else 0, self.unit, ts.dtype.kind in "iu")
+        self.origin = self.clock.origin
+
+    def span(self) -> tuple[float, float]:
+        if not self.n:
+            return 0.0, 0.0
+        return float(self.clock.seconds(self.ts[0])), float(self.clock.seconds(self.ts[self.n - 1]))
+
+    def window(self, t_start, t_end) -> tuple[int, int]:
+        lo = 0 if t_start is None else bisect_seconds(self.ts, self.clock, t_start, 0, self.n)
+        hi = self.n if t_end is None else bisect_seconds(self.ts, self.clock, t_end, lo, self.n)
+        return lo, hi
+
+    def events(self, lo: int, hi: int) -> Events:
+        t = self.clock.seconds(self.ts[lo:hi])
+        check_time_span(t, f"{self.path}: events/ts", self.unit)
+        x, y, p = (self.f[name][lo:hi] for name in ("events/xs", "events/ys", "events/ps"))
+        return build_events(self.path, t, x, y, p, self.sensor_size, polarity="auto", t_origin=self.origin)
+
+    def frames(self, t_start=None, t_end=None, meta=None) -> Frames | None:
+        """The frames in [t_start, t_end) on the events' clock, sorted by time (one HQF sequence has a frame
+        out of order); their 'event_idx' attributes go to ``meta["frame_event_idx"]``."""
+        import h5py
+
+        f, path = self.f, self.path
+        if "images" not in f or not isinstance(f["images"], h5py.Group) or not len(f["images"]):
+            return None
+        group = f["images"]
+        keys = np.array(sorted(group))
+        stamps = []
+        for k in keys:
+            if not isinstance(group[k], h5py.Dataset):
+                raise EventDataError(f"{path}: images/{k} is a group, not an image dataset; remove it or store the "
+                                     "frame as a dataset")
+            value = group[k].attrs.get("timestamp")
+            try:
+                stamp = float(np.asarray(value).reshape(()))
+            except (TypeError, ValueError):
+                raise EventDataError(f"{path}: images/{k} has no numeric 'timestamp' attribute (got {value!r}); "
+                                     "every frame needs one") from None
+            if not math.isfinite(stamp):
+                raise EventDataError(f"{path}: images/{k} has a non-finite 'timestamp'; repair or remove that frame")
+            stamps.append(stamp)
+        stamps = np.array(stamps, dtype=np.float64)   # float64 holds whole microseconds exactly for 285 years
+        stamps = ((stamps - self.clock.origin_units) / self.clock.per_s if self.clock.integer
+                  else stamps / self.clock.per_s - self.origin)
+        keep = np.ones(len(keys), dtype=bool)
+        if t_start is not None:
+            keep &= stamps >= t_start
+        if t_end is not None:
+            keep &= stamps < t_end
+        order = np.argsort(stamps[keep], kind="stable")
+        keys, stamps = keys[keep][order], stamps[keep][order]
+        if not len(keys):
+            return None
+        images = [to_grey_uint8(group[k][()], f"{path}:images/{k}") for k in keys]
+        if len({im.shape for im in images}) > 1:
+            raise EventDataError(f"{path}: the frames have different sizes {sorted({im.shape for im in images})}")
+        frames = Frames(np.stack(images), stamps, self.origin)
+        if frames.size != self.sensor_size:
+            raise EventDataError(f"{path}: frames are {frames.size} but sensor_resolution is "
+                                 f"{self.sensor_size} (both (H, W))")
+        if meta is not None and all("event_idx" in group[k].attrs for k in keys):  # indices into the file's events
+            meta["frame_event_idx"] = np.array([int(np.asarray(group[k].attrs["event_idx"]).reshape(()))
+                                                for k in keys])
+        return frames
+
+
+def read_h5(path, *, t_start=None, t_end=None, time_unit="auto") -> Recording:
+    """An HQF-style h5 file, optionally only the time window [t_start, t_end).
+
+    Args:
+        t_start, t_end: seconds on the returned clock (file time minus ``t_origin``). The window
+            is found by binary search on the ts dataset on disk and only that slice is read; frames
+            are restricted to the same window. Frames come sorted by timestamp.
+        time_unit: unit of events/ts and the frames' timestamps; 'auto': an integer dataset is
+            microseconds (with a TimeUnitWarning), floats seconds.
+    Raises:
+        EventDataError for a missing, damaged or incomplete file, missing datasets or attributes.
+    """
+    path = existing(path)
+    check_reader_window(t_start, t_end)
+    f = _open_file(path)
+    try:
+        with f:
+            layout = _Layout(f, path, time_unit)
+            if t_start is not None or t_end is not None:
+                probe_sorted(layout.ts, path)
+            lo, hi = layout.window(t_start, t_end)
+            if hi <= lo:
+                first, last = layout.span()
+                span = f"[{first:.6f}, {last:.6f}] s" if layout.n else "nothing"
+                raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
+                                     f"{span} (relative to t_origin = {layout.origin}); choose a window inside that range")
+            events = layout.events(lo, hi)
+            meta = {"format": "h5", "path": str(path), "attrs": {k: plain_attr(v) for k, v in f.attrs.items()},
+                    "event_slice": (lo, hi), "time_unit": layout.unit}
+            frames = layout.frames(t_start, t_end, meta)
+    except EventDataError:
+        raise
+    except H5_ERRORS as err:
+        raise _damaged(path, err) from None
+    return Recording(events, frames, meta)
+
+
+class HqfSource(RecordingSource):
+    """Windows of an HQF h5 file: each found by bisection on events/ts, only its slice read. Holds the file open."""
+
+    def __init__(self, path, *, time_unit="auto"):
+        path = existing(path)
+        self._f = _open_file(path)
+        try:
+            self._layout = layout = _Layout(self._f, path, time_unit)
+            probe_sorted(layout.ts, path)
+            self.meta = {"format": "h5", "path": str(path),
+                         "attrs": {k: plain_attr(v) for k, v in self._f.attrs.items()}, "time_unit": layout.unit}
+            self.frames = layout.frames(meta=self.meta)
+            self.t_span = layout.span()
+        except EventDataError:
+            self.close()
+            raise
+        except H5_ERRORS as err:
+            self.close()
+            raise _damaged(path, err) from None
+        self.path, self.format = path, "h5"
+        self.sensor_size, self.t_origin, self.n_events = layout.sensor_size, layout.origin, layout.n
+
+    def _read_window(self, t0: float, t1: float) -> Events:
+        try:
+            lo, hi = self._layout.window(t0, t1)
+            return self._layout.events(lo, hi) if hi > lo else Events.empty(self.sensor_size, self.t_origin)
+        except EventDataError:
+            raise
+        except H5_ERRORS as err:
+            raise _damaged(self.path, err) from None
+
+    def close(self) -> None:
+        f, self._f = getattr(self, "_f", None), None
+        if f is not None:
+            f.close()
+
+
+def _sniff(path, head) -> bool:
+    return head is not None and head.startswith(b"\x89HDF\r\n\x1a\n")
+
+
+FORMAT = FileFormat(
+    name="h5", description="an HQF-style .h5/.hdf5 file", reader=read_h5, suffixes=(".h5", ".hdf5"),
+    sniff=_sniff, windowed=True, open_source=HqfSource, options=("time_unit",), priority=20)

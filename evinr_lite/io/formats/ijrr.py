@@ -1,0 +1,131 @@
+"""An IJRR / Event Camera Dataset sequence folder (the unzipped text release): events.txt,
+images.txt with images/, calib.txt.
+
+Absolute clocks (IJRR: about 1.47e9 s written with 9 decimals) do not fit float64 at nanosecond
+resolution; the text parser (:mod:`evinr_lite.io.text`) subtracts a whole-second ``t_origin``
+exactly before any float is formed, and the frames are read on the events' origin.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ...core.events import EventDataError, check_time_span
+from ...core.frames import Frames, to_grey_uint8
+from ...core.recording import Recording
+from ..text import NS, origin_to_ns, parse_event_text, parse_frame_list, read_text_bytes
+from .base import FileFormat, build_events, existing, sensor_from_header, size_hint
+
+__all__ = ["read_ijrr_folder", "read_frames_ijrr", "FORMAT"]
+
+
+def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s") -> Frames:
+    """Frames listed in ``folder/images.txt`` (`t images/frame_%08d.png` per line), in time order.
+
+    Args:
+        folder: the IJRR sequence folder.
+        t_origin: seconds subtracted exactly from the timestamps (pass the events' ``t_origin``);
+            None: automatic, as for the events.
+        time_unit: unit of the timestamps (the events' unit), 's' by default.
+    Returns:
+        Frames with grey uint8 images [F, H, W] (RGB is converted to grey).
+    """
+    from skimage.io import imread
+
+    folder = existing(folder, "folder")
+    listing = folder / "images.txt"
+    if not listing.exists():
+        raise EventDataError(f"{folder}: no images.txt, so no frames; expected lines `t images/frame_%08d.png`")
+    try:
+        data = read_text_bytes(listing, "frame list")
+    except EventDataError as err:
+        if "is empty" not in str(err):
+            raise
+        data = b""
+    t, names, origin_ns = parse_frame_list(data, None if t_origin is None else origin_to_ns(t_origin),
+                                           source=listing, time_unit=time_unit)
+    if not names:
+        raise EventDataError(f"{listing} lists no frames; expected lines `t images/frame_%08d.png` "
+                             "(or remove images.txt and give the sensor size)")
+    images = []
+    for name in names:
+        image_path = folder / name
+        if not image_path.is_file():
+            raise EventDataError(f"{listing} lists {image_path.name}, but {image_path} does not exist (or is not a file)")
+        try:
+            image = imread(image_path)
+        except Exception as err:   # Pillow / imageio raise many types on a damaged image
+            raise EventDataError(f"{image_path}: not a readable image ({type(err).__name__}: {err}); the file is "
+                                 "damaged: replace it or remove its line from images.txt") from None
+        images.append(to_grey_uint8(image, image_path))
+    shapes = {im.shape for im in images}
+    if len(shapes) > 1:
+        raise EventDataError(f"{listing}: the frames have different sizes {sorted(shapes)}; all must share one (H, W)")
+    try:
+        return Frames(np.stack(images), t, origin_ns / NS).sorted()
+    except EventDataError as err:
+        raise EventDataError(f"{listing}: {err}") from None
+
+
+def _read_calib(path: Path) -> dict | list:
+    values = np.loadtxt(path, ndmin=1).ravel().tolist()
+    names = ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")
+    return dict(zip(names, values)) if len(values) == len(names) else values
+
+
+def read_ijrr_folder(folder, *, t_origin=None, sensor_size=None, time_unit="auto") -> Recording:
+    """An IJRR / Event Camera Dataset sequence folder (the unzipped text release).
+
+    Reads events.txt (p in {0, 1}), the frames of images.txt on the events' clock, and calib.txt
+    (``meta["calib"] = {fx, fy, cx, cy, k1, k2, p1, p2, k3}``) when present. The sensor size is the
+    frames' (H, W) (or a `W H` header of events.txt when there are no frames).
+
+    Args:
+        t_origin: seconds subtracted from all timestamps; None: whole seconds of the first event
+            when the clock is absolute (>= 1e5 s), else 0.
+        sensor_size: (H, W); needed only when there are no frames and no `W H` header (then the
+            events' size is unknown); checked against the frames / header otherwise.
+        time_unit: unit of the timestamps of events.txt and images.txt ('auto': see
+            :func:`read_events_txt`).
+    """
+    folder = existing(folder, "folder")
+    events_path = folder / "events.txt"
+    if not events_path.exists():
+        raise EventDataError(f"{folder}: no events.txt; an IJRR folder holds events.txt, "
+                             "images.txt, images/, calib.txt")
+    raw = parse_event_text(events_path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
+    check_time_span(raw.t, events_path, raw.time_unit)
+    frames = (read_frames_ijrr(folder, t_origin=raw.origin_ns / NS, time_unit=raw.time_unit)
+              if (folder / "images.txt").exists() else None)
+    known = sensor_from_header(events_path, raw.header, frames.size if frames is not None else None)
+    if known is not None and sensor_size is not None and tuple(int(v) for v in sensor_size) != tuple(known):
+        H, W = known
+        raise EventDataError(f"{folder}: the frames (or header) say the sensor is (H, W) = {tuple(known)} ({H}x{W}) "
+                             f"but sensor_size={tuple(int(v) for v in sensor_size)} was given; leave it out or pass "
+                             f"sensor_size=({H}, {W})")
+    sensor_size = known if known is not None else sensor_size
+    if sensor_size is None:
+        raise EventDataError(
+            f"{folder}: no images.txt and no `W H` header in events.txt, so the sensor size is unknown; "
+            f"pass sensor_size=(H, W){size_hint(raw.x, raw.y)}"
+        )
+    events = build_events(events_path, raw.t, raw.x, raw.y, raw.p, sensor_size,
+                           polarity="auto", t_origin=raw.origin_ns / NS)
+    meta = {"format": "ijrr", "path": str(folder), "time_unit": raw.time_unit}
+    if (folder / "calib.txt").is_file():
+        try:
+            meta["calib"] = _read_calib(folder / "calib.txt")
+        except (ValueError, OSError) as err:
+            raise EventDataError(f"{folder / 'calib.txt'}: not a list of numbers ({err}); repair or remove it") from None
+    return Recording(events, frames, meta)
+
+
+
+def _sniff(path, head) -> bool:
+    return head is None and (Path(path) / "events.txt").exists()
+
+
+FORMAT = FileFormat(
+    name="ijrr", description="an IJRR folder (events.txt, images.txt, images/, calib.txt)", reader=read_ijrr_folder,
+    folder=True, sniff=_sniff, takes_sensor_size=True, options=("t_origin", "time_unit"), priority=0)

@@ -1,0 +1,148 @@
+"""An ``.npy`` array [N, 4] of events (columns ``txyp`` by default), memory-mapped.
+
+The array records neither the sensor size (``sensor_size=`` is needed) nor the time unit (integers
+are taken as microseconds with a TimeUnitWarning, floats as seconds; ``time_unit=`` sets it). The
+file is memory-mapped: a window (``t_start`` / ``t_end``, or :class:`NpySource`) is found by
+bisection on the time column and only its rows are read.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ...core.events import EventDataError, Events, check_time_span, resolve_time_unit
+from ...core.recording import Recording
+from ..source import RecordingSource
+from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, existing, load_npy,
+                   probe_sorted, size_hint, to_seconds)
+
+__all__ = ["read_events_npy", "read_npy", "NpySource", "FORMAT", "MAGIC"]
+
+MAGIC = b"\x93NUMPY"
+
+
+class _Opened:
+    """A checked [N, 4] memory map: its columns, clock and time unit."""
+
+    def __init__(self, path, sensor_size, columns, time_unit):
+        self.path = path = existing(path)
+        if not isinstance(columns, str) or sorted(columns) != sorted("txyp"):
+            raise EventDataError(f"columns must be a permutation of 'txyp' (e.g. 'txyp' or 'xytp'), got {columns!r}")
+        a = load_npy(path, mmap=True)
+        if a.ndim != 2 or a.shape[1] != 4 or a.dtype.kind not in "iuf":
+            raise EventDataError(
+                f"{path}: expected a numeric array of shape [N, 4] with columns {' '.join(columns)} "
+                f"(set columns= for another order), got shape {a.shape} and dtype {a.dtype}; for an EVREAL "
+                "folder (events_ts.npy, events_xy.npy, ...) use read_evreal_folder"
+            )
+        self.array, self.columns = a, columns
+        self.t = a[:, columns.index("t")]
+        if sensor_size is None:
+            head = np.array(a[:100_000])
+            col = {c: head[:, i] for i, c in enumerate(columns)}
+            raise EventDataError(
+                f"{path}: an .npy array does not record the sensor size; pass sensor_size=(H, W) (rows, columns)"
+                + size_hint(col["x"], col["y"]) + (" (from the first 100,000 events)" if len(a) > 100_000 else "")
+            )
+        self.sensor_size = sensor_size
+        self.unit = resolve_time_unit(a.dtype.kind, time_unit, path)
+        if a.dtype.kind == "f" and a.dtype.itemsize < 8 and self.unit == "s":
+            raise EventDataError(f"{path}: the array is {a.dtype}; float32/float16 timestamps lose microseconds (and "
+                                 "whole seconds on absolute clocks): save it as float64, or with integer "
+                                 "microseconds and time_unit='us'")
+        n = len(a)
+        if n and not np.isfinite(float(self.t[0])):
+            raise EventDataError(f"{path}: the first timestamp is {float(self.t[0])} (non-finite); repair or drop it")
+        self.clock = Clock(self.t[0] if n else 0, self.unit, a.dtype.kind in "iu")
+
+    def rows(self, lo: int, hi: int, polarity: str) -> Events:
+        block = np.array(self.array[lo:hi])   # only these rows are read from disk
+        col = {c: block[:, i] for i, c in enumerate(self.columns)}
+        t = self.clock.seconds(col["t"])
+        check_time_span(t, self.path, self.unit)
+        return build_events(self.path, t, col["x"], col["y"], col["p"], self.sensor_size, polarity=polarity,
+                            t_origin=self.clock.origin)
+
+    def window(self, t_start, t_end) -> tuple[int, int]:
+        n = len(self.array)
+        lo = 0 if t_start is None else bisect_seconds(self.t, self.clock, t_start, 0, n)
+        hi = n if t_end is None else bisect_seconds(self.t, self.clock, t_end, lo, n)
+        return lo, hi
+
+
+def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", time_unit="auto",
+                    sort=False, t_start: float | None = None, t_end: float | None = None) -> Events:
+    """Events from an .npy array [N, 4].
+
+    Args:
+        path: .npy file holding an [N, 4] numeric array.
+        sensor_size: (H, W); required (an .npy array does not record it).
+        columns: order of the columns, a permutation of 'txyp' (e.g. 'xytp' for MVSEC).
+        polarity: encoding of p, see :func:`~evinr_lite.core.events.normalize_polarity`.
+        time_unit: unit of t: 's', 'ms', 'us' or 'ns'; 'auto': an integer array is microseconds
+            (with a TimeUnitWarning), a floating-point one seconds. Implausible spans are refused.
+        sort: sort the events by time instead of raising on unsorted input (reads the whole file).
+        t_start, t_end: seconds on the returned clock; only the rows with t_start <= t < t_end are
+            read (found by bisection on the memory-mapped time column; the times must be sorted).
+    """
+    check_reader_window(t_start, t_end)
+    opened = _Opened(path, sensor_size, columns, time_unit)
+    if sort:
+        block = np.array(opened.array)
+        col = {c: block[:, i] for i, c in enumerate(columns)}
+        t, origin, _ = to_seconds(opened.path, col["t"], time_unit)
+        events = build_events(opened.path, t, col["x"], col["y"], col["p"], sensor_size, polarity=polarity,
+                              t_origin=origin, sort=True)
+        return events if t_start is None and t_end is None else events.slice_time(t_start, t_end)
+    if t_start is None and t_end is None:
+        return opened.rows(0, len(opened.array), polarity)
+    probe_sorted(opened.t, opened.path)
+    lo, hi = opened.window(t_start, t_end)
+    if hi <= lo:
+        n = len(opened.array)
+        span = (f"[{float(opened.clock.seconds(opened.t[0])):.6f}, {float(opened.clock.seconds(opened.t[n - 1])):.6f}] s"
+                if n else "nothing (no events)")
+        raise EventDataError(f"{opened.path}: no events in the window [{t_start}, {t_end}) s; the events cover {span} "
+                             f"(relative to t_origin = {opened.clock.origin}); choose a window inside that range")
+    return opened.rows(lo, hi, polarity)
+
+
+def read_npy(path, **options) -> Recording:
+    """:func:`read_events_npy` as a Recording (no frames)."""
+    return Recording(read_events_npy(path, **options), None, {"format": "npy", "path": str(path)})
+
+
+class NpySource(RecordingSource):
+    """Windows of a memory-mapped .npy array: each window is found by bisection and only its rows are read."""
+
+    def __init__(self, path, *, sensor_size=None, columns="txyp", polarity="auto", time_unit="auto"):
+        self._opened = opened = _Opened(path, sensor_size, columns, time_unit)
+        probe_sorted(opened.t, opened.path)
+        self._polarity = polarity
+        n = len(opened.array)
+        self.path, self.format = opened.path, "npy"
+        self.sensor_size = tuple(int(v) for v in sensor_size)
+        self.t_origin = opened.clock.origin
+        self.n_events = n
+        self.t_span = ((float(opened.clock.seconds(opened.t[0])), float(opened.clock.seconds(opened.t[n - 1])))
+                       if n else (0.0, 0.0))
+        check_time_span(np.array(self.t_span), opened.path, opened.unit)
+        self.frames = None
+        self.meta = {"format": "npy", "path": str(opened.path)}
+
+    def _read_window(self, t0: float, t1: float) -> Events:
+        lo, hi = self._opened.window(t0, t1)
+        if hi <= lo:
+            return Events.empty(self.sensor_size, self.t_origin)
+        return self._opened.rows(lo, hi, self._polarity)
+
+
+def _sniff(path, head) -> bool:
+    return head is not None and head.startswith(MAGIC)
+
+
+FORMAT = FileFormat(
+    name="npy", description="an [N, 4] .npy array", reader=read_npy, suffixes=(".npy",), sniff=_sniff,
+    needs_sensor_size=True, takes_sensor_size=True, windowed=True, open_source=NpySource,
+    options=("columns", "polarity", "time_unit", "sort"))

@@ -1,0 +1,153 @@
+"""The registry of formats: detection, ``read_recording`` and the capability tables, all derived from
+the ``FileFormat`` each format module declares.
+
+Adding a format is one new module in this package that defines its reader and a ``FORMAT`` (found
+here by walking the package); detection, :func:`read_recording`, :data:`SUPPORTED_FORMATS`,
+:func:`~evinr_lite.io.source.open_recording` and the tables the command line uses follow from it.
+"""
+from __future__ import annotations
+
+import importlib
+import os
+import pkgutil
+import stat
+from pathlib import Path
+
+from ...core.events import EventDataError, Events
+from ...core.recording import Recording
+from .base import FileFormat
+
+__all__ = ["FORMATS", "get_format", "detect_format", "read_recording", "read_events", "sniff_format",
+           "SUPPORTED_FORMATS", "RECORDING_SUFFIXES", "SIZE_FREE_FORMATS", "READER_WINDOW_FORMATS",
+           "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder"]
+
+HEAD_BYTES = 64
+UNSUPPORTED = {   # first bytes of files that are recognised but not read -> the fix
+    b"#!AER-DAT3": "an AEDAT3 file; only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) "
+                   "or export the events to a `t x y p` text file",
+    b"#!AER-DAT2": "an AEDAT2 file; only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) "
+                   "or export the events to a `t x y p` text file",
+    b"#!AER-DAT1": "an AEDAT2 file; only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) "
+                   "or export the events to a `t x y p` text file",
+    b"PK\x03\x04": "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside",
+}
+
+
+def _collect() -> tuple[FileFormat, ...]:
+    """Every FORMAT / FORMATS of the package's modules, in the order they are tried (``priority``)."""
+    found = []
+    for info in pkgutil.iter_modules(importlib.import_module(__package__).__path__):
+        module = importlib.import_module(f"{__package__}.{info.name}")
+        declared = getattr(module, "FORMATS", None) or getattr(module, "FORMAT", None)
+        if declared is not None:
+            found.extend(declared if isinstance(declared, tuple) else (declared,))
+    return tuple(sorted(found, key=lambda fmt: (fmt.priority, fmt.name)))
+
+
+FORMATS: tuple[FileFormat, ...] = _collect()
+_BY_NAME = {fmt.name: fmt for fmt in FORMATS}
+
+SUPPORTED_FORMATS = "; ".join(fmt.description for fmt in FORMATS)
+RECORDING_SUFFIXES = tuple(dict.fromkeys(s for fmt in FORMATS for s in fmt.suffixes))   # files taken from a folder
+SIZE_FREE_FORMATS = tuple(fmt.name for fmt in FORMATS if fmt.needs_sensor_size)     # may not record the sensor size
+READER_WINDOW_FORMATS = tuple(fmt.name for fmt in FORMATS if fmt.windowed)          # read only a window from disk
+SENSOR_ARG_FORMATS = tuple(fmt.name for fmt in FORMATS if fmt.takes_sensor_size)    # take sensor_size=
+TIME_UNIT_FORMATS = tuple(fmt.name for fmt in FORMATS if fmt.time_unit is None and "time_unit" in fmt.options)
+FIXED_UNITS = {fmt.name: fmt.time_unit for fmt in FORMATS if fmt.time_unit is not None}
+
+
+def get_format(name: str) -> FileFormat:
+    """The declaration of the format called ``name``."""
+    try:
+        return _BY_NAME[name]
+    except KeyError:
+        raise EventDataError(f"unknown format {name!r}; known: {', '.join(_BY_NAME)}") from None
+
+
+def _checked_path(path) -> Path:
+    if isinstance(path, (str, bytes)) and not path.strip():   # Path("") is ".", the current folder
+        raise EventDataError("the recording's path is empty; pass the file or folder to read")
+    path = Path(path)
+    if not path.exists():
+        raise EventDataError(f"no such file or folder: {path}; check the path")
+    try:
+        mode = path.stat().st_mode
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read ({err.strerror})") from None
+    if not (stat.S_ISDIR(mode) or stat.S_ISREG(mode)):
+        raise EventDataError(f"{path} is not a regular file or folder (a FIFO, pipe or device); save the recording "
+                             "to a file first")
+    return path
+
+
+def detect_format(path) -> str:
+    """The format of a recording, from its content first and its name second.
+
+    Returns the name of one of :data:`FORMATS` ("ijrr", "evreal", "canonical", "h5", "aedat4",
+    "prophesee_raw", "prophesee_dat", "npy", "txt"). Raises EventDataError naming the supported
+    formats otherwise.
+    """
+    path = _checked_path(path)
+    if path.is_dir():
+        if not os.access(path, os.R_OK | os.X_OK):
+            raise EventDataError(f"{path}: no permission to read this folder")
+        for fmt in FORMATS:
+            if fmt.folder and fmt.sniff(path, None):
+                return fmt.name
+        raise EventDataError(f"{path}: folder of unknown format (no events.txt or events_ts.npy); "
+                             f"supported formats: {SUPPORTED_FORMATS}")
+    if path.stat().st_size == 0:
+        raise EventDataError(f"{path} is empty (0 bytes); the file was not written completely: copy it again")
+    try:
+        with open(path, "rb") as f:
+            head = f.read(HEAD_BYTES)
+        for fmt in FORMATS:
+            if not fmt.folder and fmt.sniff(path, head):
+                return fmt.name
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read ({err.strerror}); check its permissions") from None
+    for magic, problem in UNSUPPORTED.items():
+        if head.startswith(magic):
+            raise EventDataError(f"{path}: {problem}")
+    suffix = path.suffix.lower()
+    for fmt in FORMATS:
+        if fmt.by_suffix and suffix in fmt.suffixes:
+            return fmt.name
+    raise EventDataError(f"{path}: unknown format {suffix or '(no extension)'!r} (and its content is none of "
+                         f"the known ones); supported formats: {SUPPORTED_FORMATS}")
+
+
+def is_recording_folder(path) -> bool:
+    """True when ``path`` is a folder in a recording format (IJRR, EVREAL), not a folder of recordings."""
+    path = Path(path)
+    return path.is_dir() and any(fmt.folder and fmt.sniff(path, None) for fmt in FORMATS)
+
+
+def sniff_format(path) -> str | None:
+    """The format of a file from its first bytes alone: a format's name, 'hdf5' for any HDF5 file,
+    'aedat2' / 'aedat3' / 'zip' for files recognised but not read, or None (not recognised: maybe text)."""
+    path = Path(path)
+    with open(path, "rb") as f:
+        head = f.read(HEAD_BYTES)
+    if head.startswith(b"\x89HDF\r\n\x1a\n"):
+        return "hdf5"
+    for fmt in FORMATS:
+        if not fmt.folder and not fmt.by_suffix and fmt.sniff(path, head):
+            return fmt.name
+    names = {b"#!AER-DAT3": "aedat3", b"#!AER-DAT2": "aedat2", b"#!AER-DAT1": "aedat2", b"PK\x03\x04": "zip"}
+    return next((name for magic, name in names.items() if head.startswith(magic)), None)
+
+
+def read_recording(path, **options) -> Recording:
+    """Read any supported recording; the format is detected by :func:`detect_format`.
+
+    ``options`` go to that format's reader (e.g. ``sensor_size=``, ``time_unit=``, ``t_start=`` /
+    ``t_end=`` for the formats that read only a window). ``meta["format"]`` names the format read.
+    """
+    fmt = get_format(detect_format(path))
+    return fmt.reader(Path(path), **options)
+
+
+def read_events(path, **options) -> Events:
+    """Only the events of :func:`read_recording`."""
+    return read_recording(path, **options).events

@@ -1,0 +1,240 @@
+"""Loading a recording for a job: any format, the sensor size supplied or checked, the time unit
+passed where the format allows it, a time window; and what a recording holds, for ``evinr-lite info``.
+
+The options each format takes come from its declaration (:mod:`evinr_lite.io.formats`), so adding a
+format needs no change here. Times are seconds on the recording's clock: relative to its
+``t_origin`` (the whole seconds of the first event on an absolute clock, else 0).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..core.events import EventDataError
+from ..core.frames import Frames
+from ..core.recording import Recording
+from .formats.base import FileFormat
+from .formats.registry import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,
+                               TIME_UNIT_FORMATS, detect_format, get_format)
+from .source import MemorySource, RecordingSource
+
+__all__ = ["open_recording", "read_any", "load_recording", "describe_recording", "format_info", "reader_options",
+           "check_sensor_size_matches", "SIZE_FREE_FORMATS", "READER_WINDOW_FORMATS", "SENSOR_ARG_FORMATS",
+           "TIME_UNIT_FORMATS", "FIXED_UNITS", "INFO_SAMPLE_EVENTS"]
+
+INFO_SAMPLE_EVENTS = 2_000_000   # info reads at most about this many events (evenly spread) for the polarity balance
+
+
+def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | None = None) -> dict:
+    """The keyword options for ``fmt``'s reader: ``sensor_size`` where the reader takes it, ``time_unit``
+    where the format does not fix it (a different unit for a format that fixes its own is refused)."""
+    options = {}
+    if fmt.takes_sensor_size and sensor_size is not None:
+        options["sensor_size"] = sensor_size
+    if time_unit is not None:
+        if fmt.time_unit is None and "time_unit" in fmt.options:
+            options["time_unit"] = time_unit
+        elif fmt.time_unit != time_unit:
+            raise EventDataError(f"{path}: a {fmt.name} file stores its timestamps in {fmt.time_unit or 's'} "
+                                 f"by its format, so time_unit={time_unit!r} cannot apply; leave time_unit= out")
+    return options
+
+
+def check_sensor_size_matches(path, found, sensor_size) -> None:
+    """Refuse a ``sensor_size`` argument that differs from the recording's (H, W)."""
+    if sensor_size is not None and tuple(int(v) for v in sensor_size) != tuple(found):
+        H, W = found
+        raise EventDataError(f"{path}: the recording's sensor is (H, W) = {tuple(found)} ({H}x{W}) but "
+                             f"sensor size {tuple(int(v) for v in sensor_size)} was given; leave it out or pass {H}x{W}")
+
+
+def open_recording(path, *, sensor_size=None, time_unit: str | None = None, **options) -> RecordingSource:
+    """Open a recording (any format :func:`~evinr_lite.io.detect_format` knows) for reading window by window.
+
+    Args:
+        path: file or folder.
+        sensor_size: (H, W); supplied to formats that may not record it, checked against the others.
+        time_unit: unit of the timestamps for formats that do not fix it ('s', 'ms', 'us', 'ns'; None:
+            the reader's detection); refused for formats that fix theirs.
+        options: the format's other reader options (e.g. ``columns=`` for .npy).
+    Formats that can read a window without the rest (memory-mapped .npy, canonical and HQF h5, AEDAT4
+    and Prophesee packets) do so; the others (text, IJRR and EVREAL folders) are read once and sliced.
+    """
+    fmt = get_format(detect_format(path))
+    options = {**reader_options(fmt, path, sensor_size, time_unit), **options}
+    if fmt.open_source is not None:
+        source = fmt.open_source(Path(path), **options)
+    else:
+        recording = fmt.reader(Path(path), **options)
+        source = MemorySource(recording.events, recording.frames, recording.meta, path=path,
+                              format=recording.meta.get("format", fmt.name))
+    try:
+        check_sensor_size_matches(path, source.sensor_size, sensor_size)
+    except EventDataError:
+        source.close()
+        raise
+    return source
+
+
+def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None,
+             time_unit: str | None = None) -> Recording:
+    """Read a recording of any supported format, the sensor size checked or supplied.
+
+    Args:
+        path: file or folder; the format is detected (:func:`evinr_lite.io.detect_format`).
+        sensor_size: (H, W). Needed for formats that do not record it (.npy, text without a
+            `W H` header, an IJRR folder without images.txt, some Prophesee .raw); for the others
+            it must match the file's.
+        t_start, t_end: passed to readers that read only a window from disk (the others read all).
+        time_unit: unit of the timestamps for formats that do not fix it (.npy, text, IJRR, EVREAL,
+            HQF h5): 's', 'ms', 'us', 'ns'; None: the reader's detection (integers are taken as
+            microseconds, with a warning). For AEDAT4 / Prophesee (microseconds) and canonical files
+            (seconds) a different unit is refused.
+    Raises:
+        EventDataError: missing file, unknown format, wrong or missing sensor size, a time unit the
+            format does not allow.
+    """
+    fmt = get_format(detect_format(path))
+    kwargs = reader_options(fmt, path, sensor_size, time_unit)
+    if fmt.windowed:
+        kwargs.update(t_start=t_start, t_end=t_end)
+    rec = fmt.reader(Path(path), **kwargs)
+    check_sensor_size_matches(path, rec.events.sensor_size, sensor_size)
+    return Recording(rec.events, rec.frames, {**rec.meta, "format": rec.meta.get("format", fmt.name)})
+
+
+def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None,
+                   time_unit: str | None = None) -> Recording:
+    """Read a recording (any supported format) restricted to the window [t_start, t_end).
+
+    Args:
+        path, sensor_size, time_unit: see :func:`read_any`.
+        t_start, t_end: seconds on the recording's clock; None: from the first / to the last event.
+    Returns:
+        Recording whose events lie in the window and whose frames lie in [start, end], the span
+        to reconstruct, stored as ``meta["window"]`` = (start, end) seconds.
+    Raises:
+        EventDataError: missing file, unknown format, wrong sensor size, empty window (each
+            message says what to do).
+    """
+    for name, value in (("t_start", t_start), ("t_end", t_end)):
+        if value is not None and not math.isfinite(value):
+            raise EventDataError(f"{name}= must be a finite number of seconds, got {value}")
+    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
+    events, frames = rec.events, rec.frames
+    if not get_format(rec.meta["format"]).windowed:
+        events = events.slice_time(t_start, t_end)
+    if len(events) < 2:
+        raise EventDataError(f"{path}: only {len(events)} event(s) in the window [{t_start}, {t_end}) s; "
+                             "choose a longer window (see `evinr-lite info` for the time span)")
+    start = float(events.t[0]) if t_start is None else float(t_start)
+    end = float(events.t[-1]) if t_end is None else float(t_end)
+    if frames is not None:  # only frames the events can reach: inside [start, end]
+        keep = (frames.t >= start) & (frames.t <= end)
+        frames = Frames(frames.images[keep], frames.t[keep], frames.t_origin) if keep.any() else None
+    return Recording(events, frames, {**rec.meta, "window": (start, end)})
+
+
+def _on_fraction(source: RecordingSource) -> tuple[float | None, int]:
+    """(fraction of ON events, events looked at): all of them up to INFO_SAMPLE_EVENTS, else 16 evenly
+    spread windows holding about that many in all (so info on a multi-GB file reads a few MB)."""
+    n = source.n_events
+    t0, t1 = source.t_span
+    if n == 0:
+        return None, 0
+    end = math.nextafter(t1, math.inf)
+    if n is not None and n <= INFO_SAMPLE_EVENTS:
+        edges = [(t0, end)]
+    else:
+        width = (t1 - t0) * INFO_SAMPLE_EVENTS / n / 16
+        edges = [(a, min(a + width, end)) for a in np.linspace(t0, t1 - width, 16)]
+    on = seen = 0
+    for a, b in edges:
+        if b > a:
+            part = source.events(a, b)
+            on += int(np.count_nonzero(part.p > 0))
+            seen += len(part)
+    return (on / seen if seen else None), seen
+
+
+def describe_recording(rec) -> dict:
+    """What a recording holds: format, sensor, time span, event count and rate, polarity balance,
+    frames. Times are seconds on the recording's clock (relative to ``t_origin``).
+
+    ``rec`` is a :class:`Recording`, or a :class:`~evinr_lite.io.source.RecordingSource` (from
+    :func:`~evinr_lite.io.open_recording`): then only what the format can tell cheaply is read (the
+    count and span from the file's structure, the polarity balance from a sample of at most
+    :data:`INFO_SAMPLE_EVENTS` events, reported as ``on_fraction_events``), so a multi-GB file
+    answers in seconds.
+    """
+    if isinstance(rec, RecordingSource):
+        source, frames, meta = rec, rec.frames, rec.meta
+        n, (first, last) = source.n_events, source.t_span
+        on_fraction, looked = _on_fraction(source)
+        H, W = source.sensor_size
+        t_origin = source.t_origin
+    else:
+        ev, frames, meta = rec.events, rec.frames, rec.meta
+        n = len(ev)
+        first, last = (float(ev.t[0]), float(ev.t[-1])) if n else (None, None)
+        on_fraction, looked = (float(np.mean(ev.p > 0)) if n else None), n
+        H, W = ev.sensor_size
+        t_origin = ev.t_origin
+    duration = float(last - first) if n and n > 1 else 0.0
+    info = {
+        "format": meta.get("format"), "path": meta.get("path"),
+        "sensor_size": [H, W], "t_origin": t_origin,
+        "t_first": first if n else None, "t_last": last if n else None,
+        "duration_s": duration, "n_events": n,
+        "event_rate_per_s": n / duration if n and duration > 0 else None,
+        "events_per_pixel": n / (H * W) if n is not None else None,
+        "on_fraction": on_fraction,
+        "n_frames": 0,
+    }
+    if n is not None and looked < n:
+        info["on_fraction_events"] = looked
+    if frames is not None and len(frames):
+        fr = frames
+        info.update(n_frames=len(fr), frame_size=list(fr.size), frames_t_first=float(fr.t[0]),
+                    frames_t_last=float(fr.t[-1]),
+                    frame_rate_per_s=(len(fr) - 1) / float(fr.t[-1] - fr.t[0]) if len(fr) > 1 and fr.t[-1] > fr.t[0] else None)
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "cfa", "read_notes"):
+        if meta.get(key) is not None:
+            value = meta[key]
+            info[key] = list(value) if isinstance(value, tuple) else value
+    return info
+
+
+def format_info(info: dict) -> str:
+    """Human-readable lines for :func:`describe_recording`'s dict."""
+    H, W = info["sensor_size"]
+    lines = [f"format        {info['format']}  ({info['path']})",
+             f"sensor        {H}x{W} (H x W)"]
+    if info["n_events"]:
+        rate = info["event_rate_per_s"]
+        sampled = (f" (from {info['on_fraction_events']:,} events spread over the recording)"
+                   if "on_fraction_events" in info else "")
+        lines += [f"events        {info['n_events']:,}" + (f"  ({rate:,.0f} per s, {rate / (H * W):.2f} per pixel "
+                                                             "per s)" if rate else ""),
+                  f"time span     {info['t_first']:.6f} .. {info['t_last']:.6f} s  ({info['duration_s']:.6f} s; "
+                  f"times relative to t_origin = {info['t_origin']:.0f} s)"]
+        if info["on_fraction"] is not None:
+            lines.append(f"polarity      {100 * info['on_fraction']:.1f}% ON, {100 * (1 - info['on_fraction']):.1f}% "
+                         f"OFF{sampled}")
+    else:
+        lines.append("events        none")
+    if info["n_frames"]:
+        fr = info.get("frame_rate_per_s")
+        lines.append(f"frames        {info['n_frames']} of {info['frame_size'][0]}x{info['frame_size'][1]}, "
+                     f"{info['frames_t_first']:.6f} .. {info['frames_t_last']:.6f} s"
+                     + (f" ({fr:.1f} per s)" if fr else "") + "  -> reconstructions are scored against them")
+    else:
+        lines.append("frames        none (nothing to score against)")
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "cfa"):
+        if key in info:
+            lines.append(f"{key:<13} {info[key]}")
+    for text in info.get("read_notes", ()):
+        lines.append(f"note          {text}")
+    return "\n".join(lines)
