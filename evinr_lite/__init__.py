@@ -19,6 +19,10 @@ Subpackages, in layers (a module imports only its own layer or lower ones; the t
     apps        the command line, the demo, the reconstruct job
 
 Data flow: file -> Events -> event frames -> solver -> log intensity -> tone map -> metrics / export.
+
+Every subpackage's face is reachable from here (``ev.method.FrameINR``, ``ev.viz.show_frames``), each
+imported on first use like every name here: the notebooks import only ``evinr_lite as ev`` (and one
+teaching import), and ``import evinr_lite`` itself stays light.
 """
 # Names are imported when first used (PEP 562), so that `import evinr_lite` and the command's
 # start-up stay light (no numpy or torch): the command handles Ctrl-C from its first line, and
@@ -53,3 +57,4 @@ __all__ = ["Events", "EventDataError", "Frames", "Recording", "read_recording", 
            "tonemap_reinhard", "evaluate", "results_table", "fast_mode", "pick", "default_device"]
 
 __version__ = "0.1.0"
+

@@ -188,3 +188,36 @@ def test_benchmark_script_runs_small():
                             device="cpu", log=lines.append)
     assert [r["n_models"] for r in result["rows"]] == [1, 3] and result["same_predictions"]
     assert "seq./batched" in lines[1] and len(lines) == 5
+
+
+# ---- ensemble alignment (chain_offsets) -------------------------------------------------------------
+
+def test_chain_offsets_is_the_solvers_alignment():
+    """The exercise's reference, fed by overlap_predictions, equals method.ensemble.alignment_offsets."""
+    from evinr_lite.method.models import FrameINR
+    from evinr_lite.method.solver import split_windows
+
+    windows = split_windows(0.0, 3.0, 1.2, 0.3)
+    model = FrameINR((3, 4), windows, hidden_features=8, hidden_layers=1, first_omega_0=10.0, seed=0)
+    mine = accel.chain_offsets(*accel.overlap_predictions(model, windows))
+    np.testing.assert_allclose(mine, accel.alignment_offsets(model, windows), atol=1e-5)
+    one = accel.chain_offsets(*accel.overlap_predictions(model, windows[:1]))
+    assert one.shape == (1, 3, 4) and not one.any()
+
+
+def test_chain_offsets_check_catches_the_named_mistakes(capsys):
+    assert exercises.check("chain_offsets", accel.chain_offsets)
+    cases = [kw for _, kw in exercises.get("chain_offsets").cases()]
+    assert any(kw["prev"].shape[0] == 0 for kw in cases)      # a single network: the boundary K = 0
+    assert any(kw["prev"].shape[1] == 1 for kw in cases)      # one sample per overlap
+    for wrong, words in ((accel._not_chained, "np.cumsum"), (accel._next_minus_prev, "not F_k - F_{k-1}"),
+                         (accel._no_leading_zero, "first one zero")):
+        capsys.readouterr()
+        assert not exercises.check("chain_offsets", wrong)
+        assert words in capsys.readouterr().out
+    # one sample's difference, or the median over the samples, instead of the mean fails too
+    first = lambda prev, nxt: accel.chain_offsets(np.asarray(prev)[:, :1], np.asarray(nxt)[:, :1])  # noqa: E731
+    median = lambda prev, nxt: np.concatenate([np.zeros((1,) + np.shape(prev)[2:]),  # noqa: E731
+                                               np.cumsum(np.median(np.subtract(prev, nxt), axis=1), axis=0)])
+    assert not exercises.check("chain_offsets", first, verbose=False)
+    assert not exercises.check("chain_offsets", median, verbose=False)

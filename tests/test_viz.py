@@ -249,3 +249,17 @@ def test_exercise_checks_pass_the_reference_and_name_each_known_mistake(name, ca
     for message, wrong in ex.hints.items():
         assert not exercises.check(name, wrong)
         assert message in capsys.readouterr().out, f"the hint {message!r} is never shown"
+
+
+def test_show_frames_colour_bar_is_one_shared_labelled_bar():
+    from evinr_lite.viz import show_frames
+
+    frames = np.random.default_rng(0).normal(size=(3, 4, 5))
+    fig = show_frames({"a": frames, "b": -frames}, [0.1, 0.2, 0.3], cmap="RdBu_r", vmin=-2, vmax=2,
+                      colorbar_label="change of log intensity")
+    bars = [ax for ax in fig.axes if ax.get_label() == "<colorbar>"]
+    assert len(bars) == 1 and bars[0].get_ylabel() == "change of log intensity"
+    assert bars[0].get_ylim() == (-2.0, 2.0)
+    plain = show_frames({"a": frames})
+    assert not [ax for ax in plain.axes if ax.get_label() == "<colorbar>"]
+    plt.close("all")

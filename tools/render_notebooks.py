@@ -16,6 +16,14 @@ Why nbconvert and not jupyter-book / myst-nb: the site is a flat list of execute
 nbconvert (already installed with JupyterLab) writes in one call per notebook; jupyter-book would
 add a Sphinx build, a table of contents and a configuration file for the same pages.
 
+**Executed copies** (``--executed``): the same fast-mode execution, saved as notebooks in
+``docs/executed/NN_name.ipynb`` with every output, figures re-encoded small (at most
+``EXECUTED_WIDTH`` pixels wide, 64-colour PNG), so that a reader sees every figure and printed
+result in the repository's web view without running anything. ``--check-executed`` (and
+``tests/test_executed_notebooks.py``) says which copies are missing, extra, stale (a cell's source
+differs from its notebook's) or broken (a cell that did not run, or an error output). Regenerate
+after changing a notebook: ``nice python tools/render_notebooks.py --executed --only 04``.
+
 The site is written into a temporary folder beside ``--out`` and renamed into place when every
 notebook has run (a failing notebook stops the build, names the cell, and leaves ``--out`` as it
 was). Exit status: 0 done, 1 a notebook failed, 2 bad arguments.
@@ -38,6 +46,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
 THUMB_WIDTH = 360   # pixels
+EXECUTED = ROOT / "docs" / "executed"
+EXECUTED_WIDTH = 640   # pixels: the widest figure in an executed copy
+EXECUTED_COLOURS = 64  # palette size of its PNGs (figures are line plots and grey images)
 
 INDEX_CSS = """
 body { font-family: system-ui, sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 1em; color: #222; }
@@ -226,13 +237,116 @@ def build(out="site", *, full: bool = False, only=None, notebooks_dir: Path = NO
     return {"entries": entries, "seconds": seconds, "out": str(out)}
 
 
+# ---- executed copies ------------------------------------------------------------------------------
+
+def small_png(png: bytes, width: int = EXECUTED_WIDTH, colours: int = EXECUTED_COLOURS) -> bytes:
+    """A figure re-encoded small: at most ``width`` pixels wide, a ``colours``-colour palette PNG."""
+    from PIL import Image
+
+    img = Image.open(io.BytesIO(png)).convert("RGB")
+    if img.width > width:
+        img = img.resize((width, round(img.height * width / img.width)), Image.LANCZOS)
+    out = io.BytesIO()
+    img.quantize(colours, method=Image.Quantize.MEDIANCUT).save(out, format="PNG", optimize=True)
+    return out.getvalue()
+
+
+def _cell_key(cell) -> tuple:
+    return cell["cell_type"], "".join(cell["source"]) if isinstance(cell["source"], list) else cell["source"]
+
+
+def executed_copy(nb, seconds: float, source_name: str):
+    """The executed notebook made small and stable: small figures, no widget state, no timestamps."""
+    for cell in nb.cells:
+        cell.get("metadata", {}).pop("execution", None)
+        for out in cell.get("outputs", []):
+            data = out.get("data", {})
+            if "image/png" in data:
+                data["image/png"] = base64.b64encode(small_png(base64.b64decode(data["image/png"]))).decode()
+                out.get("metadata", {}).pop("image/png", None)
+            data.pop("application/vnd.jupyter.widget-view+json", None)
+    nb.metadata.pop("widgets", None)
+    nb.metadata["evinr_executed"] = {"source": f"notebooks/{source_name}", "mode": "fast (EVINR_FAST=1)",
+                                     "seconds": round(seconds, 1),
+                                     "regenerate": f"python tools/render_notebooks.py --executed --only {source_name[:2]}"}
+    return nb
+
+
+def executed_problems(notebooks_dir: Path = NOTEBOOKS, executed_dir: Path = EXECUTED) -> list[str]:
+    """What is wrong with the executed copies: missing, extra, stale or broken (empty when all is well)."""
+    sources = {p.name: p for p in notebook_paths(notebooks_dir)}
+    copies = {p.name: p for p in sorted(Path(executed_dir).glob("[0-9][0-9]_*.ipynb"))}
+    found = [f"missing: {executed_dir.name}/{n}" for n in sources if n not in copies]
+    found += [f"extra: {executed_dir.name}/{n} (no notebooks/{n})" for n in copies if n not in sources]
+    for name in sorted(set(sources) & set(copies)):
+        src_cells = json.loads(sources[name].read_text())["cells"]
+        copy_cells = json.loads(copies[name].read_text())["cells"]
+        if [_cell_key(c) for c in src_cells] != [_cell_key(c) for c in copy_cells]:
+            diff = next((i for i, (a, b) in enumerate(zip(src_cells, copy_cells)) if _cell_key(a) != _cell_key(b)),
+                        min(len(src_cells), len(copy_cells)))
+            found.append(f"stale: {executed_dir.name}/{name} (cell {diff} differs from notebooks/{name})")
+            continue
+        for i, cell in enumerate(copy_cells):
+            if cell["cell_type"] != "code" or not "".join(cell["source"]).strip():
+                continue
+            if cell.get("execution_count") is None:
+                found.append(f"broken: {executed_dir.name}/{name} cell {i} did not run")
+                break
+            if any(o.get("output_type") == "error" for o in cell.get("outputs", [])):
+                found.append(f"broken: {executed_dir.name}/{name} cell {i} has an error output")
+                break
+    return found
+
+
+def write_executed(only=None, *, notebooks_dir: Path = NOTEBOOKS, out: Path = EXECUTED, timeout: int = 1200,
+                   log=print) -> list[Path]:
+    """Execute (fast mode) and write the executed copy of each notebook, atomically; returns the paths."""
+    import nbformat
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for path in notebook_paths(Path(notebooks_dir), only):
+        log(f"render_notebooks: executing {path.name} ...", end=" ", flush=True)
+        nb, seconds = execute(path, full=False, timeout=timeout)
+        nb = executed_copy(nb, seconds, path.name)
+        fd, tmp = tempfile.mkstemp(dir=out, prefix=f".{path.name}.", suffix=".tmp")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            nbformat.write(nb, f)
+        os.replace(tmp, out / path.name)
+        written.append(out / path.name)
+        log(f"{seconds:.1f} s, {(out / path.name).stat().st_size / 1e3:.0f} kB")
+    return written
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--full", action="store_true", help="execute at the notebooks' full sizes (default: fast mode)")
     p.add_argument("--out", default=str(ROOT / "site"), help="output folder (default: site/ in the repository)")
     p.add_argument("--only", nargs="+", metavar="NN", help="only these notebooks (prefixes such as 01 05, or names)")
     p.add_argument("--timeout", type=int, default=1200, help="seconds allowed per cell (default: 1200)")
+    p.add_argument("--executed", action="store_true",
+                   help="write the executed copies docs/executed/NN_*.ipynb (fast mode) instead of the site")
+    p.add_argument("--check-executed", action="store_true",
+                   help="only report missing, extra, stale or broken executed copies (exit 1)")
     args = p.parse_args(argv)
+    if args.check_executed:
+        found = executed_problems()
+        for line in found:
+            print(line)
+        if found:
+            print("regenerate with `nice python tools/render_notebooks.py --executed --only NN`", file=sys.stderr)
+            return 1
+        print("docs/executed/: every executed copy is current")
+        return 0
+    if args.executed:
+        from nbclient.exceptions import CellExecutionError
+        try:
+            write_executed(args.only, timeout=args.timeout)
+        except CellExecutionError as err:
+            print(f"\nrender_notebooks: error: {err}", file=sys.stderr)
+            return 1
+        return 0
     try:
         build(args.out, full=args.full, only=args.only, timeout=args.timeout)
     except RuntimeError as err:

@@ -8,6 +8,10 @@ The reference solutions of the notebook's exercises live here and are registered
   timestamps).
 - :func:`crossfade_weights`: how an ensemble's predictions are mixed, linear ramps across each
   overlap (the same weights as the solver's ``blend_weights``).
+- :func:`chain_offsets`: ensemble alignment, each network's per-pixel offset chained onto its
+  predecessor's over their overlap (the same rule as the solver's ``alignment_offsets``, re-exported
+  here; ``tests/test_accel_exercises.py`` pins the two together). :func:`overlap_predictions` gives
+  its inputs from a trained model.
 
 Helpers for the experiments:
 
@@ -39,12 +43,12 @@ from ..core.events import Events
 from ..method.losses import spatial_differences
 from ..method.models import FrameINR
 from ..sim.scenes import VaryingSpeedScene
-from ..method.solver import blend_networks, predict_networks
+from ..method.solver import alignment_offsets, blend_networks, predict_networks
 
 __all__ = [
     "bisect_equal_count", "within_bin_detail", "crossfade_weights", "VaryingSpeedScene", "ensemble_predictions", "frame_change",
     "overlap_mask", "window_bins", "per_network_loss", "train_networks", "single_copies",
-    "batched_vs_sequential",
+    "batched_vs_sequential", "chain_offsets", "overlap_predictions", "alignment_offsets", "predict_networks",
 ]
 
 
@@ -256,6 +260,77 @@ exercises.register(
         "the first window must not fade in at the start of the sequence, nor the last fade out at its end "
         "(there is no neighbour to hand over to)": _fades_at_both_ends,
         "every window covering t has weight 1: the weights of each time must sum to 1": _not_normalised,
+    })
+
+
+# ---- ensemble alignment ----------------------------------------------------------------------
+
+def chain_offsets(prev, nxt) -> np.ndarray:
+    """Per-network, per-pixel offsets that chain every network onto its predecessor.
+
+    Args:
+        prev, nxt: float [K, S, H, W]: for each overlap k = 1..K, network k-1 (``prev[k-1]``) and
+            network k (``nxt[k-1]``) at the same S sample times inside their overlap (K = N - 1;
+            K = 0 for a single network).
+
+    Returns:
+        float64 [K + 1, H, W]: offset_0 = 0 and offset_k = offset_{k-1} + mean over the S samples of
+        (F_{k-1} - F_k), so that network k plus its offset agrees on average with network k-1 plus
+        its own over their overlap.
+    """
+    prev = np.asarray(prev, dtype=np.float64)
+    nxt = np.asarray(nxt, dtype=np.float64)
+    steps = (prev - nxt).mean(axis=1)                                  # [K, H, W]
+    return np.concatenate([np.zeros((1,) + prev.shape[2:]), np.cumsum(steps, axis=0)])
+
+
+def overlap_predictions(model, windows, n_samples: int = 8):
+    """(prev, nxt) float32 [N - 1, n_samples, H, W]: networks k-1 and k at the sample times of overlap k
+    (``n_samples`` evenly spaced, both ends included), the inputs of :func:`chain_offsets`."""
+    windows = np.asarray(windows, dtype=np.float64)
+    H, W = model.sensor_size
+    prev = np.zeros((len(windows) - 1, n_samples, H, W), np.float32)
+    nxt = np.zeros_like(prev)
+    for k in range(1, len(windows)):
+        F = predict_networks(model, np.linspace(windows[k, 0], windows[k - 1, 1], n_samples))
+        prev[k - 1], nxt[k - 1] = F[k - 1], F[k]
+    return prev, nxt
+
+
+def _inputs_chain(rng):
+    cases = []
+    for K, S, shape in ((3, 4, (2, 3)), (1, 8, (3, 2)), (4, 1, (2, 2))):   # S = 1: a single sample
+        prev = rng.normal(size=(K, S) + shape)
+        # each overlap: one offset apart, plus a disagreement that varies from sample to sample (so that the
+        # mean over the samples differs from one sample's difference or their median)
+        nxt = prev + rng.normal(size=(K, 1) + shape) + 0.3 * rng.exponential(size=(K, S) + shape)
+        cases.append(dict(prev=prev, nxt=nxt))
+    prev = rng.normal(size=(2, 3, 2, 2))
+    cases.append(dict(prev=prev, nxt=prev.copy()))                     # networks that already agree: offsets 0
+    cases.append(dict(prev=np.zeros((0, 5, 2, 3)), nxt=np.zeros((0, 5, 2, 3))))   # one network, no overlap
+    return cases
+
+
+def _not_chained(prev, nxt):
+    prev, nxt = np.asarray(prev, dtype=np.float64), np.asarray(nxt, dtype=np.float64)
+    return np.concatenate([np.zeros((1,) + prev.shape[2:]), (prev - nxt).mean(axis=1)])
+
+
+def _next_minus_prev(prev, nxt):
+    return chain_offsets(nxt, prev)
+
+
+def _no_leading_zero(prev, nxt):
+    return chain_offsets(prev, nxt)[1:]
+
+
+exercises.register(
+    "chain_offsets", chain_offsets, _inputs_chain, atol=1e-9,
+    hints={
+        "chain the offsets: offset_k = offset_{k-1} + mean(F_{k-1} - F_k) (np.cumsum over the overlaps), "
+        "not each overlap's difference on its own": _not_chained,
+        "the offset moves network k onto network k-1: mean(F_{k-1} - F_k), not F_k - F_{k-1}": _next_minus_prev,
+        "network 0 keeps offset 0: return K + 1 offsets, the first one zero": _no_leading_zero,
     })
 
 

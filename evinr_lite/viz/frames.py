@@ -13,7 +13,7 @@ __all__ = ["show_frames", "show_images", "plot_histories"]
 
 
 def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: float = 0.0, vmax: float = 1.0,
-                cell_size: float = 1.6, row_titles: dict | None = None):
+                cell_size: float = 1.6, row_titles: dict | None = None, colorbar_label: str | None = None):
     """A grid of frames: one row per entry of ``rows``, one column per frame.
 
     Args:
@@ -23,6 +23,9 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
         cmap, vmin, vmax: how values map to grey (tone-mapped frames lie in [0, 1]).
         cell_size: inches per image (width), for a new figure.
         row_titles: optional ``{label: extra text}`` appended to the row's label (e.g. a score).
+        colorbar_label: when given, one colour bar for the whole grid (every image shares ``vmin``,
+            ``vmax`` and ``cmap``) labelled with it, unit included (e.g. "change of log intensity");
+            pass one for signed or colour-mapped values, whose colours mean nothing without it.
 
     Returns:
         The figure.
@@ -42,10 +45,11 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
     else:
         fig.clf()
     axes = np.atleast_2d(fig.subplots(n, Q, squeeze=False))
+    image = None
     for r, (label, frames) in enumerate(stacks.items()):
         for q in range(Q):
             ax = axes[r, q]
-            ax.imshow(frames[q], cmap=cmap, vmin=vmin, vmax=vmax, interpolation="nearest")
+            image = ax.imshow(frames[q], cmap=cmap, vmin=vmin, vmax=vmax, interpolation="nearest")
             ax.set_xticks([])
             ax.set_yticks([])
             if r == 0 and times is not None:
@@ -53,6 +57,8 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
         extra = (row_titles or {}).get(label)
         axes[r, 0].set_ylabel(label if extra is None else f"{label}\n{extra}", fontsize=9)
     fig.subplots_adjust(wspace=0.03, hspace=0.12)
+    if colorbar_label is not None:
+        fig.colorbar(image, ax=list(axes.ravel()), fraction=0.02, pad=0.01).set_label(colorbar_label, fontsize=9)
     return fig
 
 
