@@ -189,3 +189,15 @@ def test_batch_task_estimate_takes_plain_arguments():
     mb = estimate_task_memory_mb((24, 32), 2.0, 10**6, n_frames=5, config=cfg)
     solver = estimate_memory((24, 32), 0.0, 2.0, 10**6, 5, cfg)["total"]
     assert mb == pytest.approx(PROCESS_MIB + (2 * 17 * 10**6 + solver) / 2**20)
+
+
+def test_the_command_lines_choices_are_the_librarys():
+    """The command line spells its choices itself (it starts without importing torch): they must stay the library's."""
+    from evinr_lite.apps.cli import RECIPE_CHOICES, TIME_UNIT_CHOICES
+    from evinr_lite.core.events import TIME_UNITS
+    from evinr_lite.method.anchor import ANCHOR_MODES
+    from evinr_lite.method.recipes import RECIPES
+
+    assert set(RECIPE_CHOICES) == set(RECIPES) and set(TIME_UNIT_CHOICES) == set(TIME_UNITS)
+    actions = {a.dest: a for a in build_parser()._subparsers._group_actions[0].choices["reconstruct"]._actions}
+    assert set(actions["anchor"].choices) == set(ANCHOR_MODES)
