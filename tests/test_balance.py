@@ -1,0 +1,107 @@
+"""The ON/OFF balance estimated from events alone (evinr_lite.method.balance) and its hook in reconstruct."""
+import numpy as np
+import pytest
+
+from evinr_lite.core.events import EventDataError, Events
+from evinr_lite.method import EvINRConfig, reconstruct
+from evinr_lite.method.balance import (PolarityCounts, balance_from_counts, estimate_balance, polarity_counts,
+                                       prepare_events)
+from evinr_lite.sim.scenes import OscillatingScene
+from evinr_lite.sim.simulate import add_hot_pixels, simulate_scene
+
+SIZE = (30, 40)
+
+
+def _scene(duration=20.0):
+    return OscillatingScene("astronaut", SIZE, duration, path=((12.0, 4.0, 4.0, 0.0), (2.0, 3.0, 1.3, 1.0)))
+
+
+@pytest.fixture(scope="module")
+def unequal():
+    """20 s to and fro, C+ 0.25 and C- 0.20 (true imbalance (0.25 - 0.20) / 0.45 = 0.111)."""
+    return simulate_scene(_scene(), C=0.225, C_pos=0.25, C_neg=0.20, seed=0)
+
+
+def test_long_span_recovers_the_true_pair(unequal):
+    fit = estimate_balance(unequal, 0.225)
+    assert fit.applied and fit.shrink > 0.8
+    assert fit.raw_imbalance == pytest.approx(0.05 / 0.45, abs=0.01)
+    assert fit.C[0] == pytest.approx(0.25, abs=0.006) and fit.C[1] == pytest.approx(0.20, abs=0.006)
+    assert 0.5 * (fit.C[0] + fit.C[1]) == pytest.approx(0.225)          # the nominal C stays the mean
+
+
+def test_equal_thresholds_give_no_imbalance():
+    ev = simulate_scene(_scene(), C=0.2, seed=1)
+    assert abs(estimate_balance(ev, 0.2).imbalance) < 0.01
+
+
+def test_on_only_hot_pixels_are_left_out(unequal):
+    hot_ev, hot = add_hot_pixels(unequal, 8, 40.0, seed=2, on_only=True)
+    on, off = polarity_counts(hot_ev)
+    naive = (off.sum() - on.sum()) / (on.sum() + off.sum())
+    fit = estimate_balance(hot_ev, 0.225)
+    assert fit.n_hot >= 8
+    assert abs(fit.raw_imbalance - 0.111) < 0.01 < abs(naive - 0.111)    # the naive pool is pulled towards ON
+
+
+def test_short_spans_are_shrunk_towards_the_nominal_C(unequal):
+    short = estimate_balance(unequal.slice_time(0.0, 0.5), 0.225)
+    whole = estimate_balance(unequal, 0.225)
+    assert short.shrink < whole.shrink and abs(short.imbalance) < abs(whole.imbalance)
+
+
+def test_a_given_pair_is_kept_and_bad_counts_are_refused(unequal):
+    fit = estimate_balance(unequal, (0.3, 0.1))
+    assert not fit.applied and fit.C == (0.3, 0.1)
+    with pytest.raises(EventDataError, match="same shape"):
+        balance_from_counts(np.zeros((2, 3)), np.zeros((3, 2)), 0.2)
+    few = Events.from_arrays([0.0, 1.0], [0, 1], [0, 0], [1, -1], SIZE)
+    assert not estimate_balance(few, 0.2).applied                      # too few pixels fired: nominal C
+
+
+def test_running_counts_match_one_span(unequal):
+    counts = PolarityCounts(SIZE)
+    for a in np.arange(0.0, 20.0, 5.0):
+        counts.update(unequal.slice_time(a, a + 5.0, allow_empty=True))
+    np.testing.assert_allclose(counts.fit(0.225).C, estimate_balance(unequal, 0.225).C)
+    with pytest.raises(EventDataError, match="decay"):
+        PolarityCounts(SIZE, decay=0.0)
+
+
+def test_prepare_events_returns_a_copy_and_the_paper_recipe_keeps_C(unequal):
+    cfg = EvINRConfig(C=0.225, balance="events", hot_pixels="drop", progress=False)
+    ev, new = prepare_events(unequal, cfg)
+    assert cfg.C == 0.225 and new.C[0] > new.C[1]
+    paper = EvINRConfig.paper(C=0.225)
+    assert paper.balance == "none" and paper.hot_pixels == "keep"
+    assert prepare_events(unequal, paper)[1].C == 0.225
+    with pytest.raises(EventDataError, match="balance"):
+        EvINRConfig(balance="frames")
+
+
+def test_balance_removes_the_drift_of_a_long_recording(unequal):
+    """Integrated with one C, the level drifts with the event count; with the balance it does not."""
+    scene = _scene()
+    times = np.linspace(1.0, 19.0, 10)
+    truth = scene.log_intensity(times).mean(axis=(1, 2))
+
+    def drift(balance):
+        rec = reconstruct(unequal, times, EvINRConfig(C=0.225, balance=balance, hidden_features=64, progress=False),
+                          t_start=0.0, t_end=20.0)
+        err = rec.log_intensity.mean(axis=(1, 2)) - truth
+        return abs(err[-1] - err[0])
+
+    assert drift("events") < 0.5 * drift("none")
+
+
+def test_a_streamed_source_gets_the_same_plan_as_the_whole_span(unequal):
+    from evinr_lite.io.source import MemorySource
+    from evinr_lite.method.balance import prepare_source
+
+    hot_ev, hot = add_hot_pixels(unequal, 8, 400.0, seed=2, on_only=True)
+    cfg = EvINRConfig(C=0.225, tau=5.0, progress=False)
+    ev, whole = prepare_events(hot_ev, cfg)
+    streamed, source = prepare_source(MemorySource(hot_ev), 0.0, float(hot_ev.t[-1]), cfg)
+    assert streamed.C == whole.C
+    np.testing.assert_array_equal(source.events(0.0, 30.0).t, ev.t)
+    assert len(ev) < len(hot_ev)                                       # the hot pixels were dropped
