@@ -313,6 +313,7 @@ def write_executed(only=None, *, notebooks_dir: Path = NOTEBOOKS, out: Path = EX
         fd, tmp = tempfile.mkstemp(dir=out, prefix=f".{path.name}.", suffix=".tmp")
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             nbformat.write(nb, f)
+        os.chmod(tmp, 0o644)                    # mkstemp makes it private; a repository file is readable
         os.replace(tmp, out / path.name)
         written.append(out / path.name)
         log(f"{seconds:.1f} s, {(out / path.name).stat().st_size / 1e3:.0f} kB")
