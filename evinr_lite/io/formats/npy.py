@@ -1,9 +1,9 @@
-"""An ``.npy`` array [N, 4] of events (columns ``txyp`` by default), memory-mapped.
+"""An ``.npy`` array [N, 4] of events (columns ``txyp`` by default), read a window at a time.
 
 The array records neither the sensor size (``sensor_size=`` is needed) nor the time unit (integers
-are taken as microseconds with a TimeUnitWarning, floats as seconds; ``time_unit=`` sets it). The
-file is memory-mapped: a window (``t_start`` / ``t_end``, or :class:`NpySource`) is found by
-bisection on the time column and only its rows are read.
+are taken as microseconds with a TimeUnitWarning, floats as seconds; ``time_unit=`` sets it). A
+window (``t_start`` / ``t_end``, or :class:`NpySource`) is found by bisection on the time column
+(one element read per step) and only its rows are read.
 """
 from __future__ import annotations
 
@@ -22,8 +22,48 @@ __all__ = ["read_events_npy", "read_npy", "NpySource", "FORMAT", "MAGIC"]
 MAGIC = b"\x93NUMPY"
 
 
+class _Rows:
+    """Rows of an [N, 4] .npy file read with plain file reads at their offset (not through a memory map:
+    the kernel's read-ahead would map megabytes around each element a bisection touches, and count
+    them in the process's memory). ``table[lo:hi]`` -> array [hi - lo, 4]; ``column(i)`` -> a column
+    whose elements ``column[k]`` are read one at a time. Fortran-ordered files use the memory map."""
+
+    def __init__(self, path, mapped: np.memmap):
+        self.path, self.shape, self.dtype = path, mapped.shape, mapped.dtype
+        self.offset = int(mapped.offset)
+        self.mapped = mapped if not mapped.flags.c_contiguous else None
+        if self.mapped is None and path.stat().st_size < self.offset + mapped.size * mapped.dtype.itemsize:
+            raise EventDataError(f"{path}: the .npy header claims {mapped.shape} but the file is shorter; it is "
+                                 "damaged or incomplete")
+
+    def __len__(self) -> int:
+        return int(self.shape[0])
+
+    def __getitem__(self, rows: slice) -> np.ndarray:
+        lo, hi, _ = rows.indices(len(self))
+        if self.mapped is not None:
+            return np.array(self.mapped[lo:hi])
+        with open(self.path, "rb") as f:
+            f.seek(self.offset + lo * 4 * self.dtype.itemsize)
+            block = np.fromfile(f, dtype=self.dtype, count=max(hi - lo, 0) * 4)
+        return block.reshape(-1, 4)
+
+    def column(self, index: int) -> "_Column":
+        return _Column(self, index)
+
+
+class _Column:
+    """One column of a :class:`_Rows`, element by element (for bisection)."""
+
+    def __init__(self, rows: _Rows, index: int):
+        self.rows, self.index, self.shape = rows, index, (len(rows),)
+
+    def __getitem__(self, k: int):
+        return self.rows[int(k):int(k) + 1][0, self.index]
+
+
 class _Opened:
-    """A checked [N, 4] memory map: its columns, clock and time unit."""
+    """A checked [N, 4] .npy file: its rows, time column, clock and time unit."""
 
     def __init__(self, path, sensor_size, columns, time_unit):
         self.path = path = existing(path)
@@ -36,14 +76,15 @@ class _Opened:
                 f"(set columns= for another order), got shape {a.shape} and dtype {a.dtype}; for an EVREAL "
                 "folder (events_ts.npy, events_xy.npy, ...) use read_evreal_folder"
             )
-        self.array, self.columns = a, columns
-        self.t = a[:, columns.index("t")]
+        self.array, self.columns = _Rows(path, a), columns
+        self.t = self.array.column(columns.index("t"))
+        n = len(self.array)
         if sensor_size is None:
-            head = np.array(a[:100_000])
+            head = self.array[:100_000]
             col = {c: head[:, i] for i, c in enumerate(columns)}
             raise EventDataError(
                 f"{path}: an .npy array does not record the sensor size; pass sensor_size=(H, W) (rows, columns)"
-                + size_hint(col["x"], col["y"]) + (" (from the first 100,000 events)" if len(a) > 100_000 else "")
+                + size_hint(col["x"], col["y"]) + (" (from the first 100,000 events)" if n > 100_000 else "")
             )
         self.sensor_size = sensor_size
         self.unit = resolve_time_unit(a.dtype.kind, time_unit, path)
@@ -51,13 +92,12 @@ class _Opened:
             raise EventDataError(f"{path}: the array is {a.dtype}; float32/float16 timestamps lose microseconds (and "
                                  "whole seconds on absolute clocks): save it as float64, or with integer "
                                  "microseconds and time_unit='us'")
-        n = len(a)
         if n and not np.isfinite(float(self.t[0])):
             raise EventDataError(f"{path}: the first timestamp is {float(self.t[0])} (non-finite); repair or drop it")
         self.clock = Clock(self.t[0] if n else 0, self.unit, a.dtype.kind in "iu")
 
     def rows(self, lo: int, hi: int, polarity: str) -> Events:
-        block = np.array(self.array[lo:hi])   # only these rows are read from disk
+        block = self.array[lo:hi]   # only these rows are read from disk
         col = {c: block[:, i] for i, c in enumerate(self.columns)}
         t = self.clock.seconds(col["t"])
         check_time_span(t, self.path, self.unit)
@@ -84,12 +124,12 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
             (with a TimeUnitWarning), a floating-point one seconds. Implausible spans are refused.
         sort: sort the events by time instead of raising on unsorted input (reads the whole file).
         t_start, t_end: seconds on the returned clock; only the rows with t_start <= t < t_end are
-            read (found by bisection on the memory-mapped time column; the times must be sorted).
+            read (found by bisection on the time column on disk; the times must be sorted).
     """
     check_reader_window(t_start, t_end)
     opened = _Opened(path, sensor_size, columns, time_unit)
     if sort:
-        block = np.array(opened.array)
+        block = opened.array[:]
         col = {c: block[:, i] for i, c in enumerate(columns)}
         t, origin, _ = to_seconds(opened.path, col["t"], time_unit)
         events = build_events(opened.path, t, col["x"], col["y"], col["p"], sensor_size, polarity=polarity,
@@ -114,7 +154,7 @@ def read_npy(path, **options) -> Recording:
 
 
 class NpySource(RecordingSource):
-    """Windows of a memory-mapped .npy array: each window is found by bisection and only its rows are read."""
+    """Windows of an .npy array on disk: each window is found by bisection and only its rows are read."""
 
     def __init__(self, path, *, sensor_size=None, columns="txyp", polarity="auto", time_unit="auto"):
         self._opened = opened = _Opened(path, sensor_size, columns, time_unit)
