@@ -139,6 +139,23 @@ def check_time_span(t, source, time_unit: str, *, flag: str = "time_unit") -> No
             f"the time unit is probably wrong: pass {flag}={others[0]!r} (or {', '.join(repr(u) for u in others[1:])})")
 
 
+def _check_integer_seconds(t: np.ndarray) -> None:
+    """Integer timestamps given to ``Events()`` (which takes seconds): the time-span plausibility rule of
+    the readers (:func:`check_time_span`) refuses those that cannot be seconds; the others are taken
+    as seconds with a :class:`TimeUnitWarning` that names the assumption and the override."""
+    fix = "Events.from_arrays(t, x, y, p, sensor_size, time_unit='us') (or 'ns', 'ms')"
+    try:
+        check_time_span(t, "Events(): integer timestamps", "s", flag="time_unit")
+    except EventDataError as err:
+        raise EventDataError(f"{err}; Events() takes float64 seconds: for integer microseconds use {fix}") from None
+    if t.size:
+        import warnings
+
+        warnings.warn(f"Events(): the timestamps are integers; taken as whole seconds. If they are microseconds "
+                      f"or nanoseconds, use {fix}; for seconds pass them as float64 to silence this note",
+                      TimeUnitWarning, stacklevel=4)
+
+
 def auto_origin(t_first: float) -> float:
     """Whole seconds of the first timestamp when it is large (an absolute clock), else 0."""
     return float(math.floor(t_first)) if math.isfinite(t_first) and abs(t_first) >= LARGE_T else 0.0
@@ -175,9 +192,16 @@ def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
 def check_sensor_size(sensor_size) -> tuple[int, int]:
     """(H, W) as two positive ints, or an EventDataError that says what is wrong."""
     try:
-        H, W = (int(v) for v in sensor_size)
-    except (TypeError, ValueError):
-        raise EventDataError(f"sensor_size must be (H, W), two positive integers; got {sensor_size!r}") from None
+        values = list(sensor_size)
+        if len(values) != 2:
+            raise ValueError
+        # whole numbers only: int() would silently make 30.7 rows into 30 (and True into 1)
+        if any(isinstance(v, (bool, np.bool_, str, bytes)) or float(v) != int(v) for v in values):
+            raise ValueError
+        H, W = (int(v) for v in values)
+    except (TypeError, ValueError, OverflowError):
+        raise EventDataError(f"sensor_size must be (H, W), two positive whole numbers (rows, columns); got "
+                             f"{sensor_size!r}") from None
     if H <= 0 or W <= 0:
         raise EventDataError(f"sensor_size must be (H, W) with positive sizes; got {(H, W)}")
     return H, W
@@ -228,6 +252,8 @@ class Events:
                 "timestamps are float32/float16, which loses microseconds (and whole seconds on absolute "
                 "clocks); keep them float64 (or integer us/ns with Events.from_arrays(..., time_unit='us'))"
             )
+        if t.dtype.kind in "iu":   # seconds are floats: integers are usually us or ns, so say so or refuse
+            _check_integer_seconds(t)
         t = t.astype(np.float64, copy=False)
         if not np.all(np.isfinite(t)):
             bad = int(np.flatnonzero(~np.isfinite(t))[0])

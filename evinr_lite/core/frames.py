@@ -5,7 +5,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .events import EventDataError
+from .checks import check_image_values
+from .events import EventDataError, InputError
 
 __all__ = ["Frames", "to_grey_uint8", "to_uint8", "GREY_WEIGHTS"]
 
@@ -17,7 +18,8 @@ class Frames:
     """F grey frames of size (H, W) and their timestamps.
 
     Attributes:
-        images: [F, H, W], uint8 (0..255) or float in [0, 1]; indexed [frame, y (row), x (column)].
+        images: [F, H, W], uint8 (0..255) or float in [0, 1] (finite; floats in 0..255 are refused);
+            indexed [frame, y (row), x (column)].
         t: float64 [F], seconds relative to ``t_origin`` (the same clock as the events they go with);
             readers return them sorted, :meth:`sorted` sorts others.
         t_origin: float, seconds; absolute time of t = 0.
@@ -35,6 +37,10 @@ class Frames:
             raise EventDataError(f"frames must be uint8 (0..255) or float in [0, 1], got dtype {images.dtype}")
         if images.ndim != 3:
             raise EventDataError(f"frames must have shape [F, H, W] (grey), got {images.shape}")
+        try:   # the scorer's rule, here too: float images in [0, 1], finite (0..255 floats are refused)
+            check_image_values(images, "frame images")
+        except InputError as err:
+            raise EventDataError(str(err)) from None
         t = np.asarray(self.t, dtype=np.float64)
         if t.shape != (images.shape[0],):
             raise EventDataError(f"{images.shape[0]} frames but {t.shape[0] if t.ndim == 1 else t.shape} timestamps")

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from skimage.metrics import structural_similarity
 
+from ..core.checks import check_image_values
 from ..core.frames import to_uint8
 
 __all__ = ["mse", "ssim", "equalize", "score_pairs", "score_frames", "protocol_description", "PROTOCOLS",
@@ -122,6 +123,9 @@ def score_pairs(pred, gt, equalization: str = "none") -> tuple[np.ndarray, np.nd
     if len(pred) == 0 or len(pred) != len(gt):
         raise ValueError(f"need one or more matched frame pairs, got {len(pred)} predictions and {len(gt)} "
                          "ground-truth frames; pass stacks [F, H, W] of the same length F >= 1")
+    # the plausibility rule of Frames and the readers: NaN, and floats on the 0..255 scale, are refused
+    check_image_values(gt, "ground-truth frames")
+    check_image_values(pred, "predicted frames", clipped=True)   # clipped to [0, 1] below: small overshoot is fine
     pred_eq = np.stack([equalize(a, equalization) for a in pred])
     gt_eq = np.stack([equalize(b, equalization) for b in gt])
     m = np.array([mse(a, b) for a, b in zip(pred_eq, gt_eq)])

@@ -38,7 +38,15 @@ def as_thresholds(C, name: str = "C") -> tuple[float, float]:
             and math.isfinite(c) and c > 0 for c in values):
         raise EventDataError(f"{name} must be a positive number or a pair (c_pos, c_neg) of positive numbers "
                              f"(log units per event, e.g. {name}=0.2 or {name}=(0.22, 0.18)), got {C!r}")
+    if max(values) > MAX_C:   # plausibility: beyond it the frames overflow to inf, or saturate to black/white
+        raise EventDataError(f"{name}={C!r} is not a plausible contrast threshold: it is the log-intensity change of "
+                             f"one event, 0.05 to 1.5 for event cameras, and at most {MAX_C:g} here (e^{MAX_C:g} = "
+                             f"{math.exp(MAX_C):,.0f} times brighter per event); pass the camera's C (e.g. {name}=0.2), "
+                             "or fit it from the APS frames (C='auto' on the command line: --C auto)")
     return float(values[0]), float(values[1])
+
+
+MAX_C = 10.0   # log units per event; the largest contrast threshold accepted (see as_thresholds)
 
 
 @dataclass(frozen=True, eq=False)

@@ -199,6 +199,11 @@ class EvINRConfig:
             raise EventDataError(f"lr_decay must be in (0, 1], got {self.lr_decay}")
         if not 0 < number("display_mean", self.display_mean) < 1:
             raise EventDataError(f"display_mean must be in (0, 1), got {self.display_mean}")
+        level = self.display_mean ** (1.0 / self.gamma)   # the tone map's grey level: it must exist in floats
+        if not 0.0 < level < 1.0 or not math.isfinite(math.log(level / (1.0 - level))):
+            raise EventDataError(f"gamma={self.gamma!r} with display_mean={self.display_mean!r} leaves the tone map no "
+                                 f"grey level (display_mean ** (1 / gamma) = {level!r}); use a gamma of about 0.01 "
+                                 "to 100 (the paper's 0.6)")
         if self.tau is not None and not number("tau", self.tau) > number("overlap", self.overlap) >= 0:
             raise EventDataError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
         for name in ("head_solve", "coarse_to_fine", "progress"):

@@ -58,6 +58,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
+from ..core.checks import real_number, require, whole_number
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from .binning import events_to_frames
@@ -384,8 +385,25 @@ def fit_contrast(frames: Frames, events: Events, *, method: str = "iv", span: st
         EventDataError: fewer than two frames in the events' span, too few pixels with events, a
             non-positive fit; the message says to give C instead.
     """
+    require(frames, Frames, "frames")          # every argument checked where it enters
+    require(events, Events, "events")
+    if method not in FIT_METHODS:
+        raise EventDataError(f"method must be one of {FIT_METHODS}, got {method!r}")
     if span not in SPANS:
         raise EventDataError(f"span must be one of {SPANS}, got {span!r}")
+    min_events = whole_number(min_events, "min_events", lo=0)
+    max_frames = whole_number(max_frames, "max_frames", lo=2)
+    block = whole_number(block, "block", lo=1)
+    n_bootstrap = whole_number(n_bootstrap, "n_bootstrap", lo=0)
+    seed = whole_number(seed, "seed", lo=0)
+    eps = real_number(eps, "eps", lo=0.0, hi=1.0, lo_open=True)
+    try:
+        lo, hi = (float(v) for v in exposed)
+    except (TypeError, ValueError):
+        lo = hi = math.nan
+    if not 0.0 <= lo < hi <= 1.0:
+        raise EventDataError(f"exposed= must be (low, high) with 0 <= low < high <= 1 (intensities in [0, 1]), "
+                             f"got {exposed!r}")
     if tuple(frames.size) != tuple(events.sensor_size):
         raise EventDataError(f"frames are {frames.size} but the events' sensor is {events.sensor_size} (H, W); "
                              "they cannot be compared")

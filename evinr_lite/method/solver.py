@@ -39,7 +39,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from ..core.checks import check_result_frames, require, whole_number
 from ..core.events import EventDataError, Events
+from ..core.frames import Frames
 from .anchor import fit_anchor, frames_in_window, linear_frames
 from .config import EvINRConfig
 from .ensemble import alignment_offsets, blend_networks, blend_weights, predict_networks, split_windows
@@ -83,8 +85,15 @@ class Reconstruction:
         return np.zeros(0) if self.anchor is None else self.anchor.times.copy()
 
     def at(self, times, chunk: int = 256) -> np.ndarray:
-        """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W]."""
-        t = np.atleast_1d(np.asarray(times, np.float64))
+        """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W].
+        ``chunk``: frames computed at once (a whole number >= 1)."""
+        chunk = whole_number(chunk, "chunk", lo=1)
+        try:
+            t = np.atleast_1d(np.asarray(times, np.float64))
+        except (TypeError, ValueError):
+            raise EventDataError(f"times= must be seconds (a number or an array of numbers), got {times!r}") from None
+        if t.ndim != 1 or not np.all(np.isfinite(t)):
+            raise EventDataError(f"times= must be finite seconds in a 1-D array, got shape {t.shape}")
         L = blend_networks(self.model, self.windows, t, self.offsets, chunk)
         return L if self.anchor is None else L + self.anchor.offset_at(t)
 
@@ -113,7 +122,9 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     Returns:
         Reconstruction with frames [Q, H, W] in [0, 1] and log intensities [Q, H, W].
     """
-    cfg = config or EvINRConfig()
+    events = require(events, Events, "events")                                 # every argument where it enters
+    cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")
+    require(frames, Frames, "frames", none_ok=True)
     q, events, t_start, t_end = _checked_span(events, query_times, t_start, t_end)
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)               # 1. windows
     frames = _checked_anchor_frames(frames, events.sensor_size, t_start, t_end, cfg)   # before training
@@ -126,7 +137,7 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
                          every=cfg.anchor_every, smoothing=cfg.anchor_smoothing)
         history["anchor"] = fit.summary()
         L = blend_networks(model, windows, q, offsets) + fit.offset_at(q)       # = Reconstruction.at(q)
-        return Reconstruction(q, L, linear_frames(L), model, windows, offsets, cfg, history, fit)
+        return _checked_result(Reconstruction(q, L, linear_frames(L), model, windows, offsets, cfg, history, fit))
     grid = _offset_grid(t_start, t_end, len(windows), cfg)
     if cfg.offset_solve == "median_gradient":                                   # 4. offset solve
         # one offset image for all networks: the alignment stays
@@ -134,7 +145,20 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     offsets += _level_shift(blend_networks(model, windows, grid, offsets), cfg)  # 5. level anchor
     L = blend_networks(model, windows, q, offsets)
     frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)                  # 6. tone map
-    return Reconstruction(q, L, frames, model, windows, offsets, cfg, history)
+    return _checked_result(Reconstruction(q, L, frames, model, windows, offsets, cfg, history))
+
+
+RESULT_FIX = ("the settings do not fit these events: check C (the log-intensity change per event, 0.05 to 1.5 for "
+              "event cameras; or fit it: --C auto), keep the recipe's learning rate (a smaller lr=), and for anchors "
+              "use APS frames with distinct timestamps")
+
+
+def _checked_result(rec: Reconstruction) -> Reconstruction:
+    """The reconstruction, unless its output is not a result: NaN or infinite values, or every frame
+    one constant although events were given (at least 2, see :func:`_checked_span`) -> ResultError."""
+    check_result_frames(rec.log_intensity, what="EvINR's log intensity", input_varies=False, fix=RESULT_FIX)
+    check_result_frames(rec.frames, what="EvINR's frames", input_varies=True, fix=RESULT_FIX)
+    return rec
 
 
 def _checked_span(events: Events, query_times, t_start, t_end):
