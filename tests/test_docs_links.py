@@ -193,6 +193,8 @@ def test_named_modules_functions_and_source_files_exist(path):
                 problems.append(f"{path.relative_to(ROOT)}:{line}: {name} ({type(err).__name__}: {err})")
         for m in _SOURCE.finditer(text):
             rel = m.group(1)
+            if re.search(r"NN|\*", rel):                             # a pattern (notebooks/NN_name.ipynb)
+                continue
             if not any(p.exists() for p in (ROOT / rel, ROOT / "evinr_lite" / rel, path.parent / rel)):
                 problems.append(f"{path.relative_to(ROOT)}:{line}: {rel} does not exist")
     assert not problems, "the docs name things that do not exist (update the docs):\n" + "\n".join(problems)
