@@ -198,3 +198,19 @@ def test_named_modules_functions_and_source_files_exist(path):
             if not any(p.exists() for p in (ROOT / rel, ROOT / "evinr_lite" / rel, path.parent / rel)):
                 problems.append(f"{path.relative_to(ROOT)}:{line}: {rel} does not exist")
     assert not problems, "the docs name things that do not exist (update the docs):\n" + "\n".join(problems)
+
+
+def test_docs_architecture_lists_every_module():
+    """docs/architecture.md's 'Every module' names each module of evinr_lite under its subpackage."""
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    listed = text.split("<!-- modules -->", 1)[1].split("<!-- /modules -->", 1)[0]
+    sections = {m.group(1): m.group(2) for m in re.finditer(r"^### `([\w.]+)`\n(.*?)(?=^### |\Z)", listed, re.M | re.S)}
+    missing = []
+    for path in sorted((ROOT / "evinr_lite").rglob("*.py")):
+        if path.name in ("__init__.py", "__main__.py") or path.parent == ROOT / "evinr_lite":
+            continue
+        package = ".".join(path.parent.relative_to(ROOT / "evinr_lite").parts)
+        if not re.search(rf"^- `{path.stem}`: \S", sections.get(package, ""), re.M):
+            missing.append(f"{package}.{path.stem}")
+    assert sections and not missing, ("docs/architecture.md does not list these modules (add a line with the "
+                                      "module's first docstring sentence): " + ", ".join(missing))
