@@ -212,5 +212,5 @@ def test_docs_architecture_lists_every_module():
         package = ".".join(path.parent.relative_to(ROOT / "evinr_lite").parts)
         if not re.search(rf"^- `{path.stem}`: \S", sections.get(package, ""), re.M):
             missing.append(f"{package}.{path.stem}")
-    assert sections and not missing, ("docs/architecture.md does not list these modules (add a line with the "
-                                      "module's first docstring sentence): " + ", ".join(missing))
+    assert sections and not missing, ("docs/architecture.md does not list these modules (run python "
+                                      "tools/doc_modules.py): " + ", ".join(missing))
