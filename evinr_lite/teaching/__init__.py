@@ -10,8 +10,8 @@ Only this subpackage knows the registry; the library never registers anything.
 """
 from . import exercises
 from . import (ablation_exercises, accel_exercises, aed_exercises, coordinate_exercises, discussion_exercises,
-               events2d, frame_exercises, head_exercises, pde1d, realdata_exercises, recording_exercises, training_exercises)
+               events2d, frame_exercises, head_exercises, pde1d, poisson_exercises, realdata_exercises, recording_exercises, training_exercises)
 
 __all__ = ["exercises", "pde1d", "events2d", "coordinate_exercises", "frame_exercises", "training_exercises",
-           "head_exercises", "accel_exercises", "ablation_exercises", "discussion_exercises", "realdata_exercises", "aed_exercises",
+           "head_exercises", "poisson_exercises", "accel_exercises", "ablation_exercises", "discussion_exercises", "realdata_exercises", "aed_exercises",
            "recording_exercises"]
