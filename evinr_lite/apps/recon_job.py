@@ -34,6 +34,7 @@ from ..method.recipes import (DEFAULT_C, RECIPES, contrast_option, format_contra
                               resolve_contrast)
 from ..method.solver import Reconstruction, reconstruct
 from .options import RunOptions, check_run_options, parse_times  # noqa: F401
+from .stream_job import run_streaming, streamable, video_fps
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
@@ -136,12 +137,6 @@ def score_recording(result: Reconstruction, gt: Frames | None) -> dict | None:
 
 # ---- export ----------------------------------------------------------------------------------
 
-def _video_fps(times: np.ndarray) -> float:
-    """Playback rate: the median spacing of the frames, kept between 2 and 60 frames per second."""
-    if len(times) < 2:
-        return 10.0
-    step = float(np.median(np.diff(times)))
-    return float(np.clip(1.0 / step, 2.0, 60.0)) if step > 0 else 10.0
 
 
 def export_reconstruction(out_dir, rec: Recording, result: Reconstruction, scores: dict | None = None, *,
@@ -177,21 +172,15 @@ def export_reconstruction(out_dir, rec: Recording, result: Reconstruction, score
 
 def _write_reconstruction(tmp: Path, rec: Recording, result: Reconstruction, scores: dict | None, *,
                           settings: dict | None, video: bool, log) -> dict:
-    from ..io.export import save_csv, save_frames_png, save_gif, save_mp4, save_timestamps
-    from ..io.output import save_json
+    from ..io.export import save_frames_png, save_gif, save_mp4, save_timestamps
 
     written = ["frames/", "timestamps.txt"]
-    run = {"input": rec.meta.get("path"), "format": rec.meta.get("format"),
-           "sensor_size": list(rec.events.sensor_size), "t_origin": rec.events.t_origin,
-           "window_s": list(rec.meta["window"]), "n_events": len(rec.events),
-           "n_frames_written": len(result.times), "times_s": result.times.tolist(),
-           **(settings or {}), "evinr_config": result.history.get("config"),
-           "train_time_s": result.history.get("train_time_s")}
+    settings = dict(settings or {})
     # into the staging folder; the caller renames it into place
     save_frames_png(tmp / "frames", result.frames)
     save_timestamps(tmp / "timestamps.txt", result.times, rec.events.t_origin)
     if video:
-        fps = _video_fps(result.times)
+        fps = video_fps(result.times)
         save_gif(tmp / "reconstruction.gif", result.frames, fps)
         written.append("reconstruction.gif")
         try:
@@ -199,7 +188,26 @@ def _write_reconstruction(tmp: Path, rec: Recording, result: Reconstruction, sco
             written.append("reconstruction.mp4")
         except RuntimeError as err:
             log(f"warning: {err}")
-        run["video_fps"] = fps
+        settings["video_fps"] = fps
+    return write_results(tmp, rec, result.times, result.history, scores, settings=settings, written=written)
+
+
+def write_results(tmp: Path, rec: Recording, times, history: dict, scores: dict | None, *, settings: dict | None,
+                  written: list, n_events: int | None = None) -> dict:
+    """Everything of a run folder but its frames (which the caller wrote: ``written`` lists them):
+    ``gt/``, ``metrics.json``, ``metrics.csv`` when scored, and ``run.json``. Returns run.json's contents.
+    ``n_events``: the events reconstructed (default ``len(rec.events)``; a streamed run holds none in memory)."""
+    from ..io.export import save_csv, save_frames_png, save_timestamps
+    from ..io.output import save_json
+
+    written = list(written)
+    times = np.asarray(times, np.float64)
+    run = {"input": rec.meta.get("path"), "format": rec.meta.get("format"),
+           "sensor_size": list(rec.events.sensor_size), "t_origin": rec.events.t_origin,
+           "window_s": list(rec.meta["window"]), "n_events": len(rec.events) if n_events is None else int(n_events),
+           "n_frames_written": len(times), "times_s": times.tolist(),
+           **(settings or {}), "evinr_config": history.get("config"),
+           "train_time_s": history.get("train_time_s")}
     if scores is not None:
         gt = rec.frames
         save_frames_png(tmp / "gt", gt.images)
@@ -255,7 +263,7 @@ def denoise_recording(rec: Recording, path, log=print):
 
 
 def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwrite: bool = False, log=print,
-                    command: str = "", **fields) -> dict:
+                    command: str = "", resume: bool = False, **fields) -> dict:
     """load -> window -> reconstruct -> score -> export; the ``evinr-lite reconstruct`` command.
 
     The run's options are a :class:`~evinr_lite.apps.options.RunOptions` (``options``), or its
@@ -271,6 +279,11 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
     device, the file, its format, the sensor size, the window, the times and the memory needed.
     ``overwrite`` replaces ``out_dir``; ``command`` is recorded in the lock so a second run can
     name this one. Returns the contents of run.json (with "scores" when the recording has frames).
+
+    Events-only grey runs without denoise or C="auto" stream (:mod:`evinr_lite.apps.stream_job`):
+    only each window's events are read, memory is set by the window and the sensor, and a run
+    that is killed can be continued with ``resume=True`` (``--resume``) without recomputing its
+    finished windows. The others read the window into memory and solve it whole.
     """
     from ..core.runtime import default_device
     from ..io.output import OutputDir
@@ -278,6 +291,13 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
     t0 = time.perf_counter()
     options = RunOptions.of(options, **fields)   # every option checked, once, before anything is touched
     anchor, colour = options.anchor, options.colour
+    if streamable(options):
+        with OutputDir(out_dir, overwrite=overwrite, inputs=[path], log=log, command=command) as target:
+            run, times, scores = run_streaming(path, target, options, resume=resume, log=log, t0=t0)
+        return _finish(run, times, scores, target.given, t0, options, log)
+    if resume:
+        log("note: --resume applies to streamed runs (events only, without --denoise, --C auto, --anchor or "
+            "--colour); this run starts from the beginning")
     with OutputDir(out_dir, overwrite=overwrite, inputs=[path], log=log, command=command) as target:
         try:
             device_name = str(default_device(options.device))
@@ -329,10 +349,15 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
             settings["colour"] = {"cfa": result.history["cfa"], "thresholds": result.history["thresholds"],
                                   "grid": list(result.frames.shape[1:3]), **(colour_scores or {})}
         run = export_reconstruction(target, rec, result, scores, settings=settings, video=options.video, log=log)
+    return _finish(run, times, scores, target.given, t0, options, log)
+
+
+def _finish(run: dict, times, scores, out_dir, t0: float, options, log) -> dict:
+    """The run's closing line (frames, time, scores, anchors, colour) and its total time."""
+    anchor = options.anchor
     seconds = time.perf_counter() - t0
-    out_dir = target.given
     line = (f"wrote {len(times)} frames to {out_dir}/ in {seconds:.1f} s "
-            f"(training {result.history['train_time_s']:.1f} s)")
+            f"(training {run.get('train_time_s') or 0.0:.1f} s)")
     if scores:
         parts = [f"{eq}: MSE {s['mse']:.4f} SSIM {s['ssim']:.3f}" + (f" LPIPS {s['lpips']:.3f}" if s.get("lpips") else "")
                  for eq, s in scores.items()]

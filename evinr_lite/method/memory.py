@@ -39,38 +39,78 @@ def available_bytes(device: str = "cpu") -> int:
         return 1 << 62
 
 
-def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_frames: int,
-                    config: EvINRConfig) -> dict:
-    """Bytes a reconstruction of [t_start, t_end] (seconds) will need, by part, before anything is allocated.
+PROCESS_BYTES = 280e6   # Python, numpy, scipy, torch, OpenCV and Pillow loaded (measured RSS ~270 MB on CPU)
+EVENT_BYTES = 17.0      # one event in memory: t float64, x, y int32, p int8
+READ_BYTES = 2 * EVENT_BYTES   # while a window is read and converted (the file's columns, then Events)
 
-    What it counts: ``networks`` (each window's SIREN with its H*W head: weights, gradients and
-    Adam's two moments, float32; one network per window of :func:`~evinr_lite.method.ensemble.split_windows`),
-    ``bins`` (the event frames and the loss terms over them: 3 float32 [B, H, W]), ``frames`` (the
-    ``n_frames`` queried log intensities and tone-mapped frames). Not counted: the events themselves,
-    the Python process and torch's own workspace. An estimate (within a factor of about 2).
+
+def _n_windows(span: float, config: EvINRConfig) -> int:
+    if config.tau is not None and span > MAX_WINDOWS * (config.tau - config.overlap):
+        return MAX_WINDOWS   # far beyond any memory: not worth allocating the windows to count them
+    return len(split_windows(0.0, span, config.tau, config.overlap)) if span > 0 else 1
+
+
+def _final_bins(window_s: float, n_window_events: float, config: EvINRConfig) -> int:
+    """Final bins of one network window (as training.initial boundaries and the bisections give them)."""
+    if config.binning == "fixed":
+        n = max(2 ** config.n_bisections, config.min_bins, int(round(window_s / config.bin_duration)))
+    else:
+        n = math.ceil(n_window_events / config.events_per_bin)
+    return max(int(n), 1)
+
+
+def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_frames: int,
+                    config: EvINRConfig, *, streaming: bool = False, n_kept: int = 0) -> dict:
+    """Peak bytes a reconstruction of [t_start, t_end] (seconds) will need, by part, before anything is allocated.
+
+    What it counts (float32 unless said; P = H * W pixels, d = hidden_features, B final bins per
+    window, N windows, Q = ``n_frames`` query times):
+
+    - ``process``: the interpreter and the libraries (PROCESS_BYTES);
+    - ``events``: the events held (all of them; streaming: one window's, while it is read);
+    - ``networks``: the H*W heads (d + 1) P, times 4 with Adam (weights, gradients, two moments),
+      N of them (streaming: one);
+    - ``bins``: the event frames B x P of every window, twice while they are stacked (streaming: one window),
+      plus the fused training step's three B x P work arrays when n_iters > 0;
+    - ``frames``: whole solve: every network at every query time [N, Q, P], its offset copy, the
+      float64 blend and the float64 tone map [Q, P]; streaming: one prediction batch
+      (streaming.PREDICT_CELLS) with its float64 tone map, the offset grid (max(64, 8 N) frames) and
+      its float64 median workspace for one row block, the overlap's partial blends, and ``n_kept``
+      frames kept in memory (those at ground-truth times; the GIF's uint8 frames count as n_kept / 4).
+
+    Measured against peak RSS in ``benchmarks/scale.py`` (the target: within 25 %).
 
     Returns:
-        {"total": bytes, "parts": {"networks", "bins", "frames"}, "n_windows", "n_bins", "n_frames", "span_s"}.
+        {"total": bytes, "parts": {...}, "n_windows", "n_bins" (per window), "n_frames", "span_s", "streaming"}.
     """
     span = max(float(t_end) - float(t_start), 0.0)
     H, W = sensor_size
-    pixels = float(H) * float(W)
-    if config.tau is not None and span > MAX_WINDOWS * (config.tau - config.overlap):
-        n_windows = MAX_WINDOWS   # far beyond any memory: not worth allocating the windows to count them
+    P = float(H) * float(W)
+    N = _n_windows(span, config)
+    window_s = span if N == 1 else (span + (N - 1) * config.overlap) / N
+    per_window_events = float(n_events) * (window_s / span if span > 0 else 1.0)
+    B = _final_bins(window_s, per_window_events, config)
+    d = config.hidden_features
+    head = 4.0 * (d + 1) * P * (4 if config.n_iters > 0 else 1)
+    trunk = 4.0 * (2 * d + config.hidden_layers * (d * d + d)) * (4 if config.n_iters > 0 else 1)
+    bins = 4.0 * B * P * (2 + (3 if config.n_iters > 0 else 0))
+    Q = float(n_frames)
+    if streaming:
+        from .streaming import PREDICT_CELLS
+
+        batch = min(Q, max(1.0, PREDICT_CELLS // P)) * P
+        grid = float(max(64, 8 * N)) * P
+        overlap_frames = Q * min(1.0, config.overlap / span) if span > 0 and N > 1 else 0.0
+        parts = {"process": PROCESS_BYTES, "events": READ_BYTES * per_window_events,
+                 "networks": head + trunk, "bins": bins,
+                 "frames": batch * (4 + 16) + grid * 4 + min(grid, 1 << 24) * 16 + overlap_frames * P * 8
+                 + float(n_kept) * P * 4}
     else:
-        n_windows = len(split_windows(0.0, span, config.tau, config.overlap)) if span > 0 else 1
-    hidden = config.hidden_features
-    params = 2 * hidden + config.hidden_layers * (hidden * hidden + hidden) + (hidden + 1) * pixels
-    if config.binning == "fixed":
-        n_bins = math.ceil(span / config.bin_duration)
-    else:
-        n_bins = math.ceil(n_events / config.events_per_bin)
-    n_bins = max(n_bins, 1)
-    n_frames = int(n_frames)
-    parts = {"networks": 16.0 * params * n_windows, "bins": 3 * 4.0 * n_bins * pixels,
-             "frames": 2 * 16.0 * n_frames * pixels}
-    return {"total": sum(parts.values()), "parts": parts, "n_windows": n_windows, "n_bins": n_bins,
-            "n_frames": n_frames, "span_s": span}
+        parts = {"process": PROCESS_BYTES, "events": EVENT_BYTES * float(n_events),
+                 "networks": (head + trunk) * N, "bins": bins * N,
+                 "frames": Q * P * (2 * 4 * N + 8 + 16 + 4 + 4)}
+    return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
+            "span_s": span, "streaming": bool(streaming)}
 
 
 def _gib(n_bytes: float) -> str:
@@ -78,14 +118,16 @@ def _gib(n_bytes: float) -> str:
 
 
 def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_frames: int, config: EvINRConfig,
-                 device: str = "cpu", *, fraction: float = 0.8, events_span=None) -> dict:
+                 device: str = "cpu", *, fraction: float = 0.8, events_span=None, streaming: bool = False,
+                 n_kept: int = 0) -> dict:
     """Refuse (EventDataError) a reconstruction whose :func:`estimate_memory` exceeds ``fraction`` of
     the free memory (:func:`available_bytes`), naming the estimate and the parameter to change.
 
     ``events_span``: (first, last) event time in seconds, named in the advice (default: the window).
     Returns the estimate.
     """
-    est = estimate_memory(sensor_size, t_start, t_end, n_events, n_frames, config)
+    est = estimate_memory(sensor_size, t_start, t_end, n_events, n_frames, config, streaming=streaming,
+                          n_kept=n_kept)
     free = available_bytes(device)
     if est["total"] <= fraction * free:
         return est
@@ -101,7 +143,14 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
                  f"[{ev_lo:.6f}, {ev_hi:.6f}] s) or use a longer bin_duration"),
         "frames": (f"{est['n_frames']:,} output frames of {H}x{W} pixels; ask for fewer frames with fps= or at=, "
                    "or shorten the window with t_start=/t_end="),
+        "events": (f"the events in memory ({est['span_s']:.6g} s of them); shorten the window with t_start=/t_end= "
+                   f"(the events cover [{ev_lo:.6f}, {ev_hi:.6f}] s)"),
+        "process": "the libraries alone; free some memory first",
     }[worst]
+    if est.get("streaming") and worst in ("networks", "bins"):   # one window at a time: the window sets it
+        fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.bin_duration:g} s, "
+               f"hidden_features={config.hidden_features}); use a longer bin_duration, a shorter tau or fewer "
+               "hidden_features")
     raise EventDataError(f"this reconstruction needs about {_gib(est['total'])} of memory but about {_gib(free)} is "
                          f"free on {device}: most of it for {fix}")
 

@@ -43,7 +43,9 @@ from ..core.checks import check_result_frames, require, whole_number
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from .anchor import fit_anchor, frames_in_window, linear_frames
+from .balance import prepare_events
 from .config import EvINRConfig
+from .memory import check_memory
 from .ensemble import alignment_offsets, blend_networks, blend_weights, predict_networks, split_windows
 from .models import FrameINR
 from .offset import median_gradient_offset
@@ -106,7 +108,8 @@ class Reconstruction:
 
 
 def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, *,
-                t_start: float | None = None, t_end: float | None = None, frames=None) -> Reconstruction:
+                t_start: float | None = None, t_end: float | None = None, frames=None,
+                memory_guard: bool = True) -> Reconstruction:
     """Reconstruct log intensity and tone-mapped frames at ``query_times`` from events alone.
 
     Args:
@@ -118,6 +121,11 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
         frames: the APS frames (:class:`~evinr_lite.core.frames.Frames`, on the events' clock) for
             ``config.anchor`` "first" or "all" (:mod:`evinr_lite.method.anchor`); frames outside
             [t_start, t_end] are ignored. Needed by an anchored config, refused by an events-only one.
+        memory_guard: refuse (EventDataError, before training) a reconstruction whose memory estimate
+            (:func:`~evinr_lite.method.memory.estimate_memory`: N networks, their bins, every network
+            at every query time) exceeds 80 % of the free memory, naming the setting to change, as
+            the command line does; False skips the check. Long recordings: stream them
+            (:func:`~evinr_lite.method.streaming.stream_reconstruct`).
 
     Returns:
         Reconstruction with frames [Q, H, W] in [0, 1] and log intensities [Q, H, W].
@@ -126,9 +134,13 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")
     require(frames, Frames, "frames", none_ok=True)
     q, events, t_start, t_end = _checked_span(events, query_times, t_start, t_end)
+    events, cfg = prepare_events(events, cfg)                                   # 0. hot pixels, ON/OFF balance
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)               # 1. windows
     frames = _checked_anchor_frames(frames, events.sensor_size, t_start, t_end, cfg)   # before training
-    model, history = train_frame_inr(events, windows, cfg)                      # 2. train / closed-form head
+    if memory_guard:                                                            # before anything large is allocated
+        check_memory(events.sensor_size, t_start, t_end, len(events), len(q), cfg, _device_name(cfg),
+                     events_span=(float(events.t[0]), float(events.t[-1])))
+    model, history = train_frame_inr(events, windows, cfg, model=_initial_model(events.sensor_size, windows, cfg))
     model.eval()
     offsets = alignment_offsets(model, windows)                                 # 3. align the networks
     history["config"] = asdict(cfg)
@@ -159,6 +171,26 @@ def _checked_result(rec: Reconstruction) -> Reconstruction:
     check_result_frames(rec.log_intensity, what="EvINR's log intensity", input_varies=False, fix=RESULT_FIX)
     check_result_frames(rec.frames, what="EvINR's frames", input_varies=True, fix=RESULT_FIX)
     return rec
+
+
+def _device_name(cfg: EvINRConfig) -> str:
+    """The device the config trains on, as the memory check names it ("cpu" when none can be chosen)."""
+    from ..core.runtime import default_device
+
+    try:
+        return str(default_device(cfg.device))
+    except RuntimeError:   # no such device: train_frame_inr says so with its own message
+        return "cpu"
+
+
+def _initial_model(sensor_size, windows: np.ndarray, cfg: EvINRConfig) -> FrameINR:
+    """The N networks to train, on the config's device; a head that is only solved in closed form
+    (head_solve with no Adam step) is not drawn (saves d x H*W random numbers per network)."""
+    from ..core.runtime import default_device
+
+    solve_only = cfg.head_solve and cfg.n_iters == 0
+    return FrameINR(sensor_size, windows, cfg.hidden_features, cfg.hidden_layers, cfg.omega_0, cfg.first_omega_0,
+                    seed=cfg.seed, init_head=not solve_only).to(default_device(cfg.device))
 
 
 def _checked_span(events: Events, query_times, t_start, t_end):

@@ -39,6 +39,7 @@ import torch
 
 from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
+from .balance import prepare_source
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
@@ -256,6 +257,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
 
     source = as_source(source)
     cfg, q, t_start, t_end = _check(source, query_times, config, t_start, t_end, offset_from)
+    cfg, source = prepare_source(source, t_start, t_end, cfg)    # hot pixels, ON/OFF balance (method/balance.py)
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
     if state is None:
         state = StreamState.start(windows, source.sensor_size)

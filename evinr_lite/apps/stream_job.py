@@ -1,0 +1,279 @@
+"""The reconstruct job over a stream of windows: bounded memory at any recording length, resumable.
+
+:func:`~evinr_lite.apps.recon_job.run_reconstruct` hands events-only runs here
+(:func:`streamable`). The recording is opened as a source (only each window's events are read,
+:func:`~evinr_lite.io.load.open_recording`), reconstructed window by window
+(:func:`~evinr_lite.method.streaming.stream_reconstruct`, the same result as the whole-sequence
+solve), and its frames are written into the run's staging folder a batch at a time.
+
+Resume: while it runs, a folder ``.<name>.resume`` beside the output holds the stream's state after
+every window and the log intensities finished so far (a spill file, 4 bytes x H x W per frame),
+with a marker naming the input (resolved path, size, modification time) and the result settings.
+A run that is killed leaves it behind; ``resume=True`` (``evinr-lite reconstruct ... --resume``)
+continues from the last finished window when the marker matches, and refuses otherwise; a run
+without ``resume`` replaces it. It is removed once the result is committed. The output folder
+itself stays all-or-nothing (:class:`~evinr_lite.io.output.OutputDir`), and its lock covers the
+resume folder too.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import time
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from ..core.events import EventDataError, Events
+from ..core.frames import Frames
+from ..core.recording import Recording
+
+__all__ = ["streamable", "run_streaming", "resume_folder", "video_fps", "RESUME_MARKER", "GIF_LIMIT_BYTES"]
+
+RESUME_MARKER = ".evinr-resume.json"   # inside the resume folder: the proof it is this job's own
+GIF_LIMIT_BYTES = 512 << 20            # uint8 frames kept for the GIF; beyond, the GIF is skipped (the MP4 streams)
+
+
+def streamable(options) -> bool:
+    """True for runs the stream can do: events only, grey, without the steps that need every event of
+    the window at once (denoise, C fitted from the frames)."""
+    return options.anchor == "none" and not options.colour and not options.denoise and options.C != "auto"
+
+
+def resume_folder(out_path: Path) -> Path:
+    """The resume folder of an output folder: ``.<name>.resume`` beside it."""
+    out_path = Path(os.path.abspath(out_path))
+    return out_path.parent / f".{out_path.name}.resume"
+
+
+def _identity(path) -> dict:
+    """The input's identity: resolved path, size and modification time (a folder: of its files too)."""
+    p = Path(path).resolve()
+    st = p.stat()
+    ident = {"path": str(p), "size": st.st_size, "mtime_ns": st.st_mtime_ns}
+    if p.is_dir():
+        ident["files"] = sorted((str(f.relative_to(p)), f.stat().st_size, f.stat().st_mtime_ns)
+                                for f in p.rglob("*") if f.is_file())
+    return ident
+
+
+def _key(path, config, times, window) -> dict:
+    """What a saved state must match to be resumed: the input, the settings, the times and the span."""
+    digest = hashlib.sha256(np.ascontiguousarray(times, np.float64).tobytes()).hexdigest()
+    cfg = {k: v for k, v in asdict(config).items() if k not in ("progress",)}
+    return json.loads(json.dumps({"input": _identity(path), "config": cfg, "times_sha256": digest,
+                                  "window": [float(window[0]), float(window[1])]}, default=str))
+
+
+def _prepare_resume(folder: Path, key: dict, resume: bool, log):
+    """The StreamState to resume from (or None), the folder made ready. A folder without this job's
+    marker is never touched."""
+    from ..method.streaming import StreamState
+
+    marker = folder / RESUME_MARKER
+    if folder.exists() or folder.is_symlink():
+        if folder.is_symlink() or not marker.is_file():
+            raise EventDataError(f"{folder} exists but was not made by evinr-lite (no {RESUME_MARKER} inside); "
+                                 "move it away, or choose another output folder")
+        try:
+            saved = json.loads(marker.read_text())
+        except (OSError, ValueError):
+            saved = None
+        state_file = folder / "state.npz"
+        if resume and saved == key and state_file.is_file():
+            try:
+                state = StreamState.load(state_file)
+            except (OSError, ValueError, KeyError) as err:
+                raise EventDataError(f"{state_file}: the saved state cannot be read ({err}); run without --resume "
+                                     "to start again") from None
+            log(f"resuming from {folder}: {state.next_window} of {len(state.windows)} window(s) already done")
+            return state
+        if resume:
+            what = "another input or other settings" if saved != key else "no finished window"
+            raise EventDataError(f"--resume: the stopped run in {folder} was for {what}; run without --resume to "
+                                 "start again (its state is then replaced)")
+        log(f"a stopped run's state in {folder} is replaced (pass --resume to continue it instead)")
+        shutil.rmtree(folder)
+    elif resume:
+        log(f"--resume: no stopped run to continue ({folder} does not exist); starting from the first window")
+    folder.mkdir(parents=True)
+    tmp = folder / f".{RESUME_MARKER}.partial"
+    tmp.write_text(json.dumps(key))
+    tmp.replace(marker)
+    return None
+
+
+def _header(path, options, log):
+    """(source, span (lo, hi), ground-truth Frames in the span or None, a Recording carrying the
+    metadata and the span, with no events) after every check that needs no training."""
+    from ..io.load import open_recording
+
+    source = open_recording(path, sensor_size=options.sensor_size, time_unit=options.time_unit)
+    first, last = source.t_span
+    lo = first if options.t_start is None else float(options.t_start)
+    hi = last if options.t_end is None else float(options.t_end)
+    if source.n_events == 0 or not (hi > lo) or lo > last or hi < first:
+        source.close()
+        raise EventDataError(f"{path}: no events in the window [{options.t_start}, {options.t_end}) s; the events "
+                             f"cover [{first:.6f}, {last:.6f}] s; choose a window inside it (see `evinr-lite info`)")
+    frames = source.frames
+    if frames is not None:   # only frames the events can reach: inside [lo, hi]
+        keep = (frames.t >= lo) & (frames.t <= hi)
+        frames = Frames(frames.images[keep], frames.t[keep], frames.t_origin) if keep.any() else None
+    H, W = source.sensor_size
+    empty = Events(np.zeros(0), np.zeros(0, np.int32), np.zeros(0, np.int32), np.zeros(0, np.int8), (H, W),
+                   source.t_origin)
+    meta = {**source.meta, "format": source.format, "path": str(path), "window": (lo, hi)}
+    return source, (lo, hi), frames, Recording(empty, frames, meta)
+
+
+def run_streaming(path, target, options, *, resume: bool = False, log=print, t0: float | None = None):
+    """The body of ``evinr-lite reconstruct`` for a :func:`streamable` run, into the opened
+    :class:`~evinr_lite.io.output.OutputDir` ``target``. Returns (run.json's contents, times, scores)."""
+    from ..core.runtime import default_device
+    from ..io.export import save_timestamps
+    from ..method.memory import check_memory
+    from ..method.recipes import format_contrast, resolve_contrast
+    from ..method.streaming import stream_reconstruct
+    from .recon_job import choose_times, score_predictions, write_results
+
+    t0 = time.perf_counter() if t0 is None else t0
+    try:
+        device_name = str(default_device(options.device))
+    except RuntimeError as err:
+        raise EventDataError(str(err)) from None
+    source, (lo, hi), gt, rec = _header(path, options, log)
+    with source:
+        times, times_source = choose_times(rec, fps=options.fps, at=options.at)
+        C, C_source, _ = resolve_contrast(rec, options.C, path, log)
+        config = options.config(C)
+        H, W = source.sensor_size
+        n_events = source.n_events if source.n_events is not None else 0
+        gt_t = gt.t if gt is not None else np.zeros(0)
+        query = np.unique(np.concatenate([times, gt_t]))        # sorted: the exported times and the scored ones
+        est = check_memory((H, W), lo, hi, n_events, len(query), config, device_name, events_span=source.t_span,
+                           streaming=True)
+        log(f"streaming {source.format} {H}x{W} over [{lo:.6f}, {hi:.6f}] s"
+            + (f" ({n_events:,} events)" if source.n_events is not None else "")
+            + (f", {len(gt)} ground-truth frames" if gt is not None else ", no frames")
+            + f"; memory estimate {est['total'] / 2**30:.2f} GiB")
+        log(f"reconstructing {times_source} with EvINR ({options.recipe} recipe, C = {format_contrast(C)} {C_source}, "
+            f"{config.n_iters} Adam iterations{' + the closed-form output layer' if config.head_solve else ''}, "
+            f"{device_name}), window by window")
+        folder = resume_folder(target.path)
+        state = _prepare_resume(folder, _key(path, config, times, (lo, hi)), resume, log)
+        writer = _FrameWriter(target.staging, times, query, gt_t, options.video, log)
+        parts = stream_reconstruct(source, query, config, t_start=lo, t_end=hi, workdir=folder, state=state,
+                                   on_state=lambda s: s.save(folder / "state.npz"), progress=options.progress)
+        history = {}
+        for part in parts:
+            writer.add(part)
+            history = part.history
+    save_timestamps(target.staging / "timestamps.txt", times, source.t_origin)
+    written = ["frames/", "timestamps.txt"] + writer.finish()
+    scores = score_predictions(writer.gt_frames(), gt.t, gt) if gt is not None else None
+    history = {**history, "config": asdict(config), "streamed": True}
+    settings = {"C": C, "C_source": C_source, "times_source": times_source, "device": device_name,
+                "seed": options.seed, "memory_estimate_bytes": est["total"]}
+    if writer.video_fps is not None:
+        settings["video_fps"] = writer.video_fps
+    run = write_results(target.staging, rec, times, history, scores, settings=settings, written=written,
+                        n_events=n_events)
+    target.commit()
+    shutil.rmtree(folder, ignore_errors=True)   # committed: nothing left to resume
+    return run, times, scores
+
+
+class _FrameWriter:
+    """Writes each finished frame of the exported times as a PNG (and into the MP4) as it arrives,
+    and keeps the frames at the ground-truth times for scoring."""
+
+    def __init__(self, staging: Path, times, query, gt_t, video: bool, log):
+        self.folder = staging / "frames"
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.staging, self.log = staging, log
+        self.export_at = np.searchsorted(query, times)          # query index of each exported frame
+        self.gt_at = np.searchsorted(query, gt_t)
+        self.export_of = {int(q): i for i, q in enumerate(self.export_at)}
+        self.gt_of = {int(q): i for i, q in enumerate(self.gt_at)}
+        self.gt = [None] * len(gt_t)
+        self.video = video
+        self.video_fps = video_fps(times) if video else None
+        self.mp4 = None
+        self.gif = [] if video else None
+        self.n_times = len(times)
+
+    def add(self, part) -> None:
+        from ..core.frames import to_uint8
+        from ..io.output import save_png
+
+        u8 = to_uint8(part.frames)
+        for j, q in enumerate(part.indices.tolist()):
+            i = self.export_of.get(q)
+            if i is not None:
+                save_png(self.folder / f"frame_{i:05d}.png", u8[j])
+                if self.video:
+                    self._video_frame(u8[j])
+            g = self.gt_of.get(q)
+            if g is not None:
+                self.gt[g] = part.frames[j].copy()
+
+    def _video_frame(self, img: np.ndarray) -> None:
+        if self.mp4 is None:
+            self.mp4 = _Mp4(self.staging / "reconstruction.mp4", self.video_fps, img.shape, self.log)
+        self.mp4.write(img)
+        if self.gif is not None:
+            if (len(self.gif) + 1) * img.size > GIF_LIMIT_BYTES:
+                self.log(f"note: the GIF is skipped ({self.n_times:,} frames of {img.shape[0]}x{img.shape[1]} would "
+                         f"need over {GIF_LIMIT_BYTES >> 20} MB); the PNGs and the MP4 hold every frame")
+                self.gif = None
+            else:
+                self.gif.append(img)
+
+    def finish(self) -> list:
+        from ..io.export import save_gif
+
+        written = []
+        if self.mp4 is not None and self.mp4.close():
+            written.append("reconstruction.mp4")
+        if self.gif:
+            save_gif(self.staging / "reconstruction.gif", np.stack(self.gif), self.video_fps)
+            written.append("reconstruction.gif")
+        return written
+
+    def gt_frames(self) -> np.ndarray:
+        return np.stack(self.gt)
+
+
+class _Mp4:
+    """An MP4 written frame by frame (OpenCV), as :func:`~evinr_lite.io.export.save_mp4` writes a stack."""
+
+    def __init__(self, path: Path, fps: float, shape, log):
+        import cv2
+
+        H, W = shape
+        self.pad = (H % 2, W % 2)   # most players need even sizes
+        self.writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
+                                      (W + self.pad[1], H + self.pad[0]), isColor=False)
+        self.ok = self.writer.isOpened()
+        if not self.ok:
+            log(f"warning: OpenCV could not open an MP4 writer for {path}; the PNGs are still written")
+
+    def write(self, img: np.ndarray) -> None:
+        if self.ok:
+            self.writer.write(np.pad(img, ((0, self.pad[0]), (0, self.pad[1]))))
+
+    def close(self) -> bool:
+        self.writer.release()
+        return self.ok
+
+
+def video_fps(times: np.ndarray) -> float:
+    """Playback rate: the median spacing of the frames, kept between 2 and 60 frames per second."""
+    if len(times) < 2:
+        return 10.0
+    step = float(np.median(np.diff(times)))
+    return float(np.clip(1.0 / step, 2.0, 60.0)) if step > 0 else 10.0
