@@ -24,9 +24,13 @@ from . import DataFetchError, cache_dir
 
 
 def _fmt_window(w) -> str:
-    if w is None or not all(math.isfinite(v) for v in w):
+    try:
+        lo, hi = (float(v) for v in w)
+    except (TypeError, ValueError):
+        return "whole" if w is None else f"{w!r} (unexpected)"
+    if not (math.isfinite(lo) and math.isfinite(hi)):
         return "whole"
-    return f"[{w[0]:g}, {w[1]:g}] s"
+    return f"[{lo:g}, {hi:g}] s"
 
 
 def _cmd_list(args) -> int:
@@ -97,18 +101,35 @@ def _cmd_convert(args) -> int:
     return 0
 
 
+def _show(value, spec: str = "", unit: str = "") -> str:
+    """One attribute for the description: formatted when present and of the right kind, else "?" (a
+    file written by another tool may lack an optional attribute; that is not a crash of this command)."""
+    if value is None:
+        return "?"
+    try:
+        return f"{value:{spec}}{unit}"
+    except (TypeError, ValueError):
+        return f"{value!r}{unit} (unexpected)"
+
+
 def _cmd_info(args) -> int:
     from . import info
 
     i = info(args.file)
-    H, W = i["sensor_size"]
-    print(f"{args.file}\n  {i.get('dataset') or '?'} / {i.get('sequence') or '?'}: {i.get('source', '')}")
-    print(f"  {i['n_events']} events over [{i['t_first']:.6f}, {i['t_last']:.6f}] s (t_origin {i['t_origin']:.0f} s), "
-          f"{i['n_frames']} frames, sensor {W}x{H}, C = {i['C']:g}")
-    print(f"  evaluation window {_fmt_window(i['eval_window'])} on the file's clock "
-          f"(published {_fmt_window(i.get('eval_window_published'))} after t_zero = {i['t_zero']:.6f} s)")
-    if i["meta"]:
-        print(f"  meta: {', '.join(sorted(i['meta']))}")
+    size = i.get("sensor_size")
+    try:
+        H, W = (int(v) for v in size)
+        sensor = f"{W}x{H}"
+    except (TypeError, ValueError):
+        sensor = "?"
+    print(f"{args.file}\n  {i.get('dataset') or '?'} / {i.get('sequence') or '?'}: {i.get('source') or ''}")
+    print(f"  {_show(i.get('n_events'))} events over [{_show(i.get('t_first'), '.6f')}, {_show(i.get('t_last'), '.6f')}] s "
+          f"(t_origin {_show(i.get('t_origin'), '.0f')} s), {_show(i.get('n_frames'))} frames, sensor {sensor}, "
+          f"C = {_show(i.get('C'), 'g')}")
+    print(f"  evaluation window {_fmt_window(i.get('eval_window'))} on the file's clock "
+          f"(published {_fmt_window(i.get('eval_window_published'))} after t_zero = {_show(i.get('t_zero'), '.6f')} s)")
+    if i.get("meta"):
+        print(f"  meta: {', '.join(sorted(map(str, i['meta'])))}")
     return 0
 
 
