@@ -74,8 +74,9 @@ def test_many_windows_give_the_whole_sequence_result(scene_events, tmp_path):
     # same networks, alignment, cross-fade, offset image and level: equal up to float32 rounding
     np.testing.assert_allclose(L, whole.log_intensity, rtol=0, atol=1e-4 * np.abs(whole.log_intensity).max())
     np.testing.assert_allclose(frames, whole.frames, rtol=0, atol=1e-4)
-    # each window read only its own events (never the whole recording)
-    assert len(source.asked) == 4
+    # each window read only its own events (never the whole recording); before them, the counting pass
+    # of method/balance.prepare_source (hot pixels, ON/OFF balance) read the span in chunks of tau
+    assert len(source.asked) == 4 + 3
     assert all(t1 - t0 <= cfg.tau + 1e-6 for t0, t1 in source.asked)
     assert (tmp_path / "log_intensity.f32").stat().st_size == len(q) * SIZE[0] * SIZE[1] * 4   # the spill
 
@@ -166,3 +167,56 @@ def test_bad_requests_are_refused_before_any_training(scene_events):
         next(stream_reconstruct(events, [0.6, 0.5], _config()))
     with pytest.raises(EventDataError, match="outside"):
         next(stream_reconstruct(events, [5.0], _config(), t_start=0.0, t_end=3.0))
+
+
+def _recording_file(path, seconds=10.0, size=SIZE):
+    """A canonical file of a 2 s scene repeated (as benchmarks/scale.py builds long recordings)."""
+    from evinr_lite.io.canonical import CanonicalWriter
+
+    ev = simulate_scene(make_scene("camera", sensor_size=size, duration=2.0), C=0.2, seed=0)
+    with CanonicalWriter(path, sensor_size=size, C=0.2) as w:
+        for k in range(int(np.ceil(seconds / 2.0))):
+            keep = ev.t + 2.0 * k < seconds
+            w.add_events(ev.t[keep] + 2.0 * k, ev.x[keep], ev.y[keep], ev.p[keep])
+    return path
+
+
+def test_a_killed_command_resumes_without_recomputing_finished_windows(tmp_path, monkeypatch):
+    from PIL import Image
+
+    from evinr_lite.apps.recon_job import run_reconstruct
+    from evinr_lite.method import streaming
+
+    path = _recording_file(tmp_path / "rec.h5")
+    quiet = dict(fps=5, video=False, progress=False, log=lambda *a: None)
+    whole = run_reconstruct(path, tmp_path / "whole", **quiet)
+    assert len(whole["times_s"]) >= 45
+    trained = []
+    train = streaming.train_window
+    monkeypatch.setattr(streaming, "train_window", lambda ev, w, k, cfg: (trained.append(k), train(ev, w, k, cfg))[1])
+    save = StreamState.save
+
+    def killed_after_two(self, file):
+        save(self, file)
+        if self.next_window == 2:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(StreamState, "save", killed_after_two)
+    with pytest.raises(KeyboardInterrupt):
+        run_reconstruct(path, tmp_path / "out", **quiet)
+    assert trained == [0, 1]
+    assert not (tmp_path / "out").exists() and (tmp_path / ".out.resume" / "state.npz").is_file()
+    assert not list(tmp_path.glob(".out.partial-*"))           # the staging folder is gone, the lock too
+    assert not (tmp_path / ".out.lock").exists()
+    monkeypatch.setattr(StreamState, "save", save)
+    with pytest.raises(EventDataError, match="another input or other settings"):   # not these settings' state
+        run_reconstruct(path, tmp_path / "out", **{**quiet, "fps": 4}, resume=True)
+    assert (tmp_path / ".out.resume").is_dir()                 # refused, nothing removed
+    run = run_reconstruct(path, tmp_path / "out", **quiet, resume=True)
+    assert trained == [0, 1, 2]                                # only the third window was trained again
+    assert not (tmp_path / ".out.resume").exists()             # committed: the state is removed
+    assert run["times_s"] == whole["times_s"]
+    for name in ("frame_00000.png", "frame_00024.png", "frame_00044.png"):
+        a = np.asarray(Image.open(tmp_path / "whole" / "frames" / name))
+        b = np.asarray(Image.open(tmp_path / "out" / "frames" / name))
+        np.testing.assert_array_equal(a, b)

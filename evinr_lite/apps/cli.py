@@ -167,6 +167,9 @@ def build_parser() -> argparse.ArgumentParser:
                           "reconstructing (evinr_lite.method.denoise defaults); run.json records what was removed")
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
+    rec.add_argument("--resume", action="store_true",
+                     help="continue a stopped run into the same --out from its last finished window (events-only "
+                          "runs stream window by window and keep their state in .OUT.resume beside --out)")
     rec.add_argument("--quiet", action="store_true", help="no progress bar")
 
     demo = sub.add_parser("demo", help="reconstruct a built-in synthetic scene and score it (no download)",
@@ -239,7 +242,7 @@ def _run_options(args):
 def _reconstruct(args) -> None:
     from .recon_job import run_reconstruct
 
-    run_reconstruct(args.recording, args.out, _run_options(args), overwrite=args.overwrite,
+    run_reconstruct(args.recording, args.out, _run_options(args), overwrite=args.overwrite, resume=args.resume,
                     command=" ".join(["evinr-lite", *sys.argv[1:]]))
 
 

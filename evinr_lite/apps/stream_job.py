@@ -169,9 +169,14 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
         parts = stream_reconstruct(source, query, config, t_start=lo, t_end=hi, workdir=folder, state=state,
                                    on_state=lambda s: s.save(folder / "state.npz"), progress=options.progress)
         history = {}
-        for part in parts:
-            writer.add(part)
-            history = part.history
+        try:
+            for part in parts:
+                writer.add(part)
+                history = part.history
+        except BaseException:   # interrupted or failed: the finished windows stay for --resume
+            if (folder / "state.npz").is_file():
+                log(f"the finished windows are kept in {folder}; the same command with --resume continues from them")
+            raise
     save_timestamps(target.staging / "timestamps.txt", times, source.t_origin)
     written = ["frames/", "timestamps.txt"] + writer.finish()
     scores = score_predictions(writer.gt_frames(), gt.t, gt) if gt is not None else None
