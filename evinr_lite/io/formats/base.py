@@ -19,7 +19,8 @@ from ...core.events import EventDataError, Events, check_time_span, relative_sec
 from ..text import read_text_bytes
 
 __all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
-           "json_file", "size_value", "plain_attr", "check_declared_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted"]
+           "json_file", "size_value", "plain_attr", "check_declared_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
+           "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE"]
 
 
 @dataclass(frozen=True)
@@ -241,3 +242,84 @@ def probe_sorted(column, source, n_probe: int = 1025) -> None:
         raise EventDataError(f"{source}: the timestamps are not sorted (t[{a}] = {values[down[0]]!r} > t[{b}] = "
                              f"{values[down[0] + 1]!r}), so a time window cannot be found without reading "
                              "everything; read the whole file with sort=True, or sort it and save it again")
+
+
+# ---- one clock, plausible units ------------------------------------------------------------
+
+SLOW_SECONDS_RATE = 1e3   # events per second; decimal timestamps read as seconds that come slower get a note
+
+
+def note_decimal_seconds(t_first: float, t_last: float, n: int, time_unit, unit: str, source, meta) -> None:
+    """Decimal timestamps taken as seconds by detection (``time_unit`` 'auto' / None) that come at under
+    :data:`SLOW_SECONDS_RATE` events per second look like milliseconds (0.5 s written in ms reads as
+    500 s): say so, with the override, in a note. A unit given explicitly is taken as given."""
+    from ...core.events import MAX_RATE_PER_S
+    from ..notes import note
+
+    span = float(t_last - t_first)
+    if time_unit not in (None, "auto") or unit != "s" or n < 1000 or span <= 0:
+        return
+    rate = n / span
+    if rate < SLOW_SECONDS_RATE and rate * 1e3 <= MAX_RATE_PER_S:
+        note(meta, f"{source}: the decimal timestamps were read as seconds, so the {n:,} events span {span:,.6g} s "
+                   f"at only {rate:,.3g} events per second; that is more like milliseconds ({span / 1e3:,.6g} s at "
+                   f"{rate * 1e3:,.3g} per second): if they are milliseconds, pass time_unit='ms' (--time-unit ms)")
+
+
+def _plausible_frames(t: np.ndarray, span: tuple[float, float]) -> bool:
+    """Frame times (s) that can belong to events spanning ``span``: finite, within the span widened by half
+    its length (at least 1 s) on each side, and at most 100,000 frames per second apart."""
+    e0, e1 = span
+    pad = max(0.5 * (e1 - e0), 1.0)
+    if not np.all(np.isfinite(t)) or np.any(t < e0 - pad) or np.any(t > e1 + pad):
+        return False
+    steps = np.diff(np.sort(t))
+    steps = steps[steps > 0]
+    return steps.size == 0 or float(np.median(steps)) >= 1e-5
+
+
+def _evident_frames(t: np.ndarray, span: tuple[float, float]) -> bool:
+    """Frame times (s) read in another unit that evidently belong to events spanning ``span``: plausible,
+    at least half of them inside the span, and (two frames or more) spread over at least 1 % of it, so
+    that units 1000 times apart cannot both qualify."""
+    e0, e1 = span
+    if not _plausible_frames(t, span) or np.mean((t >= e0) & (t <= e1)) < 0.5:
+        return False
+    return len(t) < 2 or float(np.max(t) - np.min(t)) >= 0.01 * (e1 - e0)
+
+
+def frames_on_event_clock(frame_seconds, unit: str, span: tuple[float, float] | None, source, meta, *,
+                          what: str = "the frame timestamps"):
+    """The frames' times in seconds on the events' clock, checked to be on it.
+
+    Args:
+        frame_seconds: ``frame_seconds(u)`` -> float64 [F]: the stored frame stamps read in unit ``u``
+            as seconds relative to the events' ``t_origin``.
+        unit: the unit the events were read in (the frames' unit unless evident otherwise).
+        span: (first, last) event time in seconds (None: no events, nothing to check against).
+    Returns:
+        (times [F] seconds, the unit used for the frames).
+    Raises:
+        EventDataError naming both spans and the fix when the frames are on another clock and no
+        other unit (s, ms, us, ns) evidently puts them on the events' (an offset between an absolute
+        and a relative clock cannot be derived exactly, so it is refused, not guessed).
+    """
+    from ...core.events import TIME_UNITS
+    from ..notes import note
+
+    t = frame_seconds(unit)
+    if span is None or span[1] <= span[0] or not len(t) or _plausible_frames(t, span):
+        return t, unit
+    fits = [u for u in TIME_UNITS if u != unit and _evident_frames(frame_seconds(u), span)]
+    first, last = float(np.min(t)), float(np.max(t))
+    if len(fits) == 1:
+        note(meta, f"{source}: {what} read in {unit!r} span {first:,.6g} .. {last:,.6g} s, outside the events' "
+                   f"{span[0]:,.6g} .. {span[1]:,.6g} s; read in {fits[0]!r} they lie on the events' clock, so they "
+                   f"are taken as {fits[0]}")
+        return frame_seconds(fits[0]), fits[0]
+    raise EventDataError(
+        f"{source}: the frames and the events are not on one clock: {what} span {first:,.6g} .. {last:,.6g} s but "
+        f"the events span {span[0]:,.6g} .. {span[1]:,.6g} s (both read in {unit!r}, relative to the events' "
+        "t_origin), and no other unit (s, ms, us, ns) puts them together; write the frame timestamps on the events' "
+        "clock (same unit, same zero: both absolute or both relative to the same start), or pass time_unit= if "
+        "the events' unit was guessed wrong")

@@ -9,7 +9,9 @@ import numpy as np
 from ...core.events import TIME_UNITS, EventDataError
 from ...core.frames import Frames
 from ...core.recording import Recording
-from .base import FileFormat, build_events, existing, json_file, load_npy, size_value, to_seconds
+from ..notes import note
+from .base import (FileFormat, build_events, existing, frames_on_event_clock, json_file, load_npy,
+                   note_decimal_seconds, size_value, to_seconds)
 
 __all__ = ["read_evreal_folder", "FORMAT"]
 
@@ -47,6 +49,10 @@ def read_evreal_folder(folder, *, time_unit="auto") -> Recording:
         raise EventDataError(f"{folder / 'events_p.npy'}: expected numeric polarities, got dtype {p.dtype}")
     t, origin, unit = to_seconds(folder / "events_ts.npy", ts, time_unit)
     events = build_events(folder, t, xy[:, 0], xy[:, 1], p, sensor_size, polarity="auto", t_origin=origin)
+    meta = {"format": "evreal", "path": str(folder), "metadata": metadata, "time_unit": unit}
+    span = (float(events.t[0]), float(events.t[-1])) if len(events) else None
+    if span is not None:
+        note_decimal_seconds(*span, len(events), time_unit, unit, folder / "events_ts.npy", meta)
     frames = None
     if (folder / "images.npy").exists():
         if not (folder / "images_ts.npy").exists():
@@ -56,7 +62,12 @@ def read_evreal_folder(folder, *, time_unit="auto") -> Recording:
         if images_ts.ndim != 1 or images_ts.dtype.kind not in "iuf":
             raise EventDataError(f"{folder / 'images_ts.npy'}: expected a 1-D numeric array, got shape "
                                  f"{images_ts.shape} dtype {images_ts.dtype}")
-        frame_t = np.asarray(images_ts, np.float64) * TIME_UNITS[unit] - origin
+        stamps = np.asarray(images_ts, np.float64)
+        frame_t, _ = frames_on_event_clock(lambda u: stamps * TIME_UNITS[u] - origin, unit, span,
+                                           folder / "images_ts.npy", meta)
+        if np.any(np.diff(frame_t) < 0):
+            note(meta, f"{folder / 'images_ts.npy'}: the frames are not in time order; they are read sorted by "
+                       "their timestamps")
         try:
             frames = Frames(images, frame_t, origin).sorted()
         except EventDataError as err:
@@ -64,7 +75,6 @@ def read_evreal_folder(folder, *, time_unit="auto") -> Recording:
         if frames.size != sensor_size:
             raise EventDataError(f"{folder}: frames are {frames.size} but sensor_resolution is "
                                  f"{sensor_size} (both (H, W))")
-    meta = {"format": "evreal", "path": str(folder), "metadata": metadata, "time_unit": unit}
     if (folder / "image_event_indices.npy").exists():
         meta["image_event_indices"] = load("image_event_indices.npy")
     return Recording(events, frames, meta)

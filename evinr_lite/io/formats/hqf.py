@@ -14,8 +14,9 @@ from ...core.events import TIME_UNITS, EventDataError, Events, check_time_span, 
 from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
 from ..source import RecordingSource
-from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, existing, plain_attr,
-                   probe_sorted, size_value)
+from ..notes import note
+from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, existing,
+                   frames_on_event_clock, note_decimal_seconds, plain_attr, probe_sorted, size_value)
 
 __all__ = ["read_h5", "HqfSource", "FORMAT"]
 
@@ -73,6 +74,11 @@ class _Layout:
         self.clock = Clock(ts[0] if n else 0, self.unit, ts.dtype.kind in "iu")
         self.origin = self.clock.origin
 
+    def note_units(self, time_unit, meta) -> None:
+        """A note when decimal timestamps detected as seconds come too slowly for seconds."""
+        if self.n > 1:
+            note_decimal_seconds(*self.span(), self.n, time_unit, self.unit, f"{self.path}: events/ts", meta)
+
     def span(self) -> tuple[float, float]:
         if not self.n:
             return 0.0, 0.0
@@ -113,9 +119,19 @@ class _Layout:
             if not math.isfinite(stamp):
                 raise EventDataError(f"{path}: images/{k} has a non-finite 'timestamp'; repair or remove that frame")
             stamps.append(stamp)
-        stamps = np.array(stamps, dtype=np.float64)   # float64 holds whole microseconds exactly for 285 years
-        stamps = ((stamps - self.clock.origin_units) / self.clock.per_s if self.clock.integer
-                  else stamps / self.clock.per_s - self.origin)
+        raw = np.array(stamps, dtype=np.float64)   # float64 holds whole microseconds exactly for 285 years
+
+        def seconds(unit):   # the stamps in ``unit`` on the events' clock (the events' own unit: exactly as they)
+            if unit == self.unit:
+                return ((raw - self.clock.origin_units) / self.clock.per_s if self.clock.integer
+                        else raw / self.clock.per_s - self.origin)
+            return raw * TIME_UNITS[unit] - self.origin
+
+        span = self.span() if self.n else None
+        stamps, _ = frames_on_event_clock(seconds, self.unit, span, f"{path}: images/*.attrs['timestamp']", meta)
+        if np.any(np.diff(stamps) < 0):   # one HQF sequence has a frame out of order
+            note(meta, f"{path}: the frames' timestamps are not in the order of their names; they are read sorted "
+                       "by time")
         keep = np.ones(len(keys), dtype=bool)
         if t_start is not None:
             keep &= stamps >= t_start
@@ -167,6 +183,7 @@ def read_h5(path, *, t_start=None, t_end=None, time_unit="auto") -> Recording:
             events = layout.events(lo, hi)
             meta = {"format": "h5", "path": str(path), "attrs": {k: plain_attr(v) for k, v in f.attrs.items()},
                     "event_slice": (lo, hi), "time_unit": layout.unit}
+            layout.note_units(time_unit, meta)
             frames = layout.frames(t_start, t_end, meta)
     except EventDataError:
         raise
@@ -186,6 +203,7 @@ class HqfSource(RecordingSource):
             probe_sorted(layout.ts, path)
             self.meta = {"format": "h5", "path": str(path),
                          "attrs": {k: plain_attr(v) for k, v in self._f.attrs.items()}, "time_unit": layout.unit}
+            layout.note_units(time_unit, self.meta)
             self.frames = layout.frames(meta=self.meta)
             self.t_span = layout.span()
         except EventDataError:

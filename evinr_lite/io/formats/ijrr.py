@@ -15,12 +15,14 @@ from ...core.events import EventDataError, check_time_span
 from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
 from ..text import NS, origin_to_ns, parse_event_text, parse_frame_list, read_text_bytes
-from .base import FileFormat, build_events, existing, sensor_from_header, size_hint
+from ..notes import note
+from .base import (FileFormat, build_events, existing, frames_on_event_clock, note_decimal_seconds, sensor_from_header,
+                   size_hint)
 
 __all__ = ["read_ijrr_folder", "read_frames_ijrr", "FORMAT"]
 
 
-def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s") -> Frames:
+def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s", events_span=None, meta: dict | None = None) -> Frames:
     """Frames listed in ``folder/images.txt`` (`t images/frame_%08d.png` per line), in time order.
 
     Args:
@@ -28,8 +30,13 @@ def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s") -> Frames:
         t_origin: seconds subtracted exactly from the timestamps (pass the events' ``t_origin``);
             None: automatic, as for the events.
         time_unit: unit of the timestamps (the events' unit), 's' by default.
+        events_span: (first, last) event time in seconds on the same origin: the frames are checked to
+            be on the events' clock (another unit that evidently fits is taken with a note, anything
+            else refused; see :func:`~evinr_lite.io.formats.base.frames_on_event_clock`).
+        meta: where notes go (``meta["read_notes"]``).
     Returns:
-        Frames with grey uint8 images [F, H, W] (RGB is converted to grey).
+        Frames with grey uint8 images [F, H, W] (RGB is converted to grey), sorted by time (with a
+        note when images.txt lists them out of order).
     """
     from skimage.io import imread
 
@@ -43,11 +50,17 @@ def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s") -> Frames:
         if "is empty" not in str(err):
             raise
         data = b""
-    t, names, origin_ns = parse_frame_list(data, None if t_origin is None else origin_to_ns(t_origin),
-                                           source=listing, time_unit=time_unit)
+    origin = None if t_origin is None else origin_to_ns(t_origin)
+    t, names, origin_ns = parse_frame_list(data, origin, source=listing, time_unit=time_unit)
     if not names:
         raise EventDataError(f"{listing} lists no frames; expected lines `t images/frame_%08d.png` "
                              "(or remove images.txt and give the sensor size)")
+    if events_span is not None:
+        t, _ = frames_on_event_clock(
+            lambda u: t if u == time_unit else parse_frame_list(data, origin_ns, source=listing, time_unit=u)[0],
+            time_unit, events_span, listing, meta)
+    if np.any(np.diff(t) < 0):
+        note(meta, f"{listing}: the frames are not listed in time order; they are read sorted by their timestamps")
     images = []
     for name in names:
         image_path = folder / name
@@ -96,7 +109,10 @@ def read_ijrr_folder(folder, *, t_origin=None, sensor_size=None, time_unit="auto
                              "images.txt, images/, calib.txt")
     raw = parse_event_text(events_path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
     check_time_span(raw.t, events_path, raw.time_unit)
-    frames = (read_frames_ijrr(folder, t_origin=raw.origin_ns / NS, time_unit=raw.time_unit)
+    meta = {"format": "ijrr", "path": str(folder), "time_unit": raw.time_unit}
+    note_decimal_seconds(raw.t[0], raw.t[-1], len(raw.t), time_unit, raw.time_unit, events_path, meta)
+    frames = (read_frames_ijrr(folder, t_origin=raw.origin_ns / NS, time_unit=raw.time_unit,
+                               events_span=(float(raw.t[0]), float(raw.t[-1])), meta=meta)
               if (folder / "images.txt").exists() else None)
     known = sensor_from_header(events_path, raw.header, frames.size if frames is not None else None)
     if known is not None and sensor_size is not None and tuple(int(v) for v in sensor_size) != tuple(known):
@@ -112,14 +128,12 @@ def read_ijrr_folder(folder, *, t_origin=None, sensor_size=None, time_unit="auto
         )
     events = build_events(events_path, raw.t, raw.x, raw.y, raw.p, sensor_size,
                            polarity="auto", t_origin=raw.origin_ns / NS)
-    meta = {"format": "ijrr", "path": str(folder), "time_unit": raw.time_unit}
     if (folder / "calib.txt").is_file():
         try:
             meta["calib"] = _read_calib(folder / "calib.txt")
         except (ValueError, OSError) as err:
             raise EventDataError(f"{folder / 'calib.txt'}: not a list of numbers ({err}); repair or remove it") from None
     return Recording(events, frames, meta)
-
 
 
 def _sniff(path, head) -> bool:

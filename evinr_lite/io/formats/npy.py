@@ -15,7 +15,7 @@ from ...core.events import EventDataError, Events, check_time_span, resolve_time
 from ...core.recording import Recording
 from ..source import RecordingSource
 from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, existing, load_npy,
-                   probe_sorted, size_hint, to_seconds)
+                   note_decimal_seconds, probe_sorted, size_hint, to_seconds)
 
 __all__ = ["read_events_npy", "read_npy", "NpySource", "FORMAT", "MAGIC"]
 
@@ -96,6 +96,13 @@ class _Opened:
             raise EventDataError(f"{path}: the first timestamp is {float(self.t[0])} (non-finite); repair or drop it")
         self.clock = Clock(self.t[0] if n else 0, self.unit, a.dtype.kind in "iu")
 
+    def note_units(self, time_unit, meta) -> None:
+        """A note when decimal timestamps detected as seconds come too slowly for seconds."""
+        n = len(self.array)
+        if n > 1:
+            first, last = self.clock.seconds(self.t[0]), self.clock.seconds(self.t[n - 1])
+            note_decimal_seconds(float(first), float(last), n, time_unit, self.unit, self.path, meta)
+
     def rows(self, lo: int, hi: int, polarity: str) -> Events:
         block = self.array[lo:hi]   # only these rows are read from disk
         col = {c: block[:, i] for i, c in enumerate(self.columns)}
@@ -112,7 +119,8 @@ class _Opened:
 
 
 def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", time_unit="auto",
-                    sort=False, t_start: float | None = None, t_end: float | None = None) -> Events:
+                    sort=False, t_start: float | None = None, t_end: float | None = None,
+                    meta: dict | None = None) -> Events:
     """Events from an .npy array [N, 4].
 
     Args:
@@ -125,9 +133,11 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
         sort: sort the events by time instead of raising on unsorted input (reads the whole file).
         t_start, t_end: seconds on the returned clock; only the rows with t_start <= t < t_end are
             read (found by bisection on the time column on disk; the times must be sorted).
+        meta: where notes go (``meta["read_notes"]``); they are also warnings (ReadNote).
     """
     check_reader_window(t_start, t_end)
     opened = _Opened(path, sensor_size, columns, time_unit)
+    opened.note_units(time_unit, meta)
     if sort:
         block = opened.array[:]
         col = {c: block[:, i] for i, c in enumerate(columns)}
@@ -150,7 +160,8 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
 
 def read_npy(path, **options) -> Recording:
     """:func:`read_events_npy` as a Recording (no frames)."""
-    return Recording(read_events_npy(path, **options), None, {"format": "npy", "path": str(path)})
+    meta = {"format": "npy", "path": str(path)}
+    return Recording(read_events_npy(path, meta=meta, **options), None, meta)
 
 
 class NpySource(RecordingSource):
@@ -159,6 +170,8 @@ class NpySource(RecordingSource):
     def __init__(self, path, *, sensor_size=None, columns="txyp", polarity="auto", time_unit="auto"):
         self._opened = opened = _Opened(path, sensor_size, columns, time_unit)
         probe_sorted(opened.t, opened.path)
+        self.meta = {"format": "npy", "path": str(opened.path)}
+        opened.note_units(time_unit, self.meta)
         self._polarity = polarity
         n = len(opened.array)
         self.path, self.format = opened.path, "npy"
@@ -169,7 +182,6 @@ class NpySource(RecordingSource):
                        if n else (0.0, 0.0))
         check_time_span(np.array(self.t_span), opened.path, opened.unit)
         self.frames = None
-        self.meta = {"format": "npy", "path": str(opened.path)}
 
     def _read_window(self, t0: float, t1: float) -> Events:
         lo, hi = self._opened.window(t0, t1)

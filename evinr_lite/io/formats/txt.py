@@ -10,12 +10,13 @@ from pathlib import Path
 from ...core.events import Events, EventDataError, check_time_span
 from ...core.recording import Recording
 from ..text import NS, origin_to_ns, parse_event_text
-from .base import FileFormat, build_events, sensor_from_header, size_hint
+from .base import FileFormat, build_events, note_decimal_seconds, sensor_from_header, size_hint
 
 __all__ = ["read_events_txt", "read_txt", "looks_like_event_text", "FORMAT"]
 
 
-def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, time_unit="auto") -> Events:
+def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, time_unit="auto",
+                    meta: dict | None = None) -> Events:
     """Events from a text file of `t x y p` lines (IJRR events.txt, rpg_e2vid .txt).
 
     Args:
@@ -26,11 +27,14 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, t
         t_origin: seconds subtracted from every timestamp (exactly). None: the whole seconds of the
             first timestamp when it is >= 1e5 s (an absolute clock), else 0.
         time_unit: unit of t, 's', 'ms', 'us', 'ns'; 'auto': integer timestamps are microseconds
-            (with a TimeUnitWarning), decimals seconds. Implausible spans are refused.
+            (with a TimeUnitWarning), decimals seconds. Implausible spans are refused; decimals that
+            come too slowly for seconds get a note (:func:`~.base.note_decimal_seconds`).
+        meta: where notes go (``meta["read_notes"]``); they are also warnings (ReadNote).
     """
     path = Path(path)
     raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
     check_time_span(raw.t, path, raw.time_unit)
+    note_decimal_seconds(raw.t[0], raw.t[-1], len(raw.t), time_unit, raw.time_unit, path, meta)
     sensor_size = sensor_from_header(path, raw.header, sensor_size)
     if sensor_size is None:
         raise EventDataError(
@@ -43,7 +47,8 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, t
 
 def read_txt(path, **options) -> Recording:
     """:func:`read_events_txt` as a Recording (no frames)."""
-    return Recording(read_events_txt(path, **options), None, {"format": "txt", "path": str(path)})
+    meta = {"format": "txt", "path": str(path)}
+    return Recording(read_events_txt(path, meta=meta, **options), None, meta)
 
 
 def looks_like_event_text(path: Path) -> bool:
