@@ -27,7 +27,7 @@ class EvINRConfig:
 
     Three named recipes (``benchmarks/quality_zoo.py`` compares them in one run):
 
-    - ``EvINRConfig()``: the kit's default, chosen on the mean of the scene zoo (nine seeded scenes,
+    - ``EvINRConfig()``: the kit's default, chosen on the mean of the scene zoo (seeded scenes,
       ``evinr_lite.sim.zoo``) and the real slider_depth chunk, never on one scene;
     - ``EvINRConfig.paper()``: the paper's recipe exactly (Sec. 3-4);
     - ``EvINRConfig.v0_1()``: the kit's earlier default (the paper's plus first_omega_0 = 10 and
@@ -49,8 +49,24 @@ class EvINRConfig:
     - lam=0.01 instead of 0.05: with the exact head, less smoothing wins on the zoo (quick zoo,
       CLAHE-SSIM mean: 0.293 at lam 1, 0.403 at 0.2, 0.482 at 0.05, 0.528 at 0.01). On the real chunk,
       lam from 0.003 to 1 moves CLAHE-SSIM only between 0.256 and 0.272.
-    - hidden_features=256: the same zoo scores as 512 (within 0.002) at a quarter of the solve's
-      d^2 work.
+    - hidden_features=128 (issue 21; 256 before, 512 in the paper): the same scores as 256 at about half
+      the time. Seven full-size zoo scenes (noisy_gravel, unequal_onhot, camera_240x180,
+      astronaut_rotzoom, lowtex_light, text_shake, drift_clock), mean CLAHE-SSIM / SSIM / MSE 0.6401 /
+      0.6931 / 0.0337 in 11.3 s against 0.6396 / 0.6930 / 0.0336 in 23.8 s (camera_240x180: 2.1 s
+      against 3.1 s); quick zoo, eight scenes: 0.5485 against 0.5492; real chunk 0.350 / 0.416 / 0.0889
+      both. (256 had matched 512 within 0.002 at a quarter of the solve's d^2 work.) Longer bins
+      (1/16 s, min_bins 32) won on the quick zoo (0.562 against 0.549) but lost on the full-size scenes
+      (0.624 against 0.640: text_shake 0.453 against 0.511, fast shake needs short bins): not taken.
+    - balance="events", hot_pixels="drop" (issue 21): C+ and C- from the events' ON/OFF counts when
+      one C is given (:mod:`evinr_lite.method.balance`: pooled counts, hot pixels left out, shrunk
+      towards the nominal C as far as the span carries evidence), and hot pixels' events left out.
+      long_pan_20s (20 s, C+ 0.25 / C- 0.20 given as 0.225, ON-only hot pixels): CLAHE-SSIM / SSIM /
+      MSE 0.494 / 0.554 / 0.0462 -> 0.514 / 0.576 / 0.0349, level error per quarter +0.144 +0.062
+      -0.032 -0.101 -> +0.023 +0.018 +0.010 +0.009, better than the same recording cut into
+      independent 2 s windows (0.500 / 0.551 / 0.0452). On 2-3 s scenes the shrinkage leaves C nearly
+      as given (quick zoo mean 0.5302 -> 0.5319; unequal_onhot 0.577 -> 0.605 from the hot pixels);
+      real chunk 0.349 -> 0.350. Measured with ``python benchmarks/quality_zoo.py --quick --variant
+      "bal=balance='events',hot_pixels='drop'"`` and ``--long --scenes long_pan_20s``.
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
       (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
@@ -101,6 +117,12 @@ class EvINRConfig:
         offset_solve: how the per-pixel offset that events cannot fix is chosen: "none" (left to the
             regularizer, as in the paper) or "median_gradient" (:mod:`evinr_lite.method.offset`:
             the offset that makes the temporal median of each pixel's gradient zero).
+        balance: "none" (ON and OFF events weigh C as given) or "events": when C is one number, C+ and
+            C- are estimated from the events' ON/OFF counts, their mean kept at C, shrunk towards C as
+            far as the span carries little evidence (:mod:`evinr_lite.method.balance`); a given pair is
+            used as it is.
+        hot_pixels: "keep" or "drop": the events of pixels firing far above the sensor's robust rate
+            (:func:`evinr_lite.method.denoise.hot_pixel_mask`) are left out before training.
         anchor: APS frames as anchors (:mod:`evinr_lite.method.anchor`; pass ``frames=`` to
             :func:`reconstruct`): "none" (events only, the default), "first" (the first frame in the
             window sets the per-pixel offset) or "all" (every ``anchor_every``-th frame is a soft
@@ -128,7 +150,7 @@ class EvINRConfig:
     temporal_loss: str = "difference"
     regularizer: str = "tikhonov"
     lam: float = 0.01
-    hidden_features: int = 256
+    hidden_features: int = 128
     hidden_layers: int = 3
     omega_0: float = 30.0
     first_omega_0: float | None = 10.0
@@ -145,6 +167,8 @@ class EvINRConfig:
     display_mean: float = 0.5
     head_solve: bool = True
     offset_solve: str = "median_gradient"
+    balance: str = "events"
+    hot_pixels: str = "drop"
     anchor: str = "none"
     anchor_every: int = 2
     anchor_smoothing: float = 0.03
@@ -155,7 +179,8 @@ class EvINRConfig:
     def __post_init__(self):
         # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
-                   "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient")}
+                   "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient"),
+                   "balance": ("none", "events"), "hot_pixels": ("keep", "drop")}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
@@ -240,7 +265,7 @@ class EvINRConfig:
                       "omega_0": 30.0, "first_omega_0": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
                       "tau": 5.0, "overlap": 0.5, "gamma": 0.6, "head_solve": False, "offset_solve": "none",
-                      **overrides})
+                      "balance": "none", "hot_pixels": "keep", **overrides})
 
     @classmethod
     def v0_1(cls, **overrides) -> "EvINRConfig":
