@@ -134,7 +134,7 @@ def quick(z: ZooScene) -> ZooScene:
 
 
 def simulate(z: ZooScene):
-    """(scene, events, gt times [10], gt intensity frames [10, H, W] in (0, 1])."""
+    """(scene, events, gt times [n_scored], gt intensity frames [n_scored, H, W] in (0, 1], clipped at 1)."""
     scene = z.build(z.size, z.duration)
     kw = {} if z.C_pos is None else {"C_pos": z.C_pos, "C_neg": z.C_neg}
     if z.threshold_drift:
@@ -150,7 +150,8 @@ def simulate(z: ZooScene):
     if z.dark_noise_hz > 0:
         events = add_light_noise(events, scene, z.dark_noise_hz, seed=rng, t_start=0.0, t_end=z.duration)
     times = np.linspace(0.1 * z.duration, 0.95 * z.duration, z.n_scored)
-    return scene, events, times, scene.intensity(times).astype(np.float32)
+    # a frame camera saturates: light above full scale (a brightening scene, cubic overshoot at edges) reads 1
+    return scene, events, times, np.clip(scene.intensity(times), 0.0, 1.0).astype(np.float32)
 
 
 def effective_C(z: ZooScene) -> float:
