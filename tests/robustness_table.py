@@ -1,11 +1,16 @@
-"""The bad-input case table of issue 13: each case class with its count and its outcomes.
+"""The bad-input case table (issues 13 and 25): each case class with its count and its outcomes.
 
-    python tests/robustness_table.py            runs tests/test_robustness*.py and tests/test_signals.py
+    python tests/robustness_table.py            every file below; exit status 1 unless the four counts are 0
+    python tests/robustness_table.py --round3   only issue 25's classes (its test files)
 
 One pytest case is one row of the table. A passing case ended as it must (a clear error naming the
-problem, or the correct result, and nothing left behind); a failing one is counted by what its
-failure says: a traceback or internal error, files left behind, the input or an existing output
-changed (data loss), else a silent wrong result. Exit status 1 if any case failed.
+problem, or the correct result, and nothing left behind). A failing one is counted by what its failure
+says, in this order: a traceback shown to the user; an internal error on bad input (the command's
+"internal error", or an exception other than an assertion escaping the library); files left behind;
+the input, an existing output or a user's file changed (data loss); else a silent wrong result.
+
+The verdict line asks for 0 data loss, 0 tracebacks, 0 internal errors on bad input and 0 silent wrong
+results (leftovers and skips are shown too).
 """
 import re
 import sys
@@ -15,38 +20,86 @@ from pathlib import Path
 import pytest
 
 HERE = Path(__file__).resolve().parent
-FILES = ["test_robustness.py", "test_robustness_more.py", "test_signals.py"]
+ROUND2 = ["test_robustness.py", "test_robustness_more.py", "test_signals.py"]
+ROUND3 = ["test_batch_ownership.py", "test_api_checks.py", "test_signals_edges.py", "test_robustness_round3.py",
+          "test_io_reliability.py", "test_options.py"]
 
-# test function (prefix) -> case class; the first match wins
+# (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
-    ("output path / data loss", r"test_out_|test_output_|test_read_only_parent|test_check_output_path|"
-                                r"test_demo_refuses_an_existing_out|test_data_fetch_convert_refuses"),
-    ("signals", r"test_signal_|test_sigterm_|test_a_kill_"),
-    ("concurrent runs", r"test_a_second_run|test_output_dir_lock|test_a_stale_lock"),
-    ("option values", r"test_option_values|test_demo_option|test_window_and_time|test_reconstruct_option|"
-                      r"test_at_|test_reconstruct_argument|test_info_option|test_info_arguments|test_demo_|"
-                      r"test_batch_"),
-    ("EvINRConfig fields", r"test_config_"),
-    ("Python API misuse", r"test_events_|test_reconstruct_query|test_reconstruct_spans|test_read_recording_"),
-    ("memory / sizes", r"test_memory_|test_a_tiny_bin|test_sensor_"),
-    ("time units", r"test_integer_|test_implausible|test_time_unit|test_each_time_unit|test_a_wrong_time_unit"),
-    ("damaged files", r"test_damaged_(files|npy|txt|ijrr|evreal|hqf|canonical)|test_odd_|test_npy_|test_npz_|"
-                      r"test_hqf_|test_h5_|test_event_camera_|test_raw_|test_a_file_with_no_events"),
-    ("polarity", r"test_both_polarity|test_polarity_"),
-    ("guard / --debug / argparse", r"test_an_internal_error|test_unknown_subcommand|test_help_|test_argparse_|"
-                                   r"test_the_guard"),
-    ("data_fetch", r"test_data_fetch_"),
+    # ---- issue 25 -------------------------------------------------------------------------------
+    ("batch ownership", "test_batch_ownership.py",
+     r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"
+     r"test_the_command_refuses_out"),
+    ("input identity in resume", "test_batch_ownership.py",
+     r"test_a_different_input|test_a_changed_file|test_one_recording_reached|test_labels_do_not_depend"),
+    ("batch leftovers", "test_batch_ownership.py", r"test_no_lock_file|test_a_scheduler_address"),
+    ("one clock for frames and events", "test_io_reliability.py", r"test_(ijrr|hqf|evreal)_frame"),
+    ("plausibility of units and ranges", "test_io_reliability.py", r"test_decimal_milliseconds|test_fast_decimal"),
+    ("plausibility of units and ranges", "test_api_checks.py",
+     r"test_events_refuse_a_sensor|test_events_take|test_integer_|test_frames_and_the_scorer|test_the_scorer_still|"
+     r"test_config_values|test_the_command_refuses_an_implausible_C"),
+    ("checked indexes", "test_io_reliability.py", r"test_a_damaged_time_index|test_find_time_index|test_unsorted_frame"),
+    ("typed metadata", "test_io_reliability.py", r"test_wrongly_typed_meta|test_a_canonical_dataset|test_an_hqf_dataset"),
+    ("typed metadata", "test_robustness_round3.py", r"test_data_fetch_info_"),
+    ("one time-list parser", "test_options.py",
+     r"test_a_list_on_one_line|test_a_long_list|test_timestamps_txt|test_bad_time_lists|test_a_folder_is_not|"
+     r"test_the_command_line_reads"),
+    ("API arguments", "test_api_checks.py", r"test_reconstruct_names|test_at_|test_fit_contrast|test_the_helpers"),
+    ("non-finite or constant output refused", "test_api_checks.py", r"test_output_that_is_not"),
+    ("scored index = written ground truth", "test_api_checks.py", r"test_metrics_gt_index|test_a_frame_exactly_at_end"),
+    ("signals from the first instruction", "test_signals_edges.py",
+     r"test_signal_at_start_up|test_three_quick|test_an_interrupt_that|test_a_second_signal"),
+    ("pipes", "test_signals_edges.py", r"test_a_reader_that_closes"),
+    ("deleted cwd / info without torch", "test_signals_edges.py", r"test_a_deleted_current|test_info_and_help"),
+    ("leftovers (locks, partials, ENOSPC)", "test_signals_edges.py", r"test_enospc"),
+    ("guard / --debug / argparse", "test_robustness_round3.py", r"test_both_commands_share"),
+    # ---- issue 13 -------------------------------------------------------------------------------
+    ("output path / data loss", None, r"test_out_|test_output_|test_read_only_parent|test_check_output_path|"
+                                      r"test_demo_refuses_an_existing_out|test_data_fetch_convert_refuses"),
+    ("signals", None, r"test_signal_|test_sigterm_|test_a_kill_"),
+    ("concurrent runs", None, r"test_a_second_run|test_output_dir_lock|test_a_stale_lock"),
+    ("option values", None, r"test_option_values|test_demo_option|test_window_and_time|test_reconstruct_option|"
+                            r"test_at_|test_reconstruct_argument|test_info_option|test_info_arguments|test_demo_|"
+                            r"test_batch_"),
+    ("EvINRConfig fields", None, r"test_config_"),
+    ("Python API misuse", None, r"test_events_|test_reconstruct_query|test_reconstruct_spans|test_read_recording_"),
+    ("memory / sizes", None, r"test_memory_|test_a_tiny_bin|test_sensor_"),
+    ("time units", None, r"test_integer_|test_implausible|test_time_unit|test_each_time_unit|test_a_wrong_time_unit"),
+    ("damaged files", None, r"test_damaged_(files|npy|txt|ijrr|evreal|hqf|canonical)|test_odd_|test_npy_|test_npz_|"
+                            r"test_hqf_|test_h5_|test_event_camera_|test_raw_|test_a_file_with_no_events"),
+    ("polarity", None, r"test_both_polarity|test_polarity_"),
+    ("guard / --debug / argparse", None, r"test_an_internal_error|test_unknown_subcommand|test_help_|test_argparse_|"
+                                         r"test_the_guard"),
+    ("data_fetch", None, r"test_data_fetch_"),
 ]
-COLUMNS = ["cases", "clear error / correct", "tracebacks", "silent wrong results", "leftovers", "data loss",
-           "skipped"]
+COLUMNS = ["cases", "clear error / correct", "data loss", "tracebacks", "internal errors on bad input",
+           "silent wrong results", "leftovers", "skipped"]
+MUST_BE_ZERO = ["data loss", "tracebacks", "internal errors on bad input", "silent wrong results"]
 
 
 def case_class(nodeid: str) -> str:
-    name = nodeid.split("::")[-1]
-    for label, pattern in CLASSES:
-        if re.match(pattern, name):
+    path, _, name = nodeid.partition("::")
+    name = name.split("::")[-1]
+    file = Path(path).name
+    for label, in_file, pattern in CLASSES:
+        if (in_file is None or in_file == file) and re.match(pattern, name):
             return label
     return "other"
+
+
+def outcome(report) -> str:
+    """The column of one failed case, from what its failure says."""
+    text = str(report.longrepr)
+    crash = getattr(getattr(report.longrepr, "reprcrash", None), "message", "") or ""
+    if re.search(r"Traceback \(most recent|panicked|Exception ignored", text):
+        return "tracebacks"
+    if "internal error" in text or (crash and not re.match(r"(AssertionError|Failed|assert )", crash)):
+        return "internal errors on bad input"      # an exception other than an assertion escaped
+    if re.search(r"left files|leftover|\.partial-|\.lock\b|\.batch\.lock", text):
+        return "leftovers"
+    if re.search(r"snapshot|changed or left|data loss|was lost|user's own|keep me|read_text\(\) == ", text):
+        return "data loss"
+    return "silent wrong results"
 
 
 class Tally:
@@ -62,23 +115,17 @@ class Tally:
         elif report.passed:
             row["clear error / correct"] += 1
         else:
-            text = str(report.longrepr)
-            if re.search(r"Traceback|internal error|panicked", text):
-                row["tracebacks"] += 1
-            elif "left files" in text or "leftover" in text:
-                row["leftovers"] += 1
-            elif re.search(r"changed or left|data loss|was lost", text):
-                row["data loss"] += 1
-            else:
-                row["silent wrong results"] += 1
-        if report.when == "call" or report.failed or report.skipped:
-            row["cases"] += 1
+            row[outcome(report)] += 1
+        row["cases"] += 1
 
 
-def main() -> int:
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    files = ROUND3 if "--round3" in argv else ROUND2 + ROUND3
+    files = [f for f in files if (HERE / f).exists()]
     tally = Tally()
-    code = pytest.main([*(str(HERE / f) for f in FILES), "-q", "-p", "no:cacheprovider"], plugins=[tally])
-    order = [label for label, _ in CLASSES] + ["other"]
+    code = pytest.main([*(str(HERE / f) for f in files), "-q", "-p", "no:cacheprovider"], plugins=[tally])
+    order = list(dict.fromkeys(label for label, _, _ in CLASSES)) + ["other"]
     total = Counter()
     print(f"\n| class | {' | '.join(COLUMNS)} |\n|---|{'---|' * len(COLUMNS)}")
     for label in order:
@@ -87,7 +134,10 @@ def main() -> int:
             total.update(row)
             print(f"| {label} | {' | '.join(str(row[c]) for c in COLUMNS)} |")
     print(f"| **total** | {' | '.join(str(total[c]) for c in COLUMNS)} |")
-    return int(code != 0)
+    verdict = ", ".join(f"{total[c]} {c}" for c in MUST_BE_ZERO)
+    ok = not any(total[c] for c in MUST_BE_ZERO) and code == 0
+    print(f"\n{'PASS' if ok else 'FAIL'}: {verdict} ({len(files)} files: {', '.join(files)})")
+    return 0 if ok else 1
 
 
 if __name__ == "__main__":
