@@ -53,6 +53,7 @@ CLASSES = [
     ("deleted cwd / info without torch", "test_signals_edges.py", r"test_a_deleted_current|test_info_and_help"),
     ("leftovers (locks, partials, ENOSPC)", "test_signals_edges.py", r"test_enospc"),
     ("guard / --debug / argparse", "test_robustness_round3.py", r"test_both_commands_share"),
+    ("output path / data loss", "test_robustness_round3.py", r"test_an_out_through"),
     # ---- issue 13 -------------------------------------------------------------------------------
     ("output path / data loss", None, r"test_out_|test_output_|test_read_only_parent|test_check_output_path|"
                                       r"test_demo_refuses_an_existing_out|test_data_fetch_convert_refuses"),

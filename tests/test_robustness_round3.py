@@ -70,3 +70,18 @@ def test_both_commands_share_one_guard(capsys, monkeypatch, exc, code):
     assert got_df == got_ev == code
     assert err_df.startswith(("data_fetch: ", "\ndata_fetch: ")) and err_ev.startswith(("evinr-lite: ", "\nevinr-lite: "))
     assert "Traceback" not in err_df + err_ev
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "demo", "batch"])
+@pytest.mark.parametrize("out", ["loop", "loop/x", "loop/x/y"])
+def test_an_out_through_a_symlink_loop_is_a_clear_error_for_every_command(capsys, tmp_path, monkeypatch, command, out):
+    from evinr_lite.sim.recordings import write_example_recording
+
+    rec = write_example_recording(tmp_path / "rec", sensor_size=(12, 16), duration=0.2, frame_rate=10.0)
+    (tmp_path / "loop").symlink_to("loop")
+    monkeypatch.chdir(tmp_path)
+    argv = {"reconstruct": ["reconstruct", str(rec), "--out", out, "--quiet"], "demo": ["demo", "--out", out],
+            "batch": ["batch", str(rec), "--out", out, "--quiet"]}[command]
+    code = evinr_main(argv)
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("evinr-lite: error:") and "Traceback" not in err, err
