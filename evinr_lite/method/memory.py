@@ -74,9 +74,10 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
       plus the fused training step's three B x P work arrays when n_iters > 0;
     - ``frames``: whole solve: every network at every query time [N, Q, P], its offset copy, the
       float64 blend and the float64 tone map [Q, P]; streaming: one prediction batch
-      (streaming.PREDICT_CELLS) with its float64 tone map, the offset grid (max(64, 8 N) frames) and
-      its float64 median workspace for one row block, the overlap's partial blends, and ``n_kept``
-      frames kept in memory (those at ground-truth times; the GIF's uint8 frames count as n_kept / 4).
+      (streaming.PREDICT_CELLS frames x pixels, at least MIN_BATCH frames) with its tone-mapped and
+      uint8 copies, the tone map's float64 work arrays (TONEMAP_CELLS), the offset grid (max(64, 8 N)
+      frames) with the median's float64 workspace (three copies), the overlap's partial blends, and
+      ``n_kept`` frames kept in memory (those at ground-truth times).
 
     Measured against peak RSS in ``benchmarks/scale.py`` (the target: within 25 %).
 
@@ -96,14 +97,14 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
     bins = 4.0 * B * P * (2 + (3 if config.n_iters > 0 else 0))
     Q = float(n_frames)
     if streaming:
-        from .streaming import PREDICT_CELLS
+        from .streaming import MIN_BATCH, PREDICT_CELLS, TONEMAP_CELLS
 
-        batch = min(Q, max(1.0, PREDICT_CELLS // P)) * P
+        batch = min(Q, max(MIN_BATCH, PREDICT_CELLS // P)) * P
         grid = float(max(64, 8 * N)) * P
         overlap_frames = Q * min(1.0, config.overlap / span) if span > 0 and N > 1 else 0.0
         parts = {"process": PROCESS_BYTES, "events": READ_BYTES * per_window_events,
                  "networks": head + trunk, "bins": bins,
-                 "frames": batch * (4 + 16) + grid * 4 + min(grid, 1 << 24) * 16 + overlap_frames * P * 8
+                 "frames": batch * (4 + 4 + 4) + TONEMAP_CELLS * 24 + grid * (4 + 24) + overlap_frames * P * 8
                  + float(n_kept) * P * 4}
     else:
         parts = {"process": PROCESS_BYTES, "events": EVENT_BYTES * float(n_events),

@@ -48,9 +48,12 @@ from .tonemap import anchor_level, tonemap_reinhard
 from .training import train_frame_inr
 
 __all__ = ["stream_reconstruct", "StreamPart", "StreamState", "train_window", "network_at", "chain_offset",
-           "alignment_times", "first_window_offset", "offset_grid", "span_offset", "OFFSET_FROM", "PREDICT_CELLS", "N_ALIGN_SAMPLES"]
+           "alignment_times", "first_window_offset", "offset_grid", "span_offset", "tonemap", "OFFSET_FROM", "PREDICT_CELLS", "MIN_BATCH",
+           "N_ALIGN_SAMPLES"]
 
-PREDICT_CELLS = 1 << 24     # frames x pixels per prediction batch (64 MB of float32), whatever the sensor
+PREDICT_CELLS = 1 << 23     # frames x pixels per prediction batch (32 MB of float32) ...
+MIN_BATCH = 32              # ... but at least this many frames: each batch reads the d x H*W head once
+TONEMAP_CELLS = 1 << 21     # frames x pixels tone-mapped at once (its float64 work arrays stay ~50 MB)
 N_ALIGN_SAMPLES = 8         # times at which neighbouring networks are compared (as ensemble.alignment_offsets)
 _EDGE = 1e-9                # seconds: a time this close to a window belongs to it (as ensemble.blend_weights)
 OFFSET_FROM = ("span", "first_window")
@@ -158,8 +161,22 @@ def network_at(model: FrameINR, times: np.ndarray) -> np.ndarray:
     """A one-network model's output (no offset) at ``times`` [Q] (s): float32 [Q, H, W], predicted
     a bounded number of frames at a time (PREDICT_CELLS), whatever the sensor."""
     H, W = model.sensor_size
-    chunk = max(1, PREDICT_CELLS // (H * W))
-    return predict_networks(model, np.asarray(times, np.float64), chunk)[0]
+    return predict_networks(model, np.asarray(times, np.float64), _batch(H * W))[0]
+
+
+def _batch(pixels: int) -> int:
+    """Frames per prediction batch for a sensor of ``pixels``."""
+    return max(MIN_BATCH, PREDICT_CELLS // max(pixels, 1))
+
+
+def tonemap(L: np.ndarray, gamma: float) -> np.ndarray:
+    """:func:`~evinr_lite.method.tonemap.tonemap_reinhard` of L [Q, H, W] as float32, a few frames at a
+    time (the same values; its float64 work arrays stay small)."""
+    out = np.empty(L.shape, np.float32)
+    step = max(1, TONEMAP_CELLS // max(int(np.prod(L.shape[1:])), 1))
+    for i in range(0, len(L), step):
+        out[i:i + step] = tonemap_reinhard(L[i:i + step], gamma)
+    return out
 
 
 def train_window(events: Events, windows: np.ndarray, k: int, config: EvINRConfig):
@@ -355,7 +372,7 @@ def _windows(source, q, grid, cfg, state, spill, on_state, progress):
                               state.windows_log + [log])
             part = None
             if spill is None:
-                part = StreamPart(q[q_idx], q_idx, q_L, tonemap_reinhard(q_L, cfg.gamma).astype(np.float32),
+                part = StreamPart(q[q_idx], q_idx, q_L, tonemap(q_L, cfg.gamma),
                                   (k, float(lo), float(hi)), _history(new))
             else:
                 with open(spill, "ab") as f:
@@ -374,7 +391,7 @@ def _final_pass(spill, q, offset, cfg, sensor_size, history):
     """The spilled log intensities plus the offset, tone-mapped, a bounded batch at a time."""
     H, W = sensor_size
     P = H * W
-    step = max(1, PREDICT_CELLS // P)
+    step = _batch(P)
     with open(spill, "rb") as f:
         for i0 in range(0, len(q), step):
             n = min(step, len(q) - i0)
@@ -384,7 +401,7 @@ def _final_pass(spill, q, offset, cfg, sensor_size, history):
                                      "it was changed while the run was stopped: start again without resuming")
             L += offset
             idx = np.arange(i0, i0 + n, dtype=np.int64)
-            yield StreamPart(q[idx], idx, L, tonemap_reinhard(L, cfg.gamma).astype(np.float32), None, history)
+            yield StreamPart(q[idx], idx, L, tonemap(L, cfg.gamma), None, history)
 
 
 def _blend_window(model, windows, k, times, total_offset, pending, pending_sum):
