@@ -2,12 +2,10 @@
 zoo figures quoted in the docs are those of the committed results (benchmarks/zoo_results.json)."""
 from __future__ import annotations
 
-import json
 import re
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -110,38 +108,40 @@ def test_the_readme_keeps_its_sections_and_length():
     assert len(text.splitlines()) <= 200, "README.md is meant to be read in five minutes: move detail to docs/"
 
 
-def _zoo():
-    d = json.loads((ROOT / "benchmarks" / "zoo_results.json").read_text())
-    zoo = [s for name, s in d["scenes"].items() if name != "real_slider_chunk"]
-    return d, zoo
+def _doc_figures():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("doc_figures", ROOT / "tools" / "doc_figures.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-def test_the_zoo_means_in_docs_defaults_are_the_committed_results():
-    d, zoo = _zoo()
-    text = (ROOT / "docs" / "defaults.md").read_text(encoding="utf-8")
-    checked = 0
-    for method in d["methods"]:
-        m = re.search(rf"^\| {re.escape(method)}\b[^|]*\|([^\n]*)$", text, re.M)
-        assert m, f"docs/defaults.md has no row for {method}"
-        cells = [c.strip() for c in m.group(1).strip(" |").split("|")]
-        rows = [s["rows"][method] for s in zoo]
-        want = [f"{np.mean([r['ssim_clahe'] for r in rows]):.3f}", f"{np.mean([r['ssim_none'] for r in rows]):.3f}",
-                f"{np.mean([r['mse_none'] for r in rows]):.4f}"]
-        assert cells[:3] == want, f"docs/defaults.md's {method} row {cells[:3]} != zoo_results.json {want}"
-        real = d["scenes"]["real_slider_chunk"]["rows"].get(method)
-        if real is not None:
-            assert cells[4:6] == [f"{real['ssim_clahe']:.3f}", f"{real['ssim_none']:.3f}"], method
-        checked += 1
-    assert checked == len(d["methods"]) >= 5
+def test_the_zoo_tables_in_the_docs_are_the_committed_results():
+    """docs/defaults.md and benchmarks/README.md quote benchmarks/zoo_results.json as it is committed."""
+    figures = _doc_figures()
+    for name, table in figures.blocks(figures.load()).items():
+        page = figures.BLOCKS[name]
+        assert figures.current(page.read_text(encoding="utf-8"), name) == table, (
+            f"{page.relative_to(ROOT)}: the {name} table differs from benchmarks/zoo_results.json; "
+            "run python tools/doc_figures.py")
 
 
-def test_the_zoo_table_in_benchmarks_readme_is_the_committed_results():
-    d, zoo = _zoo()
-    text = (ROOT / "benchmarks" / "README.md").read_text(encoding="utf-8")
-    for name, scene in d["scenes"].items():
-        want = [f"{scene['rows'][m]['ssim_clahe']:.3f} / {scene['rows'][m]['ssim_none']:.3f}"
-                if m in scene["rows"] else "-" for m in d["methods"]]
-        assert f"| {name} | " + " | ".join(want) + " |" in text, f"benchmarks/README.md: the {name} row is stale"
+def test_doc_figures_means_and_missing_runs():
+    """The zoo mean leaves out the real chunk and the scenes a method did not run on; a gap prints '-'."""
+    figures = _doc_figures()
+    row = {"ssim_clahe": 0.5, "ssim_none": 0.6, "mse_none": 0.01, "time_s": 2.0}
+    results = {"methods": ["kit", "paper"], "scenes": {
+        "a": {"rows": {"kit": row, "paper": {**row, "ssim_clahe": 0.2}}},
+        "b": {"rows": {"kit": {**row, "ssim_clahe": 0.7, "time_s": 4.0}}},                # paper skipped here
+        figures.REAL: {"rows": {"kit": {**row, "ssim_clahe": 0.9}}}}}
+    assert figures.zoo_mean(results, "kit", "ssim_clahe") == pytest.approx(0.6)         # (0.5 + 0.7) / 2
+    assert figures.zoo_mean(results, "paper", "ssim_clahe") == pytest.approx(0.2)
+    summary = figures.summary_table(results)
+    assert "| kit (`EvINRConfig()`) | 0.600 | 0.600 | 0.0100 | 3.0 s | 0.900 | 0.600 |" in summary
+    assert "| paper (`EvINRConfig.paper()`) | 0.200 | 0.600 | 0.0100 | 2.0 s | - | - |" in summary
+    table = figures.scene_table(results)
+    assert "| b | 0.700 / 0.600 | - |" in table and "| **zoo mean** | 0.600 / 0.600 | 0.200 / 0.600 |" in table
 
 
 def test_the_readme_python_example_runs():

@@ -1,0 +1,104 @@
+"""Rewrite the scene-zoo tables of the docs from the committed results (benchmarks/zoo_results.json).
+
+    python tools/doc_figures.py            # after `python benchmarks/quality_zoo.py` has rewritten the JSON
+
+Two tables, each between HTML comment markers, so the prose around them stays hand-written:
+
+- docs/defaults.md, ``<!-- zoo-summary -->``: one row per method: the zoo mean (every scene but the
+  real chunk on which the method ran) of CLAHE-SSIM, SSIM, MSE and wall time, and the real chunk's
+  CLAHE-SSIM and SSIM;
+- benchmarks/README.md, ``<!-- zoo-table -->``: CLAHE-SSIM / SSIM per scene and method, and the mean row.
+
+tests/test_docs_links.py fails when the docs differ from what this writes.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "benchmarks" / "zoo_results.json"
+REAL = "real_slider_chunk"
+LABELS = {"kit": "kit (`EvINRConfig()`)", "paper": "paper (`EvINRConfig.paper()`)",
+          "v0_1": "v0_1 (`EvINRConfig.v0_1()`)", "hf": "hf (high-pass filter)"}
+BLOCKS = {"zoo-summary": ROOT / "docs" / "defaults.md", "zoo-table": ROOT / "benchmarks" / "README.md"}
+
+
+def load(path: Path = RESULTS) -> dict:
+    return json.loads(Path(path).read_text(encoding="utf-8"))
+
+
+def zoo_mean(results: dict, method: str, key: str) -> float | None:
+    """Mean of ``key`` over the synthetic scenes where ``method`` ran (None when it ran on none)."""
+    values = [s["rows"][method][key] for name, s in results["scenes"].items()
+              if name != REAL and key in s["rows"].get(method, {})]
+    return float(np.mean(values)) if values else None
+
+
+def _f(v, digits: int = 3) -> str:
+    return "-" if v is None else f"{v:.{digits}f}"
+
+
+def summary_table(results: dict) -> str:
+    """docs/defaults.md's table: one row per method."""
+    real = results["scenes"].get(REAL, {}).get("rows", {})
+    lines = ["| method | zoo mean CLAHE-SSIM | SSIM | MSE | time | real chunk CLAHE-SSIM | SSIM |",
+             "|---|---|---|---|---|---|---|"]
+    for m in results["methods"]:
+        t = zoo_mean(results, m, "time_s")
+        cells = [_f(zoo_mean(results, m, "ssim_clahe")), _f(zoo_mean(results, m, "ssim_none")),
+                 _f(zoo_mean(results, m, "mse_none"), 4), "-" if t is None else f"{t:.1f} s",
+                 _f(real.get(m, {}).get("ssim_clahe")), _f(real.get(m, {}).get("ssim_none"))]
+        lines.append(f"| {LABELS.get(m, m)} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def scene_table(results: dict) -> str:
+    """benchmarks/README.md's table: CLAHE-SSIM / SSIM per scene and method, then the zoo mean."""
+    methods = results["methods"]
+
+    def pair(row):
+        if row is None or "ssim_clahe" not in row:
+            return "-"
+        return f"{row['ssim_clahe']:.3f} / {row['ssim_none']:.3f}"
+
+    lines = ["| scene (CLAHE-SSIM / SSIM) | " + " | ".join(methods) + " |", "|---|" + "---|" * len(methods)]
+    for name, scene in results["scenes"].items():
+        lines.append(f"| {name} | " + " | ".join(pair(scene["rows"].get(m)) for m in methods) + " |")
+    means = [pair({"ssim_clahe": zoo_mean(results, m, "ssim_clahe"), "ssim_none": zoo_mean(results, m, "ssim_none")})
+             if zoo_mean(results, m, "ssim_clahe") is not None else "-" for m in methods]
+    lines.append("| **zoo mean** | " + " | ".join(means) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def blocks(results: dict) -> dict:
+    return {"zoo-summary": summary_table(results), "zoo-table": scene_table(results)}
+
+
+def current(text: str, name: str) -> str:
+    """The text between ``<!-- name -->`` and ``<!-- /name -->`` (blank lines around it dropped)."""
+    inner = text.split(f"<!-- {name} -->", 1)[1].split(f"<!-- /{name} -->", 1)[0]
+    return inner.strip("\n") + "\n"
+
+
+def replace(text: str, name: str, table: str) -> str:
+    head, rest = text.split(f"<!-- {name} -->", 1)
+    _, tail = rest.split(f"<!-- /{name} -->", 1)
+    return f"{head}<!-- {name} -->\n{table}<!-- /{name} -->{tail}"
+
+
+def main() -> None:
+    results = load()
+    for name, table in blocks(results).items():
+        page = BLOCKS[name]
+        new = replace(page.read_text(encoding="utf-8"), name, table)
+        tmp = page.with_name(page.name + ".tmp")
+        tmp.write_text(new, encoding="utf-8")
+        tmp.replace(page)                  # written beside, then renamed into place
+        print(f"wrote {page.relative_to(ROOT)} ({name})")
+
+
+if __name__ == "__main__":
+    main()
