@@ -15,6 +15,7 @@ Benchmarks (each is also a script with its own --help):
     zoo          benchmarks/quality_zoo.py     quality and time on the scene zoo (kit, paper, v0.1, baselines, oracle)
     robustness   benchmarks/robustness.py      quality as events are thinned, noise added, C mis-given (3 zoo scenes)
     denoise      benchmarks/denoise.py         hot pixels and background removed vs the truth, the gain, tonic
+    scale        benchmarks/scale.py           reconstruct's wall time, training and peak memory, 2-120 s, up to 1280x720
 
 ratio >= 1 means the target is met (measured / target, or target / measured for times and memory).
 Times are wall-clock on this machine, the fastest of several repeats; on a machine shared with
@@ -31,7 +32,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks import (binning_speed, denoise, end_to_end, ensemble_speed, inference, quality_zoo,  # noqa: E402
-                        robustness, simulate_speed, train_step)
+                        robustness, scale, simulate_speed, train_step)
 from benchmarks.common import machine, print_table, write_json  # noqa: E402
 
 BENCHMARKS = {
@@ -44,6 +45,7 @@ BENCHMARKS = {
     "zoo": lambda a: quality_zoo.run(a.quick),
     "robustness": lambda a: robustness.run(a.quick),
     "denoise": lambda a: denoise.run(a.quick),
+    "scale": lambda a: scale.run(a.quick),
 }
 
 
