@@ -68,18 +68,26 @@ def _dct_rows(X: np.ndarray, sensor_size, inverse: bool = False) -> None:
 
 
 def _solve_frequencies(X: np.ndarray, M: np.ndarray, E_hat: np.ndarray, V: np.ndarray, lam_: np.ndarray,
-                       mu: np.ndarray) -> None:
+                       mu: np.ndarray, eps_s: float = 0.0) -> float:
     """X [d, P] float32 <- V (Lambda + mu_p)^-1 M E_hat[:, p] for every spatial frequency p, with
     M = V^T A^T [d, B] and E_hat [B, P] the DCT of the event frames: the same as V (Lambda + mu)^-1 V^T
     DCT(A^T E), at B/d of the cost (the DCT over pixels commutes with A^T over bins). Float64 over
-    chunks of columns (V can be large where G is ill-conditioned), stored as float32."""
+    chunks of columns (V can be large where G is ill-conditioned), stored as float32. Returns the
+    temporal loss's sum |A W - E|^2 (Parseval: the same in the DCT domain), from the eigenbasis."""
     d, P = X.shape
     cols = max(1, _CHUNK_CELLS // max(d, 1))
+    loss = 0.0
     for c0 in range(0, P, cols):
         c1 = min(P, c0 + cols)
-        Y = M @ E_hat[:, c0:c1].astype(np.float64)
-        Y /= lam_[:, None] + mu[None, c0:c1]
-        X[:, c0:c1] = V @ Y
+        Ec = E_hat[:, c0:c1].astype(np.float64)
+        m = M @ Ec
+        Y = m / (lam_[:, None] + mu[None, c0:c1])
+        Xc = V @ Y
+        # |A x - e|^2 per column from the eigenbasis: x = V y, V^T (S + eps_s I) V = Lambda, V^T A^T e = m:
+        # x^T S x - 2 x^T A^T e + |e|^2 = sum y (lam y - 2 m) - eps_s |x|^2 + |e|^2
+        loss += float(np.sum(Y * (lam_[:, None] * Y - 2 * m)) - eps_s * np.sum(Xc * Xc) + np.sum(Ec * Ec))
+        X[:, c0:c1] = Xc
+    return loss
 
 
 @torch.no_grad()
@@ -148,14 +156,8 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
         lam_, V = scipy.linalg.eigh(S + eps_s * np.eye(d), G + eps_g * np.eye(d))   # S V = G V diag(lam_)
         E_hat = E[n].float().cpu().numpy().copy()                        # [B, P]: the event frames' DCT
         _dct_rows(E_hat, (H, W))
-        _solve_frequencies(weights[n], V.T @ A64[n].T, E_hat, V, lam_, mu)   # DCT(W), every frequency
-        # the temporal loss |A W - E|^2 = |A DCT(W) - DCT(E)|^2 (orthonormal), a few bins at a time
-        Xn = torch.from_numpy(weights[n])
-        step = max(1, _CHUNK_CELLS // max(P, 1))
-        for b0 in range(0, B, step):
-            r = torch.mm(A[n, b0:b0 + step].float().cpu(), Xn)
-            r -= torch.from_numpy(E_hat[b0:b0 + step])
-            total += float(torch.linalg.vector_norm(r).double() ** 2)
+        # DCT(W) at every frequency, and the temporal loss |A W - E|^2 (= |A DCT(W) - DCT(E)|^2)
+        total += _solve_frequencies(weights[n], V.T @ A64[n].T, E_hat, V, lam_, mu, eps_s)
         del E_hat
         _dct_rows(weights[n], (H, W), inverse=True)                     # W
     if not in_place:
