@@ -210,11 +210,18 @@ class _FrameWriter:
         self.mp4 = None
         self.gif = [] if video else None
         self.n_times = len(times)
+        self.range = (np.inf, -np.inf)   # of every frame written: a constant output is refused at the end
 
     def add(self, part) -> None:
+        from ..core.checks import check_result_frames
         from ..core.frames import to_uint8
         from ..io.output import save_png
+        from ..method.solver import RESULT_FIX
 
+        # as reconstruct refuses them: output that is not finite (here, per part), or constant (at the end)
+        check_result_frames(part.log_intensity, what="EvINR's log intensity", input_varies=False, fix=RESULT_FIX)
+        if part.frames.size:
+            self.range = (min(self.range[0], float(part.frames.min())), max(self.range[1], float(part.frames.max())))
         u8 = to_uint8(part.frames)
         for j, q in enumerate(part.indices.tolist()):
             i = self.export_of.get(q)
@@ -239,8 +246,12 @@ class _FrameWriter:
                 self.gif.append(img)
 
     def finish(self) -> list:
+        from ..core.checks import check_result_frames
         from ..io.export import save_gif
+        from ..method.solver import RESULT_FIX
 
+        check_result_frames(np.array(self.range, np.float32)[:, None, None], what="EvINR's frames", input_varies=True,
+                            fix=RESULT_FIX)
         written = []
         if self.mp4 is not None and self.mp4.close():
             written.append("reconstruction.mp4")
