@@ -92,7 +92,7 @@ def check_settings(*, C=None, sensor_size=None, eval_window=None, time_unit=None
     """Values that are stored in the converted file, checked before converting (DataFetchError)."""
     import math
 
-    from evinr_lite.core.events import TIME_UNITS
+    from evinr_lite.core.events import TIME_UNITS, check_time_range
 
     if C is not None and (isinstance(C, bool) or not isinstance(C, (int, float)) or not math.isfinite(C) or C <= 0):
         raise DataFetchError(f"C must be a positive finite contrast threshold, got {C!r} (--C)")
@@ -104,12 +104,7 @@ def check_settings(*, C=None, sensor_size=None, eval_window=None, time_unit=None
         if not (0 < H <= 1 << 16 and 0 < W <= 1 << 16):
             raise DataFetchError(f"sensor size must be (H, W) with sides in 1..65536; got {(H, W)} (--sensor-size H W)")
     if eval_window not in (None, _UNSET):
-        try:
-            lo, hi = (float(v) for v in eval_window)
-        except (TypeError, ValueError):
-            raise DataFetchError(f"eval_window must be (start, end) seconds, got {eval_window!r}") from None
-        if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
-            raise DataFetchError(f"eval_window must be finite with end > start, got {eval_window!r}")
+        check_time_range(eval_window, "eval_window", DataFetchError)
     if time_unit not in (None, "auto") and time_unit not in TIME_UNITS:
         raise DataFetchError(f"time unit must be one of {', '.join(TIME_UNITS)}, got {time_unit!r} (--time-unit)")
 

@@ -24,7 +24,7 @@ import math
 from .guard import InputError   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
-           "TimeUnitWarning", "resolve_time_unit", "check_time_span", "MAX_SPAN_S"]
+           "TimeUnitWarning", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S"]
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
@@ -137,6 +137,23 @@ def check_time_span(t, source, time_unit: str, *, flag: str = "time_unit") -> No
             f"{source}: read in {time_unit!r}, the timestamps span {span:,.6g} s ({span / 3600:,.3g} hours) with "
             f"{t.size:,} events ({rate:,.3g} per second); that is implausible for an event recording, so "
             f"the time unit is probably wrong: pass {flag}={others[0]!r} (or {', '.join(repr(u) for u in others[1:])})")
+
+
+def check_time_range(value, name: str, error=None) -> tuple[float, float]:
+    """``(start, end)`` in seconds, both finite with end > start, as two floats.
+
+    The one check of a time range given as a pair (a coordinate network's ``t_range``, a converted
+    file's ``eval_window``); ``error`` is the exception class raised (default EventDataError), and the
+    message names ``name``.
+    """
+    error = error or EventDataError
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be (start, end) in seconds, two numbers; got {value!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and hi > lo):
+        raise error(f"{name} [{lo}, {hi}] s is empty, reversed or not finite; the end must exceed the start")
+    return lo, hi
 
 
 def _check_integer_seconds(t: np.ndarray) -> None:

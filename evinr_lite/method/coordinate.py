@@ -49,7 +49,7 @@ from torch import nn
 
 from .binning import events_to_frames, fixed_duration_boundaries
 from ..core.runtime import default_device
-from ..core.events import EventDataError, Events, check_sensor_size
+from ..core.events import EventDataError, Events, check_sensor_size, check_time_range
 from .siren import Siren
 from .tonemap import anchor_level, tonemap_reinhard
 
@@ -61,13 +61,7 @@ _RENDER_CHUNK = 1 << 16   # coordinates evaluated at once by render()
 
 
 def _check_range(t_range) -> tuple[float, float]:
-    try:
-        t0, t1 = (float(v) for v in t_range)
-    except (TypeError, ValueError):
-        raise EventDataError(f"t_range must be (t_start, t_end) in seconds, got {t_range!r}") from None
-    if not (math.isfinite(t0) and math.isfinite(t1) and t1 > t0):
-        raise EventDataError(f"t_range [{t0}, {t1}] s is empty or reversed; t_end must exceed t_start")
-    return t0, t1
+    return check_time_range(t_range, "t_range")
 
 
 # ---- the network -----------------------------------------------------------------------
