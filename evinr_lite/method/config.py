@@ -67,6 +67,12 @@ class EvINRConfig:
       as given (quick zoo mean 0.5302 -> 0.5319; unequal_onhot 0.577 -> 0.605 from the hot pixels);
       real chunk 0.349 -> 0.350. Measured with ``python benchmarks/quality_zoo.py --quick --variant
       "bal=balance='events',hot_pixels='drop'"`` and ``--long --scenes long_pan_20s``.
+
+    With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results_short.md``, 2 shared
+    cores): kit 0.566 / 0.602 / 0.0410, integration + median-gradient offset 0.524 / 0.589 / 0.0404
+    (the INR: 1.08x in CLAHE-SSIM), HF with its cutoff swept per scene 0.523 / 0.569 / 0.0518, leaky
+    integration swept 0.512 / 0.561 / 0.0516; real chunk 0.350 / 0.416 / 0.0889 (1.13x integration +
+    offset); camera_240x180 (2 s at 180x240) in 2.5 s.
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
       (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
