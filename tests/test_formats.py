@@ -97,6 +97,15 @@ def test_aedat4_frames_from_dv_processing(tmp_path):
     np.testing.assert_array_equal(rec.frames.images, np.stack(images))
     windowed = read_aedat4(path, t_start=0.8, t_end=1.5)   # frames at 0.557, 1.357, 2.157 s
     assert len(windowed.frames) == 1 and np.array_equal(windowed.frames.images[0], images[1])
+    from evinr_lite.io import open_recording
+
+    with open_recording(path) as src:   # the streaming source: the same frames, on the same clock
+        np.testing.assert_array_equal(src.frames.t, rec.frames.t)
+        np.testing.assert_array_equal(src.frames.images, rec.frames.images)
+        assert src.n_events == len(rec.events) and src.t_origin == rec.events.t_origin
+        loaded = src.load(0.8, 1.5)
+        assert len(loaded.frames) == 1 and np.array_equal(loaded.frames.images[0], images[1])
+        np.testing.assert_array_equal(loaded.events.t, windowed.events.t)
 
 
 def test_raw_without_size_needs_sensor_size(tmp_path):
