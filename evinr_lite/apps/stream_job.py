@@ -9,9 +9,10 @@ solve), and its frames are written into the run's staging folder a batch at a ti
 Resume: while it runs, a folder ``.<name>.resume`` beside the output holds the stream's state after
 every window and the log intensities finished so far (a spill file, 4 bytes x H x W per frame),
 with a marker naming the input (resolved path, size, modification time) and the result settings.
-A run that is killed leaves it behind; ``resume=True`` (``evinr-lite reconstruct ... --resume``)
+A run that is stopped after a finished window leaves it behind (and says so; one stopped
+before any leaves nothing); ``resume=True`` (``evinr-lite reconstruct ... --resume``)
 continues from the last finished window when the marker matches, and refuses otherwise; a run
-without ``resume`` replaces it. It is removed once the result is committed. The output folder
+without ``resume`` replaces it. It is removed once every frame is in the staging folder. The output folder
 itself stays all-or-nothing (:class:`~evinr_lite.io.output.OutputDir`), and its lock covers the
 resume folder too.
 """
@@ -173,10 +174,15 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
             for part in parts:
                 writer.add(part)
                 history = part.history
-        except BaseException:   # interrupted or failed: the finished windows stay for --resume
+        except BaseException:   # interrupted or failed: finished windows stay for --resume, else nothing stays
             if (folder / "state.npz").is_file():
                 log(f"the finished windows are kept in {folder}; the same command with --resume continues from them")
+            else:
+                shutil.rmtree(folder, ignore_errors=True)
             raise
+    # every frame is in the staging folder: nothing is left to resume, and from here on an interruption
+    # leaves nothing behind (the export is short)
+    shutil.rmtree(folder, ignore_errors=True)
     save_timestamps(target.staging / "timestamps.txt", times, source.t_origin)
     written = ["frames/", "timestamps.txt"] + writer.finish()
     scores = score_predictions(writer.gt_frames(), gt.t, gt) if gt is not None else None
@@ -188,7 +194,6 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     run = write_results(target.staging, rec, times, history, scores, settings=settings, written=written,
                         n_events=n_events)
     target.commit()
-    shutil.rmtree(folder, ignore_errors=True)   # committed: nothing left to resume
     return run, times, scores
 
 
