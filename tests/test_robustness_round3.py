@@ -63,7 +63,7 @@ def test_both_commands_share_one_guard(capsys, monkeypatch, exc, code):
         raise exc()
 
     monkeypatch.setattr(data_fetch, "info", boom)
-    monkeypatch.setattr(describe, "read_any", boom)
+    monkeypatch.setattr(describe, "open_recording", boom)
     got_df, _, err_df = _run_df(capsys, "info", "x.h5")
     got_ev = evinr_main(["info", "x.h5"])
     err_ev = capsys.readouterr().err

@@ -220,10 +220,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _info(args) -> None:
-    from .describe import describe_recording, format_info, read_any   # no torch: info needs none
+    from .describe import describe_recording, format_info, open_recording   # no torch: info needs none
 
-    rec = read_any(args.recording, sensor_size=args.sensor, time_unit=args.time_unit)
-    info = describe_recording(rec)
+    with open_recording(args.recording, sensor_size=args.sensor, time_unit=args.time_unit) as source:
+        info = describe_recording(source)   # reads only what the format can tell cheaply (seconds on GB files)
     print(json.dumps(info, indent=2) if args.json else format_info(info))
 
 

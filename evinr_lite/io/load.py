@@ -122,10 +122,13 @@ def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_en
     for name, value in (("t_start", t_start), ("t_end", t_end)):
         if value is not None and not math.isfinite(value):
             raise EventDataError(f"{name}= must be a finite number of seconds, got {value}")
-    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=t_end, time_unit=time_unit)
+    # One window rule for every format, here rather than per reader: events in [start, end), frames in
+    # [start, end]. Readers that read only a window from disk are asked for a little more (a frame
+    # exactly at t_end included) and everything is cut here.
+    reader_end = None if t_end is None else math.nextafter(float(t_end), math.inf)
+    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=reader_end, time_unit=time_unit)
     events, frames = rec.events, rec.frames
-    if not get_format(rec.meta["format"]).windowed:
-        events = events.slice_time(t_start, t_end)
+    events = events.slice_time(t_start, t_end)
     if len(events) < 2:
         raise EventDataError(f"{path}: only {len(events)} event(s) in the window [{t_start}, {t_end}) s; "
                              "choose a longer window (see `evinr-lite info` for the time span)")
