@@ -20,10 +20,14 @@ import numpy as np
 
 from ..core.events import TIME_UNITS, EventDataError
 from ..method.anchor import ANCHOR_MODES
+from ..core.recording import Recording
 from ..method.config import EvINRConfig
+from ..method.memory import check_times_memory
 from ..method.recipes import RECIPES, contrast_option, recipe_config
 
-__all__ = ["RunOptions", "parse_times", "check_run_options", "BATCH_FIELDS"]
+__all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "BATCH_FIELDS", "DEFAULT_FPS"]
+
+DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
 BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor")
@@ -238,3 +242,36 @@ def check_run_options(**fields) -> RunOptions:
     """Every option of :func:`~evinr_lite.apps.recon_job.run_reconstruct` checked before any file is
     read: :class:`RunOptions` (EventDataError naming the option)."""
     return RunOptions(**fields)
+
+
+def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[np.ndarray, str]:
+    """The times to reconstruct and where they come from.
+
+    Args:
+        fps: frames per second over the window (the first half a frame period after its start).
+        at: explicit times (array, '0.1,0.2' text, or a file: :func:`~evinr_lite.apps.options.parse_times`).
+        Neither: the ground-truth frame times when the recording has frames, else DEFAULT_FPS.
+    Returns:
+        (times float64 [Q] seconds, a short description of the choice).
+    """
+    if fps is not None and at is not None:
+        raise EventDataError("give either fps= or at=, not both")
+    lo, hi = rec.meta["window"]
+    if at is not None:
+        times = parse_times(at)
+        outside = times[(times < lo) | (times > hi)]
+        if outside.size:
+            raise EventDataError(f"requested time {outside[0]} s is outside the reconstructed window "
+                                 f"[{lo:.6f}, {hi:.6f}] s; choose times inside it (or widen t_start=/t_end=)")
+        return times, f"{len(times)} requested times"
+    if fps is None and rec.frames is not None:
+        inside = rec.frames.t[(rec.frames.t >= lo) & (rec.frames.t <= hi)]
+        if inside.size:
+            return inside.copy(), f"the {inside.size} ground-truth frame times"
+    fps = DEFAULT_FPS if fps is None else float(fps)
+    if not (math.isfinite(fps) and fps > 0):
+        raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
+    n = int(math.floor((hi - lo) * fps))
+    check_times_memory(n, rec.events.sensor_size, f"{n:,} frames at {fps:g} per second over [{lo:.6f}, {hi:.6f}] s")
+    times = lo + (np.arange(n) + 0.5) / fps if n >= 1 else np.array([0.5 * (lo + hi)])
+    return times, f"{len(times)} frames at {fps:g} per second"

@@ -139,7 +139,8 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     from ..method.memory import check_memory
     from ..method.recipes import format_contrast, resolve_contrast
     from ..method.streaming import stream_reconstruct
-    from .recon_job import choose_times, score_predictions, write_results
+    from .options import choose_times
+    from .results import score_predictions, write_results
 
     t0 = time.perf_counter() if t0 is None else t0
     try:
