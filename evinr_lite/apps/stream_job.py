@@ -32,7 +32,7 @@ from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from ..core.recording import Recording
 
-__all__ = ["streamable", "run_streaming", "resume_folder", "video_fps", "RESUME_MARKER", "GIF_LIMIT_BYTES"]
+__all__ = ["streamable", "run_streaming", "check_disk", "resume_folder", "video_fps", "RESUME_MARKER", "GIF_LIMIT_BYTES"]
 
 RESUME_MARKER = ".evinr-resume.json"   # inside the resume folder: the proof it is this job's own
 GIF_LIMIT_BYTES = 512 << 20            # uint8 frames kept for the GIF; beyond, the GIF is skipped (the MP4 streams)
@@ -158,6 +158,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
         query = np.unique(np.concatenate([times, gt_t]))        # sorted: the exported times and the scored ones
         est = check_memory((H, W), lo, hi, n_events, len(query), config, device_name, events_span=source.t_span,
                            streaming=True)
+        check_disk(len(query), (H, W), target.staging)
         log(f"streaming {source.format} {H}x{W} over [{lo:.6f}, {hi:.6f}] s"
             + (f" ({n_events:,} events)" if source.n_events is not None else "")
             + (f", {len(gt)} ground-truth frames" if gt is not None else ", no frames")
@@ -196,6 +197,24 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
                         n_events=n_events)
     target.commit()
     return run, times, scores
+
+
+def check_disk(n_frames: int, sensor_size, folder, *, fraction: float = 0.8) -> dict:
+    """Refuse (EventDataError) a streamed run whose frames would not fit on the disk of ``folder``.
+
+    A streamed run keeps its frames on disk, not in memory: each one is spilled as float32 log
+    intensities (4 bytes a pixel) until the offset is known, then written as a PNG (at most one byte a
+    pixel, and at least one 4 KiB file-system block). Returns {"total", "free"} in bytes.
+    """
+    H, W = sensor_size
+    need = float(n_frames) * (4.0 * H * W + max(4096.0, float(H * W)))
+    free = float(shutil.disk_usage(Path(folder).parent if not Path(folder).exists() else folder).free)
+    if need > fraction * free:
+        raise EventDataError(f"this reconstruction needs about {need / 2**30:,.1f} GiB of disk for its {n_frames:,} "
+                             f"output frames of {H}x{W} pixels but about {free / 2**30:,.1f} GiB is free beside "
+                             f"the output; ask for fewer frames with fps=/--fps or at=/--at, or shorten the window "
+                             "with t_start=/t_end= (--start/--end)")
+    return {"total": need, "free": free}
 
 
 class _FrameWriter:

@@ -160,7 +160,7 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
     if est.get("streaming") and worst in ("networks", "bins"):   # one window at a time: the window sets it
         fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.bin_duration:g} s, "
                f"hidden_features={config.hidden_features}); use a longer bin_duration, a shorter tau or fewer "
-               "hidden_features")
+               "hidden_features, or check the sensor size (sensor_size=(H, W))")
     raise EventDataError(f"this reconstruction needs about {_gib(est['total'])} of memory but about {_gib(free)} is "
                          f"free on {device}: most of it for {fix}")
 
