@@ -68,7 +68,7 @@ class EvINRConfig:
       real chunk 0.349 -> 0.350. Measured with ``python benchmarks/quality_zoo.py --quick --variant
       "bal=balance='events',hot_pixels='drop'"`` and ``--long --scenes long_pan_20s``.
 
-    With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results_short.md``, 2 shared
+    With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 shared
     cores): kit 0.566 / 0.602 / 0.0410, integration + median-gradient offset 0.524 / 0.589 / 0.0404
     (the INR: 1.08x in CLAHE-SSIM), HF with its cutoff swept per scene 0.523 / 0.569 / 0.0518, leaky
     integration swept 0.512 / 0.561 / 0.0516; real chunk 0.350 / 0.416 / 0.0889 (1.13x integration +
