@@ -49,7 +49,10 @@ def test_first_recovers_the_static_background(static_cam):
     assert anchored > 0.8 and anchored > events_only + 0.3, (anchored, events_only)
     # at the anchor the output is the frame itself (to rounding of uint8 and eps)
     np.testing.assert_allclose(rec.log_intensity[0], frame_log(frames.images[0]), atol=1e-3)
-    np.testing.assert_allclose(rec.frames_at(ft[3:5]), rec.frames[3:5], atol=1e-5)
+    # querying a subset of the times gives the same frames up to float32 rounding: the hidden features
+    # differ by ~1e-6 with the batch's shape, and the closed-form head's weights (|w| ~ 100) carry that
+    # to ~1e-4 (measured 2.2e-4 on this machine's oneDNN kernels)
+    np.testing.assert_allclose(rec.frames_at(ft[3:5]), rec.frames[3:5], atol=1e-3)
     assert rec.history["anchor"]["n_held_out"] == len(ft) - 1
     # events-only records no anchors
     assert reconstruct(events, ft, EvINRConfig(**FAST)).anchor_times.size == 0
