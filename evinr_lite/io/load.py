@@ -72,6 +72,13 @@ def open_recording(path, *, sensor_size=None, time_unit: str | None = None, **op
                               format=recording.meta.get("format", fmt.name))
     try:
         check_sensor_size_matches(path, source.sensor_size, sensor_size)
+        first, last = (float(v) for v in source.t_span)
+        if not (math.isfinite(first) and math.isfinite(last) and first <= last):
+            # what a source reads cheaply (its first and last timestamps) already shows a damaged file
+            what = "non-finite" if not (math.isfinite(first) and math.isfinite(last)) else "not sorted"
+            raise EventDataError(f"{path}: the timestamps are damaged ({what}): the first event is at {first!r} s "
+                                 f"and the last at {last!r} s, where they must be finite and increasing; "
+                                 "re-export the recording, or convert the original with python -m data_fetch convert RAW")
     except EventDataError:
         source.close()
         raise

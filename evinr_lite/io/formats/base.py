@@ -253,17 +253,19 @@ def note_decimal_seconds(t_first: float, t_last: float, n: int, time_unit, unit:
     """Decimal timestamps taken as seconds by detection (``time_unit`` 'auto' / None) that come at under
     :data:`SLOW_SECONDS_RATE` events per second look like milliseconds (0.5 s written in ms reads as
     500 s): say so, with the override, in a note. A unit given explicitly is taken as given."""
-    from ...core.events import MAX_RATE_PER_S
+    from ...core.events import MAX_RATE_PER_S, MAX_SPAN_S, MIN_RATE_PER_S
     from ..notes import note
 
     span = float(t_last - t_first)
-    if time_unit not in (None, "auto") or unit != "s" or n < 1000 or span <= 0:
+    if time_unit not in (None, "auto") or unit != "s" or n < 1000 or not span > 0:
         return
     rate = n / span
+    if span > MAX_SPAN_S or rate < MIN_RATE_PER_S:   # implausible in seconds: check_time_span's error says it all
+        return
     if rate < SLOW_SECONDS_RATE and rate * 1e3 <= MAX_RATE_PER_S:
         note(meta, f"{source}: the decimal timestamps were read as seconds, so the {n:,} events span {span:,.6g} s "
                    f"at only {rate:,.3g} events per second; that is more like milliseconds ({span / 1e3:,.6g} s at "
-                   f"{rate * 1e3:,.3g} per second): if they are milliseconds, pass time_unit='ms' (--time-unit ms)")
+                   f"{rate * 1e3:,.3g} per second): if they are milliseconds, pass time_unit='ms'")
 
 
 def _plausible_frames(t: np.ndarray, span: tuple[float, float]) -> bool:
