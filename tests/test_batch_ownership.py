@@ -144,7 +144,10 @@ def test_labels_do_not_depend_on_the_order_of_the_inputs(tmp_path):
 
 # ---- 4. leftovers: a batch leaves only its results ------------------------------------------------------
 
-def test_no_lock_file_stays_and_a_batch_that_could_not_start_leaves_nothing(data, tmp_path):
+def test_no_lock_file_stays_and_a_batch_that_could_not_start_leaves_nothing(data, tmp_path, monkeypatch):
+    import evinr_lite.apps.batch as batch_module
+
+    monkeypatch.setattr(batch_module, "SCHEDULER_TIMEOUT", "2s")   # nothing listens: no need to wait 20 s
     out = tmp_path / "out"
     batch([data / "rec_camera"], out)
     assert not (out / ".batch.lock").exists()

@@ -49,6 +49,8 @@ __all__ = ["run_batch", "resolve_inputs", "evaluate_recording", "summarize", "es
            "RECORDING_SUFFIXES", "input_identity", "result_state", "result_settings", "check_batch_out",
            "check_scheduler_address", "OWNER_MARKER"]
 
+SCHEDULER_TIMEOUT = "20s"   # how long a --scheduler address is tried before "cannot reach" (distributed retries)
+
 SETTINGS_FILE = "batch.json"           # the settings a DIR was made with (a rerun must use the same) and its recordings
 OWNER_MARKER = ".evinr-batch.json"     # inside each DIR/<name>/ a batch wrote: the input's identity and the settings
 LOCK_FILE = ".batch.lock"
@@ -660,7 +662,7 @@ def _run(items, out_dir: Path, settings: dict, *, scheduler, workers, client, se
     try:
         if client is None and scheduler is not None:
             try:
-                client = own_client = Client(scheduler, timeout="20s")
+                client = own_client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
             except (OSError, ValueError, TypeError) as err:
                 raise EventDataError(f"cannot reach the Dask scheduler at {scheduler} ({type(err).__name__}: {err}); "
                                      "check that it is running and the address (tcp://host:port), or leave "
