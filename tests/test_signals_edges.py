@@ -197,3 +197,35 @@ def test_enospc_while_locking_a_batch_leaves_nothing(tmp_path, monkeypatch, reco
     with pytest.raises(EventDataError, match="No space left"):
         run_batch([recording], tmp_path / "out", sequential=True, progress=False, log=lambda *a: None)
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_an_interrupt_raised_where_python_ignores_exceptions_is_not_lost(capsys):
+    """A signal whose Interrupted is raised inside a weakref callback (as when an import releases its
+    module lock) is only printed by Python ("Exception ignored in ..."): the guard delivers it again,
+    so it still stops the command at its next line, and nothing is printed."""
+    import signal
+    import time
+    import weakref
+
+    from evinr_lite.core.guard import Interrupted, termination_signals
+
+    class Thing:
+        pass
+
+    def callback(ref):   # runs when the object goes away; exceptions raised here are unraisable
+        signal.raise_signal(signal.SIGINT)
+        for _ in range(1000):   # the handler runs here, inside the callback
+            pass
+
+    reached = []
+    with pytest.raises(Interrupted):
+        with termination_signals():
+            thing = Thing()
+            ref = weakref.ref(thing, callback)
+            del thing
+            deadline = time.monotonic() + 10
+            while time.monotonic() < deadline:   # the command's next lines: the interrupt must arrive here
+                reached.append(1)
+    assert ref() is None and time.monotonic() < deadline
+    err = capsys.readouterr().err
+    assert "Exception ignored" not in err and "Traceback" not in err, err

@@ -54,11 +54,30 @@ class _SignalState:
     def __init__(self):
         self.seen: list[int] = []
         self.armed = True          # False once the command's work is over: signals are only noted
+        self.swallowed = False     # the first Interrupted was raised where Python ignores exceptions
 
     def handler(self, signum, frame):
         self.seen.append(int(signum))
-        if self.armed and len(self.seen) == 1:
+        if self.armed and (len(self.seen) == 1 or self.swallowed):
+            self.swallowed = False
             raise Interrupted(signum)
+
+    def unraisable(self, unraisable, previous):
+        """sys.unraisablehook: an Interrupted raised inside a weakref callback, a __del__ or another place
+        whose exceptions Python only prints (e.g. while an import releases its module lock) would be
+        lost and the command would go on; deliver the signal once more instead, to be raised at the
+        next ordinary line of the command."""
+        exc = unraisable.exc_value
+        if isinstance(exc, Interrupted) and self.armed:
+            import _thread
+
+            self.swallowed = True
+            # from another thread, a moment later: a signal raised here would run its handler inside this hook
+            timer = threading.Timer(0.05, _thread.interrupt_main, args=(exc.signum,))
+            timer.daemon = True
+            timer.start()
+            return
+        previous(unraisable)
 
     def note(self, signum, frame):
         self.seen.append(int(signum))
@@ -88,9 +107,12 @@ def termination_signals():
             continue
         previous[sig] = current
         signal.signal(sig, _state.handler)
+    state, hook = _state, sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: state.unraisable(unraisable, hook)
     try:
         yield
     finally:
+        sys.unraisablehook = hook
         for sig, handler in previous.items():
             signal.signal(sig, handler)
         seen, _state = _state.seen, outer
