@@ -45,9 +45,22 @@ def poisson_integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
 def median_gradient_offset(frames) -> np.ndarray:
     """The offset g [H, W] (float64, mean 0) to add to every frame of ``frames`` [K, H, W] (log
     intensities over the sequence) so that the temporal median of each pixel's gradient is zero."""
-    F = np.asarray(frames, dtype=np.float64)
-    if F.ndim != 3 or F.shape[0] < 1:
-        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {F.shape}")
-    gx = -np.median(np.diff(F, axis=2), axis=0)
-    gy = -np.median(np.diff(F, axis=1), axis=0)
+    frames = np.asarray(frames)
+    if frames.ndim != 3 or frames.shape[0] < 1:
+        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {frames.shape}")
+    # a block of rows at a time, with time as the contiguous axis: the same float64 differences and
+    # medians as on the whole stack, a few times faster, and work arrays of one block (about 2 M
+    # cells) instead of three float64 copies of the stack (which matters at HD, where K is 64 or more)
+    K, H, W = frames.shape
+    rows = max(1, (1 << 21) // max(K * W, 1))
+    gx = np.empty((H, W - 1))
+    gy = np.empty((H - 1, W))
+    for r0 in range(0, H, rows):
+        r1 = min(H, r0 + rows)
+        block = np.asarray(frames[:, r0:min(H, r1 + 1)], dtype=np.float64)   # one extra row for dy
+        dx = np.moveaxis(np.diff(block[:, :r1 - r0], axis=2), 0, -1)          # [rows, W - 1, K]
+        gx[r0:r1] = -np.median(np.ascontiguousarray(dx), axis=-1)
+        if r1 - r0 + (r1 < H) > 1:
+            dy = np.moveaxis(np.diff(block, axis=1), 0, -1)                   # [rows (- 1 at the end), W, K]
+            gy[r0:r0 + dy.shape[0]] = -np.median(np.ascontiguousarray(dy), axis=-1)
     return poisson_integrate(gx, gy)

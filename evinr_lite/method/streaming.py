@@ -46,13 +46,13 @@ from .balance import prepare_source
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
-from .offset import poisson_integrate
+from .offset import median_gradient_offset
 from .tonemap import anchor_level, tonemap_reinhard
 from .training import train_frame_inr
 
 __all__ = ["stream_reconstruct", "StreamPart", "StreamState", "train_window", "network_at", "chain_offset",
            "alignment_times", "first_window_offset", "offset_grid", "span_offset", "tonemap",
-           "median_gradient_offset_blocked", "OFFSET_FROM", "PREDICT_CELLS", "MIN_BATCH", "N_ALIGN_SAMPLES"]
+           "OFFSET_FROM", "PREDICT_CELLS", "MIN_BATCH", "N_ALIGN_SAMPLES"]
 
 PREDICT_CELLS = 1 << 23     # frames x pixels per prediction batch (32 MB of float32) ...
 MIN_BATCH = 32              # ... but at least this many frames: each batch reads the d x H*W head once
@@ -213,7 +213,7 @@ def first_window_offset(model: FrameINR, window, config: EvINRConfig) -> np.ndar
     H, W = model.sensor_size
     offset = np.zeros((H, W), np.float32)
     if config.offset_solve == "median_gradient":
-        offset += median_gradient_offset_blocked(F).astype(np.float32)
+        offset += median_gradient_offset(F).astype(np.float32)
     F += offset
     offset += np.float32(anchor_level(config.gamma, config.display_mean) - float(F.mean()))
     return offset
@@ -311,33 +311,13 @@ class _nothing:
         return False
 
 
-def median_gradient_offset_blocked(frames: np.ndarray, rows: int | None = None) -> np.ndarray:
-    """:func:`~evinr_lite.method.offset.median_gradient_offset` of frames [G, H, W], the same values
-    (float64 differences of the same float32 frames, the same medians), computed a block of rows at a
-    time with time as the contiguous axis: a few times faster, and its float64 work arrays are those
-    of one block (about 2 M cells), not three copies of the whole grid."""
-    G, H, W = frames.shape
-    rows = rows or max(1, (1 << 21) // max(G * W, 1))
-    gx = np.empty((H, W - 1))
-    gy = np.empty((H - 1, W))
-    for r0 in range(0, H, rows):
-        r1 = min(H, r0 + rows)
-        block = frames[:, r0:min(H, r1 + 1)].astype(np.float64)          # one extra row for the y differences
-        dx = np.moveaxis(np.diff(block[:, :r1 - r0], axis=2), 0, -1)     # [rows, W - 1, G]
-        gx[r0:r1] = -np.median(np.ascontiguousarray(dx), axis=-1)
-        if r1 - r0 + (r1 < H) > 1:
-            dy = np.moveaxis(np.diff(block, axis=1), 0, -1)              # [rows (- 1 at the end), W, G]
-            gy[r0:r0 + dy.shape[0]] = -np.median(np.ascontiguousarray(dy), axis=-1)
-    return poisson_integrate(gx, gy)
-
-
 def span_offset(grid_frames: np.ndarray, config: EvINRConfig) -> np.ndarray:
     """The offset image + level [H, W] float32 from the aligned log intensities on the whole span's
     grid [G, H, W], by the steps and float32 order of the whole-sequence solve."""
     H, W = grid_frames.shape[1:]
     offset = np.zeros((H, W), np.float32)
     if config.offset_solve == "median_gradient":
-        offset += median_gradient_offset_blocked(grid_frames).astype(np.float32)
+        offset += median_gradient_offset(grid_frames).astype(np.float32)
     shifted = grid_frames + offset
     offset += np.float32(anchor_level(config.gamma, config.display_mean) - float(shifted.mean()))
     return offset
