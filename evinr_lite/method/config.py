@@ -123,6 +123,10 @@ class EvINRConfig:
         offset_solve: how the per-pixel offset that events cannot fix is chosen: "none" (left to the
             regularizer, as in the paper) or "median_gradient" (:mod:`evinr_lite.method.offset`:
             the offset that makes the temporal median of each pixel's gradient zero).
+        offset_window: with offset_solve "median_gradient", the seconds over which one offset image
+            is solved: on spans longer than 1.5 windows the offset becomes a slow per-pixel trend,
+            one image per ``offset_window`` seconds, linear in time between them
+            (:func:`~evinr_lite.method.offset.median_gradient_trend`); None: one image for any span.
         balance: "none" (ON and OFF events weigh C as given) or "events": when C is one number, C+ and
             C- are estimated from the events' ON/OFF counts, their mean kept at C, shrunk towards C as
             far as the span carries little evidence (:mod:`evinr_lite.method.balance`); a given pair is
@@ -173,6 +177,7 @@ class EvINRConfig:
     display_mean: float = 0.5
     head_solve: bool = True
     offset_solve: str = "median_gradient"
+    offset_window: float | None = 5.0
     balance: str = "events"
     hot_pixels: str = "drop"
     anchor: str = "none"
@@ -235,6 +240,10 @@ class EvINRConfig:
             raise EventDataError(f"gamma={self.gamma!r} with display_mean={self.display_mean!r} leaves the tone map no "
                                  f"grey level (display_mean ** (1 / gamma) = {level!r}); use a gamma of about 0.01 "
                                  "to 100 (the paper's 0.6)")
+        if self.offset_window is not None and not number("offset_window", self.offset_window) > 0:
+            raise EventDataError(f"offset_window must be positive seconds or None (one offset image for the whole "
+                                 f"span), got {self.offset_window!r}")
+        self.offset_window = None if self.offset_window is None else float(self.offset_window)
         if self.tau is not None and not number("tau", self.tau) > number("overlap", self.overlap) >= 0:
             raise EventDataError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
         for name in ("head_solve", "coarse_to_fine", "progress"):

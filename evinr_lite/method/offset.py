@@ -15,15 +15,29 @@ gradient minus the temporal median of the frames' gradients, and integrates that
 in the least-squares sense (a Poisson equation with Neumann borders, solved exactly with the
 DCT). For a static background the median is the background's own gradient, which is removed
 (events never see it; an APS frame would be needed). One convex solve on one H x W image.
+
+On a long recording one image is not enough: what the events get wrong builds up slowly and
+differently at every pixel (a threshold that drifts with temperature, per-pixel mismatch of C+
+and C-, background activity's random walk), so the offset that makes the median gradient zero
+over the first seconds is not the one over the last. :func:`median_gradient_trend` therefore
+solves one image per ``window`` seconds of the span (from the frames within ``window`` of its
+knot) and interpolates them linearly in time (:class:`OffsetTrend`): a slow per-pixel trend,
+part of the method rather than a patch applied afterwards. On spans up to about 1.5 windows it is
+the single image above.
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
 
 from .head_solve import laplacian_eigenvalues
 
-__all__ = ["median_gradient_offset", "poisson_integrate"]
+__all__ = ["median_gradient_offset", "poisson_integrate", "median_gradient_trend", "OffsetTrend", "offset_grid",
+           "MIN_TREND_FRAMES"]
+
+MIN_TREND_FRAMES = 8     # a knot's median looks at least at this many grid frames (the nearest, if its window holds fewer)
 
 
 def poisson_integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
@@ -64,3 +78,70 @@ def median_gradient_offset(frames) -> np.ndarray:
             dy = np.moveaxis(np.diff(block, axis=1), 0, -1)                   # [rows (- 1 at the end), W, K]
             gy[r0:r0 + dy.shape[0]] = -np.median(np.ascontiguousarray(dy), axis=-1)
     return poisson_integrate(gx, gy)
+
+
+@dataclass
+class OffsetTrend:
+    """A per-pixel offset that varies slowly in time: ``images`` float32 [K, H, W] at ``knots`` float64
+    [K] (seconds), linear in time between knots and constant beyond the first and the last."""
+
+    knots: np.ndarray
+    images: np.ndarray
+
+    def add_to(self, L: np.ndarray, times) -> np.ndarray:
+        """L [Q, H, W] (float32 log intensities at ``times`` [Q] s) plus the offset, in place; returns L."""
+        t = np.asarray(times, np.float64)
+        if len(self.knots) == 1:
+            L += self.images[0]
+            return L
+        i = np.clip(np.searchsorted(self.knots, t, side="right") - 1, 0, len(self.knots) - 2)
+        w = np.clip((t - self.knots[i]) / (self.knots[i + 1] - self.knots[i]), 0.0, 1.0).astype(np.float32)
+        for j in range(len(t)):          # a frame at a time: no [Q, H, W] temporary
+            L[j] += (1 - w[j]) * self.images[i[j]] + w[j] * self.images[i[j] + 1]
+        return L
+
+    def at(self, times) -> np.ndarray:
+        """The offset at ``times`` [Q] (s): float32 [Q, H, W]."""
+        t = np.atleast_1d(np.asarray(times, np.float64))
+        return self.add_to(np.zeros((len(t), *self.images.shape[1:]), np.float32), t)
+
+
+def median_gradient_trend(times, frames, window: float | None) -> OffsetTrend:
+    """The slowly varying offset that makes the median gradient zero locally in time.
+
+    Args:
+        times: float64 [G] increasing seconds of ``frames`` [G, H, W] (log intensities over the span).
+        window: seconds between knots, and how far from its knot a frame counts; None, or a span
+            shorter than 1.5 windows: one image for the whole span (:func:`median_gradient_offset`).
+
+    Returns:
+        :class:`OffsetTrend` with K = max(1, round(span / window)) + 1 knots evenly over the span
+        (1 knot when one image is solved); each image float32, mean 0.
+    """
+    t = np.asarray(times, np.float64)
+    frames = np.asarray(frames)
+    if t.ndim != 1 or len(t) != len(frames) or len(t) < 1:
+        raise ValueError(f"times [G] and frames [G, H, W] must match, got {t.shape} and {frames.shape}")
+    if window is not None and not window > 0:
+        raise ValueError(f"window must be positive seconds or None, got {window!r}")
+    span = float(t[-1] - t[0])
+    n = 1 if window is None else max(1, int(round(span / window)))
+    if n == 1:
+        return OffsetTrend(t[:1].copy(), median_gradient_offset(frames).astype(np.float32)[None])
+    knots = np.linspace(t[0], t[-1], n + 1)
+    images = []
+    for k in knots:
+        near = np.flatnonzero(np.abs(t - k) <= window * (1 + 1e-9))
+        if near.size < MIN_TREND_FRAMES:
+            near = np.sort(np.argsort(np.abs(t - k), kind="stable")[:MIN_TREND_FRAMES])
+        images.append(median_gradient_offset(frames[near]).astype(np.float32))
+    return OffsetTrend(knots, np.stack(images))
+
+
+def offset_grid(t_start: float, t_end: float, n_windows: int, offset_solve: str) -> np.ndarray:
+    """float64 [G] times (s) at which the offset solve and the level anchor look at a span of
+    ``n_windows`` network windows (the whole-sequence solve and streaming share it)."""
+    n_grid = min(64, 8 * n_windows)          # the level anchor's times (as the paper's recipe always had them)
+    if offset_solve == "median_gradient":
+        n_grid = max(64, 8 * n_windows)      # a temporal median wants many frames; the level anchor shares them
+    return np.linspace(t_start, t_end, n_grid)

@@ -48,7 +48,7 @@ from .config import EvINRConfig
 from .memory import check_memory
 from .ensemble import alignment_offsets, blend_networks, blend_weights, predict_networks, split_windows
 from .models import FrameINR
-from .offset import median_gradient_offset
+from .offset import median_gradient_trend, offset_grid
 from .tonemap import anchor_level, tonemap_reinhard
 from .training import train_frame_inr
 
@@ -69,6 +69,8 @@ class Reconstruction:
         config: the EvINRConfig used. history: training curves and time (see train_frame_inr).
         anchor: the :class:`~evinr_lite.method.anchor.AnchorFit` of an anchored reconstruction
             (``config.anchor`` "first" or "all"), else None; ``anchor_times`` the frames it used.
+        trend: the :class:`~evinr_lite.method.offset.OffsetTrend` added on top of ``offsets`` when the
+            offset varies over a long span (``config.offset_window``), else None (the offset is in ``offsets``).
     """
 
     times: np.ndarray
@@ -80,6 +82,7 @@ class Reconstruction:
     config: EvINRConfig
     history: dict = field(repr=False)
     anchor: object = field(default=None, repr=False)
+    trend: object = field(default=None, repr=False)
 
     @property
     def anchor_times(self) -> np.ndarray:
@@ -97,6 +100,8 @@ class Reconstruction:
         if t.ndim != 1 or not np.all(np.isfinite(t)):
             raise EventDataError(f"times= must be finite seconds in a 1-D array, got shape {t.shape}")
         L = blend_networks(self.model, self.windows, t, self.offsets, chunk)
+        if self.trend is not None:
+            self.trend.add_to(L, t)
         return L if self.anchor is None else L + self.anchor.offset_at(t)
 
     def frames_at(self, times) -> np.ndarray:
@@ -150,14 +155,24 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
         history["anchor"] = fit.summary()
         L = blend_networks(model, windows, q, offsets) + fit.offset_at(q)       # = Reconstruction.at(q)
         return _checked_result(Reconstruction(q, L, linear_frames(L), model, windows, offsets, cfg, history, fit))
-    grid = _offset_grid(t_start, t_end, len(windows), cfg)
+    grid = offset_grid(t_start, t_end, len(windows), cfg.offset_solve)
+    trend = None
     if cfg.offset_solve == "median_gradient":                                   # 4. offset solve
-        # one offset image for all networks: the alignment stays
-        offsets += median_gradient_offset(blend_networks(model, windows, grid, offsets)).astype(np.float32)
-    offsets += _level_shift(blend_networks(model, windows, grid, offsets), cfg)  # 5. level anchor
+        trend = median_gradient_trend(grid, blend_networks(model, windows, grid, offsets), cfg.offset_window)
+        if len(trend.knots) == 1:   # one offset image for all networks: the alignment stays
+            offsets += trend.images[0]
+            trend = None
+    L_grid = blend_networks(model, windows, grid, offsets)
+    if trend is not None:           # a slow per-pixel trend over a long span (offset.median_gradient_trend)
+        trend.add_to(L_grid, grid)
+        history["offset_knots_s"] = trend.knots.tolist()
+    offsets += _level_shift(L_grid, cfg)                                        # 5. level anchor
+    del L_grid
     L = blend_networks(model, windows, q, offsets)
+    if trend is not None:
+        trend.add_to(L, q)
     frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)                  # 6. tone map
-    return _checked_result(Reconstruction(q, L, frames, model, windows, offsets, cfg, history))
+    return _checked_result(Reconstruction(q, L, frames, model, windows, offsets, cfg, history, trend=trend))
 
 
 RESULT_FIX = ("the settings do not fit these events: check C (the log-intensity change per event, 0.05 to 1.5 for "
@@ -221,14 +236,6 @@ def _checked_anchor_frames(frames, sensor_size, t_start: float, t_end: float, cf
         raise EventDataError("frames= were given but config.anchor is 'none' (events only): pass "
                              "EvINRConfig(anchor='first') or anchor='all' to use them, or leave frames= out")
     return None
-
-
-def _offset_grid(t_start: float, t_end: float, n_windows: int, cfg: EvINRConfig) -> np.ndarray:
-    """float64 [G] times (s) at which the offset solve and the level anchor look at the sequence."""
-    n_grid = min(64, 8 * n_windows)          # the level anchor's times (as the paper's recipe always had them)
-    if cfg.offset_solve == "median_gradient":
-        n_grid = max(64, 8 * n_windows)      # a temporal median wants many frames; the level anchor shares them
-    return np.linspace(t_start, t_end, n_grid)
 
 
 def _level_shift(L_grid: np.ndarray, cfg: EvINRConfig) -> np.float32:

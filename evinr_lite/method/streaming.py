@@ -46,7 +46,7 @@ from .balance import prepare_source
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
-from .offset import median_gradient_offset
+from .offset import OffsetTrend, median_gradient_offset, median_gradient_trend, offset_grid
 from .tonemap import anchor_level, tonemap_reinhard
 from .training import train_frame_inr
 
@@ -146,15 +146,6 @@ def _spill_path(workdir) -> Path:
 
 
 
-def offset_grid(t_start: float, t_end: float, n_windows: int, config: EvINRConfig) -> np.ndarray:
-    """float64 [G] times (s) at which the offset solve and the level anchor look at a span of
-    ``n_windows`` windows (the whole-sequence solve's grid; streaming uses it over the first window)."""
-    n_grid = min(64, 8 * n_windows)          # the level anchor's times (as the paper's recipe always had them)
-    if config.offset_solve == "median_gradient":
-        n_grid = max(64, 8 * n_windows)      # a temporal median wants many frames; the level anchor shares them
-    return np.linspace(t_start, t_end, n_grid)
-
-
 def alignment_times(windows: np.ndarray, k: int) -> np.ndarray:
     """float64 [S] times (s) at which networks k - 1 and k are compared: their overlap."""
     return np.linspace(windows[k, 0], windows[k - 1, 1], N_ALIGN_SAMPLES)
@@ -208,7 +199,7 @@ def first_window_offset(model: FrameINR, window, config: EvINRConfig) -> np.ndar
     Same grid, same steps and same float32 order as the whole-sequence solve over one window
     (:func:`offset_grid`, median_gradient_offset, the level anchor), so a one-window span gives
     the identical result."""
-    grid = offset_grid(float(window[0]), float(window[1]), 1, config)
+    grid = offset_grid(float(window[0]), float(window[1]), 1, config.offset_solve)
     F = network_at(model, grid)
     H, W = model.sensor_size
     offset = np.zeros((H, W), np.float32)
@@ -284,7 +275,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
     elif state.windows.shape != windows.shape or not np.allclose(state.windows, windows, rtol=0, atol=1e-9):
         raise EventDataError("the saved streaming state belongs to another plan of windows (another span, tau or "
                              "overlap); start again without it")
-    grid = offset_grid(t_start, t_end, len(windows), cfg) if offset_from == "span" else np.zeros(0)
+    grid = offset_grid(t_start, t_end, len(windows), cfg.offset_solve) if offset_from == "span" else np.zeros(0)
     if offset_from == "first_window":
         for part, _ in _windows(source, q, grid, cfg, state, None, on_state, progress):
             yield part
@@ -293,7 +284,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
         spill = _spill_path(folder)
         for _, state in _windows(source, q, grid, cfg, state, spill, on_state, progress):
             pass
-        offset = span_offset(state.grid, cfg)
+        offset = span_offset(state.grid, cfg, grid)
         yield from _final_pass(spill, q, offset, cfg, source.sensor_size, _history(state))
 
 
@@ -311,16 +302,27 @@ class _nothing:
         return False
 
 
-def span_offset(grid_frames: np.ndarray, config: EvINRConfig) -> np.ndarray:
-    """The offset image + level [H, W] float32 from the aligned log intensities on the whole span's
-    grid [G, H, W], by the steps and float32 order of the whole-sequence solve."""
+def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times=None) -> OffsetTrend:
+    """The offset + level from the aligned log intensities on the whole span's grid [G, H, W] at
+    ``grid_times`` [G] (s), by the steps and float32 order of the whole-sequence solve: an
+    :class:`~evinr_lite.method.offset.OffsetTrend` whose images include the level (one knot, one
+    image, unless ``config.offset_window`` makes the offset a trend over a long span)."""
     H, W = grid_frames.shape[1:]
     offset = np.zeros((H, W), np.float32)
+    trend = None
     if config.offset_solve == "median_gradient":
-        offset += median_gradient_offset(grid_frames).astype(np.float32)
+        t = np.arange(len(grid_frames), dtype=np.float64) if grid_times is None else np.asarray(grid_times, np.float64)
+        trend = median_gradient_trend(t, grid_frames, config.offset_window if grid_times is not None else None)
+        if len(trend.knots) == 1:
+            offset += trend.images[0]
+            trend = None
     shifted = grid_frames + offset
+    if trend is not None:
+        trend.add_to(shifted, grid_times)
     offset += np.float32(anchor_level(config.gamma, config.display_mean) - float(shifted.mean()))
-    return offset
+    if trend is None:
+        return OffsetTrend(np.zeros(1), offset[None])
+    return OffsetTrend(trend.knots, trend.images + offset)
 
 
 def _history(state: StreamState) -> dict:
@@ -390,8 +392,8 @@ def _windows(source, q, grid, cfg, state, spill, on_state, progress):
         bar.close()
 
 
-def _final_pass(spill, q, offset, cfg, sensor_size, history):
-    """The spilled log intensities plus the offset, tone-mapped, a bounded batch at a time."""
+def _final_pass(spill, q, offset: OffsetTrend, cfg, sensor_size, history):
+    """The spilled log intensities plus the offset (trend), tone-mapped, a bounded batch at a time."""
     H, W = sensor_size
     P = H * W
     step = _batch(P)
@@ -402,8 +404,8 @@ def _final_pass(spill, q, offset, cfg, sensor_size, history):
             if L.shape[0] != n:
                 raise EventDataError(f"the spill file {spill} is short ({i0 + L.shape[0]} of {len(q)} frames); "
                                      "it was changed while the run was stopped: start again without resuming")
-            L += offset
             idx = np.arange(i0, i0 + n, dtype=np.int64)
+            offset.add_to(L, q[idx])
             yield StreamPart(q[idx], idx, L, tonemap(L, cfg.gamma), None, history)
 
 
