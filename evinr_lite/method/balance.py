@@ -195,11 +195,15 @@ def estimate_balance(events: Events, C, **kw) -> BalanceFit:
     return balance_from_counts(*polarity_counts(events), C, **kw)
 
 
-def plan_from_counts(n_on, n_off, cfg):
+def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0):
     """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance == "events"`` and
-    C is one number, and the hot pixels to drop (bool [H, W], all False unless ``cfg.hot_pixels ==
-    "drop"``), from the span's per-pixel counts. The caller's config is not changed (a copy)."""
+    C is one number, ``lam="auto"`` replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
+    for windows covering ``fraction`` of the span), and the hot pixels to drop (bool [H, W], all False
+    unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
+    changed (a copy)."""
     from dataclasses import replace
+
+    from .smoothing import auto_lam
 
     n_on = np.asarray(n_on, np.float64)
     n_off = np.asarray(n_off, np.float64)
@@ -211,6 +215,8 @@ def plan_from_counts(n_on, n_off, cfg):
         fit = balance_from_counts(np.where(hot, 0, n_on), np.where(hot, 0, n_off), cfg.C)
         if fit.applied:
             cfg = replace(cfg, C=fit.C)
+    if cfg.lam == "auto":
+        cfg = replace(cfg, lam=auto_lam(np.where(hot, 0, n_on), np.where(hot, 0, n_off), fraction))
     return cfg, hot
 
 
@@ -221,13 +227,18 @@ def drop_pixels(events: Events, mask) -> Events:
     return events.take(~mask[events.y, events.x])
 
 
-def prepare_events(events: Events, cfg):
+def prepare_events(events: Events, cfg, span: tuple | None = None):
     """The solver's first step (a hook in :func:`~evinr_lite.method.solver.reconstruct`): ``(events, cfg)``
-    with hot pixels dropped (``cfg.hot_pixels == "drop"``) and C replaced by the pair estimated from
-    these events (``cfg.balance == "events"``, one C given): :func:`plan_from_counts` on their counts."""
+    with hot pixels dropped (``cfg.hot_pixels == "drop"``), C replaced by the pair estimated from
+    these events (``cfg.balance == "events"``, one C given) and ``lam="auto"`` by its value:
+    :func:`plan_from_counts` on their counts. ``span``: (t_start, t_end) seconds reconstructed
+    (default: the events' first and last time), which sets how much of it one window covers."""
+    from .smoothing import window_fraction
+
     if not len(events):
         return events, cfg
-    cfg, hot = plan_from_counts(*polarity_counts(events), cfg)
+    t0, t1 = (float(events.t[0]), float(events.t[-1])) if span is None else span
+    cfg, hot = plan_from_counts(*polarity_counts(events), cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap))
     return drop_pixels(events, hot), cfg
 
 
@@ -250,7 +261,9 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
     over [t_start, t_end] in chunks of ``chunk_s`` seconds (default ``cfg.tau``, so memory stays that
     of one window), so every window is trained with the same C pair and without the same hot pixels
     as the whole-sequence solve."""
-    if cfg.balance == "none" and cfg.hot_pixels == "keep":
+    from .smoothing import window_fraction
+
+    if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto":
         return cfg, source
     chunk_s = chunk_s or cfg.tau or (t_end - t_start)
     counts = PolarityCounts(tuple(source.sensor_size))
@@ -258,5 +271,5 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
     for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
         last = i == len(edges) - 2                               # the span's end is inclusive, as in reconstruct
         counts.update(source.events(a, np.nextafter(b, np.inf) if last else b))
-    cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg)
+    cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap))
     return cfg, (_WithoutPixels(source, hot) if hot.any() else source)

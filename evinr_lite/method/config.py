@@ -46,9 +46,28 @@ class EvINRConfig:
       derivative is a first-order approximation.
     - offset_solve="median_gradient": the per-pixel offset that events never fix is solved
       explicitly instead of drifting under the regularizer (the ghost).
-    - lam=0.01 instead of 0.05: with the exact head, less smoothing wins on the zoo (quick zoo,
-      CLAHE-SSIM mean: 0.293 at lam 1, 0.403 at 0.2, 0.482 at 0.05, 0.528 at 0.01). On the real chunk,
-      lam from 0.003 to 1 moves CLAHE-SSIM only between 0.256 and 0.272.
+    - offset_window=5.0 (issue 21): on spans longer than 7.5 s the offset is a slow per-pixel trend
+      (one median-gradient image per 5 s, linear between), which follows what builds up at every
+      pixel over a long recording; shorter spans keep the single image. ``python
+      benchmarks/quality_zoo.py --long --scenes drift_clock,long_pan_20s,long_ijrr_60s --methods
+      kit,one_image --variant one_image=offset_window=None``: long_pan_20s 0.514 / 0.576 / 0.0349 ->
+      0.545 / 0.591 / 0.0343, long_ijrr_60s 0.489 / 0.471 / 0.0161 -> 0.516 / 0.483 / 0.0157,
+      drift_clock 0.747 -> 0.752; windows of 1-2 s lost on every short scene (0.602 -> 0.582 at 1 s
+      on astronaut_rotzoom).
+    - lam="auto" instead of 0.05 (0.01 before issue 21): with the exact head, less smoothing wins where
+      much texture passes each pixel, and more where little does (quick zoo, fixed lam, CLAHE-SSIM
+      mean: 0.293 at lam 1, 0.403 at 0.2, 0.482 at 0.05, 0.528 at 0.01). The Tikhonov term damps the
+      changes' quantization noise and the texture alike, and pulls each frame towards the window's
+      mean frame (on long_ijrr_60s the texture's amplitude fell to 0.3 at a pan's turning points, 0.67
+      for integration). :mod:`~evinr_lite.method.smoothing` sets lam = 0.3 / m^2 within [0.002, 0.01],
+      m the events per pixel per window that came and went. ``python benchmarks/lam_rule.py --long``
+      (sweep and rule per scene): 13 short zoo scenes 0.566 / 0.602 / 0.0409 -> 0.574 / 0.611 /
+      0.0406 (best gains grass_light_noisy 0.555 -> 0.597, noisy_gravel 0.523 -> 0.546; worst loss
+      dark_falling 0.420 -> 0.413, whose events are mostly a global dimming); real chunk unchanged
+      (0.350 / 0.416 / 0.0889, lam 0.01); long_ijrr_60s 0.516 -> 0.570 (hf_best 0.552, leaky_best
+      0.559); long_pan_20s 0.545 -> 0.539. The scenes that want more than 0.01 (unequal_onhot: 0.723
+      at 0.1; object_static_cam) and less than 0.002 stay at the bounds: beyond them the rule
+      would trade the real chunk (0.311 at 0.1) and long_pan_20s (0.523 at 0.001).
     - hidden_features=128 (issue 21; 256 before, 512 in the paper): the same scores as 256 at about half
       the time. Seven full-size zoo scenes (noisy_gravel, unequal_onhot, camera_240x180,
       astronaut_rotzoom, lowtex_light, text_shake, drift_clock), mean CLAHE-SSIM / SSIM / MSE 0.6401 /
@@ -94,7 +113,9 @@ class EvINRConfig:
         temporal_loss: "derivative" (paper, Eq. 5-6: dF/dt at bin mid-points times bin length) or
             "difference" (F(b_{i+1}) - F(b_i) at bin boundaries: exact integral form).
         regularizer: "tikhonov" (paper, Eq. 9), "tv" (reference code) or "none".
-        lam: weight lambda of the regularizer (paper: 0.05; finite differences in pixel units).
+        lam: weight lambda of the regularizer (paper: 0.05; finite differences in pixel units), or
+            "auto": chosen from the events' activity per network window, LAM_SCALE / m^2 within
+            [0.002, 0.01] (:mod:`~evinr_lite.method.smoothing`; m: events per pixel that came and went).
     Network (SIREN):
         hidden_features, hidden_layers: width and depth (paper: 512, 3).
         omega_0: frequency factor of the hidden layers (SIREN's default 30).
@@ -159,7 +180,7 @@ class EvINRConfig:
     events_per_bin: int = 100
     temporal_loss: str = "difference"
     regularizer: str = "tikhonov"
-    lam: float = 0.01
+    lam: float | str = "auto"
     hidden_features: int = 128
     hidden_layers: int = 3
     omega_0: float = 30.0
@@ -229,8 +250,11 @@ class EvINRConfig:
             if number(name, getattr(self, name), integer=True) < low:
                 raise EventDataError(f"{name} must be at least {low}, got {getattr(self, name)}")
             setattr(self, name, int(getattr(self, name)))
-        if not number("lam", self.lam) >= 0:
-            raise EventDataError(f"lam must be zero or positive, got {self.lam}")
+        if isinstance(self.lam, str):
+            if self.lam != "auto":
+                raise EventDataError(f"lam must be a number >= 0 or 'auto' (chosen from the events), got {self.lam!r}")
+        elif not number("lam", self.lam) >= 0:
+            raise EventDataError(f"lam must be zero or positive (or 'auto'), got {self.lam}")
         if not 0 < number("lr_decay", self.lr_decay) <= 1:
             raise EventDataError(f"lr_decay must be in (0, 1], got {self.lr_decay}")
         if not 0 < number("display_mean", self.display_mean) < 1:

@@ -139,7 +139,7 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")
     require(frames, Frames, "frames", none_ok=True)
     q, events, t_start, t_end = _checked_span(events, query_times, t_start, t_end)
-    events, cfg = prepare_events(events, cfg)                                   # 0. hot pixels, ON/OFF balance
+    events, cfg = prepare_events(events, cfg, (t_start, t_end))                 # 0. hot pixels, ON/OFF balance, lam
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)               # 1. windows
     frames = _checked_anchor_frames(frames, events.sensor_size, t_start, t_end, cfg)   # before training
     if memory_guard:                                                            # before anything large is allocated

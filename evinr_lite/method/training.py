@@ -132,6 +132,15 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
         model = FrameINR(events.sensor_size, windows, cfg.hidden_features, cfg.hidden_layers,
                          cfg.omega_0, cfg.first_omega_0, seed=cfg.seed).to(device)
     device = model.head_weight.device
+    if cfg.lam == "auto":   # reconstruct() resolves it over the whole span; a direct call, from these events
+        from dataclasses import replace
+
+        from .balance import polarity_counts
+        from .smoothing import auto_lam
+
+        span = float(windows[-1, 1] - windows[0, 0])
+        fraction = min(1.0, float(windows[0, 1] - windows[0, 0]) / span) if span > 0 else 1.0
+        cfg = replace(cfg, lam=auto_lam(*polarity_counts(events), fraction))
     if model.n_models != len(windows):
         raise ValueError(f"model holds {model.n_models} networks but {len(windows)} windows were given")
     head = [model.head_weight, model.head_bias]
@@ -142,7 +151,7 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
     boundaries = _initial_boundaries(events, windows, cfg)
     bins = _Bins.build(events, boundaries, cfg.C, device)
     regularizer = cfg.regularizer if cfg.lam > 0 else "none"
-    history = {"loss": [], "temporal": [], "regularizer": [], "n_bins": []}
+    history = {"loss": [], "temporal": [], "regularizer": [], "n_bins": [], "lam": float(cfg.lam)}
     bisect_at = set(cfg.c2f_iters) if cfg.coarse_to_fine else set()
     buffers = {}   # the fused path's work arrays, reused from step to step
 

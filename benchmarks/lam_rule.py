@@ -1,0 +1,98 @@
+"""lam="auto" against fixed values of lam, on every zoo scene and the real chunk, in one run.
+
+    python benchmarks/lam_rule.py             # the short scenes and the real chunk (about 2 min on 2 cores)
+    python benchmarks/lam_rule.py --long      # also the 20 s and 60 s recordings (several minutes more)
+    python benchmarks/lam_rule.py --quick     # the quick zoo's smaller scenes
+
+For each scene: the activity m (events per pixel per network window that came and went,
+``evinr_lite.method.smoothing.activity``), the lam that ``EvINRConfig(lam="auto")`` gives, and
+CLAHE-SSIM / SSIM / MSE of the kit's default with lam "auto" and with each fixed lam of the sweep. The
+best fixed lam per scene is what a user with the ground truth in hand would pick; the rule has only
+the events. Writes benchmarks/lam_rule_results.{json,md}.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.common import write_json  # noqa: E402
+from benchmarks.quality_zoo import real_chunk, score  # noqa: E402
+from evinr_lite.method.balance import plan_from_counts, polarity_counts  # noqa: E402
+from evinr_lite.method.config import EvINRConfig  # noqa: E402
+from evinr_lite.method.smoothing import activity, window_fraction  # noqa: E402
+from evinr_lite.method.solver import reconstruct  # noqa: E402
+from evinr_lite.sim.zoo import default_scenes, effective_C, quick, simulate  # noqa: E402
+
+SWEEP = (0.001, 0.002, 0.005, 0.01, 0.03, 0.1)
+
+
+def scene_row(name, events, times, gt, C, log=print) -> dict:
+    t0, t1 = float(min(events.t[0], times.min())), float(max(events.t[-1], times.max()))
+    cfg = EvINRConfig(C=C, progress=False)
+    n_on, n_off = polarity_counts(events)
+    fraction = window_fraction(t0, t1, cfg.tau, cfg.overlap)
+    planned, hot = plan_from_counts(n_on, n_off, cfg, fraction)
+    m = activity(np.where(hot, 0, n_on), np.where(hot, 0, n_off)) * fraction
+    row = {"activity": m, "lam_auto": planned.lam, "scores": {}}
+    for lam in ("auto",) + SWEEP:
+        t = time.perf_counter()
+        rec = reconstruct(events, times, EvINRConfig(C=C, lam=lam, progress=False))
+        row["scores"][str(lam)] = {**{k: v for k, v in score(rec.frames, times, gt, times).items()
+                                      if k in ("ssim_clahe", "ssim_none", "mse_none")},
+                                   "time_s": time.perf_counter() - t}
+    fixed = {k: v for k, v in row["scores"].items() if k != "auto"}
+    row["best_fixed"] = max(fixed, key=lambda k: fixed[k]["ssim_clahe"])
+    s = row["scores"]
+    log(f"{name:20s} m {m:5.1f}  lam auto {planned.lam:.4f}  CLAHE-SSIM auto {s['auto']['ssim_clahe']:.3f}  "
+        + "  ".join(f"{k}: {v['ssim_clahe']:.3f}" for k, v in fixed.items()) + f"  (best fixed {row['best_fixed']})")
+    return row
+
+
+def markdown(rows: dict) -> str:
+    head = "| scene | activity m | lam auto | auto | " + " | ".join(f"lam {v:g}" for v in SWEEP) + " | best fixed |"
+    lines = [head, "|" + "---|" * (5 + len(SWEEP))]
+    for name, r in rows.items():
+        cells = [f"{r['scores'][k]['ssim_clahe']:.3f} / {r['scores'][k]['ssim_none']:.3f} / {r['scores'][k]['mse_none']:.4f}"
+                 for k in ("auto",) + tuple(str(v) for v in SWEEP)]
+        lines.append(f"| {name} | {r['activity']:.1f} | {r['lam_auto']:.4f} | " + " | ".join(cells) + f" | {r['best_fixed']} |")
+    short = [r for n, r in rows.items() if not r.get("long") and n != "real_slider_chunk"]
+    if short:
+        means = [np.mean([r["scores"][k]["ssim_clahe"] for r in short]) for k in ("auto",) + tuple(str(v) for v in SWEEP)]
+        lines.append(f"| **mean, {len(short)} short zoo scenes (CLAHE-SSIM)** | | | " + " | ".join(f"{v:.3f}" for v in means)
+                     + " | |")
+    lines += ["", "Cells: CLAHE-SSIM / SSIM / MSE of the kit's default (EvINRConfig()) with lam \"auto\" and with each "
+              "fixed lam; activity m: events per pixel per network window that came and went "
+              "(evinr_lite.method.smoothing). Written by `python benchmarks/lam_rule.py`."]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--quick", action="store_true")
+    p.add_argument("--long", action="store_true")
+    p.add_argument("--json", default="benchmarks/lam_rule_results.json")
+    p.add_argument("--md", default="benchmarks/lam_rule_results.md")
+    a = p.parse_args(argv)
+    rows = {}
+    for z in default_scenes(long=a.long):
+        z = quick(z) if a.quick else z
+        scene, events, times, gt = simulate(z)
+        rows[z.name] = {**scene_row(z.name, events, times, gt, effective_C(z)), "long": z.long}
+    found = real_chunk()
+    if found is not None:
+        rec, gt, gt_t = found
+        rows["real_slider_chunk"] = scene_row("real_slider_chunk", rec.events, gt_t, gt, 1.0)
+    write_json(a.json, {"quick": a.quick, "sweep": list(SWEEP), "scenes": rows})
+    Path(a.md).write_text(markdown(rows))
+    print(f"json: {a.json}\nmarkdown: {a.md}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
