@@ -41,12 +41,17 @@ def _f(v, digits: int = 3) -> str:
     return "-" if v is None else f"{v:.{digits}f}"
 
 
+def _ran(results: dict) -> list:
+    """The run's methods that scored at least one scene (kit_windows runs on long scenes only)."""
+    return [m for m in results["methods"] if any(m in s["rows"] for s in results["scenes"].values())]
+
+
 def summary_table(results: dict) -> str:
     """docs/defaults.md's table: one row per method."""
     real = results["scenes"].get(REAL, {}).get("rows", {})
     lines = ["| method | zoo mean CLAHE-SSIM | SSIM | MSE | time | real chunk CLAHE-SSIM | SSIM |",
              "|---|---|---|---|---|---|---|"]
-    for m in results["methods"]:
+    for m in _ran(results):
         t = zoo_mean(results, m, "time_s")
         cells = [_f(zoo_mean(results, m, "ssim_clahe")), _f(zoo_mean(results, m, "ssim_none")),
                  _f(zoo_mean(results, m, "mse_none"), 4), "-" if t is None else f"{t:.1f} s",
@@ -57,7 +62,7 @@ def summary_table(results: dict) -> str:
 
 def scene_table(results: dict) -> str:
     """benchmarks/README.md's table: CLAHE-SSIM / SSIM per scene and method, then the zoo mean."""
-    methods = results["methods"]
+    methods = _ran(results)
 
     def pair(row):
         if row is None or "ssim_clahe" not in row:

@@ -34,10 +34,10 @@ class EvINRConfig:
       head_lr_scale = 30, tuned on the demo scene alone); notebooks 03-11 train it.
 
     The kit's default departs from the paper in these fields. Zoo means (CLAHE-SSIM / SSIM / MSE; wall
-    time per scene, 2 CPU cores shared with other jobs):
-    ``python benchmarks/quality_zoo.py``: kit 0.555 / 0.583 / 0.030 in 1.6 s, paper 0.320 / 0.402 /
-    0.051 in 92 s, v0.1 0.499 / 0.527 / 0.042 in 69 s, integration 0.425 / 0.513 / 0.042, high-pass
-    filter 0.464 / 0.507 / 0.047.
+    time per scene):
+    ``python benchmarks/quality_zoo.py`` (13 short scenes, one run on 2 quiet cores): kit 0.574 / 0.611 /
+    0.0406 in 0.5 s, paper 0.377 / 0.454 / 0.0586 in 24.2 s, v0.1 0.525 / 0.557 / 0.0500 in 24.7 s,
+    integration 0.430 / 0.505 / 0.0517, high-pass filter 0.478 / 0.531 / 0.0558.
 
     - head_solve=True, n_iters=0, coarse_to_fine=False: the output layer is solved in closed form
       for the SIREN's initial hidden layers. Training the hidden layers first (60 Adam steps) changed
@@ -87,11 +87,11 @@ class EvINRConfig:
       real chunk 0.349 -> 0.350. Measured with ``python benchmarks/quality_zoo.py --quick --variant
       "bal=balance='events',hot_pixels='drop'"`` and ``--long --scenes long_pan_20s``.
 
-    With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 shared
-    cores): kit 0.566 / 0.602 / 0.0410, integration + median-gradient offset 0.524 / 0.589 / 0.0404
-    (the INR: 1.08x in CLAHE-SSIM), HF with its cutoff swept per scene 0.523 / 0.569 / 0.0518, leaky
+    With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 quiet
+    cores): kit 0.574 / 0.611 / 0.0406, integration + median-gradient offset 0.524 / 0.589 / 0.0404
+    (the INR: 1.10x in CLAHE-SSIM), HF with its cutoff swept per scene 0.523 / 0.569 / 0.0518, leaky
     integration swept 0.512 / 0.561 / 0.0516; real chunk 0.350 / 0.416 / 0.0889 (1.13x integration +
-    offset); camera_240x180 (2 s at 180x240) in 2.5 s.
+    offset); camera_240x180 (2 s at 180x240) in 0.4 s (2.5 s on a shared machine).
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
       (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
