@@ -250,7 +250,10 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
             intensities are written to a spill file in ``workdir`` as it finishes, and the frames
             are handed out in one final pass (about 4 bytes x H x W per query time on disk).
             "first_window": from the grid over the first window; each window's frames are final
-            (and handed out) as soon as it finishes; identical when the span is one window.
+            (and handed out) as soon as it finishes; identical when the span is one window. It
+            keeps one offset image for the whole recording: the slow trend of
+            ``config.offset_window`` (:func:`~evinr_lite.method.offset.median_gradient_trend`)
+            needs the whole span, so only mode "span" applies it.
         workdir: folder for the spill file (mode "span"; default: a temporary folder, removed at the
             end). To resume, pass the same folder and the saved ``state``.
         state: a :class:`StreamState` saved by ``on_state`` to resume from (its plan must match).
