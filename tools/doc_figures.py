@@ -14,9 +14,13 @@ tests/test_docs_links.py fails when the docs differ from what this writes.
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from textfile import write_beside  # noqa: E402  (tools/textfile.py)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "zoo_results.json"
@@ -99,9 +103,7 @@ def main() -> None:
     for name, table in blocks(results).items():
         page = BLOCKS[name]
         new = replace(page.read_text(encoding="utf-8"), name, table)
-        tmp = page.with_name(page.name + ".tmp")
-        tmp.write_text(new, encoding="utf-8")
-        tmp.replace(page)                  # written beside, then renamed into place
+        write_beside(page, new)
         print(f"wrote {page.relative_to(ROOT)} ({name})")
 
 

@@ -10,7 +10,11 @@ from __future__ import annotations
 import ast
 import re
 import textwrap
+import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from textfile import write_beside  # noqa: E402  (tools/textfile.py)
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("core", "io", "io/formats", "sim", "method", "evaluation", "viz", "teaching", "apps")   # by layer
@@ -43,9 +47,7 @@ def main() -> None:
     head, rest = text.split("<!-- modules -->\n", 1)
     _, tail = rest.split("<!-- /modules -->", 1)
     new = head + "<!-- modules -->\n\n" + module_list() + "<!-- /modules -->" + tail
-    tmp = page.with_name(page.name + ".tmp")
-    tmp.write_text(new, encoding="utf-8")
-    tmp.replace(page)                      # written beside, then renamed into place
+    write_beside(page, new)
     print(f"wrote {page.relative_to(ROOT)}")
 
 

@@ -28,11 +28,12 @@ from __future__ import annotations
 import argparse
 import copy
 import json
-import os
 import re
 import sys
-import tempfile
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from textfile import write_beside  # noqa: E402  (tools/textfile.py)
 
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE_DIR = ROOT / "notebooks"
@@ -139,17 +140,6 @@ def expected_copies(source_dir: Path = SOURCE_DIR) -> dict[str, str]:
     return out
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
-
-
 def problems(source_dir: Path = SOURCE_DIR, student_dir: Path = STUDENT_DIR) -> list[str]:
     """What differs between ``student_dir`` and freshly generated copies (empty when up to date)."""
     expected = expected_copies(source_dir)
@@ -172,7 +162,7 @@ def generate(source_dir: Path = SOURCE_DIR, student_dir: Path = STUDENT_DIR) -> 
     for name, text in expected.items():
         path = student_dir / name
         if not path.exists() or path.read_text() != text:
-            _write_atomic(path, text)
+            write_beside(path, text)
             changed.append(f"wrote {student_dir.name}/{name}")
     for path in sorted(student_dir.glob(PATTERN)):
         if path.name not in expected:

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["activity", "auto_lam", "window_fraction", "LAM_SCALE", "LAM_MIN", "LAM_MAX"]
+__all__ = ["activity", "auto_lam", "covered_fraction", "window_fraction", "LAM_SCALE", "LAM_MIN", "LAM_MAX"]
 
 LAM_SCALE = 0.3     # lam x m^2: lam reaches LAM_MAX below about 5.5 events per pixel per window
 LAM_MIN = 0.002     # the least smoothing: below it the zoo's long pans lose more than its busy scenes gain
@@ -37,15 +37,20 @@ def activity(n_on, n_off) -> float:
     return float(2 * np.minimum(n_on, n_off).mean()) if n_on.size else 0.0
 
 
+def covered_fraction(windows) -> float:
+    """The share of the span of ``windows`` [N, 2] (s) that the first window covers (1 for one window)."""
+    w = np.asarray(windows, np.float64)
+    span = float(w[-1, 1] - w[0, 0])
+    return float(min(1.0, (w[0, 1] - w[0, 0]) / span)) if span > 0 else 1.0
+
+
 def window_fraction(t_start: float, t_end: float, tau: float | None, overlap: float) -> float:
     """The share of the span [t_start, t_end] (s) that one network window covers (1 for one window)."""
     from .ensemble import split_windows
 
-    span = float(t_end) - float(t_start)
-    if not span > 0:
+    if not float(t_end) - float(t_start) > 0:
         return 1.0
-    w = split_windows(t_start, t_end, tau, overlap)
-    return float(min(1.0, (w[0, 1] - w[0, 0]) / span))
+    return covered_fraction(split_windows(t_start, t_end, tau, overlap))
 
 
 def auto_lam(n_on, n_off, fraction: float = 1.0) -> float:

@@ -305,7 +305,7 @@ class _nothing:
         return False
 
 
-def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times=None) -> OffsetTrend:
+def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times) -> OffsetTrend:
     """The offset + level from the aligned log intensities on the whole span's grid [G, H, W] at
     ``grid_times`` [G] (s), by the steps and float32 order of the whole-sequence solve: an
     :class:`~evinr_lite.method.offset.OffsetTrend` whose images include the level (one knot, one
@@ -314,8 +314,7 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times=None) -
     offset = np.zeros((H, W), np.float32)
     trend = None
     if config.offset_solve == "median_gradient":
-        t = np.arange(len(grid_frames), dtype=np.float64) if grid_times is None else np.asarray(grid_times, np.float64)
-        trend = median_gradient_trend(t, grid_frames, config.offset_window if grid_times is not None else None)
+        trend = median_gradient_trend(grid_times, grid_frames, config.offset_window)
         if len(trend.knots) == 1:
             offset += trend.images[0]
             trend = None

@@ -136,11 +136,9 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
         from dataclasses import replace
 
         from .balance import polarity_counts
-        from .smoothing import auto_lam
+        from .smoothing import auto_lam, covered_fraction
 
-        span = float(windows[-1, 1] - windows[0, 0])
-        fraction = min(1.0, float(windows[0, 1] - windows[0, 0]) / span) if span > 0 else 1.0
-        cfg = replace(cfg, lam=auto_lam(*polarity_counts(events), fraction))
+        cfg = replace(cfg, lam=auto_lam(*polarity_counts(events), covered_fraction(windows)))
     if model.n_models != len(windows):
         raise ValueError(f"model holds {model.n_models} networks but {len(windows)} windows were given")
     head = [model.head_weight, model.head_bias]
