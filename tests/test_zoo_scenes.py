@@ -74,6 +74,20 @@ def test_zoo_is_documented_and_simulates():
         zoo.get("nope")
 
 
+def test_heldout_scenes_are_new_and_simulate():
+    """The held-out set (no default chosen on it): its own names, images and seeds, documented, and
+    every scene simulates (quick sizes) with events and frames in range."""
+    names = [z.name for z in zoo.HELDOUT]
+    assert len(names) == len(set(names)) >= 6 and not set(names) & {z.name for z in zoo.ZOO}
+    assert all(len(z.doc) > 20 for z in zoo.HELDOUT)
+    assert not {z.seed for z in zoo.HELDOUT} & {z.seed for z in zoo.ZOO}
+    assert {z.noise_free for z in zoo.HELDOUT} == {True, False}
+    assert zoo.get(names[0]) is zoo.HELDOUT[0]
+    z = zoo.quick(zoo.get("coins_unequal_onhot"))
+    scene, events, times, gt = zoo.simulate(z)
+    assert gt.shape == (z.n_scored, *z.size) and len(events) > 1000 and 0 < gt.min() and gt.max() <= 1
+
+
 # ---- issue 21: the zoo grows (long scenes, ON-only hot pixels, drifting thresholds, light-dependent noise)
 
 def test_oscillating_scene_is_bounded_and_periodic():
