@@ -1,13 +1,17 @@
-"""Rewrite the scene-zoo tables of the docs from the committed results (benchmarks/zoo_results.json).
+"""Rewrite the scene-zoo tables of the docs from the committed results (benchmarks/zoo_results.json,
+and benchmarks/zoo_results_heldout.json for the held-out scenes).
 
-    python tools/doc_figures.py            # after `python benchmarks/quality_zoo.py` has rewritten the JSON
+    python tools/doc_figures.py            # after `python benchmarks/quality_zoo.py [--heldout]` rewrote the JSON
 
-Two tables, each between HTML comment markers, so the prose around them stays hand-written:
+Three tables, each between HTML comment markers, so the prose around them stays hand-written:
 
 - docs/defaults.md, ``<!-- zoo-summary -->``: one row per method: the zoo mean (every scene but the
   real chunk on which the method ran) of CLAHE-SSIM, SSIM, MSE and wall time, and the real chunk's
   CLAHE-SSIM and SSIM;
-- benchmarks/README.md, ``<!-- zoo-table -->``: CLAHE-SSIM / SSIM per scene and method, and the mean row.
+- benchmarks/README.md, ``<!-- zoo-table -->``: CLAHE-SSIM / SSIM per scene and method, and the mean row;
+- benchmarks/README.md, ``<!-- heldout-table -->``: per held-out scene, CLAHE-SSIM / SSIM / MSE of the
+  kit, v0_1, integration + offset and the best baseline (best of hf_best, leaky_best, integration_offset
+  by CLAHE-SSIM), the kit's ratio to that baseline, and the mean row.
 
 tests/test_docs_links.py fails when the docs differ from what this writes.
 """
@@ -24,10 +28,13 @@ from textfile import write_beside  # noqa: E402  (tools/textfile.py)
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "zoo_results.json"
+HELDOUT = ROOT / "benchmarks" / "zoo_results_heldout.json"
+BEST_OF = ("hf_best", "leaky_best", "integration_offset")     # as benchmarks/quality_zoo.py
 REAL = "real_slider_chunk"
 LABELS = {"kit": "kit (`EvINRConfig()`)", "paper": "paper (`EvINRConfig.paper()`)",
           "v0_1": "v0_1 (`EvINRConfig.v0_1()`)", "hf": "hf (high-pass filter)"}
-BLOCKS = {"zoo-summary": ROOT / "docs" / "defaults.md", "zoo-table": ROOT / "benchmarks" / "README.md"}
+BLOCKS = {"zoo-summary": ROOT / "docs" / "defaults.md", "zoo-table": ROOT / "benchmarks" / "README.md",
+          "heldout-table": ROOT / "benchmarks" / "README.md"}
 
 
 def load(path: Path = RESULTS) -> dict:
@@ -82,8 +89,37 @@ def scene_table(results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def blocks(results: dict) -> dict:
-    return {"zoo-summary": summary_table(results), "zoo-table": scene_table(results)}
+def heldout_table(results: dict) -> str:
+    """benchmarks/README.md's held-out table: kit, v0_1, integration + offset and the best baseline."""
+    def cell(row):
+        return "-" if row is None else f"{row['ssim_clahe']:.3f} / {row['ssim_none']:.3f} / {row['mse_none']:.4f}"
+
+    lines = ["| held-out scene (CLAHE-SSIM / SSIM / MSE) | kit | v0_1 | integration_offset | best baseline | "
+             "kit / best baseline (CLAHE) |", "|---|---|---|---|---|---|"]
+    ratios = []
+    for name, scene in results["scenes"].items():
+        rows = scene["rows"]
+        best = max((m for m in BEST_OF if m in rows), key=lambda m: rows[m]["ssim_clahe"], default=None)
+        ratio = rows["kit"]["ssim_clahe"] / rows[best]["ssim_clahe"] if best and "kit" in rows else None
+        ratios.append(ratio)
+        lines.append(f"| {name} | {cell(rows.get('kit'))} | {cell(rows.get('v0_1'))} | "
+                     f"{cell(rows.get('integration_offset'))} | {best or '-'}: {cell(rows.get(best))} | {_f(ratio)} |")
+    short = {"methods": results["methods"],
+             "scenes": {n: s for n, s in results["scenes"].items() if not s.get("long")}}
+    mean = {m: {k: zoo_mean(short, m, k) for k in ("ssim_clahe", "ssim_none", "mse_none")}
+            for m in ("kit", "v0_1", "integration_offset")}
+    ratios = [r for r, s in zip(ratios, results["scenes"].values()) if r is not None and not s.get("long")]
+    lines.append("| **mean, short scenes** | " + " | ".join("-" if mean[m]["ssim_clahe"] is None else cell(mean[m])
+                                                           for m in ("kit", "v0_1", "integration_offset"))
+                 + f" | | {_f(float(np.mean(ratios)) if ratios else None)} |")
+    return "\n".join(lines) + "\n"
+
+
+def blocks(results: dict, heldout: dict | None = None) -> dict:
+    out = {"zoo-summary": summary_table(results), "zoo-table": scene_table(results)}
+    if heldout is not None:
+        out["heldout-table"] = heldout_table(heldout)
+    return out
 
 
 def current(text: str, name: str) -> str:
@@ -99,8 +135,7 @@ def replace(text: str, name: str, table: str) -> str:
 
 
 def main() -> None:
-    results = load()
-    for name, table in blocks(results).items():
+    for name, table in blocks(load(), load(HELDOUT) if HELDOUT.exists() else None).items():
         page = BLOCKS[name]
         new = replace(page.read_text(encoding="utf-8"), name, table)
         write_beside(page, new)
