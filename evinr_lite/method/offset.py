@@ -27,6 +27,7 @@ the single image above.
 """
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -69,7 +70,8 @@ def median_gradient_offset(frames) -> np.ndarray:
     rows = max(1, (1 << 21) // max(K * W, 1))
     gx = np.empty((H, W - 1))
     gy = np.empty((H - 1, W))
-    for r0 in range(0, H, rows):
+
+    def block_medians(r0: int) -> None:
         r1 = min(H, r0 + rows)
         block = np.asarray(frames[:, r0:min(H, r1 + 1)], dtype=np.float64)   # one extra row for dy
         dx = np.moveaxis(np.diff(block[:, :r1 - r0], axis=2), 0, -1)          # [rows, W - 1, K]
@@ -77,7 +79,23 @@ def median_gradient_offset(frames) -> np.ndarray:
         if r1 - r0 + (r1 < H) > 1:
             dy = np.moveaxis(np.diff(block, axis=1), 0, -1)                   # [rows (- 1 at the end), W, K]
             gy[r0:r0 + dy.shape[0]] = -np.median(np.ascontiguousarray(dy), axis=-1)
+
+    starts = range(0, H, rows)
+    threads = min(len(starts), _threads())
+    if threads > 1:      # numpy's median releases the GIL: blocks on the kit's threads (the same numbers)
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(block_medians, starts))
+    else:
+        for r0 in starts:
+            block_medians(r0)
     return poisson_integrate(gx, gy)
+
+
+def _threads() -> int:
+    """Threads for the offset's medians: the kit's torch thread count (set by the runtime and batch)."""
+    import torch
+
+    return max(1, torch.get_num_threads())
 
 
 @dataclass

@@ -144,8 +144,9 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
     head = [model.head_weight, model.head_bias]
     trunk = [p for n, p in model.named_parameters() if not n.startswith("head_")]
     groups = [{"params": trunk}, {"params": head, "lr": cfg.lr * cfg.head_lr_scale}]
-    opt = make_adam(groups, lr=cfg.lr) if fast else torch.optim.Adam(groups, lr=cfg.lr)
-    sched = torch.optim.lr_scheduler.StepLR(opt, step_size=cfg.lr_decay_every, gamma=cfg.lr_decay)
+    if cfg.n_iters > 0:   # no optimizer when nothing is trained: torch's first Adam costs about 1 s (lazy imports)
+        opt = make_adam(groups, lr=cfg.lr) if fast else torch.optim.Adam(groups, lr=cfg.lr)
+        sched = torch.optim.lr_scheduler.StepLR(opt, step_size=cfg.lr_decay_every, gamma=cfg.lr_decay)
     boundaries = _initial_boundaries(events, windows, cfg)
     bins = _Bins.build(events, boundaries, cfg.C, device)
     regularizer = cfg.regularizer if cfg.lam > 0 else "none"
