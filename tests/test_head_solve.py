@@ -155,3 +155,44 @@ def test_short_windows_get_at_least_min_bins():
     assert reconstruct(events, [0.25], cfg).history["final_bins"] == cfg.min_bins == 64
     paper = EvINRConfig.paper(C=0.2, hidden_features=16, n_iters=3, c2f_iters=(1, 2), progress=False)
     assert reconstruct(events, [0.25], paper).history["final_bins"] == 16      # 0.5 s at 1/32 s
+
+
+def test_the_same_numbers_on_one_thread_and_on_two(monkeypatch):
+    """The solve's DCTs (scipy workers) and the offset's medians (a thread per row block) follow the
+    kit's torch thread count; splitting the work must not change a single number."""
+    import evinr_lite.method.offset as offset
+
+    scene = make_scene("camera", sensor_size=(40, 56), duration=1.0)
+    events = simulate_scene(scene, 0.0, 1.0, C=0.2, seed=0)
+    cfg = EvINRConfig(C=0.2, hidden_features=32, progress=False)
+    before = torch.get_num_threads()
+    try:
+        torch.set_num_threads(1)
+        one = reconstruct(events, [0.2, 0.7], cfg).log_intensity
+        torch.set_num_threads(2)
+        # [64, 100, 1024]: 32 rows per block of about 2 M cells, so four blocks on two threads
+        rows = np.random.default_rng(0).standard_normal((64, 100, 1024), dtype=np.float32)
+        monkeypatch.setattr(offset, "_threads", lambda: 1)
+        serial = median_gradient_offset(rows)
+        monkeypatch.setattr(offset, "_threads", lambda: 2)
+        np.testing.assert_array_equal(median_gradient_offset(rows), serial)
+        two = reconstruct(events, [0.2, 0.7], cfg).log_intensity
+    finally:
+        torch.set_num_threads(before)
+    np.testing.assert_array_equal(one, two)
+
+
+def test_no_optimizer_is_built_when_nothing_is_trained(monkeypatch):
+    """n_iters=0 (the kit's default) solves the head without building Adam (about 1 s of torch's lazy
+    imports on first use); a recipe that trains still builds it."""
+    import evinr_lite.method.training as training
+
+    built = []
+    real = training.make_adam
+    monkeypatch.setattr(training, "make_adam", lambda *a, **k: built.append(1) or real(*a, **k))
+    scene = make_scene("camera", sensor_size=(12, 16), duration=0.5)
+    events = simulate_scene(scene, 0.0, 0.5, C=0.2, seed=0)
+    reconstruct(events, [0.25], EvINRConfig(C=0.2, hidden_features=16, progress=False))
+    assert built == []
+    reconstruct(events, [0.25], EvINRConfig(C=0.2, hidden_features=16, n_iters=2, progress=False))
+    assert built == [1]
