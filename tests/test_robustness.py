@@ -143,6 +143,30 @@ def test_memory_is_estimated_before_allocating(capsys, npy_file, tmp_path, argv,
                        root=tmp_path)
 
 
+def test_a_huge_fps_is_refused_before_its_times_are_built(npy_file, monkeypatch, capsys, tmp_path):
+    """choose_times hands the frame count to the job's check before it builds (and the job sorts)
+    millions of times; on the command line the advice names each flag once."""
+    import evinr_lite.apps.options as options
+    from evinr_lite.apps.recon_job import load_recording
+
+    rec = load_recording(npy_file, sensor_size=(H, W))
+    lo, hi = rec.meta["window"]
+    asked = []
+
+    def refuse(n):
+        asked.append(n)
+        raise EventDataError("too many frames")
+
+    monkeypatch.setattr(options.np, "arange", lambda *a, **k: pytest.fail("built the times before the check"))
+    with pytest.raises(EventDataError, match="too many frames"):
+        options.choose_times(rec, fps=1e8, check=refuse)
+    assert asked == [int(np.floor((hi - lo) * 1e8))]
+    monkeypatch.undo()
+    err = assert_clear_error(capsys, ["reconstruct", npy_file, "--out", tmp_path / "o", "--sensor", f"{H}x{W}",
+                                      "--fps", "1e9", *FAST], r"needs about .* of disk", root=tmp_path)
+    assert "--fps/--fps" not in err and "--fps or --at" in err, err
+
+
 def test_a_tiny_bin_duration_is_refused_by_the_estimate(npy_file):
     from evinr_lite.apps.recon_job import load_recording
     from evinr_lite.method.memory import check_memory

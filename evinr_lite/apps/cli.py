@@ -273,6 +273,9 @@ def _batch(args) -> None:
 
 # Library errors name Python parameters; on the command line the same advice names the flags.
 FLAG_FOR = [
+    # advice already naming both spellings ("fps=/--fps", "t_start=/t_end= (--start/--end)") keeps the flag only
+    (re.compile(r"\bt_start=/t_end= \(--start/--end\)"), "--start/--end"),
+    (re.compile(r"\b\w+=/(--[\w-]+)"), r"\1"),
     (re.compile(r"sensor_size=\((\d+), (\d+)\)"), r"--sensor \1x\2"),
     (re.compile(r"sensor_size=\(H, W\)"), "--sensor HxW"),
     (re.compile(r"\bsensor_size="), "--sensor "),

@@ -244,13 +244,16 @@ def check_run_options(**fields) -> RunOptions:
     return RunOptions(**fields)
 
 
-def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[np.ndarray, str]:
+def choose_times(rec: Recording, *, fps: float | None = None, at=None, check=None) -> tuple[np.ndarray, str]:
     """The times to reconstruct and where they come from.
 
     Args:
         fps: frames per second over the window (the first half a frame period after its start).
         at: explicit times (array, '0.1,0.2' text, or a file: :func:`~evinr_lite.apps.options.parse_times`).
         Neither: the ground-truth frame times when the recording has frames, else DEFAULT_FPS.
+        check: called with the number of frames an fps asks for before their times are built (a
+            job's own memory or disk check, which raises EventDataError): a huge fps is refused at
+            once instead of after building and sorting millions of times.
     Returns:
         (times float64 [Q] seconds, a short description of the choice).
     """
@@ -273,5 +276,7 @@ def choose_times(rec: Recording, *, fps: float | None = None, at=None) -> tuple[
         raise EventDataError(f"fps= must be a positive number of frames per second, got {fps}")
     n = int(math.floor((hi - lo) * fps))
     check_times_memory(n, rec.events.sensor_size, f"{n:,} frames at {fps:g} per second over [{lo:.6f}, {hi:.6f}] s")
+    if check is not None:
+        check(max(n, 1))
     times = lo + (np.arange(n) + 0.5) / fps if n >= 1 else np.array([0.5 * (lo + hi)])
     return times, f"{len(times)} frames at {fps:g} per second"

@@ -180,13 +180,17 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
             from .colour_job import check_colour_recording
 
             check_colour_recording(rec)
-        times, source = choose_times(rec, fps=options.fps, at=options.at)
         C, C_source, C_fit = resolve_contrast(rec, options.C, path, log, colour=colour)
         config = options.config(C)
         lo, hi = rec.meta["window"]
         H, W = rec.events.sensor_size
-        check_memory((H, W), lo, hi, len(rec.events), len(times), config, device_name,
-                     events_span=(float(rec.events.t[0]), float(rec.events.t[-1])))
+
+        def fits(n_times: int) -> None:   # before the times are built, and again once they are
+            check_memory((H, W), lo, hi, len(rec.events), n_times, config, device_name,
+                         events_span=(float(rec.events.t[0]), float(rec.events.t[-1])))
+
+        times, source = choose_times(rec, fps=options.fps, at=options.at, check=fits)
+        fits(len(times))
         log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
             + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
             + f" in {time.perf_counter() - t0:.1f} s")

@@ -149,16 +149,21 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
         raise EventDataError(str(err)) from None
     source, (lo, hi), gt, rec = _header(path, options, log)
     with source:
-        times, times_source = choose_times(rec, fps=options.fps, at=options.at)
+        H, W = source.sensor_size
         C, C_source, _ = resolve_contrast(rec, options.C, path, log)
         config = options.config(C)
-        H, W = source.sensor_size
         n_events = source.n_events if source.n_events is not None else 0
         gt_t = gt.t if gt is not None else np.zeros(0)
+
+        def fits(n_query: int) -> dict:   # memory, then disk: before the times are built, and again after
+            est = check_memory((H, W), lo, hi, n_events, n_query, config, device_name, events_span=source.t_span,
+                               streaming=True)
+            check_disk(n_query, (H, W), target.staging)
+            return est
+
+        times, times_source = choose_times(rec, fps=options.fps, at=options.at, check=lambda n: fits(n + len(gt_t)))
         query = np.unique(np.concatenate([times, gt_t]))        # sorted: the exported times and the scored ones
-        est = check_memory((H, W), lo, hi, n_events, len(query), config, device_name, events_span=source.t_span,
-                           streaming=True)
-        check_disk(len(query), (H, W), target.staging)
+        est = fits(len(query))
         log(f"streaming {source.format} {H}x{W} over [{lo:.6f}, {hi:.6f}] s"
             + (f" ({n_events:,} events)" if source.n_events is not None else "")
             + (f", {len(gt)} ground-truth frames" if gt is not None else ", no frames")
