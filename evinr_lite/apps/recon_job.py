@@ -180,17 +180,19 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
             from .colour_job import check_colour_recording
 
             check_colour_recording(rec)
-        C, C_source, C_fit = resolve_contrast(rec, options.C, path, log, colour=colour)
-        config = options.config(C)
         lo, hi = rec.meta["window"]
         H, W = rec.events.sensor_size
 
-        def fits(n_times: int) -> None:   # before the times are built, and again once they are
+        def fits(n_times: int, config) -> None:
             check_memory((H, W), lo, hi, len(rec.events), n_times, config, device_name,
                          events_span=(float(rec.events.t[0]), float(rec.events.t[-1])))
 
-        times, source = choose_times(rec, fps=options.fps, at=options.at, check=fits)
-        fits(len(times))
+        # before the times are built (the memory estimate does not depend on C), and again once C is known
+        times, source = choose_times(rec, fps=options.fps, at=options.at,
+                                     check=lambda n: fits(n, options.config(DEFAULT_C)))
+        C, C_source, C_fit = resolve_contrast(rec, options.C, path, log, colour=colour)
+        config = options.config(C)
+        fits(len(times), config)
         log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
             + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
             + f" in {time.perf_counter() - t0:.1f} s")

@@ -137,7 +137,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     from ..core.runtime import default_device
     from ..io.export import save_timestamps
     from ..method.memory import check_memory
-    from ..method.recipes import format_contrast, resolve_contrast
+    from ..method.recipes import DEFAULT_C, format_contrast, resolve_contrast
     from ..method.streaming import stream_reconstruct
     from .options import choose_times
     from .results import score_predictions, write_results
@@ -150,20 +150,22 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     source, (lo, hi), gt, rec = _header(path, options, log)
     with source:
         H, W = source.sensor_size
-        C, C_source, _ = resolve_contrast(rec, options.C, path, log)
-        config = options.config(C)
         n_events = source.n_events if source.n_events is not None else 0
         gt_t = gt.t if gt is not None else np.zeros(0)
 
-        def fits(n_query: int) -> dict:   # memory, then disk: before the times are built, and again after
+        def fits(n_query: int, config) -> dict:   # memory, then disk
             est = check_memory((H, W), lo, hi, n_events, n_query, config, device_name, events_span=source.t_span,
                                streaming=True)
             check_disk(n_query, (H, W), target.staging)
             return est
 
-        times, times_source = choose_times(rec, fps=options.fps, at=options.at, check=lambda n: fits(n + len(gt_t)))
+        # before the times are built (the memory estimate does not depend on C), and again once C is known
+        times, times_source = choose_times(rec, fps=options.fps, at=options.at,
+                                           check=lambda n: fits(n + len(gt_t), options.config(DEFAULT_C)))
+        C, C_source, _ = resolve_contrast(rec, options.C, path, log)
+        config = options.config(C)
         query = np.unique(np.concatenate([times, gt_t]))        # sorted: the exported times and the scored ones
-        est = fits(len(query))
+        est = fits(len(query), config)
         log(f"streaming {source.format} {H}x{W} over [{lo:.6f}, {hi:.6f}] s"
             + (f" ({n_events:,} events)" if source.n_events is not None else "")
             + (f", {len(gt)} ground-truth frames" if gt is not None else ", no frames")
