@@ -172,9 +172,9 @@ def test_the_same_numbers_on_one_thread_and_on_two(monkeypatch):
         torch.set_num_threads(2)
         # [64, 100, 1024]: 32 rows per block of about 2 M cells, so four blocks on two threads
         rows = np.random.default_rng(0).standard_normal((64, 100, 1024), dtype=np.float32)
-        monkeypatch.setattr(offset, "_threads", lambda: 1)
+        monkeypatch.setattr(offset, "cpu_threads", lambda: 1)
         serial = median_gradient_offset(rows)
-        monkeypatch.setattr(offset, "_threads", lambda: 2)
+        monkeypatch.setattr(offset, "cpu_threads", lambda: 2)
         np.testing.assert_array_equal(median_gradient_offset(rows), serial)
         two = reconstruct(events, [0.2, 0.7], cfg).log_intensity
     finally:

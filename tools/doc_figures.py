@@ -29,7 +29,6 @@ from textfile import write_beside  # noqa: E402  (tools/textfile.py)
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "zoo_results.json"
 HELDOUT = ROOT / "benchmarks" / "zoo_results_heldout.json"
-BEST_OF = ("hf_best", "leaky_best", "integration_offset")     # as benchmarks/quality_zoo.py
 REAL = "real_slider_chunk"
 LABELS = {"kit": "kit (`EvINRConfig()`)", "paper": "paper (`EvINRConfig.paper()`)",
           "v0_1": "v0_1 (`EvINRConfig.v0_1()`)", "hf": "hf (high-pass filter)"}
@@ -96,19 +95,17 @@ def heldout_table(results: dict) -> str:
 
     lines = ["| held-out scene (CLAHE-SSIM / SSIM / MSE) | kit | v0_1 | integration_offset | best baseline | "
              "kit / best baseline (CLAHE) |", "|---|---|---|---|---|---|"]
-    ratios = []
     for name, scene in results["scenes"].items():
-        rows = scene["rows"]
-        best = max((m for m in BEST_OF if m in rows), key=lambda m: rows[m]["ssim_clahe"], default=None)
-        ratio = rows["kit"]["ssim_clahe"] / rows[best]["ssim_clahe"] if best and "kit" in rows else None
-        ratios.append(ratio)
+        rows, best = scene["rows"], scene["summary"].get("best_baseline")   # picked by quality_zoo.summarise
         lines.append(f"| {name} | {cell(rows.get('kit'))} | {cell(rows.get('v0_1'))} | "
-                     f"{cell(rows.get('integration_offset'))} | {best or '-'}: {cell(rows.get(best))} | {_f(ratio)} |")
+                     f"{cell(rows.get('integration_offset'))} | {best or '-'}: {cell(rows.get(best))} | "
+                     f"{_f(scene['summary'].get('kit_over_best_baseline_clahe'))} |")
     short = {"methods": results["methods"],
              "scenes": {n: s for n, s in results["scenes"].items() if not s.get("long")}}
     mean = {m: {k: zoo_mean(short, m, k) for k in ("ssim_clahe", "ssim_none", "mse_none")}
             for m in ("kit", "v0_1", "integration_offset")}
-    ratios = [r for r, s in zip(ratios, results["scenes"].values()) if r is not None and not s.get("long")]
+    ratios = [s["summary"]["kit_over_best_baseline_clahe"] for s in short["scenes"].values()
+              if "kit_over_best_baseline_clahe" in s["summary"]]
     lines.append("| **mean, short scenes** | " + " | ".join("-" if mean[m]["ssim_clahe"] is None else cell(mean[m])
                                                            for m in ("kit", "v0_1", "integration_offset"))
                  + f" | | {_f(float(np.mean(ratios)) if ratios else None)} |")

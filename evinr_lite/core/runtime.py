@@ -1,6 +1,8 @@
 """Runtime choices shared by every layer: where torch runs, fast mode, and the cache folder.
 
 - ``default_device``: a GPU when present, never required (``EVINR_DEVICE`` overrides).
+- ``cpu_threads``: how many threads the kit's numpy / scipy work may use (torch's thread count,
+  which the command line and batch workers set).
 - ``fast_mode`` / ``pick``: smaller sizes and fewer iterations so that every notebook runs in CI
   within minutes. Switched by ``EVINR_FAST`` ("1" on, "0" off); when it is unset, fast mode is on
   under pytest/nbval (``tests/conftest.py`` sets it) and in CI (``CI`` set).
@@ -12,7 +14,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["default_device", "fast_mode", "pick", "cache_dir", "weights_dir", "FAST_ENV_VAR", "CACHE_ENV_VAR"]
+__all__ = ["default_device", "cpu_threads", "fast_mode", "pick", "cache_dir", "weights_dir", "FAST_ENV_VAR", "CACHE_ENV_VAR"]
 
 CACHE_ENV_VAR = "EVINR_DATA"
 
@@ -38,6 +40,14 @@ def default_device(preference: str | None = None) -> "torch.device":
     if preference.startswith("cuda") and not torch.cuda.is_available():
         raise RuntimeError("device 'cuda' requested but no CUDA GPU is available here; use device='cpu'")
     return torch.device(preference)
+
+
+def cpu_threads() -> int:
+    """Threads for CPU work outside torch (scipy's DCT workers, the offset's median blocks): torch's own
+    thread count, so one setting (``--torch-threads``, a batch worker's share) governs both."""
+    import torch
+
+    return max(1, torch.get_num_threads())
 
 
 FAST_ENV_VAR = "EVINR_FAST"

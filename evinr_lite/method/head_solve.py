@@ -28,6 +28,8 @@ import scipy.fft
 import scipy.linalg
 import torch
 
+from ..core.runtime import cpu_threads
+
 __all__ = ["solve_head", "laplacian_eigenvalues"]
 
 
@@ -64,7 +66,7 @@ def _dct_rows(X: np.ndarray, sensor_size, inverse: bool = False) -> None:
     for r0 in range(0, X.shape[0], rows):
         r1 = min(X.shape[0], r0 + rows)
         X[r0:r1] = transform(X[r0:r1].reshape(r1 - r0, H, W).astype(np.float64), type=2, norm="ortho", axes=(1, 2),
-                             workers=max(1, torch.get_num_threads())).reshape(r1 - r0, H * W)
+                             workers=cpu_threads()).reshape(r1 - r0, H * W)
 
 
 def _solve_frequencies(X: np.ndarray, M: np.ndarray, E_hat: np.ndarray, V: np.ndarray, lam_: np.ndarray,

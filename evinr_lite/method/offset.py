@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
+from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues
 
 __all__ = ["median_gradient_offset", "poisson_integrate", "median_gradient_trend", "OffsetTrend", "offset_grid",
@@ -81,21 +82,10 @@ def median_gradient_offset(frames) -> np.ndarray:
             gy[r0:r0 + dy.shape[0]] = -np.median(np.ascontiguousarray(dy), axis=-1)
 
     starts = range(0, H, rows)
-    threads = min(len(starts), _threads())
-    if threads > 1:      # numpy's median releases the GIL: blocks on the kit's threads (the same numbers)
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(block_medians, starts))
-    else:
-        for r0 in starts:
-            block_medians(r0)
+    # numpy's median releases the GIL: the blocks run on the kit's threads (the same numbers on any count)
+    with ThreadPoolExecutor(max(1, min(len(starts), cpu_threads()))) as pool:
+        list(pool.map(block_medians, starts))
     return poisson_integrate(gx, gy)
-
-
-def _threads() -> int:
-    """Threads for the offset's medians: the kit's torch thread count (set by the runtime and batch)."""
-    import torch
-
-    return max(1, torch.get_num_threads())
 
 
 @dataclass
