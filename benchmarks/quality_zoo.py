@@ -27,9 +27,12 @@ long scenes, minutes each), the baselines ``integration`` and ``hf`` at their de
 CLAHE-SSIM against the truth: tuned with the answer in hand, which the kit never has; the sweep is in
 the JSON and the markdown), ``integration_offset`` (integration + the kit's median-gradient offset:
 what the INR must beat), ``kit_windows`` (long scenes: the kit on independent 2 s windows), and the
-oracle: the events integrated from the true frame at the first scored time, as linear intensity
-(``oracle_linear``) and tone-mapped (``oracle_tonemapped``). The oracle is what the events carry once
-the unknown per-pixel offset is given; no method sees that frame.
+oracle: the events integrated from the true frame at the first scored time, as linear intensity with
+the true level (``oracle_linear``) and shown by the display with its level anchored like every
+method's (``oracle_tonemapped``). The oracle is what the events carry once the unknown per-pixel offset
+is given; no method sees that frame. Every method is shown by the kit's display (``DISPLAY``: its tone
+map and level, ``EvINRConfig().tonemap`` and ``display_mean``): paper and v0_1 train their recipes
+exactly and are displayed like the kit, so the rows differ by the reconstruction alone.
 
 Every method is scored at 10 ground-truth times (2 per second on long scenes) through
 ``evinr_lite.evaluation.score_sequence`` under both protocols (no equalisation, and CLAHE on both
@@ -55,7 +58,7 @@ from evinr_lite.core.events import Events  # noqa: E402
 from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
 from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
-from evinr_lite.method.tonemap import anchor_mean, tonemap_reinhard  # noqa: E402
+from evinr_lite.method.tonemap import anchor_mean, to_display  # noqa: E402
 from evinr_lite.sim.zoo import HELDOUT, ZOO, default_scenes, effective_C, quick, simulate  # noqa: E402
 
 BASELINES = ("integration", "hf")                   # the baselines at their default settings
@@ -71,12 +74,15 @@ SLOW = ("paper", "v0_1")                            # trained recipes: skipped o
 SWEEP = {"hf_best": ("hf", "cutoff_hz", (0.03, 0.1, 0.3, 1.0, 3.0)),
          "leaky_best": ("leaky", "leak_hz", (0.03, 0.1, 0.3, 1.0, 3.0))}
 WINDOW_S = 2.0
+# every method is shown by the kit's display (tone map and level), so the rows differ by the reconstruction
+# alone: the trained recipes (paper, v0_1) too, though their presets keep the paper's Reinhard display
+DISPLAY = {"tonemap": EvINRConfig().tonemap, "display_mean": EvINRConfig().display_mean}
 
 
 def evinr_config(name: str, C, variants: dict) -> EvINRConfig:
     base = {"kit": EvINRConfig, "paper": EvINRConfig.paper, "v0_1": EvINRConfig.v0_1}
     if name in base:
-        return base[name](C=C, progress=False)
+        return base[name](C=C, progress=False, **DISPLAY)
     return EvINRConfig(**{**variants[name], "C": C, "progress": False})
 
 
@@ -123,7 +129,8 @@ def run_method(name: str, events: Events, times: np.ndarray, C, variants: dict, 
         frames = reconstruct_baseline(events, times, "integration", C=C, offset_solve="median_gradient").frames
     elif name in ORACLES:
         L = L_first + integrate_events(events, times, C=C) - integrate_events(events, times[:1], C=C)
-        frames = np.clip(np.exp(L), 0, 1) if name == "oracle_linear" else tonemap_reinhard(anchor_mean(L))
+        frames = (np.clip(np.exp(L), 0, 1) if name == "oracle_linear" else
+                  to_display(anchor_mean(L, **DISPLAY), DISPLAY["tonemap"]))
     elif name in WINDOWED:
         frames = windowed(events, times, C, variants)
     else:

@@ -7,7 +7,8 @@ import pytest
 from evinr_lite import Events, integrate_events
 from evinr_lite.teaching import exercises
 from evinr_lite.method.baselines import (highpass_filter, highpass_per_event, leaky_integration, reconstruct_baseline)
-from evinr_lite.method.tonemap import anchor_level
+from evinr_lite.method import EvINRConfig
+from evinr_lite.method.tonemap import anchor_level, to_display, tonemap_reinhard
 
 
 def random_events(n=400, H=5, W=7, seed=0, t_span=(0.1, 1.0)):
@@ -92,9 +93,14 @@ def test_reconstruct_baseline_makes_frames_like_the_solver(method, params):
     assert np.all((rec.frames >= 0) & (rec.frames <= 1))
     np.testing.assert_array_equal(rec.times, q)
     assert rec.history["train_time_s"] == 0.0 and rec.method == method
-    # anchored like the solver: the mean over 64 times spread over the span sits at anchor_level
+    # anchored like the solver: over 64 times spread over the span the frames' mean is display_mean
     grid = np.linspace(ev.t[0], ev.t[-1], 64)
-    assert rec.at(grid).mean() == pytest.approx(anchor_level(0.6, 0.5), abs=1e-9)
+    assert rec.params["tonemap"] == "linear" == EvINRConfig().tonemap
+    assert to_display(rec.at(grid)).mean() == pytest.approx(EvINRConfig().display_mean, abs=1e-9)
+    # the paper's display: the mean log intensity sits at Reinhard's grey level
+    paper = reconstruct_baseline(ev, q, method, C=0.2, gamma=0.6, display_mean=0.5, tonemap="reinhard", **params)
+    assert paper.at(grid).mean() == pytest.approx(anchor_level(0.6, 0.5), abs=1e-9)
+    np.testing.assert_allclose(paper.frames, tonemap_reinhard(paper.log_intensity, 0.6), atol=1e-6)
     np.testing.assert_allclose(rec.at(q), rec.log_intensity, atol=1e-12)
     np.testing.assert_allclose(rec.frames_at(q), rec.frames, atol=1e-6)
     # changes between frames are the method's own, whatever the anchor

@@ -3,7 +3,7 @@ import pytest
 import torch
 
 from evinr_lite.evaluation.metrics import mse, ssim
-from evinr_lite.method.tonemap import anchor_mean, tonemap_reinhard
+from evinr_lite.method.tonemap import anchor_level, anchor_mean, tonemap_reinhard
 
 
 def test_reinhard_matches_definition_and_is_stable():
@@ -162,3 +162,47 @@ def test_anchor_mean_with_reference():
     assert tonemap_reinhard(np.mean(ref + (A - L[3]).mean()), 0.6) == pytest.approx(0.5)
     with pytest.raises(ValueError, match="display_mean"):
         anchor_mean(L, 0.6, 1.0)
+
+
+def test_the_linear_display_is_the_intensity_and_its_level_sets_the_frames_mean():
+    from evinr_lite.method.tonemap import display_shift, to_display, tonemap_linear
+
+    rng = np.random.default_rng(3)
+    L = rng.normal(-1.0, 0.8, (6, 20, 30)).astype(np.float32)
+    np.testing.assert_allclose(tonemap_linear(L), np.minimum(np.exp(L.astype(np.float64)), 1.0))
+    np.testing.assert_allclose(tonemap_linear(torch.from_numpy(L)).numpy(), tonemap_linear(L), rtol=1e-6)
+    for mean in (0.2, 0.45, 0.8):
+        c = display_shift(L, "linear", display_mean=mean)
+        assert to_display(L + c, "linear").mean() == pytest.approx(mean, abs=1e-9)   # clipped pixels count as 1
+    # a few hot pixels far above the scene move the level of the rest very little
+    hot = L.copy()
+    hot[0, 0, :4] = 40.0
+    assert display_shift(hot) == pytest.approx(display_shift(L), abs=0.01)
+    # the paper's anchor is unchanged: the mean log intensity sits at Reinhard's grey level
+    assert (L + display_shift(L, "reinhard", 0.6, 0.5)).mean() == pytest.approx(anchor_level(0.6, 0.5), abs=1e-6)
+    with pytest.raises(ValueError, match="tonemap"):
+        to_display(L, "gamma")
+    with pytest.raises(ValueError, match="display_mean"):
+        display_shift(L, "linear", display_mean=1.0)
+
+
+def test_the_kit_shows_linear_frames_and_the_paper_its_reinhard_curve():
+    from evinr_lite import make_scene, simulate_scene
+    from evinr_lite.method import EvINRConfig, reconstruct
+    from evinr_lite.method.tonemap import to_display
+
+    sc = make_scene("camera", sensor_size=(24, 32), duration=0.5)
+    ev = simulate_scene(sc, 0.0, 0.5, C=0.2, seed=0)
+    q = np.linspace(0.1, 0.4, 3)
+    kit = EvINRConfig(C=0.2, progress=False)
+    assert (kit.tonemap, EvINRConfig.paper().tonemap, EvINRConfig.paper().display_mean) == ("linear", "reinhard", 0.5)
+    rec = reconstruct(ev, q, kit)
+    np.testing.assert_allclose(rec.frames, to_display(rec.log_intensity, "linear"), atol=1e-6)
+    np.testing.assert_allclose(rec.frames_at(q), rec.frames, atol=1e-6)
+    paper_display = reconstruct(ev, q, EvINRConfig(C=0.2, progress=False, tonemap="reinhard", display_mean=0.5))
+    np.testing.assert_allclose(paper_display.frames, tonemap_reinhard(paper_display.log_intensity, 0.6), atol=1e-6)
+    # the same reconstruction, only shown otherwise: the log intensities differ by one constant
+    d = rec.log_intensity - paper_display.log_intensity
+    assert np.ptp(d) < 1e-4
+    with pytest.raises(Exception, match="tonemap"):
+        EvINRConfig(tonemap="srgb")

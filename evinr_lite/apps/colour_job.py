@@ -31,7 +31,7 @@ from ..core.frames import GREY_WEIGHTS, Frames
 from ..core.recording import Recording
 from ..method.colour import chroma_correlation, reconstruct_colour
 from ..method.solver import EvINRConfig
-from ..method.tonemap import tonemap_reinhard
+from ..method.tonemap import to_display
 from ..sim.quadbayer import demosaic_events_rgb, reduce_mean
 
 __all__ = ["check_colour_recording", "split_colour_events", "colour_frames", "ColourResult",
@@ -104,8 +104,9 @@ class ColourResult:
         return (L + self.channel_offsets.astype(np.float32)).astype(np.float32)
 
     def frames_at(self, times) -> np.ndarray:
-        """Tone-mapped colour frames in [0, 1] at any times: float32 [Q, h, w, 3]."""
-        return tonemap_reinhard(self.at(times), self.channels[0].config.gamma).astype(np.float32)
+        """Colour frames in [0, 1] (the config's tone map) at any times: float32 [Q, h, w, 3]."""
+        cfg = self.channels[0].config
+        return to_display(self.at(times), cfg.tonemap, cfg.gamma).astype(np.float32)
 
 
 def reconstruct_colour_recording(rec: Recording, times, config: EvINRConfig | None = None) -> ColourResult:
@@ -167,7 +168,8 @@ def score_colour_recording(result: ColourResult, rec: Recording, score_predictio
         grey_gt = reduce_mean(grey / (255.0 if gt.images.dtype == np.uint8 else 1.0), 2)
         true_rgb = None
     L = result.at(t)
-    pred = tonemap_reinhard(L, result.channels[0].config.gamma).astype(np.float32)
+    cfg = result.channels[0].config
+    pred = to_display(L, cfg.tonemap, cfg.gamma).astype(np.float32)
     scores = score_predictions(pred @ GREY_WEIGHTS.astype(np.float32), t,
                                Frames(np.clip(grey_gt, 0.0, 1.0).astype(np.float32), t, gt.t_origin))
     colour = None

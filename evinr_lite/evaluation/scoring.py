@@ -185,7 +185,7 @@ def evaluate(events: Events, gt_frames, gt_times=None, methods=("evinr", "integr
         gt_frames: [G, H, W] uint8 or float in [0, 1], or Frames (then ``gt_times`` may be None).
         gt_times: [G] seconds.
         methods: any of "evinr", "integration", "leaky", "hf".
-        config: EvINRConfig for "evinr" (default: the paper's); its C, gamma and display_mean are
+        config: EvINRConfig for "evinr" (default: the kit's); its C, tonemap, gamma and display_mean are
             used by the baselines too, so every method is tone-mapped and anchored alike.
         equalizations: protocols to score with ("none", "global", "clahe").
         lpips_model: None (cached weights if present, else a note), False (skip) or an LPIPS model.
@@ -226,7 +226,7 @@ def evaluate(events: Events, gt_frames, gt_times=None, methods=("evinr", "integr
         else:
             extra = dict((baseline_params or {}).get(method, {}))
             rec = reconstruct_baseline(events, gt_times, method, C=cfg.C, gamma=cfg.gamma,
-                                       display_mean=cfg.display_mean, **extra)
+                                       display_mean=cfg.display_mean, tonemap=cfg.tonemap, **extra)
             frames, train, infer = rec.frames, 0.0, time.perf_counter() - t0
             params = dict(rec.params)
         for eq in equalizations:

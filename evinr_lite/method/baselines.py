@@ -34,7 +34,7 @@ from .anchor import frame_log, linear_frames
 from .binning import as_thresholds
 from .integration import integrate_events
 from .offset import median_gradient_offset
-from .tonemap import anchor_level, tonemap_reinhard
+from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, TONEMAPS, display_shift, to_display
 
 __all__ = ["leaky_integration", "highpass_filter", "highpass_per_event", "reconstruct_baseline",
            "BaselineReconstruction", "BASELINES", "DEFAULT_CUTOFF_HZ", "complementary_filter", "DEFAULT_GAIN",
@@ -351,21 +351,25 @@ class BaselineReconstruction:
     def frames_at(self, times) -> np.ndarray:
         if self.method in FRAME_BASELINES:     # in the APS frames' own intensity space
             return linear_frames(self.at(times))
-        return tonemap_reinhard(self.at(times), self.params["gamma"]).astype(np.float32)
+        return to_display(self.at(times), self.params["tonemap"], self.params["gamma"]).astype(np.float32)
 
 
 def reconstruct_baseline(events: Events, query_times, method: str = "integration", C=0.2, gamma: float = 0.6,
-                         display_mean: float = 0.5, *, t_start: float | None = None, t_end: float | None = None,
-                         offset_solve: str = "none", frames=None, **params) -> BaselineReconstruction:
-    """Frames from a baseline, made like the EvINR solver's: anchor, then Reinhard tone mapping.
+                         display_mean: float = DEFAULT_DISPLAY_MEAN, *, t_start: float | None = None,
+                         t_end: float | None = None, offset_solve: str = "none", frames=None,
+                         tonemap: str = DEFAULT_TONEMAP, **params) -> BaselineReconstruction:
+    """Frames from a baseline, made like the EvINR solver's: anchor, then the display's tone map.
 
-    The brightness anchor is the solver's: one constant is added so that the mean log intensity
-    over 64 times spread over [t_start, t_end] tone-maps to ``display_mean``.
+    The brightness anchor is the solver's: one constant is added so that the log intensity over 64
+    times spread over [t_start, t_end] displays at ``display_mean``
+    (:func:`~evinr_lite.method.tonemap.display_shift`). ``tonemap`` and ``display_mean`` default to
+    the kit's (:class:`~evinr_lite.method.config.EvINRConfig`), so a baseline and the kit are shown,
+    and scored, alike; pass ``tonemap="reinhard", display_mean=0.5`` for the paper's display.
 
     Args:
         events: the events. query_times: [Q] seconds.
         method: "integration", "leaky" (params: leak_hz, L0) or "hf" (params: cutoff_hz, L0).
-        C: contrast threshold (or (C_pos, C_neg)). gamma: tone-mapping exponent.
+        C: contrast threshold (or (C_pos, C_neg)). gamma: Reinhard's exponent. tonemap: "linear" or "reinhard".
         t_start, t_end: span of the anchor (default: first/last event, widened to the queries).
         offset_solve: "none" (one constant, as always), or "median_gradient": the per-pixel offset of
             :mod:`evinr_lite.method.offset`, the kit's ghost solve, applied to the baseline (an
@@ -379,6 +383,8 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
         BaselineReconstruction with ``.frames`` [Q, H, W] in [0, 1].
     """
     allowed = {"integration": ("L0",), "leaky": ("leak_hz", "L0"), "hf": ("cutoff_hz", "L0"), "complementary": ("gain",)}
+    if tonemap not in TONEMAPS:
+        raise ValueError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
     if method not in allowed:
         raise ValueError(f"method must be one of {BASELINES + FRAME_BASELINES}, got {method!r}")
     if method == "complementary":
@@ -410,11 +416,11 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
     if offset_solve not in ("none", "median_gradient"):
         raise ValueError(f"offset_solve must be 'none' or 'median_gradient', got {offset_solve!r}")
     g = median_gradient_offset(L_all[:len(grid)]) if offset_solve == "median_gradient" else 0.0
-    offset = g + anchor_level(gamma, display_mean) - float((L_all[:len(grid)] + g).mean())
+    offset = g + display_shift(L_all[:len(grid)] + g, tonemap, gamma, display_mean)
     L = L_all[len(grid):] + offset
-    frames = tonemap_reinhard(L, gamma).astype(np.float32)
+    frames = to_display(L, tonemap, gamma).astype(np.float32)
     seconds = time.perf_counter() - t0
-    rec = BaselineReconstruction(q, L, frames, method, {"C": C, "gamma": gamma, "display_mean": display_mean,
+    rec = BaselineReconstruction(q, L, frames, method, {"C": C, "tonemap": tonemap, "gamma": gamma, "display_mean": display_mean,
                                                         "offset_solve": offset_solve, **{k: v for k, v in params.items() if k != "L0"}},
                                  offset, {"train_time_s": 0.0, "time_s": seconds}, fn)
     return rec

@@ -23,7 +23,7 @@ import numpy as np
 from ..core.cfa import CHANNELS, QUAD_BAYER, effective_thresholds
 from ..core.events import EventDataError, Events
 from .solver import EvINRConfig, reconstruct
-from .tonemap import tonemap_reinhard
+from .tonemap import to_display
 
 __all__ = ["ColourReconstruction", "reconstruct_colour", "channel_offsets_from", "chroma_correlation"]
 
@@ -106,7 +106,7 @@ def reconstruct_colour(streams, query_times, config: EvINRConfig | None = None, 
     if offsets.shape != (3,):
         raise EventDataError(f"channel_offsets must be 3 numbers (log units), got shape {offsets.shape}")
     L = np.stack([r.log_intensity for r in recs], axis=-1) + offsets.astype(np.float32)
-    frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)
+    frames = to_display(L, cfg.tonemap, cfg.gamma).astype(np.float32)
     return ColourReconstruction(q, L.astype(np.float32), frames, recs, thresholds, offsets)
 
 

@@ -17,6 +17,7 @@ import numpy as np
 from ..core.events import EventDataError
 from .anchor import ANCHOR_MODES
 from .binning import as_thresholds
+from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, TONEMAPS
 
 __all__ = ["EvINRConfig"]
 
@@ -166,8 +167,12 @@ class EvINRConfig:
             may drift between anchors: 0 passes through every anchor frame, large s fits one
             least-squares offset per pixel.
     Output:
-        gamma: tone-mapping exponent (paper: 0.6). display_mean: the tone-mapped value that the
-            mean log intensity is anchored to (see the module docstring).
+        tonemap: "linear" (clip(exp(F), 0, 1): the intensity whose log changes fired the events) or
+            "reinhard" (the paper's Eq. 12, (I / (I + 1))^gamma), :mod:`evinr_lite.method.tonemap`.
+        gamma: Reinhard's exponent (paper: 0.6; unused by "linear"). display_mean: the level events
+            never fix: linear, the mean of the displayed frames over the sequence (0.4, a little below
+            mid-grey); reinhard, the display value of the mean log intensity (the
+            paper's 0.5).
     Runtime:
         seed: seeds the initialisation. device: "cpu", "cuda" or None (GPU when present).
         progress: show a progress bar (terminal or notebook).
@@ -194,8 +199,9 @@ class EvINRConfig:
     c2f_iters: tuple = (100, 200)
     tau: float | None = 5.0
     overlap: float = 0.5
+    tonemap: str = DEFAULT_TONEMAP
     gamma: float = 0.6
-    display_mean: float = 0.5
+    display_mean: float = DEFAULT_DISPLAY_MEAN
     head_solve: bool = True
     offset_solve: str = "median_gradient"
     offset_window: float | None = 5.0
@@ -212,7 +218,7 @@ class EvINRConfig:
         # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
                    "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient"),
-                   "balance": ("none", "events"), "hot_pixels": ("keep", "drop")}
+                   "balance": ("none", "events"), "hot_pixels": ("keep", "drop"), "tonemap": TONEMAPS}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
@@ -259,9 +265,9 @@ class EvINRConfig:
             raise EventDataError(f"lr_decay must be in (0, 1], got {self.lr_decay}")
         if not 0 < number("display_mean", self.display_mean) < 1:
             raise EventDataError(f"display_mean must be in (0, 1), got {self.display_mean}")
-        level = self.display_mean ** (1.0 / self.gamma)   # the tone map's grey level: it must exist in floats
-        if not 0.0 < level < 1.0 or not math.isfinite(math.log(level / (1.0 - level))):
-            raise EventDataError(f"gamma={self.gamma!r} with display_mean={self.display_mean!r} leaves the tone map no "
+        level = self.display_mean ** (1.0 / self.gamma)   # Reinhard's grey level: it must exist in floats (checked
+        if not 0.0 < level < 1.0 or not math.isfinite(math.log(level / (1.0 - level))):   # for "linear" too)
+            raise EventDataError(f"gamma={self.gamma!r} with display_mean={self.display_mean!r} leaves Reinhard's tone map no "
                                  f"grey level (display_mean ** (1 / gamma) = {level!r}); use a gamma of about 0.01 "
                                  "to 100 (the paper's 0.6)")
         if self.offset_window is not None and not number("offset_window", self.offset_window) > 0:
@@ -303,7 +309,7 @@ class EvINRConfig:
                       "min_bins": 0, "regularizer": "tikhonov", "lam": 0.05, "hidden_features": 512, "hidden_layers": 3,
                       "omega_0": 30.0, "first_omega_0": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
-                      "tau": 5.0, "overlap": 0.5, "gamma": 0.6, "head_solve": False, "offset_solve": "none",
+                      "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": 0.5, "head_solve": False, "offset_solve": "none",
                       "balance": "none", "hot_pixels": "keep", **overrides})
 
     @classmethod

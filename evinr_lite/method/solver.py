@@ -1,7 +1,7 @@
 """EvINR's solver: train frame-based INRs on events and query them at any time.
 
     rec = reconstruct(events, query_times, EvINRConfig(C=0.2))
-    rec.frames          # [Q, H, W] tone-mapped, in [0, 1]
+    rec.frames          # [Q, H, W] displayed (config.tonemap), in [0, 1]
     rec.log_intensity   # [Q, H, W] log intensity
     rec.at(t)           # log intensity at other times
 
@@ -19,11 +19,13 @@ The recipe (paper Sec. 3-4; defaults in :class:`EvINRConfig`):
    overlap, and predictions are cross-faded linearly across the overlap, so no seam shows.
 5. Anchor the brightness. Events only constrain changes of log intensity: adding any constant to
    F leaves every loss unchanged, and a per-pixel constant is only set by the regularizer. The
-   global level is therefore a choice, not a measurement: by default F is shifted so that its mean
-   over the sequence tone-maps to ``display_mean`` (0.5, mid-grey). Metrics with histogram
-   equalisation (CLAHE) are insensitive to it; others should say how the level was set.
-6. Tone-map (Reinhard with ``gamma``), or, with APS frames as anchors (``config.anchor``), let the
-   frames set the offset and the level and return their linear intensity.
+   global level is therefore a choice, not a measurement: by default F is shifted so that the
+   frames' mean over the sequence is ``display_mean`` (0.45; the paper's recipe: the mean of F
+   tone-maps to 0.5). Metrics with histogram equalisation (CLAHE) are nearly insensitive to it;
+   others should say how the level was set.
+6. Display: clip(exp(F), 0, 1) by default, or the paper's Reinhard curve with ``gamma``
+   (``config.tonemap``, :mod:`~evinr_lite.method.tonemap`); with APS frames as anchors
+   (``config.anchor``), the frames set the offset and the level and their linear intensity is returned.
 
 The kit's default (:class:`EvINRConfig`) replaces the Adam iterations of step 3 by the output
 layer's closed-form optimum and solves the per-pixel offset of step 5 explicitly.
@@ -49,7 +51,7 @@ from .memory import check_memory
 from .ensemble import alignment_offsets, blend_networks, blend_weights, predict_networks, split_windows
 from .models import FrameINR
 from .offset import median_gradient_trend, offset_grid
-from .tonemap import anchor_level, tonemap_reinhard
+from .tonemap import display_shift, to_display
 from .training import train_frame_inr
 
 __all__ = ["EvINRConfig", "Reconstruction", "reconstruct", "split_windows", "train_frame_inr",
@@ -109,7 +111,7 @@ class Reconstruction:
         intensity when anchored (:func:`evinr_lite.method.anchor.linear_frames`)."""
         if self.anchor is not None:
             return linear_frames(self.at(times))
-        return tonemap_reinhard(self.at(times), self.config.gamma).astype(np.float32)
+        return to_display(self.at(times), self.config.tonemap, self.config.gamma).astype(np.float32)
 
 
 def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, *,
@@ -171,7 +173,7 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     L = blend_networks(model, windows, q, offsets)
     if trend is not None:
         trend.add_to(L, q)
-    frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)                  # 6. tone map
+    frames = to_display(L, cfg.tonemap, cfg.gamma).astype(np.float32)           # 6. tone map
     return _checked_result(Reconstruction(q, L, frames, model, windows, offsets, cfg, history, trend=trend))
 
 
@@ -239,6 +241,6 @@ def _checked_anchor_frames(frames, sensor_size, t_start: float, t_end: float, cf
 
 
 def _level_shift(L_grid: np.ndarray, cfg: EvINRConfig) -> np.float32:
-    """The constant added to every offset so that the mean log intensity over the sequence
-    (``L_grid`` [G, H, W]) tone-maps to ``cfg.display_mean``: the level events never fix."""
-    return np.float32(anchor_level(cfg.gamma, cfg.display_mean) - float(L_grid.mean()))
+    """The constant added to every offset so that the sequence (``L_grid`` [G, H, W]) displays at
+    ``cfg.display_mean`` (:func:`~evinr_lite.method.tonemap.display_shift`): the level events never fix."""
+    return np.float32(display_shift(L_grid, cfg.tonemap, cfg.gamma, cfg.display_mean))

@@ -47,7 +47,7 @@ from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
 from .offset import OffsetTrend, median_gradient_offset, median_gradient_trend, offset_grid
-from .tonemap import anchor_level, tonemap_reinhard
+from .tonemap import display_shift, to_display
 from .training import train_frame_inr
 
 __all__ = ["stream_reconstruct", "StreamPart", "StreamState", "train_window", "network_at", "chain_offset",
@@ -163,13 +163,13 @@ def _batch(pixels: int) -> int:
     return max(MIN_BATCH, PREDICT_CELLS // max(pixels, 1))
 
 
-def tonemap(L: np.ndarray, gamma: float) -> np.ndarray:
-    """:func:`~evinr_lite.method.tonemap.tonemap_reinhard` of L [Q, H, W] as float32, a few frames at a
-    time (the same values; its float64 work arrays stay small)."""
+def tonemap(L: np.ndarray, config: EvINRConfig) -> np.ndarray:
+    """:func:`~evinr_lite.method.tonemap.to_display` of L [Q, H, W] by the config's tone map, as float32,
+    a few frames at a time (the same values; its float64 work arrays stay small)."""
     out = np.empty(L.shape, np.float32)
     step = max(1, TONEMAP_CELLS // max(int(np.prod(L.shape[1:])), 1))
     for i in range(0, len(L), step):
-        out[i:i + step] = tonemap_reinhard(L[i:i + step], gamma)
+        out[i:i + step] = to_display(L[i:i + step], config.tonemap, config.gamma)
     return out
 
 
@@ -206,7 +206,7 @@ def first_window_offset(model: FrameINR, window, config: EvINRConfig) -> np.ndar
     if config.offset_solve == "median_gradient":
         offset += median_gradient_offset(F).astype(np.float32)
     F += offset
-    offset += np.float32(anchor_level(config.gamma, config.display_mean) - float(F.mean()))
+    offset += np.float32(display_shift(F, config.tonemap, config.gamma, config.display_mean))
     return offset
 
 
@@ -321,7 +321,7 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times) -> Off
     shifted = grid_frames + offset
     if trend is not None:
         trend.add_to(shifted, grid_times)
-    offset += np.float32(anchor_level(config.gamma, config.display_mean) - float(shifted.mean()))
+    offset += np.float32(display_shift(shifted, config.tonemap, config.gamma, config.display_mean))
     if trend is None:
         return OffsetTrend(np.zeros(1), offset[None])
     return OffsetTrend(trend.knots, trend.images + offset)
@@ -379,7 +379,7 @@ def _windows(source, q, grid, cfg, state, spill, on_state, progress):
                               state.windows_log + [log])
             part = None
             if spill is None:
-                part = StreamPart(q[q_idx], q_idx, q_L, tonemap(q_L, cfg.gamma),
+                part = StreamPart(q[q_idx], q_idx, q_L, tonemap(q_L, cfg),
                                   (k, float(lo), float(hi)), _history(new))
             else:
                 with open(spill, "ab") as f:
@@ -408,7 +408,7 @@ def _final_pass(spill, q, offset: OffsetTrend, cfg, sensor_size, history):
                                      "it was changed while the run was stopped: start again without resuming")
             idx = np.arange(i0, i0 + n, dtype=np.int64)
             offset.add_to(L, q[idx])
-            yield StreamPart(q[idx], idx, L, tonemap(L, cfg.gamma), None, history)
+            yield StreamPart(q[idx], idx, L, tonemap(L, cfg), None, history)
 
 
 def _blend_window(model, windows, k, times, total_offset, pending, pending_sum):

@@ -1,9 +1,28 @@
-"""Tone mapping (Eq. 12): log intensity F -> display values in [0, 1].
+"""Display: log intensity F -> frames in [0, 1], and the level that events never fix.
 
-I = exp(F) and Gamma(I) = (I / (I + 1))^gamma. Since I / (I + 1) = sigmoid(F), this is computed
-as sigmoid(F)^gamma, which never overflows. The result depends on the absolute level of F: adding a
-constant c to F (the unknown offset that events cannot see) brightens or darkens every pixel, so a
-reconstruction is only comparable with ground truth once its offset is anchored (see each solver).
+Two tone maps (``EvINRConfig.tonemap``):
+
+- ``"reinhard"``, the paper's Eq. 12: I = exp(F) and Gamma(I) = (I / (I + 1))^gamma. Since
+  I / (I + 1) = sigmoid(F), this is computed as sigmoid(F)^gamma, which never overflows. It
+  compresses contrast (a power gamma = 0.6 of the intensity in the shadows, flattening towards white)
+  and keeps every highlight on screen.
+- ``"linear"``, the kit's default: clip(exp(F), 0, 1), the inverse of the event model. Events are
+  fired by changes of log(I) of the camera's intensity I, so exp(F) is that intensity again, with
+  its own contrast; only highlights beyond 1 are clipped.
+
+Both depend on the absolute level of F: adding a constant c to F (the unknown offset that events
+cannot see) brightens or darkens every pixel, so a reconstruction is only comparable with ground
+truth once its level is anchored (:func:`display_shift`, used by every solver and baseline):
+
+- reinhard: the mean of F over the sequence maps to ``display_mean`` (0.5, mid-grey; the paper's
+  recipe);
+- linear: the frames' mean over the sequence, clipped as displayed, is ``display_mean`` (0.4 by
+  default, a little below mid-grey: of 0.35, 0.4 and 0.45, the one value at which the linear display
+  beats the Reinhard one in CLAHE-SSIM, SSIM and MSE on both the zoo mean and the real chunk).
+
+Why linear is the default (``python benchmarks/quality_zoo.py``, docs/defaults.md "The display"):
+ground truth frames, simulated or APS, are linear intensities, and the Reinhard curve halves their
+contrast (the kit's frames had half the standard deviation of the truth's on the clean zoo scenes).
 """
 from __future__ import annotations
 
@@ -11,7 +30,13 @@ import math
 
 import numpy as np
 
-__all__ = ["tonemap_reinhard", "anchor_level", "anchor_mean"]
+__all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "tonemap_reinhard", "tonemap_linear", "to_display", "display_shift", "anchor_level",
+           "anchor_mean"]
+
+TONEMAPS = ("linear", "reinhard")
+DEFAULT_TONEMAP = "linear"  # the kit's display (EvINRConfig and the baselines share it)
+DEFAULT_DISPLAY_MEAN = 0.4   # linear: the frames' mean over the sequence
+SHIFT_SAMPLES = 1 << 20     # values of the reference used to find the linear level (an even stride through it)
 
 
 def tonemap_reinhard(L, gamma: float = 0.6):
@@ -31,6 +56,59 @@ def tonemap_reinhard(L, gamma: float = 0.6):
     return (0.5 * (1.0 + np.tanh(0.5 * L))) ** gamma  # sigmoid without overflow warnings
 
 
+def tonemap_linear(L):
+    """clip(exp(L), 0, 1), elementwise; numpy array or torch tensor, any shape (float64 for numpy)."""
+    if hasattr(L, "exp"):  # torch tensor
+        return L.clamp(max=0.0).exp()
+    L = np.asarray(L, dtype=np.float64)
+    return np.exp(np.minimum(L, 0.0))
+
+
+def to_display(L, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6):
+    """Frames in [0, 1] from log intensity ``L`` (any shape) by the tone map ``tonemap``
+    ("linear" or "reinhard"; gamma is Reinhard's exponent)."""
+    if tonemap == "linear":
+        return tonemap_linear(L)
+    if tonemap == "reinhard":
+        return tonemap_reinhard(L, gamma)
+    raise ValueError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
+
+
+def display_shift(reference, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6,
+                  display_mean: float = DEFAULT_DISPLAY_MEAN) -> float:
+    """The constant c to add to log intensities so that ``reference + c`` (log intensities on a time
+    grid, any shape) displays at ``display_mean`` by the tone map ``tonemap``.
+
+    - reinhard: the mean of ``reference + c`` is :func:`anchor_level` (the paper's anchor);
+    - linear: the mean of clip(exp(reference + c), 0, 1) is ``display_mean``. Clipped pixels count
+      as 1, so a few hot pixels or highlights cannot darken the rest. Solved by bisection on the
+      sorted values (at most SHIFT_SAMPLES of them, an even stride through ``reference``).
+    """
+    if not 0 < display_mean < 1:
+        raise ValueError(f"display_mean must be in (0, 1), got {display_mean}")
+    if tonemap == "reinhard":
+        return anchor_level(gamma, display_mean) - float(np.mean(reference))
+    if tonemap != "linear":
+        raise ValueError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
+    v = np.asarray(reference).reshape(-1)
+    v = np.sort(v[::max(1, -(-v.size // SHIFT_SAMPLES))].astype(np.float64))
+    if v.size == 0 or not np.isfinite(v[0]) or not np.isfinite(v[-1]):
+        raise ValueError("display_shift needs finite log intensities")
+    top = v[-1]
+    below = np.concatenate([[0.0], np.cumsum(np.exp(v - top))])   # below[k] = sum of exp(v_i - top), i < k
+    n = v.size
+
+    def shown_mean(c):   # mean of min(exp(v + c), 1)
+        k = np.searchsorted(v, -c)                                 # v_i < -c are not clipped
+        return (below[k] * math.exp(top + c) + (n - k)) / n
+
+    lo, hi = math.log(display_mean) - top, -v[0]                   # shown_mean(lo) <= display_mean <= shown_mean(hi) = 1
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if shown_mean(mid) < display_mean else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def anchor_level(gamma: float = 0.6, display_mean: float = 0.5) -> float:
     """The log intensity that tone-maps to ``display_mean``: logit(display_mean ** (1 / gamma)).
 
@@ -43,14 +121,14 @@ def anchor_level(gamma: float = 0.6, display_mean: float = 0.5) -> float:
     return math.log(s / (1.0 - s))
 
 
-def anchor_mean(L, gamma: float = 0.6, display_mean: float = 0.5, reference=None):
-    """``L`` shifted by one constant so that the mean of ``reference`` (default: ``L``) is
-    :func:`anchor_level`, i.e. tone-maps to ``display_mean``. numpy, any shape.
+def anchor_mean(L, gamma: float = 0.6, display_mean: float = 0.5, reference=None, tonemap: str = "reinhard"):
+    """``L`` shifted by one constant so that ``reference`` (default: ``L``) displays at
+    ``display_mean`` by ``tonemap`` (:func:`display_shift`; for "reinhard", the default here, its mean
+    is :func:`anchor_level`). numpy, any shape.
 
     The one brightness anchor of the kit: the solvers, the baselines and the notebooks all use it.
     Pass log intensities on a time grid as ``reference`` to anchor a few frames the way
     :func:`evinr_lite.method.solver.reconstruct` anchors a whole sequence.
     """
     L = np.asarray(L)
-    mean = L.mean() if reference is None else np.mean(reference)
-    return L + (anchor_level(gamma, display_mean) - float(mean))
+    return L + display_shift(L if reference is None else reference, tonemap, gamma, display_mean)
