@@ -35,10 +35,11 @@ class EvINRConfig:
       head_lr_scale = 30, tuned on the demo scene alone); notebooks 03-11 train it.
 
     The kit's default departs from the paper in these fields. Zoo means (CLAHE-SSIM / SSIM / MSE; wall
-    time per scene):
-    ``python benchmarks/quality_zoo.py`` (13 short scenes, one run on 2 quiet cores): kit 0.574 / 0.611 /
-    0.0406 in 0.5 s, paper 0.377 / 0.454 / 0.0586 in 24.2 s, v0.1 0.525 / 0.557 / 0.0500 in 24.7 s,
-    integration 0.430 / 0.505 / 0.0517, high-pass filter 0.478 / 0.531 / 0.0558.
+    time per scene; every method shown by the kit's display):
+    ``python benchmarks/quality_zoo.py`` (13 short scenes, 2 cores): kit 0.621 / 0.688 / 0.0373 in
+    0.4 s, paper 0.392 / 0.481 / 0.0578, v0.1 0.571 / 0.624 / 0.0482 (about 25 s each on quiet cores),
+    integration 0.415 / 0.453 / 0.0641, high-pass filter 0.489 / 0.556 / 0.0557. The figures in the
+    bullets before ``tonemap`` were measured with the paper's Eq. 12 display, the kit's until then.
 
     - head_solve=True, n_iters=0, coarse_to_fine=False: the output layer is solved in closed form
       for the SIREN's initial hidden layers. Training the hidden layers first (60 Adam steps) changed
@@ -88,11 +89,20 @@ class EvINRConfig:
       real chunk 0.349 -> 0.350. Measured with ``python benchmarks/quality_zoo.py --quick --variant
       "bal=balance='events',hot_pixels='drop'"`` and ``--long --scenes long_pan_20s``.
 
-    With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 quiet
-    cores): kit 0.574 / 0.611 / 0.0406, integration + median-gradient offset 0.524 / 0.589 / 0.0404
-    (the INR: 1.10x in CLAHE-SSIM), HF with its cutoff swept per scene 0.523 / 0.569 / 0.0518, leaky
-    integration swept 0.512 / 0.561 / 0.0516; real chunk 0.350 / 0.416 / 0.0889 (1.13x integration +
-    offset); camera_240x180 (2 s at 180x240) in 0.4 s (2.5 s on a shared machine).
+    - tonemap="linear", display_mean=0.4 (issue 21; the paper's Eq. 12 with the mean of F at 0.5
+      before): frames are clip(exp(F), 0, 1), the intensity whose log changes fired the events, with
+      the frames' mean over the sequence at 0.4 (:mod:`~evinr_lite.method.tonemap`). Eq. 12 halved
+      the frames' contrast against linear ground truth. One run, the same reconstructions shown four
+      ways (docs/defaults.md, "The display"): zoo mean 0.574 / 0.611 / 0.0406 (Eq. 12) -> 0.621 /
+      0.688 / 0.0373, real chunk 0.350 / 0.416 / 0.0889 -> 0.354 / 0.424 / 0.0732; display_mean 0.35
+      loses the zoo's MSE (0.0450), 0.45 loses all three on the real chunk (0.344 / 0.404 / 0.0961).
+      Per scene MSE rises on bright and noisy scenes (noisy_gravel 0.0205 -> 0.0559).
+
+    With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 cores):
+    kit 0.621 / 0.688 / 0.0373, integration + median-gradient offset 0.547 / 0.628 / 0.0381 (the INR:
+    1.13x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
+    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.354 / 0.424 / 0.0732 (1.14x integration +
+    offset); camera_240x180 (2 s at 180x240) in 0.4 s.
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
       (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
