@@ -69,7 +69,11 @@ class EvINRConfig:
       (0.350 / 0.416 / 0.0889, lam 0.01); long_ijrr_60s 0.516 -> 0.570 (hf_best 0.552, leaky_best
       0.559); long_pan_20s 0.545 -> 0.539. The scenes that want more than 0.01 (unequal_onhot: 0.723
       at 0.1; object_static_cam) and less than 0.002 stay at the bounds: beyond them the rule
-      would trade the real chunk (0.311 at 0.1) and long_pan_20s (0.523 at 0.001).
+      would trade the real chunk (0.311 at 0.1) and long_pan_20s (0.523 at 0.001). Rerun with the
+      linear display (``python benchmarks/lam_rule.py --long`` and ``--heldout``): zoo mean 0.621
+      against 0.618 for the best fixed lam (0.01), real chunk 0.354 (0.360 at 0.005), held-out 0.513
+      against 0.519 (0.01), long_pan_20s 0.567 against 0.594 (0.01), long_ijrr_60s 0.698 against 0.663
+      (0.01): the rule stays.
     - hidden_features=128 (issue 21; 256 before, 512 in the paper): the same scores as 256 at about half
       the time. Seven full-size zoo scenes (noisy_gravel, unequal_onhot, camera_240x180,
       astronaut_rotzoom, lowtex_light, text_shake, drift_clock), mean CLAHE-SSIM / SSIM / MSE 0.6401 /
