@@ -48,15 +48,20 @@ def _scores(summary):
     return {r["name"]: r.get("scores") for r in summary["recordings"]}
 
 
-def _close(a, b):
+def _close(a, b, clahe=False):
     """Equal up to float rounding: the closed-form solve runs on BLAS, whose thread count differs
-    between a worker process and this one (float32 sums in another order: relative differences near 1e-7)."""
+    between a worker process and this one (float32 sums in another order: relative differences near 1e-7).
+    CLAHE scores (under a "clahe" key, or a pooled row of that equalisation) get abs 2e-3: CLAHE equalises
+    the uint8-rounded frame, so a 1e-7 difference that crosses one rounding boundary moves a tile's whole
+    mapping (measured: 6e-4 relative on one recording in four, both processes otherwise equal)."""
     if isinstance(a, dict):
-        return isinstance(b, dict) and a.keys() == b.keys() and all(_close(a[k], b[k]) for k in a)
+        clahe = clahe or a.get("equalization") == "clahe"
+        return isinstance(b, dict) and a.keys() == b.keys() and all(_close(a[k], b[k], clahe or k == "clahe")
+                                                                    for k in a)
     if isinstance(a, (list, tuple)):
-        return isinstance(b, (list, tuple)) and len(a) == len(b) and all(_close(x, y) for x, y in zip(a, b))
+        return isinstance(b, (list, tuple)) and len(a) == len(b) and all(_close(x, y, clahe) for x, y in zip(a, b))
     if isinstance(a, float) and isinstance(b, float):
-        return a == pytest.approx(b, rel=1e-5, abs=1e-9)
+        return a == pytest.approx(b, rel=1e-5, abs=2e-3 if clahe else 1e-9)
     return a == b
 
 

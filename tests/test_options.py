@@ -102,7 +102,7 @@ def test_options_are_normalised_once():
     ({"n_iters": 0}, "n_iters="), ({"n_iters": 2.5}, "n_iters="), ({"recipe": "Paper"}, "recipe="),
     ({"seed": -1}, "seed"), ({"seed": True}, "seed"), ({"time_unit": "sec"}, "time_unit="), ({"anchor": "some"}, "anchor="),
     ({"sensor_size": (0, 5)}, "sensor_size="), ({"sensor_size": (2.5, 4)}, "sensor_size="), ({"video": "yes"}, "video="),
-    ({"colour": True, "anchor": "all"}, "colour"), ({"device": 0}, "device="),
+    ({"colour": True, "anchor": "all"}, "colour"), ({"device": 0}, "device="), ({"tonemap": "gamma"}, "tonemap="),
 ])
 def test_every_bad_option_is_refused_naming_it(fields, name):
     with pytest.raises(EventDataError, match=name.replace("(", r"\(")):
@@ -135,6 +135,13 @@ def test_options_give_the_recipes_config():
     assert cfg.C == 0.3 and cfg.n_iters == 90 and cfg.c2f_iters == (30, 60) and cfg.seed == 5
     assert cfg.anchor == "first" and not cfg.progress and cfg.first_omega_0 is None   # the paper's recipe
     assert recipe_config("kit", C=0.2) == EvINRConfig(C=0.2)
+    # the display: the recipe's own unless asked, each tone map at its own level
+    assert (RunOptions().config(0.2).tonemap, RunOptions(recipe="paper").config(0.2).tonemap) == ("linear", "reinhard")
+    paper_shown_linear = RunOptions(recipe="paper", tonemap="linear").config(0.2)
+    kit_shown_reinhard = RunOptions(tonemap="reinhard").config(0.2)
+    assert (paper_shown_linear.tonemap, paper_shown_linear.display_mean) == ("linear", EvINRConfig().display_mean)
+    assert (kit_shown_reinhard.tonemap, kit_shown_reinhard.display_mean) == ("reinhard", EvINRConfig.paper().display_mean)
+    assert kit_shown_reinhard.head_solve and not paper_shown_linear.head_solve   # only the display changed
 
 
 def test_the_command_line_maps_each_flag_to_its_option(monkeypatch, tmp_path):
@@ -144,13 +151,13 @@ def test_the_command_line_maps_each_flag_to_its_option(monkeypatch, tmp_path):
     monkeypatch.setattr(job, "run_reconstruct", lambda path, out, options, **kw: seen.update(options=options, **kw))
     argv = ["reconstruct", "rec", "--out", str(tmp_path / "o"), "--sensor", "24x32", "--C", "0.22,0.18", "--at", "0.2,0.1",
             "--start", "0.05", "--end", "0.3", "--time-unit", "us", "--device", "cpu", "--recipe", "v0_1", "--iters", "7",
-            "--seed", "9", "--anchor", "first", "--denoise", "--no-video", "--quiet", "--overwrite"]
+            "--seed", "9", "--anchor", "first", "--denoise", "--no-video", "--quiet", "--overwrite", "--tonemap", "reinhard"]
     assert main(argv) == 0
     o = seen["options"]
     assert (o.sensor_size, o.C, o.at.tolist(), o.t_start, o.t_end, o.time_unit, o.device, o.recipe, o.n_iters, o.seed,
             o.anchor, o.denoise, o.colour, o.video, o.progress) == \
         ((24, 32), (0.22, 0.18), [0.1, 0.2], 0.05, 0.3, "us", "cpu", "v0_1", 7, 9, "first", True, False, False, False)
-    assert seen["overwrite"] is True
+    assert seen["overwrite"] is True and o.tonemap == "reinhard"
     defaults = build_parser().parse_args(["reconstruct", "rec", "--out", "o"])
     assert defaults.recipe == RunOptions().recipe and defaults.seed == RunOptions().seed
 
@@ -193,7 +200,7 @@ def test_batch_task_estimate_takes_plain_arguments():
 
 def test_the_command_lines_choices_are_the_librarys():
     """The command line spells its choices itself (it starts without importing torch): they must stay the library's."""
-    from evinr_lite.apps.cli import RECIPE_CHOICES, TIME_UNIT_CHOICES
+    from evinr_lite.apps.cli import RECIPE_CHOICES, TIME_UNIT_CHOICES, TONEMAP_CHOICES
     from evinr_lite.core.events import TIME_UNITS
     from evinr_lite.method.anchor import ANCHOR_MODES
     from evinr_lite.method.recipes import RECIPES
@@ -201,3 +208,5 @@ def test_the_command_lines_choices_are_the_librarys():
     assert set(RECIPE_CHOICES) == set(RECIPES) and set(TIME_UNIT_CHOICES) == set(TIME_UNITS)
     actions = {a.dest: a for a in build_parser()._subparsers._group_actions[0].choices["reconstruct"]._actions}
     assert set(actions["anchor"].choices) == set(ANCHOR_MODES)
+    from evinr_lite.method.tonemap import TONEMAPS
+    assert set(TONEMAP_CHOICES) == set(TONEMAPS) and set(actions["tonemap"].choices) == set(TONEMAPS)

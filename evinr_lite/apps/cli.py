@@ -105,6 +105,11 @@ class _Parser(argparse.ArgumentParser):
 RECIPE_CHOICES = ("kit", "paper", "v0_1")
 RECIPE_HELP = ("the solver's recipe: kit (default; the closed-form output layer and the explicit per-pixel offset, "
                "chosen on the scene zoo), paper (the paper's recipe exactly), v0_1 (the kit's earlier default)")
+TONEMAP_CHOICES = ("linear", "reinhard")          # method.tonemap.TONEMAPS, spelled here (no torch import at start)
+TONEMAP_HELP = ("how frames are shown: linear (the intensity itself, clip(exp(F), 0, 1), the frames' mean at 0.4; "
+                "the kit's) or reinhard (the paper's Eq. 12, (I / (I + 1))^0.6 with the mean log intensity at 0.5: "
+                "compresses contrast and keeps the highlights of a high-dynamic-range scene on screen); "
+                "default: the recipe's own")
 ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose output layer is solved in closed "
               "form; 300 for paper and v0_1, with coarse-to-fine at a third and two thirds)")
 
@@ -151,6 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--end", type=_finite, help="window end, seconds on the recording's clock (see `info`)")
     rec.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
     rec.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
+    rec.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
     rec.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     rec.add_argument("--seed", type=_seed, default=0)
     rec.add_argument("--colour", action="store_true",
@@ -181,6 +187,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--C", type=_positive, default=0.2, help="contrast threshold (default: 0.2)")
     demo.add_argument("--frames", type=_count, default=8, help="number of frames to reconstruct (default: 8)")
     demo.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
+    demo.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
     demo.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     demo.add_argument("--seed", type=_seed, default=0)
     demo.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
@@ -212,6 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                  "times); scores are always taken at the ground-truth frames")
     batch.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
     batch.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
+    batch.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
     batch.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     batch.add_argument("--seed", type=_seed, default=0)
     batch.add_argument("--video", action="store_true", help="also write MP4 / GIF per recording")
@@ -236,7 +244,8 @@ def _run_options(args):
                       t_start=getattr(args, "start", None), t_end=getattr(args, "end", None),
                       time_unit=getattr(args, "time_unit", None), device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
-                      colour=getattr(args, "colour", False), video=video, progress=not args.quiet)
+                      colour=getattr(args, "colour", False), tonemap=args.tonemap, video=video,
+                      progress=not args.quiet)
 
 
 def _reconstruct(args) -> None:
@@ -252,7 +261,10 @@ def _demo(args) -> None:
     from ..method.recipes import recipe_config
 
     check_output_path(args.out, overwrite=args.overwrite)   # say so before training, not after
-    config = recipe_config(args.recipe, args.iters, C=args.C, seed=args.seed)
+    from ..method.tonemap import DISPLAY_MEANS
+
+    display = {} if args.tonemap is None else {"tonemap": args.tonemap, "display_mean": DISPLAY_MEANS[args.tonemap]}
+    config = recipe_config(args.recipe, args.iters, C=args.C, seed=args.seed, **display)
     run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
              n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)
 

@@ -24,13 +24,14 @@ from ..core.recording import Recording
 from ..method.config import EvINRConfig
 from ..method.memory import check_times_memory
 from ..method.recipes import RECIPES, contrast_option, recipe_config
+from ..method.tonemap import DISPLAY_MEANS, TONEMAPS
 
 __all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "BATCH_FIELDS", "DEFAULT_FPS"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
-BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor")
+BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap")
 MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
 _INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
 
@@ -133,6 +134,8 @@ class RunOptions:
             iterations (None: the recipe's own); seed: seeds the networks.
         anchor: "none", "first" or "all" (:mod:`evinr_lite.method.anchor`); denoise: denoise the
             window's events first; colour: one EvINR per colour channel (not with an anchor).
+        tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
+            paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
         video: also write MP4 / GIF; progress: show a progress bar.
     """
 
@@ -150,11 +153,14 @@ class RunOptions:
     anchor: str = "none"
     denoise: bool = False
     colour: bool = False
+    tonemap: str | None = None
     video: bool = True
     progress: bool = True
 
     def __post_init__(self):
         checked = {"C": contrast_option(self.C)}
+        if self.tonemap is not None and self.tonemap not in TONEMAPS:
+            raise EventDataError(f"tonemap= must be one of {TONEMAPS} (or None: the recipe's own), got {self.tonemap!r}")
         if self.anchor not in ANCHOR_MODES:
             raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {self.anchor!r}")
         if self.fps is not None and self.at is not None:
@@ -224,8 +230,9 @@ class RunOptions:
 
     def config(self, C) -> EvINRConfig:
         """The EvINRConfig of this run's recipe with the resolved threshold ``C`` (a number or a pair)."""
+        display = {} if self.tonemap is None else {"tonemap": self.tonemap, "display_mean": DISPLAY_MEANS[self.tonemap]}
         return recipe_config(self.recipe, self.n_iters, C=C, seed=self.seed, device=self.device,
-                             progress=self.progress, anchor=self.anchor)
+                             progress=self.progress, anchor=self.anchor, **display)
 
     def to_dict(self, names=None) -> dict:
         """JSON-ready values of the named fields (all by default): pairs and sizes as lists."""

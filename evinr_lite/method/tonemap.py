@@ -30,12 +30,13 @@ import math
 
 import numpy as np
 
-__all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "tonemap_reinhard", "tonemap_linear", "to_display", "display_shift", "anchor_level",
+__all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "DISPLAY_MEANS", "tonemap_reinhard", "tonemap_linear", "to_display", "display_shift", "anchor_level",
            "anchor_mean"]
 
 TONEMAPS = ("linear", "reinhard")
 DEFAULT_TONEMAP = "linear"  # the kit's display (EvINRConfig and the baselines share it)
 DEFAULT_DISPLAY_MEAN = 0.4   # linear: the frames' mean over the sequence
+DISPLAY_MEANS = {"linear": DEFAULT_DISPLAY_MEAN, "reinhard": 0.5}   # each tone map's level (Reinhard: the paper's)
 SHIFT_SAMPLES = 1 << 20     # values of the reference used to find the linear level (an even stride through it)
 
 
