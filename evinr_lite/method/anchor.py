@@ -22,7 +22,8 @@ fixes it. With ``L(t)`` the INR's log intensity (after the networks are aligned)
 
 Output space: the anchored log intensity is the frames' own, so the frames are
 ``clip(exp(L) - eps, 0, 1)`` (the APS frames' linear intensity; plain SSIM against the frames is
-meaningful). The kit's display tone map (Reinhard after the mean anchor) is measured beside it in
+meaningful). The paper's display tone map (Reinhard after the mean anchor; the kit's display until
+issue 21's linear one, :mod:`~evinr_lite.method.tonemap`) is measured beside it in
 ``benchmarks/anchors.py`` (the tone-mapped numbers there): it scores lower on every scene but the
 low-texture lowtex_light (``first``: 0.876 / 0.709 linear, 0.934 / 0.803 tone-mapped), so the linear
 output is the one produced. Frames used as anchors are excluded from scoring
@@ -35,7 +36,7 @@ equalisation / CLAHE-SSIM, on the frames not used as anchors (``first``: all but
 odd frames). CF: the complementary filter (Scheerlinck et al. 2018, gain 2 pi rad/s) fed frame 0
 (like for like with ``first``), the even frames (like for like with ``all``), or every frame as it
 arrives (its design: a frame every 50 ms); CF gain 0 is direct integration from frame 0. Events only
-is the kit default, tone-mapped (it has no level of its own)::
+is the kit default of that run, shown by Eq. 12 (it has no level of its own)::
 
     scene               events only  first        CF frame 0   CF gain 0    all          CF even      CF every
     object_static_cam   0.242/0.226  0.897/0.894  0.789/0.782  0.958/0.938  0.985/0.977  0.967/0.953  0.975/0.963
