@@ -261,10 +261,7 @@ def _demo(args) -> None:
     from ..method.recipes import recipe_config
 
     check_output_path(args.out, overwrite=args.overwrite)   # say so before training, not after
-    from ..method.tonemap import DISPLAY_MEANS
-
-    display = {} if args.tonemap is None else {"tonemap": args.tonemap, "display_mean": DISPLAY_MEANS[args.tonemap]}
-    config = recipe_config(args.recipe, args.iters, C=args.C, seed=args.seed, **display)
+    config = recipe_config(args.recipe, args.iters, args.tonemap, C=args.C, seed=args.seed)
     run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
              n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)
 

@@ -24,7 +24,7 @@ from ..core.recording import Recording
 from ..method.config import EvINRConfig
 from ..method.memory import check_times_memory
 from ..method.recipes import RECIPES, contrast_option, recipe_config
-from ..method.tonemap import DISPLAY_MEANS, TONEMAPS
+from ..method.tonemap import TONEMAPS
 
 __all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "BATCH_FIELDS", "DEFAULT_FPS"]
 
@@ -230,9 +230,8 @@ class RunOptions:
 
     def config(self, C) -> EvINRConfig:
         """The EvINRConfig of this run's recipe with the resolved threshold ``C`` (a number or a pair)."""
-        display = {} if self.tonemap is None else {"tonemap": self.tonemap, "display_mean": DISPLAY_MEANS[self.tonemap]}
-        return recipe_config(self.recipe, self.n_iters, C=C, seed=self.seed, device=self.device,
-                             progress=self.progress, anchor=self.anchor, **display)
+        return recipe_config(self.recipe, self.n_iters, self.tonemap, C=C, seed=self.seed, device=self.device,
+                             progress=self.progress, anchor=self.anchor)
 
     def to_dict(self, names=None) -> dict:
         """JSON-ready values of the named fields (all by default): pairs and sizes as lists."""

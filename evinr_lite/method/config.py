@@ -17,7 +17,7 @@ import numpy as np
 from ..core.events import EventDataError
 from .anchor import ANCHOR_MODES
 from .binning import as_thresholds
-from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, TONEMAPS
+from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEMAPS
 
 __all__ = ["EvINRConfig"]
 
@@ -323,7 +323,7 @@ class EvINRConfig:
                       "min_bins": 0, "regularizer": "tikhonov", "lam": 0.05, "hidden_features": 512, "hidden_layers": 3,
                       "omega_0": 30.0, "first_omega_0": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
-                      "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": 0.5, "head_solve": False, "offset_solve": "none",
+                      "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": DISPLAY_MEANS["reinhard"], "head_solve": False, "offset_solve": "none",
                       "balance": "none", "hot_pixels": "keep", **overrides})
 
     @classmethod

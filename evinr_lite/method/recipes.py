@@ -15,6 +15,7 @@ from ..core.recording import Recording
 from .binning import as_thresholds
 from .config import EvINRConfig
 from .contrast import fit_contrast
+from .tonemap import DISPLAY_MEANS
 
 __all__ = ["RECIPES", "recipe_config", "DEFAULT_C", "contrast_option", "format_contrast", "resolve_contrast"]
 
@@ -22,13 +23,16 @@ RECIPES = {"kit": EvINRConfig, "paper": EvINRConfig.paper, "v0_1": EvINRConfig.v
 DEFAULT_C = EvINRConfig.C   # the paper's threshold for DAVIS recordings (IJRR, HQF): EvINRConfig's own default
 
 
-def recipe_config(recipe: str = "kit", n_iters: int | None = None, **fields) -> EvINRConfig:
+def recipe_config(recipe: str = "kit", n_iters: int | None = None, tonemap: str | None = None,
+                  **fields) -> EvINRConfig:
     """The EvINRConfig of a named recipe: "kit" (``EvINRConfig()``, the default), "paper" (the paper's
     recipe exactly) or "v0_1" (the kit's default before the scene zoo).
 
     ``n_iters`` None keeps the recipe's own (kit: no Adam iteration, the output layer solved in closed
     form; paper: 300). Given, it sets the Adam iterations; for the recipes with coarse-to-fine the two
     bisections move to n_iters / 3 and 2 n_iters / 3 (the paper's 100 and 200 of 300).
+    ``tonemap`` None keeps the recipe's own display; "linear" or "reinhard" shows it that way, at that
+    tone map's own level (:data:`~evinr_lite.method.tonemap.DISPLAY_MEANS`).
     """
     if recipe not in RECIPES:
         raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {recipe!r}")
@@ -38,6 +42,11 @@ def recipe_config(recipe: str = "kit", n_iters: int | None = None, **fields) -> 
         if make().coarse_to_fine:
             c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
             fields.update(c2f_iters=c2f, coarse_to_fine=bool(c2f))
+    if tonemap is not None:
+        if tonemap not in DISPLAY_MEANS:
+            raise EventDataError(f"tonemap= must be one of {tuple(DISPLAY_MEANS)} (or None: the recipe's own), "
+                                 f"got {tonemap!r}")
+        fields.update(tonemap=tonemap, display_mean=DISPLAY_MEANS[tonemap])
     return make(**fields)
 
 

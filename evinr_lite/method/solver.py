@@ -20,7 +20,7 @@ The recipe (paper Sec. 3-4; defaults in :class:`EvINRConfig`):
 5. Anchor the brightness. Events only constrain changes of log intensity: adding any constant to
    F leaves every loss unchanged, and a per-pixel constant is only set by the regularizer. The
    global level is therefore a choice, not a measurement: by default F is shifted so that the
-   frames' mean over the sequence is ``display_mean`` (0.45; the paper's recipe: the mean of F
+   frames' mean over the sequence is ``display_mean`` (0.4; the paper's recipe: the mean of F
    tone-maps to 0.5). Metrics with histogram equalisation (CLAHE) are nearly insensitive to it;
    others should say how the level was set.
 6. Display: clip(exp(F), 0, 1) by default, or the paper's Reinhard curve with ``gamma``
