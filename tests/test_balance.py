@@ -105,3 +105,25 @@ def test_a_streamed_source_gets_the_same_plan_as_the_whole_span(unequal):
     assert streamed.C == whole.C
     np.testing.assert_array_equal(source.events(0.0, 30.0).t, ev.t)
     assert len(ev) < len(hot_ev)                                       # the hot pixels were dropped
+
+
+def test_the_priors_spread_is_the_zoos_imbalance():
+    """PRIOR is the root mean square of the imbalance simulated over the zoo (benchmarks/balance.py
+    prints it with NET_CHANGE's counterpart, which needs the scenes simulated)."""
+    from evinr_lite.method.balance import PRIOR
+    from evinr_lite.sim.zoo import default_scenes
+
+    b = [(z.C_pos - z.C_neg) / (z.C_pos + z.C_neg) if z.C_pos is not None else 0.0 for z in default_scenes(long=True)]
+    assert PRIOR == pytest.approx(float(np.sqrt(np.mean(np.square(b)))), abs=0.02)
+
+
+def test_balance_benchmark_row_reads_a_scene():
+    """benchmarks/balance.py on one quick zoo scene: the pooled estimate finds its C+ != C-."""
+    from benchmarks.balance import scene_row
+    from evinr_lite.sim.zoo import ZOO, quick
+
+    z = quick(next(s for s in ZOO if s.name == "noisy_gravel"))
+    row = scene_row(z)
+    assert row["b_true"] == pytest.approx(0.1, abs=1e-9)
+    assert abs(row["raw"] - row["b_true"]) < 0.03 and 0 < row["shrink"] < 1
+    assert abs(row["applied"]) < abs(row["raw"])

@@ -36,7 +36,7 @@ class EvINRConfig:
 
     The kit's default departs from the paper in these fields. Zoo means (CLAHE-SSIM / SSIM / MSE; wall
     time per scene; every method shown by the kit's display):
-    ``python benchmarks/quality_zoo.py`` (13 short scenes, 2 cores): kit 0.621 / 0.688 / 0.0373 in
+    ``python benchmarks/quality_zoo.py`` (13 short scenes, 2 cores): kit 0.619 / 0.687 / 0.0364 in
     0.4 s, paper 0.392 / 0.481 / 0.0578, v0.1 0.571 / 0.624 / 0.0482 (about 25 s each on quiet cores),
     integration 0.415 / 0.453 / 0.0641, high-pass filter 0.489 / 0.556 / 0.0557. The figures in the
     bullets before ``tonemap`` were measured with the paper's Eq. 12 display, the kit's until then.
@@ -92,6 +92,13 @@ class EvINRConfig:
       as given (quick zoo mean 0.5302 -> 0.5319; unequal_onhot 0.577 -> 0.605 from the hot pixels);
       real chunk 0.349 -> 0.350. Measured with ``python benchmarks/quality_zoo.py --quick --variant
       "bal=balance='events',hot_pixels='drop'"`` and ``--long --scenes long_pan_20s``.
+      The shrinkage's two prior spreads are the zoo's root mean squares (``python benchmarks/balance.py``:
+      imbalance 0.084, change of the mean log brightness over a span 0.50; NET_CHANGE was 1.0 before):
+      zoo mean 0.621 / 0.688 / 0.0373 -> 0.619 / 0.687 / 0.0364, real chunk 0.354 / 0.424 / 0.0732 ->
+      0.354 / 0.423 / 0.0694, held-out 0.513 / 0.560 / 0.0696 -> 0.516 / 0.564 / 0.0680, long_pan_20s
+      0.567 / 0.664 / 0.0379 -> 0.569 / 0.669 / 0.0352 (level error per quarter -0.027 ... -0.153 ->
+      -0.070 ... -0.116, the display level near -0.09 aside), cat_slider_20s 0.488 -> 0.494 (MSE 0.0552 ->
+      0.0503).
 
     - tonemap="linear", display_mean=0.4 (issue 21; the paper's Eq. 12 with the mean of F at 0.5
       before): frames are clip(exp(F), 0, 1), the intensity whose log changes fired the events, with
@@ -103,9 +110,9 @@ class EvINRConfig:
       Per scene MSE rises on bright and noisy scenes (noisy_gravel 0.0205 -> 0.0559).
 
     With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 cores):
-    kit 0.621 / 0.688 / 0.0373, integration + median-gradient offset 0.547 / 0.628 / 0.0381 (the INR:
+    kit 0.619 / 0.687 / 0.0364, integration + median-gradient offset 0.547 / 0.628 / 0.0381 (the INR:
     1.13x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
-    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.354 / 0.424 / 0.0732 (1.14x integration +
+    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.354 / 0.423 / 0.0694 (1.14x integration +
     offset); camera_240x180 (2 s at 180x240) in 0.4 s.
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk

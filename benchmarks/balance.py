@@ -1,0 +1,75 @@
+"""The ON/OFF balance from the events alone, scene by scene: what it estimates and how far it is trusted.
+
+    python benchmarks/balance.py              # the zoo's scenes, long ones included (about 2 min on 2 cores)
+    python benchmarks/balance.py --heldout    # the held-out scenes instead
+
+For each scene: the simulated imbalance b = (C+ - C-) / (C+ + C-), the pooled estimate from the
+counts (``raw``), the share of it that is used (``shrink``) and the result (``applied``), with the
+mean event count per usable pixel, and the truth's change of mean log intensity from the first to
+the last scored frame (what the pooled estimate cannot tell from an imbalance). The last lines give
+the root mean square of b and of that change over the scenes: the two prior spreads of
+:mod:`evinr_lite.method.balance` (PRIOR, NET_CHANGE) are set from the zoo's. Writes
+benchmarks/balance_results[_heldout].{json,md}.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.common import write_json  # noqa: E402
+from evinr_lite.method.balance import NET_CHANGE, PRIOR, balance_from_counts, polarity_counts  # noqa: E402
+from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, simulate  # noqa: E402
+
+
+def scene_row(z) -> dict:
+    """The balance of one zoo scene against its simulated thresholds."""
+    _, events, times, gt = simulate(z)
+    C = effective_C(z)
+    fit = balance_from_counts(*polarity_counts(events), C)
+    c_pos = z.C_pos if z.C_pos is not None else C
+    c_neg = z.C_neg if z.C_neg is not None else C
+    log_mean = np.log(np.clip(np.asarray(gt, np.float64), 1e-3, None)).mean(axis=(1, 2))
+    return {"span_s": float(times[-1] - times[0]), "b_true": (c_pos - c_neg) / (c_pos + c_neg),
+            "raw": fit.raw_imbalance, "shrink": fit.shrink, "applied": fit.imbalance,
+            "mean_events": fit.mean_events, "mean_log_change": float(log_mean[-1] - log_mean[0])}
+
+
+def markdown(rows: dict, rms: dict) -> str:
+    lines = ["| scene | span (s) | events per pixel | b simulated | b pooled (raw) | shrink | b applied | "
+             "truth's mean log change |", "|---|---|---|---|---|---|---|---|"]
+    for name, r in rows.items():
+        lines.append(f"| {name} | {r['span_s']:.1f} | {r['mean_events']:.1f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | "
+                     f"{r['shrink']:.2f} | {r['applied']:+.3f} | {r['mean_log_change']:+.3f} |")
+    lines += ["", f"Root mean square over these {len(rows)} scenes: simulated b {rms['b']:.3f}, mean log change "
+              f"{rms['log_change']:.2f} (the prior spreads in evinr_lite.method.balance: PRIOR {PRIOR}, NET_CHANGE "
+              f"{NET_CHANGE}). Written by `python benchmarks/balance.py`."]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--heldout", action="store_true", help="the held-out scenes instead of the zoo's")
+    a = p.parse_args(argv)
+    suffix = "_heldout" if a.heldout else ""
+    rows = {}
+    for z in (HELDOUT if a.heldout else default_scenes(long=True)):
+        rows[z.name] = r = scene_row(z)
+        print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  b {r['b_true']:+.3f}  raw {r['raw']:+.3f}  "
+              f"shrink {r['shrink']:.2f}  applied {r['applied']:+.3f}  mean log change {r['mean_log_change']:+.3f}", flush=True)
+    rms = {"b": float(np.sqrt(np.mean([r["b_true"] ** 2 for r in rows.values()]))),
+           "log_change": float(np.sqrt(np.mean([r["mean_log_change"] ** 2 for r in rows.values()])))}
+    print(f"root mean square: b {rms['b']:.3f}, mean log change {rms['log_change']:.2f}")
+    write_json(f"benchmarks/balance_results{suffix}.json", {"heldout": a.heldout, "scenes": rows, "rms": rms,
+                                                             "prior": PRIOR, "net_change": NET_CHANGE})
+    Path(f"benchmarks/balance_results{suffix}.md").write_text(markdown(rows, rms))
+    print(f"markdown: benchmarks/balance_results{suffix}.md")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
