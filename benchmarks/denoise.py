@@ -39,9 +39,8 @@ from evinr_lite.core.events import Events  # noqa: E402
 from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.method.denoise import DEFAULT_DT, correlation_filter, denoise_mask, hot_pixel_mask  # noqa: E402
 from evinr_lite.sim import zoo  # noqa: E402
-from evinr_lite.sim.simulate import add_background_noise, add_hot_pixels, simulate_scene  # noqa: E402
 
-SIGNAL, BACKGROUND, HOT = 0, 1, 2
+SIGNAL, BACKGROUND, HOT = zoo.SIGNAL, zoo.BACKGROUND, zoo.HOT
 STRESS = dict(noise_hz=2.0, hot_pixels=40, hot_hz=200.0)
 
 # name -> denoise() keyword arguments (default: two-sided, same polarity, 50 ms); None: no denoising;
@@ -74,28 +73,10 @@ def noisy_scenes(quick: bool) -> list:
 
 def simulate_labeled(z):
     """``zoo.simulate(z)`` with labels: (events, labels int8 [N] (0 signal, 1 background, 2 hot),
-    hot pixels' flat indices, times [10], gt [10, H, W]). Same seeds, same draws, same events."""
-    scene = z.build(z.size, z.duration)
-    kw = {} if z.C_pos is None else {"C_pos": z.C_pos, "C_neg": z.C_neg}
-    events = simulate_scene(scene, 0.0, z.duration, C=z.C, threshold_sigma=z.threshold_sigma,
-                            refractory=z.refractory, seed=z.seed, **kw)
-    labels = np.zeros(len(events), np.int8)
-    rng = np.random.default_rng(z.seed + 100)
-    hot = np.zeros(0, np.int64)
-    for kind in (BACKGROUND, HOT):
-        if kind == BACKGROUND and z.noise_hz > 0:
-            events, added = add_background_noise(events, z.noise_hz, seed=rng, t_start=0.0, t_end=z.duration,
-                                                 return_labels=True)
-        elif kind == HOT and z.hot_pixels:
-            events, hot, added = add_hot_pixels(events, z.hot_pixels, z.hot_hz, seed=rng, t_start=0.0,
-                                                t_end=z.duration, return_labels=True)
-        else:
-            continue
-        new = np.full(len(events), kind, np.int8)
-        new[~added] = labels                         # the merge is stable: old events keep their order
-        labels = new
-    times = np.linspace(0.1 * z.duration, 0.95 * z.duration, zoo.N_SCORED)
-    return events, labels, hot, times, scene.intensity(times).astype(np.float32)
+    hot pixels' flat indices, times [10], gt [10, H, W]). Same seeds, same draws, same events, and the
+    same ground truth (clipped at 1): it is ``zoo.simulate(z, labels=True)``."""
+    _, events, times, gt, labels, hot = zoo.simulate(z, labels=True)
+    return events, labels, hot, times, gt
 
 
 def kept_mask(events: Events, labels: np.ndarray, setting) -> tuple[np.ndarray, float]:

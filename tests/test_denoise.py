@@ -118,12 +118,19 @@ def test_zoo_simulation_with_labels_matches_the_zoo():
     from benchmarks.denoise import simulate_labeled
     from evinr_lite.sim import zoo
 
-    z = zoo.quick(zoo.get("grass_light_noisy"))
-    ev, labels, hot, _, _ = simulate_labeled(z)
-    _, ev0, _, _ = zoo.simulate(z)
-    for k in "txyp":
-        np.testing.assert_array_equal(getattr(ev, k), getattr(ev0, k))
-    assert (labels == 1).any() and (labels == 2).sum() > 0 and hot.size == z.hot_pixels
+    # background + hot pixels; ON-only hot pixels; background that grows as light falls
+    for name in ("grass_light_noisy", "unequal_onhot", "dark_falling"):
+        z = zoo.quick(zoo.get(name))
+        ev, labels, hot, times, gt = simulate_labeled(z)
+        _, ev0, times0, gt0 = zoo.simulate(z)
+        for k in "txyp":
+            np.testing.assert_array_equal(getattr(ev, k), getattr(ev0, k))
+        np.testing.assert_array_equal(times, times0)
+        np.testing.assert_array_equal(gt, gt0)                  # the scored truth, clipped at 1 like the zoo's
+        assert (labels == 1).any() and hot.size == z.hot_pixels
+        assert (labels == 2).sum() > 0 or z.hot_pixels == 0
+        if z.hot_on_only:
+            assert np.all(ev.p[labels == 2] > 0)
 
 
 # ---- hot pixels and the whole denoiser on a noisy scene ---------------------------------------

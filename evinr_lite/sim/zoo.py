@@ -185,8 +185,15 @@ def quick(z: ZooScene) -> ZooScene:
                        "duration": round(z.duration * 0.75, 3)})
 
 
-def simulate(z: ZooScene):
-    """(scene, events, gt times [n_scored], gt intensity frames [n_scored, H, W] in (0, 1], clipped at 1)."""
+SIGNAL, BACKGROUND, HOT = 0, 1, 2     # the labels of simulate(..., labels=True)
+
+
+def simulate(z: ZooScene, labels: bool = False):
+    """(scene, events, gt times [n_scored], gt intensity frames [n_scored, H, W] in (0, 1], clipped at 1).
+
+    ``labels=True`` appends (labels int8 [N]: SIGNAL 0, BACKGROUND 1 (background activity, also the
+    dark noise), HOT 2; the hot pixels' flat indices int64 [K]): the same seeds, draws and events.
+    """
     scene = z.build(z.size, z.duration)
     kw = {} if z.C_pos is None else {"C_pos": z.C_pos, "C_neg": z.C_neg}
     if z.threshold_drift:
@@ -194,16 +201,31 @@ def simulate(z: ZooScene):
     events = simulate_scene(scene, 0.0, z.duration, C=z.C, threshold_sigma=z.threshold_sigma,
                             refractory=z.refractory, seed=z.seed, **kw)
     rng = np.random.default_rng(z.seed + 100)
+    kind = np.zeros(len(events), np.int8)
+    hot = np.zeros(0, np.int64)
+
+    def merged(events_added, label):          # the merges are stable: earlier events keep their order
+        nonlocal kind
+        events, added = events_added
+        new = np.full(len(events), label, np.int8)
+        new[~added] = kind
+        kind = new
+        return events
+
     if z.noise_hz > 0:
-        events = add_background_noise(events, z.noise_hz, seed=rng, t_start=0.0, t_end=z.duration)
+        events = merged(add_background_noise(events, z.noise_hz, seed=rng, t_start=0.0, t_end=z.duration,
+                                             return_labels=True), BACKGROUND)
     if z.hot_pixels:
-        events, _ = add_hot_pixels(events, z.hot_pixels, z.hot_hz, seed=rng, t_start=0.0, t_end=z.duration,
-                                   on_only=z.hot_on_only)
+        events, hot, added = add_hot_pixels(events, z.hot_pixels, z.hot_hz, seed=rng, t_start=0.0, t_end=z.duration,
+                                            on_only=z.hot_on_only, return_labels=True)
+        events = merged((events, added), HOT)
     if z.dark_noise_hz > 0:
-        events = add_light_noise(events, scene, z.dark_noise_hz, seed=rng, t_start=0.0, t_end=z.duration)
+        events = merged(add_light_noise(events, scene, z.dark_noise_hz, seed=rng, t_start=0.0, t_end=z.duration,
+                                        return_labels=True), BACKGROUND)
     times = np.linspace(0.1 * z.duration, 0.95 * z.duration, z.n_scored)
     # a frame camera saturates: light above full scale (a brightening scene, cubic overshoot at edges) reads 1
-    return scene, events, times, np.clip(scene.intensity(times), 0.0, 1.0).astype(np.float32)
+    out = (scene, events, times, np.clip(scene.intensity(times), 0.0, 1.0).astype(np.float32))
+    return out + (kind, np.asarray(hot, np.int64)) if labels else out
 
 
 def effective_C(z: ZooScene) -> float:
