@@ -26,7 +26,8 @@ long scenes, minutes each), the baselines ``integration`` and ``hf`` at their de
 ``leaky_best`` (HF's cutoff and leaky integration's leak swept per scene, 0.03-3 Hz, the best by
 CLAHE-SSIM against the truth: tuned with the answer in hand, which the kit never has; the sweep is in
 the JSON and the markdown), ``integration_offset`` (integration + the kit's median-gradient offset:
-what the INR must beat), ``kit_windows`` (long scenes: the kit on independent 2 s windows), and the
+what the INR must beat), ``kit_windows`` (long scenes: the kit on independent 2 s windows),
+``kit_denoised`` (only when named in ``--methods``: the kit on the events after ``--denoise``), and the
 oracle: the events integrated from the true frame at the first scored time, as linear intensity with
 the true level (``oracle_linear``) and shown by the display with its level anchored like every
 method's (``oracle_tonemapped``). The oracle is what the events carry once the unknown per-pixel offset
@@ -58,6 +59,7 @@ from evinr_lite.core.events import Events  # noqa: E402
 from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
 from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
+from evinr_lite.method.denoise import denoise  # noqa: E402
 from evinr_lite.method.tonemap import anchor_mean, to_display  # noqa: E402
 from evinr_lite.sim.zoo import HELDOUT, ZOO, default_scenes, effective_C, quick, simulate  # noqa: E402
 
@@ -69,6 +71,7 @@ ORACLES = ("oracle_linear", "oracle_tonemapped")
 EVINR = ("kit", "paper", "v0_1")
 WINDOWED = ("kit_windows",)                         # long scenes: the kit on independent 2 s windows
 METHODS = EVINR + BASELINES + SWEPT + NAMED + ORACLES + WINDOWED
+OPTIONAL = ("kit_denoised",)                       # on request only: the kit on the events after --denoise
 EXTRA = NAMED                                       # kept for older callers (robustness, denoise)
 SLOW = ("paper", "v0_1")                            # trained recipes: skipped on long scenes (minutes each)
 SWEEP = {"hf_best": ("hf", "cutoff_hz", (0.03, 0.1, 0.3, 1.0, 3.0)),
@@ -131,6 +134,8 @@ def run_method(name: str, events: Events, times: np.ndarray, C, variants: dict, 
         L = L_first + integrate_events(events, times, C=C) - integrate_events(events, times[:1], C=C)
         frames = (np.clip(np.exp(L), 0, 1) if name == "oracle_linear" else
                   to_display(anchor_mean(L, **DISPLAY), DISPLAY["tonemap"]))
+    elif name == "kit_denoised":   # background activity and hot pixels removed first (evinr_lite.method.denoise)
+        frames = reconstruct(denoise(events)[0], times, evinr_config("kit", C, variants)).frames
     elif name in WINDOWED:
         frames = windowed(events, times, C, variants)
     else:
@@ -477,9 +482,9 @@ def zoo_main(argv=None) -> dict:
     a.figure = f"benchmarks/zoo_figure{suffix}.png" if a.figure is None else a.figure
     variants = dict(parse_variant(v) for v in a.variant)
     methods = [m for m in a.methods.split(",") if m] + [v for v in variants if v not in a.methods.split(",")]
-    unknown = [m for m in methods if m not in METHODS and m not in variants]
+    unknown = [m for m in methods if m not in METHODS + OPTIONAL and m not in variants]
     if unknown:
-        p.error(f"unknown methods {unknown}; use {METHODS} or add --variant NAME=...")
+        p.error(f"unknown methods {unknown}; use {METHODS + OPTIONAL} or add --variant NAME=...")
     pool = HELDOUT if a.heldout else ZOO
     if a.scenes is None:
         scenes = list(HELDOUT) if a.heldout else default_scenes(a.long)
