@@ -23,7 +23,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.common import write_json  # noqa: E402
 from evinr_lite.method.balance import NET_CHANGE, PRIOR, balance_from_counts, polarity_counts  # noqa: E402
-from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, simulate  # noqa: E402
+from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, imbalance, simulate  # noqa: E402
 
 
 def scene_row(z) -> dict:
@@ -31,10 +31,8 @@ def scene_row(z) -> dict:
     _, events, times, gt = simulate(z)
     C = effective_C(z)
     fit = balance_from_counts(*polarity_counts(events), C)
-    c_pos = z.C_pos if z.C_pos is not None else C
-    c_neg = z.C_neg if z.C_neg is not None else C
     log_mean = np.log(np.clip(np.asarray(gt, np.float64), 1e-3, None)).mean(axis=(1, 2))
-    return {"span_s": float(times[-1] - times[0]), "b_true": (c_pos - c_neg) / (c_pos + c_neg),
+    return {"span_s": float(times[-1] - times[0]), "b_true": imbalance(z),
             "raw": fit.raw_imbalance, "shrink": fit.shrink, "applied": fit.imbalance,
             "mean_events": fit.mean_events, "mean_log_change": float(log_mean[-1] - log_mean[0])}
 

@@ -111,9 +111,9 @@ def test_the_priors_spread_is_the_zoos_imbalance():
     """PRIOR is the root mean square of the imbalance simulated over the zoo (benchmarks/balance.py
     prints it with NET_CHANGE's counterpart, which needs the scenes simulated)."""
     from evinr_lite.method.balance import PRIOR
-    from evinr_lite.sim.zoo import default_scenes
+    from evinr_lite.sim.zoo import default_scenes, imbalance
 
-    b = [(z.C_pos - z.C_neg) / (z.C_pos + z.C_neg) if z.C_pos is not None else 0.0 for z in default_scenes(long=True)]
+    b = [imbalance(z) for z in default_scenes(long=True)]
     assert PRIOR == pytest.approx(float(np.sqrt(np.mean(np.square(b)))), abs=0.02)
 
 

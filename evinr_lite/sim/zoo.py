@@ -27,7 +27,8 @@ import numpy as np
 from . import scenes as sc
 from .simulate import add_background_noise, add_hot_pixels, add_light_noise, simulate_scene
 
-__all__ = ["ZooScene", "ZOO", "HELDOUT", "N_SCORED", "quick", "simulate", "effective_C", "get", "default_scenes"]
+__all__ = ["ZooScene", "ZOO", "HELDOUT", "N_SCORED", "quick", "simulate", "effective_C", "imbalance", "get", "default_scenes",
+           "SIGNAL", "BACKGROUND", "HOT"]
 
 N_SCORED = 10   # ground-truth times scored per scene, evenly spread over [0.1, 0.95] of the duration
 
@@ -203,29 +204,35 @@ def simulate(z: ZooScene, labels: bool = False):
     rng = np.random.default_rng(z.seed + 100)
     kind = np.zeros(len(events), np.int8)
     hot = np.zeros(0, np.int64)
-
-    def merged(events_added, label):          # the merges are stable: earlier events keep their order
-        nonlocal kind
-        events, added = events_added
-        new = np.full(len(events), label, np.int8)
-        new[~added] = kind
-        kind = new
-        return events
-
     if z.noise_hz > 0:
-        events = merged(add_background_noise(events, z.noise_hz, seed=rng, t_start=0.0, t_end=z.duration,
-                                             return_labels=True), BACKGROUND)
+        events, added = add_background_noise(events, z.noise_hz, seed=rng, t_start=0.0, t_end=z.duration,
+                                             return_labels=True)
+        kind = _relabelled(kind, added, BACKGROUND)
     if z.hot_pixels:
         events, hot, added = add_hot_pixels(events, z.hot_pixels, z.hot_hz, seed=rng, t_start=0.0, t_end=z.duration,
                                             on_only=z.hot_on_only, return_labels=True)
-        events = merged((events, added), HOT)
+        kind = _relabelled(kind, added, HOT)
     if z.dark_noise_hz > 0:
-        events = merged(add_light_noise(events, scene, z.dark_noise_hz, seed=rng, t_start=0.0, t_end=z.duration,
-                                        return_labels=True), BACKGROUND)
+        events, added = add_light_noise(events, scene, z.dark_noise_hz, seed=rng, t_start=0.0, t_end=z.duration,
+                                        return_labels=True)
+        kind = _relabelled(kind, added, BACKGROUND)
     times = np.linspace(0.1 * z.duration, 0.95 * z.duration, z.n_scored)
     # a frame camera saturates: light above full scale (a brightening scene, cubic overshoot at edges) reads 1
     out = (scene, events, times, np.clip(scene.intensity(times), 0.0, 1.0).astype(np.float32))
     return out + (kind, np.asarray(hot, np.int64)) if labels else out
+
+
+def _relabelled(kind: np.ndarray, added: np.ndarray, label: int) -> np.ndarray:
+    """The labels after a stable merge: the ``added`` events (bool [N_out]) get ``label``, the others
+    keep theirs (``kind`` [N_in], in order)."""
+    new = np.full(added.shape, label, np.int8)
+    new[~added] = kind
+    return new
+
+
+def imbalance(z: ZooScene) -> float:
+    """The scene's simulated ON/OFF imbalance (C+ - C-) / (C+ + C-) (0 when C+ = C-)."""
+    return 0.0 if z.C_pos is None else (z.C_pos - z.C_neg) / (z.C_pos + z.C_neg)
 
 
 def effective_C(z: ZooScene) -> float:
