@@ -24,7 +24,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.common import write_json  # noqa: E402
 from benchmarks.quality_zoo import real_chunk, score  # noqa: E402
-from evinr_lite.method.balance import plan_from_counts, polarity_counts  # noqa: E402
+from evinr_lite.method.balance import polarity_counts  # noqa: E402
+from evinr_lite.method.prepare import plan_from_counts  # noqa: E402
 from evinr_lite.method.config import EvINRConfig  # noqa: E402
 from evinr_lite.method.smoothing import activity, window_fraction  # noqa: E402
 from evinr_lite.method.solver import reconstruct  # noqa: E402

@@ -27,7 +27,8 @@ long scenes, minutes each), the baselines ``integration`` and ``hf`` at their de
 CLAHE-SSIM against the truth: tuned with the answer in hand, which the kit never has; the sweep is in
 the JSON and the markdown), ``integration_offset`` (integration + the kit's median-gradient offset:
 what the INR must beat), ``kit_windows`` (long scenes: the kit on independent 2 s windows),
-``kit_denoised`` (only when named in ``--methods``: the kit on the events after ``--denoise``), and the
+``kit_unfiltered`` (only when named in ``--methods``: the kit with ``background="keep"``, its default
+before the background filter), and the
 oracle: the events integrated from the true frame at the first scored time, as linear intensity with
 the true level (``oracle_linear``) and shown by the display with its level anchored like every
 method's (``oracle_tonemapped``). The oracle is what the events carry once the unknown per-pixel offset
@@ -59,7 +60,6 @@ from evinr_lite.core.events import Events  # noqa: E402
 from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
 from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
-from evinr_lite.method.denoise import denoise  # noqa: E402
 from evinr_lite.method.tonemap import anchor_mean, to_display  # noqa: E402
 from evinr_lite.sim.zoo import HELDOUT, ZOO, default_scenes, effective_C, quick, simulate  # noqa: E402
 
@@ -71,7 +71,7 @@ ORACLES = ("oracle_linear", "oracle_tonemapped")
 EVINR = ("kit", "paper", "v0_1")
 WINDOWED = ("kit_windows",)                         # long scenes: the kit on independent 2 s windows
 METHODS = EVINR + BASELINES + SWEPT + NAMED + ORACLES + WINDOWED
-OPTIONAL = ("kit_denoised",)                       # on request only: the kit on the events after --denoise
+OPTIONAL = ("kit_unfiltered",)                     # on request only: the kit without its background filter
 EXTRA = NAMED                                       # kept for older callers (robustness, denoise)
 SLOW = ("paper", "v0_1")                            # trained recipes: skipped on long scenes (minutes each)
 SWEEP = {"hf_best": ("hf", "cutoff_hz", (0.03, 0.1, 0.3, 1.0, 3.0)),
@@ -83,7 +83,8 @@ DISPLAY = {"tonemap": EvINRConfig().tonemap, "display_mean": EvINRConfig().displ
 
 
 def evinr_config(name: str, C, variants: dict) -> EvINRConfig:
-    base = {"kit": EvINRConfig, "paper": EvINRConfig.paper, "v0_1": EvINRConfig.v0_1}
+    base = {"kit": EvINRConfig, "paper": EvINRConfig.paper, "v0_1": EvINRConfig.v0_1,
+            "kit_unfiltered": lambda **kw: EvINRConfig(background="keep", **kw)}
     if name in base:
         return base[name](C=C, progress=False, **DISPLAY)
     return EvINRConfig(**{**variants[name], "C": C, "progress": False})
@@ -134,8 +135,6 @@ def run_method(name: str, events: Events, times: np.ndarray, C, variants: dict, 
         L = L_first + integrate_events(events, times, C=C) - integrate_events(events, times[:1], C=C)
         frames = (np.clip(np.exp(L), 0, 1) if name == "oracle_linear" else
                   to_display(anchor_mean(L, **DISPLAY), DISPLAY["tonemap"]))
-    elif name == "kit_denoised":   # background activity and hot pixels removed first (evinr_lite.method.denoise)
-        frames = reconstruct(denoise(events)[0], times, evinr_config("kit", C, variants)).frames
     elif name in WINDOWED:
         frames = windowed(events, times, C, variants)
     else:

@@ -4,8 +4,8 @@ import pytest
 
 from evinr_lite.core.events import EventDataError, Events
 from evinr_lite.method import EvINRConfig, reconstruct
-from evinr_lite.method.balance import (PolarityCounts, balance_from_counts, estimate_balance, polarity_counts,
-                                       prepare_events)
+from evinr_lite.method.balance import PolarityCounts, balance_from_counts, estimate_balance, polarity_counts
+from evinr_lite.method.prepare import prepare_events
 from evinr_lite.sim.scenes import OscillatingScene
 from evinr_lite.sim.simulate import add_hot_pixels, simulate_scene
 
@@ -96,7 +96,7 @@ def test_balance_removes_the_drift_of_a_long_recording(unequal):
 
 def test_a_streamed_source_gets_the_same_plan_as_the_whole_span(unequal):
     from evinr_lite.io.source import MemorySource
-    from evinr_lite.method.balance import prepare_source
+    from evinr_lite.method.prepare import prepare_source
 
     hot_ev, hot = add_hot_pixels(unequal, 8, 400.0, seed=2, on_only=True)
     cfg = EvINRConfig(C=0.225, tau=5.0, progress=False)

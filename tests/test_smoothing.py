@@ -4,7 +4,8 @@ import pytest
 
 from evinr_lite import EvINRConfig, make_scene, simulate_scene
 from evinr_lite.core.events import EventDataError
-from evinr_lite.method.balance import plan_from_counts, polarity_counts
+from evinr_lite.method.balance import polarity_counts
+from evinr_lite.method.prepare import plan_from_counts
 from evinr_lite.method.ensemble import split_windows
 from evinr_lite.method.smoothing import LAM_MAX, LAM_MIN, LAM_SCALE, activity, auto_lam, window_fraction
 from evinr_lite.method.solver import reconstruct

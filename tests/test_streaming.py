@@ -13,6 +13,7 @@ from evinr_lite import EvINRConfig, make_scene, simulate_scene
 from evinr_lite.core.events import EventDataError
 from evinr_lite.evaluation.scoring import score_sequence
 from evinr_lite.io.source import MemorySource
+from evinr_lite.method.prepare import REACH
 from evinr_lite.method.models import FrameINR
 from evinr_lite.method.solver import reconstruct
 from evinr_lite.method.streaming import StreamState, stream_reconstruct
@@ -74,10 +75,11 @@ def test_many_windows_give_the_whole_sequence_result(scene_events, tmp_path):
     # same networks, alignment, cross-fade, offset image and level: equal up to float32 rounding
     np.testing.assert_allclose(L, whole.log_intensity, rtol=0, atol=1e-4 * np.abs(whole.log_intensity).max())
     np.testing.assert_allclose(frames, whole.frames, rtol=0, atol=1e-4)
-    # each window read only its own events (never the whole recording); before them, the counting pass
-    # of method/balance.prepare_source (hot pixels, ON/OFF balance) read the span in chunks of tau
-    assert len(source.asked) == 4 + 3
-    assert all(t1 - t0 <= cfg.tau + 1e-6 for t0, t1 in source.asked)
+    # each window read only its own events and the background filter's reach (never the whole
+    # recording); before them, the two counting passes of method/prepare.prepare_source (raw counts for
+    # the hot pixels, filtered ones for the ON/OFF balance and lam) read the span in chunks of tau
+    assert len(source.asked) == 4 + 3 + 3
+    assert all(t1 - t0 <= cfg.tau + 2 * REACH + 1e-6 for t0, t1 in source.asked)
     assert (tmp_path / "log_intensity.f32").stat().st_size == len(q) * SIZE[0] * SIZE[1] * 4   # the spill
 
 

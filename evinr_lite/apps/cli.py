@@ -170,7 +170,9 @@ def build_parser() -> argparse.ArgumentParser:
                           "anchor frames are not scored, run.json says which; output in the frames' intensity")
     rec.add_argument("--denoise", action="store_true",
                      help="remove hot pixels and background activity from the window's events before "
-                          "reconstructing (evinr_lite.method.denoise defaults); run.json records what was removed")
+                          "reconstructing, for any recipe (evinr_lite.method.denoise defaults); run.json records "
+                          "what was removed. The kit recipe filters them anyway, inside the method "
+                          "(EvINRConfig.background), without the report")
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--resume", action="store_true",

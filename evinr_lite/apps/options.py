@@ -229,9 +229,12 @@ class RunOptions:
         return self
 
     def config(self, C) -> EvINRConfig:
-        """The EvINRConfig of this run's recipe with the resolved threshold ``C`` (a number or a pair)."""
+        """The EvINRConfig of this run's recipe with the resolved threshold ``C`` (a number or a pair).
+        With ``denoise`` the events were filtered before (and reported), so the recipe's own background
+        filter is not run a second time."""
+        extra = {"background": "keep"} if self.denoise else {}
         return recipe_config(self.recipe, self.n_iters, self.tonemap, C=C, seed=self.seed, device=self.device,
-                             progress=self.progress, anchor=self.anchor)
+                             progress=self.progress, anchor=self.anchor, **extra)
 
     def to_dict(self, names=None) -> dict:
         """JSON-ready values of the named fields (all by default): pairs and sizes as lists."""

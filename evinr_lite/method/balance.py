@@ -47,7 +47,8 @@ off by the change of mean brightness where it does (camera_translate: +0.193 for
 -0.35 over 1.7 s with 13 events per pixel), which is what the shrinkage is for.
 
 Everything works from per-pixel counts, so a streamed recording can carry :class:`PolarityCounts`
-from window to window and estimate the balance from all the events seen so far.
+from window to window and estimate the balance from all the events seen so far. Where the solver
+applies it (with the hot pixels, the background filter and lam): :mod:`evinr_lite.method.prepare`.
 """
 from __future__ import annotations
 
@@ -60,7 +61,7 @@ from .binning import as_thresholds
 from .denoise import hot_threshold
 
 __all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "balance_from_counts", "estimate_balance",
-           "prepare_events", "prepare_source", "plan_from_counts", "drop_pixels", "BALANCE_MODES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
+           "BALANCE_MODES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
 
 BALANCE_MODES = ("none", "events")
 HOT_PIXEL_MODES = ("keep", "drop")
@@ -196,83 +197,3 @@ def estimate_balance(events: Events, C, **kw) -> BalanceFit:
     if len(events) == 0:
         raise EventDataError("no events to estimate the ON/OFF balance from; pass a span with events")
     return balance_from_counts(*polarity_counts(events), C, **kw)
-
-
-def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0):
-    """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance == "events"`` and
-    C is one number, ``lam="auto"`` replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
-    for windows covering ``fraction`` of the span), and the hot pixels to drop (bool [H, W], all False
-    unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
-    changed (a copy)."""
-    from dataclasses import replace
-
-    from .smoothing import auto_lam
-
-    n_on = np.asarray(n_on, np.float64)
-    n_off = np.asarray(n_off, np.float64)
-    n = n_on + n_off
-    hot = np.zeros(n.shape, bool)
-    if cfg.hot_pixels == "drop":
-        hot = n > hot_threshold(np.rint(n))                 # denoise.hot_pixel_mask's rule, on these counts
-    if cfg.balance == "events" and np.ndim(cfg.C) == 0:
-        fit = balance_from_counts(np.where(hot, 0, n_on), np.where(hot, 0, n_off), cfg.C)
-        if fit.applied:
-            cfg = replace(cfg, C=fit.C)
-    if cfg.lam == "auto":
-        cfg = replace(cfg, lam=auto_lam(np.where(hot, 0, n_on), np.where(hot, 0, n_off), fraction))
-    return cfg, hot
-
-
-def drop_pixels(events: Events, mask) -> Events:
-    """The events without those of the pixels in ``mask`` (bool [H, W]; None or all False: unchanged)."""
-    if mask is None or not np.any(mask):
-        return events
-    return events.take(~mask[events.y, events.x])
-
-
-def prepare_events(events: Events, cfg, span: tuple | None = None):
-    """The solver's first step (a hook in :func:`~evinr_lite.method.solver.reconstruct`): ``(events, cfg)``
-    with hot pixels dropped (``cfg.hot_pixels == "drop"``), C replaced by the pair estimated from
-    these events (``cfg.balance == "events"``, one C given) and ``lam="auto"`` by its value:
-    :func:`plan_from_counts` on their counts. ``span``: (t_start, t_end) seconds reconstructed
-    (default: the events' first and last time), which sets how much of it one window covers."""
-    from .smoothing import window_fraction
-
-    if not len(events):
-        return events, cfg
-    t0, t1 = (float(events.t[0]), float(events.t[-1])) if span is None else span
-    cfg, hot = plan_from_counts(*polarity_counts(events), cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap))
-    return drop_pixels(events, hot), cfg
-
-
-class _WithoutPixels:
-    """A recording source whose events leave out some pixels (everything else is the source's)."""
-
-    def __init__(self, source, mask):
-        self._source, self._mask = source, mask
-
-    def __getattr__(self, name):
-        return getattr(self._source, name)
-
-    def events(self, t0, t1):
-        return drop_pixels(self._source.events(t0, t1), self._mask)
-
-
-def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | None = None):
-    """:func:`prepare_events` for a streamed recording (a hook in
-    :func:`~evinr_lite.method.streaming.stream_reconstruct`): ``(cfg, source)``, the counts read once
-    over [t_start, t_end] in chunks of ``chunk_s`` seconds (default ``cfg.tau``, so memory stays that
-    of one window), so every window is trained with the same C pair and without the same hot pixels
-    as the whole-sequence solve."""
-    from .smoothing import window_fraction
-
-    if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto":
-        return cfg, source
-    chunk_s = chunk_s or cfg.tau or (t_end - t_start)
-    counts = PolarityCounts(tuple(source.sensor_size))
-    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
-    for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
-        last = i == len(edges) - 2                               # the span's end is inclusive, as in reconstruct
-        counts.update(source.events(a, np.nextafter(b, np.inf) if last else b))
-    cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap))
-    return cfg, (_WithoutPixels(source, hot) if hot.any() else source)

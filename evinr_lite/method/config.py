@@ -178,6 +178,11 @@ class EvINRConfig:
             used as it is.
         hot_pixels: "keep" or "drop": the events of pixels firing far above the sensor's robust rate
             (:func:`evinr_lite.method.denoise.hot_pixel_mask`) are left out before training.
+        background: "keep" or "filter": background activity (isolated events with no event of the same
+            polarity at a neighbouring pixel within 50 ms before or after) is left out before training,
+            after the hot pixels and before the ON/OFF balance and lam are estimated
+            (:func:`evinr_lite.method.denoise.denoise` with its defaults; streamed windows are read with
+            the filter's reach beyond their edges, so they see the same events).
         anchor: APS frames as anchors (:mod:`evinr_lite.method.anchor`; pass ``frames=`` to
             :func:`reconstruct`): "none" (events only, the default), "first" (the first frame in the
             window sets the per-pixel offset) or "all" (every ``anchor_every``-th frame is a soft
@@ -230,6 +235,7 @@ class EvINRConfig:
     offset_window: float | None = 5.0
     balance: str = "events"
     hot_pixels: str = "drop"
+    background: str = "filter"
     anchor: str = "none"
     anchor_every: int = 2
     anchor_smoothing: float = 0.03
@@ -241,7 +247,8 @@ class EvINRConfig:
         # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
                    "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient"),
-                   "balance": ("none", "events"), "hot_pixels": ("keep", "drop"), "tonemap": TONEMAPS}
+                   "balance": ("none", "events"), "hot_pixels": ("keep", "drop"),
+                   "background": ("keep", "filter"), "tonemap": TONEMAPS}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
@@ -333,7 +340,7 @@ class EvINRConfig:
                       "omega_0": 30.0, "first_omega_0": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
                       "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": DISPLAY_MEANS["reinhard"], "head_solve": False, "offset_solve": "none",
-                      "balance": "none", "hot_pixels": "keep", **overrides})
+                      "balance": "none", "hot_pixels": "keep", "background": "keep", **overrides})
 
     @classmethod
     def v0_1(cls, **overrides) -> "EvINRConfig":

@@ -45,7 +45,7 @@ from ..core.checks import check_result_frames, require, whole_number
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from .anchor import fit_anchor, frames_in_window, linear_frames
-from .balance import prepare_events
+from .prepare import prepare_events
 from .config import EvINRConfig
 from .memory import check_memory
 from .ensemble import alignment_offsets, blend_networks, blend_weights, predict_networks, split_windows
@@ -141,7 +141,7 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")
     require(frames, Frames, "frames", none_ok=True)
     q, events, t_start, t_end = _checked_span(events, query_times, t_start, t_end)
-    events, cfg = prepare_events(events, cfg, (t_start, t_end))                 # 0. hot pixels, ON/OFF balance, lam
+    events, cfg = prepare_events(events, cfg, (t_start, t_end))                 # 0. hot pixels, background, ON/OFF balance, lam
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)               # 1. windows
     frames = _checked_anchor_frames(frames, events.sensor_size, t_start, t_end, cfg)   # before training
     if memory_guard:                                                            # before anything large is allocated

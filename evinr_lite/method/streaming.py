@@ -14,8 +14,9 @@ be saved after every window and resumed (``on_state``, ``state=``).
 What is the same as the whole-sequence solve (tests/test_streaming.py):
 
 - network k: the same seed (:func:`~evinr_lite.method.models.network_seed`), the same bins and the
-  same training; the ON/OFF balance and hot pixels from one counting pass over the span
-  (:func:`~evinr_lite.method.balance.prepare_source`);
+  same training and the same events: hot pixels, background filter, ON/OFF balance and lam from
+  counting passes over the span, each window read with the background filter's reach beyond its
+  edges (:func:`~evinr_lite.method.prepare.prepare_source`);
 - the alignment over each overlap and the linear cross-fade (the previous network's values at
   the shared times are carried);
 - the per-pixel offset image (``offset_solve``) and the level anchor (``display_mean``), which the
@@ -42,7 +43,7 @@ import torch
 
 from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
-from .balance import prepare_source
+from .prepare import prepare_source
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
@@ -271,7 +272,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
 
     source = as_source(source)
     cfg, q, t_start, t_end = _check(source, query_times, config, t_start, t_end, offset_from)
-    cfg, source = prepare_source(source, t_start, t_end, cfg)    # hot pixels, ON/OFF balance (method/balance.py)
+    cfg, source = prepare_source(source, t_start, t_end, cfg)    # hot pixels, background, ON/OFF balance, lam (method/prepare.py)
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
     if state is None:
         state = StreamState.start(windows, source.sensor_size)

@@ -1,0 +1,161 @@
+"""The solver's step 0: what is done to the events, and to the config, before any training.
+
+In this order, each judged on what the step before left (``EvINRConfig`` fields in brackets):
+
+1. hot pixels dropped (``hot_pixels="drop"``): pixels whose count is far above the sensor's robust
+   count (:func:`~evinr_lite.method.denoise.hot_pixel_mask`);
+2. background activity filtered (``background="filter"``): events without an event of the same
+   polarity at a neighbouring pixel within ``DEFAULT_DT`` (50 ms) before or after them
+   (:func:`~evinr_lite.method.denoise.correlation_filter`, :func:`~evinr_lite.method.denoise.denoise`'s
+   defaults). Hot pixels go first: their events would otherwise keep their neighbours' noise;
+3. the ON/OFF balance (``balance="events"``: C+ and C- from one nominal C,
+   :mod:`~evinr_lite.method.balance`) and ``lam="auto"`` (:mod:`~evinr_lite.method.smoothing`),
+   both from the per-pixel ON / OFF counts of the events that are left; pixels still hot on those
+   counts are dropped too.
+
+:func:`prepare_events` does this for events in memory (:func:`~evinr_lite.method.solver.reconstruct`),
+:func:`prepare_source` for a recording read window by window
+(:func:`~evinr_lite.method.streaming.stream_reconstruct`). The two see the same events: the stream
+counts the span in chunks first (two reading passes when the background is filtered: the hot
+pixels come from the raw counts, the balance from the filtered ones), and reads each window with the
+filter's reach (twice ``DEFAULT_DT``, clipped to the span) beyond its edges, so an event near an
+edge is judged on the same neighbours as in the whole span.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from ..core.events import EventDataError, Events
+from .balance import PolarityCounts, balance_from_counts, polarity_counts
+from .denoise import DEFAULT_DT, DEFAULT_SAME_POLARITY, DEFAULT_WINDOW, correlation_filter, hot_threshold
+from .smoothing import auto_lam, window_fraction
+
+__all__ = ["prepare_events", "prepare_source", "plan_from_counts", "drop_pixels", "filter_background",
+           "BACKGROUND_MODES", "REACH"]
+
+BACKGROUND_MODES = ("keep", "filter")
+REACH = 2 * DEFAULT_DT    # s read beyond a streamed window's edges: more than the filter's DEFAULT_DT, so rounding never matters
+
+
+def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0):
+    """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance == "events"`` and
+    C is one number, ``lam="auto"`` replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
+    for windows covering ``fraction`` of the span), and the hot pixels to drop (bool [H, W], all False
+    unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
+    changed (a copy)."""
+    n_on = np.asarray(n_on, np.float64)
+    n_off = np.asarray(n_off, np.float64)
+    n = n_on + n_off
+    hot = np.zeros(n.shape, bool)
+    if cfg.hot_pixels == "drop":
+        hot = n > hot_threshold(np.rint(n))                 # denoise.hot_pixel_mask's rule, on these counts
+    if cfg.balance == "events" and np.ndim(cfg.C) == 0:
+        fit = balance_from_counts(np.where(hot, 0, n_on), np.where(hot, 0, n_off), cfg.C)
+        if fit.applied:
+            cfg = replace(cfg, C=fit.C)
+    if cfg.lam == "auto":
+        cfg = replace(cfg, lam=auto_lam(np.where(hot, 0, n_on), np.where(hot, 0, n_off), fraction))
+    return cfg, hot
+
+
+def drop_pixels(events: Events, mask) -> Events:
+    """The events without those of the pixels in ``mask`` (bool [H, W]; None or all False: unchanged)."""
+    if mask is None or not np.any(mask):
+        return events
+    return events.take(~mask[events.y, events.x])
+
+
+def filter_background(events: Events) -> Events:
+    """The events that :func:`~evinr_lite.method.denoise.correlation_filter` keeps with
+    :func:`~evinr_lite.method.denoise.denoise`'s defaults (two-sided, same polarity, ``DEFAULT_DT``)."""
+    if len(events) == 0:
+        return events
+    return events.take(correlation_filter(events, DEFAULT_DT, same_polarity=DEFAULT_SAME_POLARITY,
+                                          window=DEFAULT_WINDOW))
+
+
+def _hot_mask(n: np.ndarray) -> np.ndarray:
+    return n > hot_threshold(np.rint(n))
+
+
+def _check_left(n_left: int, n_in: int):
+    if n_left < 2:
+        raise EventDataError(f"the background filter left {n_left} of {n_in:,} events; the recording is mostly "
+                             "isolated events (noise, or a scene too sparse for a 50 ms neighbourhood). Pass "
+                             "EvINRConfig(background='keep') to train on every event")
+
+
+def prepare_events(events: Events, cfg, span: tuple | None = None):
+    """Step 0 of :func:`~evinr_lite.method.solver.reconstruct` (see the module's docstring): ``(events,
+    cfg)`` with hot pixels and background activity removed as ``cfg`` says, C replaced by the pair
+    estimated from these events (``cfg.balance == "events"``, one C given) and ``lam="auto"`` by its
+    value. ``span``: (t_start, t_end) seconds reconstructed (default: the events' first and last
+    time), which sets how much of it one window covers."""
+    if not len(events):
+        return events, cfg
+    t0, t1 = (float(events.t[0]), float(events.t[-1])) if span is None else span
+    if cfg.background == "filter":
+        n_in = len(events)
+        if cfg.hot_pixels == "drop":
+            events = drop_pixels(events, _hot_mask(sum(polarity_counts(events))))
+        events = filter_background(events)
+        _check_left(len(events), n_in)
+    cfg, hot = plan_from_counts(*polarity_counts(events), cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap))
+    return drop_pixels(events, hot), cfg
+
+
+class _Prepared:
+    """A recording source whose windows are prepared as in the whole span: hot pixels (``first``)
+    dropped, background filtered on the window read ``REACH`` beyond its edges (within the span), then
+    the pixels of ``then`` dropped. Everything else is the source's."""
+
+    def __init__(self, source, span, first=None, background=False, then=None):
+        self._source, self._span = source, span
+        self._first, self._background, self._then = first, background, then
+
+    def __getattr__(self, name):
+        return getattr(self._source, name)
+
+    def events(self, t0, t1):
+        if not self._background:
+            return drop_pixels(drop_pixels(self._source.events(t0, t1), self._first), self._then)
+        lo, hi = self._span
+        a, b = max(t0 - REACH, lo), min(t1 + REACH, np.nextafter(hi, np.inf))   # the span's end is inclusive
+        wide = filter_background(drop_pixels(self._source.events(a, max(a, b)), self._first))
+        inside = (wide.t >= t0) & (wide.t < t1)
+        return drop_pixels(wide.take(inside), self._then)
+
+
+def _counts(source, t_start: float, t_end: float, chunk_s: float) -> PolarityCounts:
+    counts = PolarityCounts(tuple(source.sensor_size))
+    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
+    for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+        last = i == len(edges) - 2                               # the span's end is inclusive, as in reconstruct
+        counts.update(source.events(a, np.nextafter(b, np.inf) if last else b))
+    return counts
+
+
+def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | None = None):
+    """:func:`prepare_events` for a streamed recording (a hook in
+    :func:`~evinr_lite.method.streaming.stream_reconstruct`): ``(cfg, source)``. The counts are read
+    over [t_start, t_end] in chunks of ``chunk_s`` seconds (default ``cfg.tau``, so memory stays that
+    of one window): once, or twice with ``cfg.background == "filter"`` (raw counts for the hot
+    pixels, then the filtered events' counts). So every window is trained with the same C pair, lam
+    and events as the whole-span solve."""
+    if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto" and cfg.background == "keep":
+        return cfg, source
+    chunk_s = chunk_s or cfg.tau or (t_end - t_start)
+    span, first, filtered = (t_start, t_end), None, cfg.background == "filter"
+    counts = _counts(source, t_start, t_end, chunk_s)
+    if filtered:
+        if cfg.hot_pixels == "drop":
+            first = _hot_mask(counts.n_on + counts.n_off)
+        n_in = int((counts.n_on + counts.n_off).sum())
+        counts = _counts(_Prepared(source, span, first, background=True), t_start, t_end, chunk_s)
+        _check_left(int((counts.n_on + counts.n_off).sum()), n_in)
+    cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap))
+    if not filtered and not hot.any():
+        return cfg, source
+    return cfg, _Prepared(source, span, first, background=filtered, then=hot)
