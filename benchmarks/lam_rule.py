@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks.common import write_json  # noqa: E402
 from benchmarks.quality_zoo import real_chunk, score  # noqa: E402
 from evinr_lite.method.balance import polarity_counts  # noqa: E402
-from evinr_lite.method.prepare import plan_from_counts  # noqa: E402
+from evinr_lite.method.prepare import prepare_events  # noqa: E402
 from evinr_lite.method.config import EvINRConfig  # noqa: E402
 from evinr_lite.method.smoothing import activity, window_fraction  # noqa: E402
 from evinr_lite.method.solver import reconstruct  # noqa: E402
@@ -37,10 +37,9 @@ SWEEP = (0.001, 0.002, 0.005, 0.01, 0.03, 0.1)
 def scene_row(name, events, times, gt, C, log=print) -> dict:
     t0, t1 = float(min(events.t[0], times.min())), float(max(events.t[-1], times.max()))
     cfg = EvINRConfig(C=C, progress=False)
-    n_on, n_off = polarity_counts(events)
     fraction = window_fraction(t0, t1, cfg.tau, cfg.overlap)
-    planned, hot = plan_from_counts(n_on, n_off, cfg, fraction)
-    m = activity(np.where(hot, 0, n_on), np.where(hot, 0, n_off)) * fraction
+    kept, planned = prepare_events(events, cfg, (t0, t1))        # what reconstruct trains on: hot pixels, background
+    m = activity(*polarity_counts(kept)) * fraction
     row = {"activity": m, "lam_auto": planned.lam, "scores": {}}
     for lam in ("auto",) + SWEEP:
         t = time.perf_counter()
