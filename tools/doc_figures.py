@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "zoo_results.json"
 HELDOUT = ROOT / "benchmarks" / "zoo_results_heldout.json"
 REAL = "real_slider_chunk"
-LABELS = {"kit": "kit (`EvINRConfig()`)", "paper": "paper (`EvINRConfig.paper()`)",
+LABELS = {"kit": "kit (`EvINRConfig()`)", "kit_unfiltered": "kit_unfiltered (`EvINRConfig(background=\"keep\")`)", "paper": "paper (`EvINRConfig.paper()`)",
           "v0_1": "v0_1 (`EvINRConfig.v0_1()`)", "hf": "hf (high-pass filter)"}
 BLOCKS = {"zoo-summary": ROOT / "docs" / "defaults.md", "zoo-table": ROOT / "benchmarks" / "README.md",
           "heldout-table": ROOT / "benchmarks" / "README.md"}

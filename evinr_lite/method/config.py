@@ -111,11 +111,22 @@ class EvINRConfig:
       loses the zoo's MSE (0.0450), 0.45 loses all three on the real chunk (0.344 / 0.404 / 0.0961).
       Per scene MSE rises on bright and noisy scenes (noisy_gravel 0.0205 -> 0.0559).
 
+    - background="filter" (issue 21): after the hot pixels, events without an event of the same
+      polarity at a neighbouring pixel within 50 ms before or after them are left out, and the ON/OFF
+      balance and lam are estimated on the rest (:mod:`evinr_lite.method.prepare`). One run with
+      ``background="keep"`` beside it (``python benchmarks/quality_zoo.py --methods
+      kit,kit_unfiltered,...``): zoo mean 0.619 / 0.687 / 0.0364 -> 0.634 / 0.692 / 0.0366, real chunk
+      0.354 / 0.423 / 0.0694 -> 0.360 / 0.429 / 0.0690, held-out mean 0.516 / 0.564 / 0.0680 -> 0.523 /
+      0.569 / 0.0682, long_pan_20s 0.569 / 0.669 / 0.0352 -> 0.643 / 0.732 / 0.0307, unequal_onhot
+      0.637 -> 0.784; costs chelsea_speed 0.552 -> 0.536 and ihc_warp 0.436 -> 0.412 (fast motion and
+      sparse fine texture, where some signal events have no neighbour).
+
     With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 cores):
-    kit 0.619 / 0.687 / 0.0364, integration + median-gradient offset 0.547 / 0.628 / 0.0381 (the INR:
-    1.13x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
-    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.354 / 0.423 / 0.0694 (1.14x integration +
-    offset); camera_240x180 (2 s at 180x240) in 0.4 s.
+    kit 0.634 / 0.692 / 0.0366, integration + median-gradient offset 0.547 / 0.628 / 0.0381 (the INR:
+    1.16x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
+    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.360 / 0.429 / 0.0690 (1.16x integration +
+    offset); camera_240x180 (2 s at 180x240) in 0.63 s, 0.62 s unfiltered in the same run (a machine
+    shared with another run; 0.36 s quiet).
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
       (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
