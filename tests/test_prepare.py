@@ -97,3 +97,26 @@ def test_a_recording_of_isolated_events_is_refused_with_the_fix():
 def test_an_unknown_background_mode_is_refused():
     with pytest.raises(EventDataError, match="background must be one of"):
         EvINRConfig(background="median")
+
+
+def test_a_span_of_one_chunk_is_read_once_and_prepared_as_the_whole_span(noisy):
+    ev, _ = noisy
+
+    class Counting(MemorySource):
+        def __init__(self, events):
+            super().__init__(events)
+            self.reads = 0
+
+        def _read_window(self, t0, t1):
+            self.reads += 1
+            return super()._read_window(t0, t1)
+
+    cfg = EvINRConfig(C=0.225, tau=10.0, progress=False)            # the 6 s span is one counting chunk
+    t0, t1 = 0.0, float(ev.t[-1])
+    whole_ev, whole = prepare_events(ev, cfg, (t0, t1))
+    counting = Counting(ev)
+    streamed, source = prepare_source(counting, t0, t1, cfg)
+    assert counting.reads == 1 and streamed.C == whole.C and streamed.lam == whole.lam
+    parts = [source.events(a, b) for a, b in ((0.0, 2.0), (2.0, 4.5), (4.5, np.nextafter(t1, np.inf)))]
+    np.testing.assert_array_equal(np.concatenate([_key(p) for p in parts], axis=1), _key(whole_ev))
+    assert counting.reads == 1                                        # the windows are slices, not reads

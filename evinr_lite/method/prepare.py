@@ -19,7 +19,9 @@ In this order, each judged on what the step before left (``EvINRConfig`` fields 
 counts the span in chunks first (two reading passes when the background is filtered: the hot
 pixels come from the raw counts, the balance from the filtered ones), and reads each window with the
 filter's reach (twice ``DEFAULT_DT``, clipped to the span) beyond its edges, so an event near an
-edge is judged on the same neighbours as in the whole span.
+edge is judged on the same neighbours as in the whole span. A span no longer than one counting chunk
+(``cfg.tau``) is read once and prepared in memory, as :func:`prepare_events` does, and its windows are
+slices of it.
 """
 from __future__ import annotations
 
@@ -111,14 +113,16 @@ class _Prepared:
     dropped, background filtered on the window read ``REACH`` beyond its edges (within the span), then
     the pixels of ``then`` dropped. Everything else is the source's."""
 
-    def __init__(self, source, span, first=None, background=False, then=None):
+    def __init__(self, source, span, first=None, background=False, then=None, held=None):
         self._source, self._span = source, span
-        self._first, self._background, self._then = first, background, then
+        self._first, self._background, self._then, self._held = first, background, then, held
 
     def __getattr__(self, name):
         return getattr(self._source, name)
 
     def events(self, t0, t1):
+        if self._held is not None:                   # a span of one counting chunk, prepared once
+            return self._held.slice_time(t0, t1, allow_empty=True)
         if not self._background:
             return drop_pixels(drop_pixels(self._source.events(t0, t1), self._first), self._then)
         lo, hi = self._span
@@ -148,6 +152,11 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         return cfg, source
     chunk_s = chunk_s or cfg.tau or (t_end - t_start)
     span, first, filtered = (t_start, t_end), None, cfg.background == "filter"
+    if filtered and t_end - t_start <= chunk_s:
+        # the span is one chunk (no more than one window's events): read it once, prepare it as the
+        # whole-span solve does, and hand the windows slices of it instead of reading and filtering again
+        held, cfg = prepare_events(source.events(t_start, np.nextafter(t_end, np.inf)), cfg, span)
+        return cfg, _Prepared(source, span, held=held)
     counts = _counts(source, t_start, t_end, chunk_s)
     if filtered:
         if cfg.hot_pixels == "drop":
