@@ -16,7 +16,9 @@ import numpy as np
 
 from ..core.events import EventDataError
 from .anchor import ANCHOR_MODES
+from .balance import BALANCE_MODES, HOT_PIXEL_MODES
 from .binning import as_thresholds
+from .prepare import BACKGROUND_MODES
 from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEMAPS
 
 __all__ = ["EvINRConfig"]
@@ -261,8 +263,8 @@ class EvINRConfig:
         # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
                    "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient"),
-                   "balance": ("none", "events"), "hot_pixels": ("keep", "drop"),
-                   "background": ("keep", "filter"), "tonemap": TONEMAPS}
+                   "balance": BALANCE_MODES, "hot_pixels": HOT_PIXEL_MODES,
+                   "background": BACKGROUND_MODES, "tonemap": TONEMAPS}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
