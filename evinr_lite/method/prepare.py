@@ -31,7 +31,7 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, polarity_counts
-from .denoise import DEFAULT_DT, DEFAULT_SAME_POLARITY, DEFAULT_WINDOW, correlation_filter, hot_threshold
+from .denoise import DEFAULT_DT, denoise_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
 __all__ = ["prepare_events", "prepare_source", "plan_from_counts", "drop_pixels", "filter_background",
@@ -52,7 +52,7 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0):
     n = n_on + n_off
     hot = np.zeros(n.shape, bool)
     if cfg.hot_pixels == "drop":
-        hot = n > hot_threshold(np.rint(n))                 # denoise.hot_pixel_mask's rule, on these counts
+        hot = _hot_mask(n)
     if cfg.balance == "events" and np.ndim(cfg.C) == 0:
         fit = balance_from_counts(np.where(hot, 0, n_on), np.where(hot, 0, n_off), cfg.C)
         if fit.applied:
@@ -70,15 +70,15 @@ def drop_pixels(events: Events, mask) -> Events:
 
 
 def filter_background(events: Events) -> Events:
-    """The events that :func:`~evinr_lite.method.denoise.correlation_filter` keeps with
-    :func:`~evinr_lite.method.denoise.denoise`'s defaults (two-sided, same polarity, ``DEFAULT_DT``)."""
+    """The events that :func:`~evinr_lite.method.denoise.denoise` keeps with its defaults and its hot-pixel
+    stage off (the correlation filter: two-sided, same polarity, ``DEFAULT_DT``)."""
     if len(events) == 0:
         return events
-    return events.take(correlation_filter(events, DEFAULT_DT, same_polarity=DEFAULT_SAME_POLARITY,
-                                          window=DEFAULT_WINDOW))
+    return events.take(denoise_mask(events, hot_pixels=False)[0])
 
 
 def _hot_mask(n: np.ndarray) -> np.ndarray:
+    """Bool [H, W]: :func:`~evinr_lite.method.denoise.hot_pixel_mask`'s rule on per-pixel counts ``n``."""
     return n > hot_threshold(np.rint(n))
 
 
@@ -98,11 +98,9 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
     if not len(events):
         return events, cfg
     t0, t1 = (float(events.t[0]), float(events.t[-1])) if span is None else span
-    if cfg.background == "filter":
+    if cfg.background == "filter":                  # hot pixels first, then the filter: denoise() with its defaults
         n_in = len(events)
-        if cfg.hot_pixels == "drop":
-            events = drop_pixels(events, _hot_mask(sum(polarity_counts(events))))
-        events = filter_background(events)
+        events = events.take(denoise_mask(events, hot_pixels=cfg.hot_pixels == "drop")[0])
         _check_left(len(events), n_in)
     cfg, hot = plan_from_counts(*polarity_counts(events), cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap))
     return drop_pixels(events, hot), cfg
@@ -123,8 +121,8 @@ class _Prepared:
     def events(self, t0, t1):
         if self._held is not None:                   # a span of one counting chunk, prepared once
             return self._held.slice_time(t0, t1, allow_empty=True)
-        if not self._background:
-            return drop_pixels(drop_pixels(self._source.events(t0, t1), self._first), self._then)
+        if not self._background:                     # hot pixels only (``first`` is set with the filter)
+            return drop_pixels(self._source.events(t0, t1), self._then)
         lo, hi = self._span
         a, b = max(t0 - REACH, lo), min(t1 + REACH, np.nextafter(hi, np.inf))   # the span's end is inclusive
         wide = filter_background(drop_pixels(self._source.events(a, max(a, b)), self._first))
