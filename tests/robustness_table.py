@@ -125,7 +125,8 @@ def main(argv=None) -> int:
     files = ROUND3 if "--round3" in argv else ROUND2 + ROUND3
     files = [f for f in files if (HERE / f).exists()]
     tally = Tally()
-    code = pytest.main([*(str(HERE / f) for f in files), "-q", "-p", "no:cacheprovider"], plugins=[tally])
+    # -n 0: in this process, so the tally plugin sees every report (the suite itself runs on workers)
+    code = pytest.main([*(str(HERE / f) for f in files), "-q", "-p", "no:cacheprovider", "-n", "0"], plugins=[tally])
     order = list(dict.fromkeys(label for label, _, _ in CLASSES)) + ["other"]
     total = Counter()
     print(f"\n| class | {' | '.join(COLUMNS)} |\n|---|{'---|' * len(COLUMNS)}")
