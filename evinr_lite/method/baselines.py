@@ -33,7 +33,7 @@ from ..core.frames import Frames
 from .anchor import frame_log, linear_frames
 from .binning import as_thresholds
 from .integration import integrate_events
-from .offset import median_gradient_offset
+from .offset import OFFSET_SOLVES, offset_image
 from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, TONEMAPS, display_shift, to_display
 
 __all__ = ["leaky_integration", "highpass_filter", "highpass_per_event", "reconstruct_baseline",
@@ -371,9 +371,9 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
         method: "integration", "leaky" (params: leak_hz, L0) or "hf" (params: cutoff_hz, L0).
         C: contrast threshold (or (C_pos, C_neg)). gamma: Reinhard's exponent. tonemap: "linear" or "reinhard".
         t_start, t_end: span of the anchor (default: first/last event, widened to the queries).
-        offset_solve: "none" (one constant, as always), or "median_gradient": the per-pixel offset of
-            :mod:`evinr_lite.method.offset`, the kit's ghost solve, applied to the baseline (an
-            ablation: ``benchmarks/quality_zoo.py --methods integration_offset``).
+        offset_solve: "none" (one constant, as always), or "median_gradient" / "l1_gradient": the
+            per-pixel offset of :mod:`evinr_lite.method.offset`, the kit's ghost solve, applied to the
+            baseline (an ablation: ``benchmarks/quality_zoo.py --methods integration_offset``).
         frames: APS frames, for method "complementary" (params: gain in rad/s): the
             :func:`complementary_filter`, which starts at the first frame (default t_start). Its
             level is the frames': no anchor, no tone map; its frames are the frames' linear
@@ -413,9 +413,9 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
     t0 = time.perf_counter()
     grid = np.linspace(lo, hi, 64)
     L_all = fn(np.concatenate([grid, q]))
-    if offset_solve not in ("none", "median_gradient"):
-        raise ValueError(f"offset_solve must be 'none' or 'median_gradient', got {offset_solve!r}")
-    g = median_gradient_offset(L_all[:len(grid)]) if offset_solve == "median_gradient" else 0.0
+    if offset_solve not in OFFSET_SOLVES:
+        raise ValueError(f"offset_solve must be one of {OFFSET_SOLVES}, got {offset_solve!r}")
+    g = offset_image(L_all[:len(grid)], offset_solve) if offset_solve != "none" else 0.0
     offset = g + display_shift(L_all[:len(grid)] + g, tonemap, gamma, display_mean)
     L = L_all[len(grid):] + offset
     frames = to_display(L, tonemap, gamma).astype(np.float32)

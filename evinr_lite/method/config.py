@@ -18,6 +18,7 @@ from ..core.events import EventDataError
 from .anchor import ANCHOR_MODES
 from .balance import BALANCE_MODES, HOT_PIXEL_MODES
 from .binning import as_thresholds
+from .offset import OFFSET_SOLVES
 from .prepare import BACKGROUND_MODES
 from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEMAPS
 
@@ -182,9 +183,11 @@ class EvINRConfig:
             of the loss for the hidden layers (a linear least-squares problem solved in closed form,
             :mod:`evinr_lite.method.head_solve`; needs regularizer "tikhonov" or "none").
         offset_solve: how the per-pixel offset that events cannot fix is chosen: "none" (left to the
-            regularizer, as in the paper) or "median_gradient" (:mod:`evinr_lite.method.offset`:
-            the offset that makes the temporal median of each pixel's gradient zero).
-        offset_window: with offset_solve "median_gradient", the seconds over which one offset image
+            regularizer, as in the paper), "median_gradient" (:mod:`evinr_lite.method.offset`:
+            the offset that makes the temporal median of each pixel's gradient zero) or "l1_gradient"
+            (the offset that makes all frames' gradients sparsest together, their L1 norm summed over
+            the frames: :func:`~evinr_lite.method.offset.l1_gradient_offset`, an iterative solve).
+        offset_window: with an offset solve, the seconds over which one offset image
             is solved: on spans longer than 1.5 windows the offset becomes a slow per-pixel trend,
             one image per ``offset_window`` seconds, linear in time between them
             (:func:`~evinr_lite.method.offset.median_gradient_trend`); None: one image for any span.
@@ -262,7 +265,7 @@ class EvINRConfig:
     def __post_init__(self):
         # Every field checked here (EventDataError, a ValueError): a bad value never reaches training.
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
-                   "regularizer": ("tikhonov", "tv", "none"), "offset_solve": ("none", "median_gradient"),
+                   "regularizer": ("tikhonov", "tv", "none"), "offset_solve": OFFSET_SOLVES,
                    "balance": BALANCE_MODES, "hot_pixels": HOT_PIXEL_MODES,
                    "background": BACKGROUND_MODES, "tonemap": TONEMAPS}
         for name, allowed in choices.items():

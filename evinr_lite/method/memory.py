@@ -78,7 +78,8 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
       uint8 copies and the tone map's float64 work arrays (TONEMAP_CELLS); the events and bins are
       freed before it, so the larger of the two phases counts; beside them, all run long: the offset
       grid (max(64, 8 N) frames), the overlap's partial blends and ``n_kept`` frames kept in memory
-      (those at ground-truth times), counted with ``process``.
+      (those at ground-truth times), counted with ``process``;
+    - ``offset``: with ``offset_solve="l1_gradient"``, the ADMM's work arrays over the offset grid (0 otherwise).
 
     Measured against peak RSS in ``benchmarks/scale.py`` (the target: within 25 %).
 
@@ -119,6 +120,11 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
         parts = {"process": PROCESS_BYTES, "events": EVENT_BYTES * float(n_events),
                  "networks": (head + trunk) * N, "bins": bins * N,
                  "frames": Q * P * (2 * 4 * N + 8 + 16 + 4 + 4)}
+    # offset_solve "l1_gradient": its ADMM holds about twelve float32 copies of the offset grid's gradients
+    # (method/offset.py; measured: 46 bytes per grid frame and pixel at 64 x 360 x 640), beside the grid,
+    # for the moment of the solve; counted whole (an upper bound
+    # for a trend, whose knots each look at part of the grid)
+    parts["offset"] = 48.0 * float(max(64, 8 * N)) * P if config.offset_solve == "l1_gradient" else 0.0
     return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
             "span_s": span, "streaming": bool(streaming)}
 

@@ -47,7 +47,7 @@ from .prepare import prepare_source
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
-from .offset import OffsetTrend, median_gradient_offset, median_gradient_trend, offset_grid
+from .offset import OffsetTrend, median_gradient_trend, offset_grid, offset_image
 from .tonemap import display_shift, to_display
 from .training import train_frame_inr
 
@@ -198,14 +198,14 @@ def first_window_offset(model: FrameINR, window, config: EvINRConfig) -> np.ndar
     """The offset image + level [H, W] float32 that every network gets, from the first window.
 
     Same grid, same steps and same float32 order as the whole-sequence solve over one window
-    (:func:`offset_grid`, median_gradient_offset, the level anchor), so a one-window span gives
+    (:func:`offset_grid`, the offset image, the level anchor), so a one-window span gives
     the identical result."""
     grid = offset_grid(float(window[0]), float(window[1]), 1, config.offset_solve)
     F = network_at(model, grid)
     H, W = model.sensor_size
     offset = np.zeros((H, W), np.float32)
-    if config.offset_solve == "median_gradient":
-        offset += median_gradient_offset(F).astype(np.float32)
+    if config.offset_solve != "none":
+        offset += offset_image(F, config.offset_solve).astype(np.float32)
     F += offset
     offset += np.float32(display_shift(F, config.tonemap, config.gamma, config.display_mean))
     return offset
@@ -314,8 +314,8 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times) -> Off
     H, W = grid_frames.shape[1:]
     offset = np.zeros((H, W), np.float32)
     trend = None
-    if config.offset_solve == "median_gradient":
-        trend = median_gradient_trend(grid_times, grid_frames, config.offset_window)
+    if config.offset_solve != "none":
+        trend = median_gradient_trend(grid_times, grid_frames, config.offset_window, config.offset_solve)
         if len(trend.knots) == 1:
             offset += trend.images[0]
             trend = None
