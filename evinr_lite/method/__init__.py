@@ -13,7 +13,7 @@ from .colour import reconstruct_colour, channel_offsets_from, chroma_correlation
 from .contrast import frame_log_changes, estimate_contrast_threshold, fit_contrast, ContrastFit
 from .denoise import DenoiseReport, correlation_filter, hot_pixel_mask, remove_hot_pixels, denoise_mask
 from .losses import temporal_loss_derivative, temporal_loss_difference, tikhonov   # the notebooks call these
-from .offset import median_gradient_offset, poisson_integrate
+from .offset import median_gradient_offset, l1_gradient_offset, poisson_integrate
 from .anchor import linear_frames
 # `method.denoise` stays the module (call method.denoise.denoise(events)): re-exporting the function under the
 # module's own name would hide the module from attribute access.
@@ -28,4 +28,5 @@ __all__ = ["EventFrames", "events_to_frames", "events_to_frames_chunked",
            "estimate_contrast_threshold", "denoise", "DenoiseReport", "hot_pixel_mask",
            "remove_hot_pixels", "correlation_filter", "fit_contrast", "ContrastFit", "as_thresholds",
            "predict_anchored", "channel_offsets_from", "chroma_correlation", "denoise_mask", "temporal_loss_derivative",
-           "temporal_loss_difference", "tikhonov", "median_gradient_offset", "poisson_integrate", "linear_frames"]
+           "temporal_loss_difference", "tikhonov", "median_gradient_offset", "l1_gradient_offset", "poisson_integrate",
+           "linear_frames"]
