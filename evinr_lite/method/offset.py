@@ -175,7 +175,8 @@ class OffsetTrend:
 
 
 def median_gradient_trend(times, frames, window: float | None, method: str = "median_gradient") -> OffsetTrend:
-    """The slowly varying offset that makes the median gradient zero locally in time.
+    """The slowly varying offset that makes the median gradient zero locally in time (or, with
+    ``method="l1_gradient"``, the gradients sparsest: :func:`l1_gradient_offset`).
 
     Args:
         times: float64 [G] increasing seconds of ``frames`` [G, H, W] (log intensities over the span).
@@ -211,6 +212,6 @@ def offset_grid(t_start: float, t_end: float, n_windows: int, offset_solve: str)
     """float64 [G] times (s) at which the offset solve and the level anchor look at a span of
     ``n_windows`` network windows (the whole-sequence solve and streaming share it)."""
     n_grid = min(64, 8 * n_windows)          # the level anchor's times (as the paper's recipe always had them)
-    if offset_solve in ("median_gradient", "l1_gradient"):
-        n_grid = max(64, 8 * n_windows)      # a temporal median wants many frames; the level anchor shares them
+    if offset_solve != "none":
+        n_grid = max(64, 8 * n_windows)      # an offset solve wants many frames; the level anchor shares them
     return np.linspace(t_start, t_end, n_grid)
