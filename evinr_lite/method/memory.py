@@ -120,11 +120,11 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
         parts = {"process": PROCESS_BYTES, "events": EVENT_BYTES * float(n_events),
                  "networks": (head + trunk) * N, "bins": bins * N,
                  "frames": Q * P * (2 * 4 * N + 8 + 16 + 4 + 4)}
-    # offset_solve "l1_gradient": its ADMM holds about twelve float32 copies of the offset grid's gradients
-    # (method/offset.py; measured: 46 bytes per grid frame and pixel at 64 x 360 x 640), beside the grid,
-    # for the moment of the solve; counted for the whole grid (an upper bound for a trend, whose knots
-    # each look at part of it)
-    parts["offset"] = 48.0 * float(max(64, 8 * N)) * P if config.offset_solve == "l1_gradient" else 0.0
+    # offset_solve "l1_gradient": its ADMM holds each edge's K sorted values (float32, x and y edges) and a
+    # few per-edge vectors beside the grid, for the moment of the solve (method/offset.py; measured with
+    # tracemalloc: 12.1 bytes per grid frame and pixel at 64 x 360 x 640); counted for the whole grid (an
+    # upper bound for a trend, whose knots each look at part of it)
+    parts["offset"] = 13.0 * float(max(64, 8 * N)) * P if config.offset_solve == "l1_gradient" else 0.0
     return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
             "span_s": span, "streaming": bool(streaming)}
 
