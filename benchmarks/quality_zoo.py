@@ -25,8 +25,8 @@ paper's recipe exactly), ``v0_1`` (the kit's default before the zoo; paper and v
 long scenes, minutes each), the baselines ``integration`` and ``hf`` at their defaults, ``hf_best`` and
 ``leaky_best`` (HF's cutoff and leaky integration's leak swept per scene, 0.03-3 Hz, the best by
 CLAHE-SSIM against the truth: tuned with the answer in hand, which the kit never has; the sweep is in
-the JSON and the markdown), ``integration_offset`` (integration + the kit's median-gradient offset:
-what the INR must beat), ``kit_windows`` (long scenes: the kit on independent 2 s windows),
+the JSON and the markdown), ``integration_offset`` (integration + the kit's own offset solve,
+``EvINRConfig().offset_solve``: what the INR must beat), ``kit_windows`` (long scenes: the kit on independent 2 s windows),
 ``kit_unfiltered`` (only when named in ``--methods``: the kit with ``background="keep"``, its default
 before the background filter), and the
 oracle: the events integrated from the true frame at the first scored time, as linear intensity with
@@ -65,7 +65,7 @@ from evinr_lite.sim.zoo import HELDOUT, ZOO, default_scenes, effective_C, quick,
 
 BASELINES = ("integration", "hf")                   # the baselines at their default settings
 SWEPT = ("hf_best", "leaky_best")                   # HF's cutoff / leaky integration's leak picked per scene
-NAMED = ("integration_offset",)                     # integration + the kit's median-gradient offset
+NAMED = ("integration_offset",)                     # integration + the kit's own offset solve
 BEST_OF = SWEPT + NAMED                             # the baselines the kit must beat (issue 21)
 ORACLES = ("oracle_linear", "oracle_tonemapped")
 EVINR = ("kit", "paper", "v0_1")
@@ -130,7 +130,8 @@ def run_method(name: str, events: Events, times: np.ndarray, C, variants: dict, 
     elif name in SWEPT:
         frames, run_method.last_sweep = sweep_baseline(name, events, times, C, gt)
     elif name == "integration_offset":
-        frames = reconstruct_baseline(events, times, "integration", C=C, offset_solve="median_gradient").frames
+        frames = reconstruct_baseline(events, times, "integration", C=C,
+                                      offset_solve=EvINRConfig().offset_solve).frames
     elif name in ORACLES:
         L = L_first + integrate_events(events, times, C=C) - integrate_events(events, times[:1], C=C)
         frames = (np.clip(np.exp(L), 0, 1) if name == "oracle_linear" else

@@ -127,7 +127,7 @@ def test_presets():
     assert {k: v for k, v in vars(old).items() if k not in ("first_omega_0", "head_lr_scale")} == \
         {k: v for k, v in vars(paper).items() if k not in ("first_omega_0", "head_lr_scale")}
     kit = EvINRConfig()
-    assert kit.head_solve and kit.offset_solve == "median_gradient" and kit.n_iters == 0
+    assert kit.head_solve and kit.offset_solve == "l1_gradient" and kit.n_iters == 0
     assert EvINRConfig.paper(C=0.2).C == 0.2
 
 

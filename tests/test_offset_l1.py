@@ -7,7 +7,7 @@ from scipy.ndimage import gaussian_filter, shift
 from evinr_lite import EvINRConfig, make_scene, simulate_scene
 from evinr_lite.core.events import EventDataError
 from evinr_lite.method.baselines import reconstruct_baseline
-from evinr_lite.method.offset import l1_gradient_offset, median_gradient_offset, median_gradient_trend, offset_image
+from evinr_lite.method.offset import l1_gradient_offset, median_gradient_offset, offset_trend, offset_image
 from evinr_lite.method.solver import reconstruct
 from evinr_lite.method.streaming import stream_reconstruct
 
@@ -74,7 +74,7 @@ def test_integrated_events_with_mostly_flat_pixels_still_get_the_l1_solve():
 def test_the_trend_uses_the_chosen_method():
     frames = _blocks(n_frames=30)
     t = np.linspace(0.0, 3.0, len(frames))
-    trend = median_gradient_trend(t, frames, None, "l1_gradient")
+    trend = offset_trend(t, frames, None, "l1_gradient")
     np.testing.assert_array_equal(trend.images[0], l1_gradient_offset(frames).astype(np.float32))
 
 

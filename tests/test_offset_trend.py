@@ -1,4 +1,4 @@
-"""The slowly varying per-pixel offset (method/offset.py: median_gradient_trend, OffsetTrend) and its
+"""The slowly varying per-pixel offset (method/offset.py: offset_trend, OffsetTrend) and its
 use by the solver and streaming (EvINRConfig.offset_window)."""
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ from scipy.ndimage import gaussian_filter, shift
 
 from evinr_lite import EvINRConfig, make_scene, simulate_scene
 from evinr_lite.core.events import EventDataError
-from evinr_lite.method.offset import OffsetTrend, median_gradient_offset, median_gradient_trend
+from evinr_lite.method.offset import OffsetTrend, median_gradient_offset, offset_trend
 from evinr_lite.method.solver import reconstruct
 from evinr_lite.method.streaming import stream_reconstruct
 
@@ -31,7 +31,7 @@ def test_one_knot_is_the_single_image():
     t = np.linspace(0.0, 3.0, len(frames))
     ref = median_gradient_offset(frames).astype(np.float32)
     for window in (None, 5.0, 2.5):            # 3 s span: under 1.5 windows of 2.5 s or more, one image
-        trend = median_gradient_trend(t, frames, window)
+        trend = offset_trend(t, frames, window, "median_gradient")
         assert trend.knots.shape == (1,)
         np.testing.assert_array_equal(trend.images[0], ref)
 
@@ -44,8 +44,8 @@ def test_a_per_pixel_drift_is_followed_where_one_image_cannot():
     drift *= 1.0 / drift.std()                         # a per-pixel offset going from 0 to `drift` over the span
     observed = frames + (t / t[-1])[:, None, None] * drift
     truth_offset = -(t / t[-1])[:, None, None] * drift  # what must be added back (up to one image)
-    one = median_gradient_trend(t, observed, None).at(t)
-    trend = median_gradient_trend(t, observed, 4.0)
+    one = offset_trend(t, observed, None).at(t)
+    trend = offset_trend(t, observed, 4.0)
     assert len(trend.knots) == 6
     many = trend.at(t)
 

@@ -49,8 +49,13 @@ class EvINRConfig:
       the zoo means by less than 0.002 at 4x the time, so no Adam step is taken.
     - temporal_loss="difference": the closed form fits the exact integral form; the mid-point
       derivative is a first-order approximation.
-    - offset_solve="median_gradient": the per-pixel offset that events never fix is solved
-      explicitly instead of drifting under the regularizer (the ghost).
+    - offset_solve="l1_gradient": the per-pixel offset that events never fix is solved explicitly
+      instead of drifting under the regularizer (the ghost): the one image that makes all frames'
+      gradients sparsest together, by ADMM from the per-edge medians ("median_gradient", the default
+      before). Same run of ``python benchmarks/quality_zoo.py`` against the committed median run
+      (CLAHE-SSIM / SSIM / MSE): zoo mean 0.634 / 0.692 / 0.0366 -> 0.637 / 0.697 / 0.0354, real
+      chunk 0.360 / 0.429 / 0.0690 -> 0.357 / 0.426 / 0.0649; held-out and long recordings in
+      docs/defaults.md. About the median's time (0.16 s for a 64 x 180 x 240 grid).
     - offset_window=5.0 (issue 21): on spans longer than 7.5 s the offset is a slow per-pixel trend
       (one median-gradient image per 5 s, linear between), which follows what builds up at every
       pixel over a long recording; shorter spans keep the single image. ``python
@@ -128,11 +133,10 @@ class EvINRConfig:
       sparse fine texture, where some signal events have no neighbour).
 
     With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 cores):
-    kit 0.634 / 0.692 / 0.0366, integration + median-gradient offset 0.547 / 0.628 / 0.0381 (the INR:
-    1.16x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
-    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.360 / 0.429 / 0.0690 (1.16x integration +
-    offset); camera_240x180 (2 s at 180x240) in 0.63 s, 0.62 s unfiltered in the same run (a machine
-    shared with another run; 0.36 s quiet).
+    kit 0.637 / 0.697 / 0.0354, integration + the same L1 offset 0.559 / 0.635 / 0.0364 (the INR:
+    1.14x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
+    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.357 / 0.426 / 0.0649 (1.10x integration +
+    offset); camera_240x180 (2 s at 180x240) in 0.65 s, 0.5 s unfiltered in the same run.
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
       (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
@@ -186,11 +190,12 @@ class EvINRConfig:
             regularizer, as in the paper), "median_gradient" (:mod:`evinr_lite.method.offset`:
             the offset that makes the temporal median of each pixel's gradient zero) or "l1_gradient"
             (the offset that makes all frames' gradients sparsest together, their L1 norm summed over
-            the frames: :func:`~evinr_lite.method.offset.l1_gradient_offset`, an iterative solve).
+            the frames: :func:`~evinr_lite.method.offset.l1_gradient_offset`, ADMM started from the
+            median answer; the default).
         offset_window: with an offset solve, the seconds over which one offset image
             is solved: on spans longer than 1.5 windows the offset becomes a slow per-pixel trend,
             one image per ``offset_window`` seconds, linear in time between them
-            (:func:`~evinr_lite.method.offset.median_gradient_trend`); None: one image for any span.
+            (:func:`~evinr_lite.method.offset.offset_trend`); None: one image for any span.
         balance: "none" (ON and OFF events weigh C as given) or "events": when C is one number, C+ and
             C- are estimated from the events' ON/OFF counts, their mean kept at C, shrunk towards C as
             far as the span carries little evidence (:mod:`evinr_lite.method.balance`); a given pair is
@@ -250,7 +255,7 @@ class EvINRConfig:
     gamma: float = 0.6
     display_mean: float = DEFAULT_DISPLAY_MEAN
     head_solve: bool = True
-    offset_solve: str = "median_gradient"
+    offset_solve: str = "l1_gradient"
     offset_window: float | None = 5.0
     balance: str = "events"
     hot_pixels: str = "drop"

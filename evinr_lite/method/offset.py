@@ -19,7 +19,7 @@ DCT). For a static background the median is the background's own gradient, which
 On a long recording one image is not enough: what the events get wrong builds up slowly and
 differently at every pixel (a threshold that drifts with temperature, per-pixel mismatch of C+
 and C-, background activity's random walk), so the offset that makes the median gradient zero
-over the first seconds is not the one over the last. :func:`median_gradient_trend` therefore
+over the first seconds is not the one over the last. :func:`offset_trend` therefore
 solves one image per ``window`` seconds of the span (from the frames within ``window`` of its
 knot) and interpolates them linearly in time (:class:`OffsetTrend`): a slow per-pixel trend,
 part of the method rather than a patch applied afterwards. On spans up to about 1.5 windows it is
@@ -44,7 +44,7 @@ from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues
 
 __all__ = ["median_gradient_offset", "l1_gradient_offset", "SumAbsProx", "offset_image", "poisson_integrate",
-           "median_gradient_trend", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES"]
+           "offset_trend", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES"]
 
 MIN_TREND_FRAMES = 8     # a knot's median looks at least at this many grid frames (the nearest, if its window holds fewer)
 OFFSET_SOLVES = ("none", "median_gradient", "l1_gradient")
@@ -240,14 +240,14 @@ class OffsetTrend:
         return self.add_to(np.zeros((len(t), *self.images.shape[1:]), np.float32), t)
 
 
-def median_gradient_trend(times, frames, window: float | None, method: str = "median_gradient") -> OffsetTrend:
-    """The slowly varying offset that makes the median gradient zero locally in time (or, with
-    ``method="l1_gradient"``, the gradients sparsest: :func:`l1_gradient_offset`).
+def offset_trend(times, frames, window: float | None, method: str = "l1_gradient") -> OffsetTrend:
+    """The slowly varying offset that makes the frames' gradients sparsest locally in time
+    (:func:`l1_gradient_offset`; or, with ``method="median_gradient"``, each pixel's median gradient zero).
 
     Args:
         times: float64 [G] increasing seconds of ``frames`` [G, H, W] (log intensities over the span).
         window: seconds between knots, and how far from its knot a frame counts; None, or a span
-            shorter than 1.5 windows: one image for the whole span (:func:`median_gradient_offset`).
+            shorter than 1.5 windows: one image for the whole span (:func:`offset_image`).
         method: each image's solve, "median_gradient" or "l1_gradient" (:func:`offset_image`).
 
     Returns:

@@ -50,7 +50,7 @@ from .config import EvINRConfig
 from .memory import check_memory
 from .ensemble import alignment_offsets, blend_networks, blend_weights, predict_networks, split_windows
 from .models import FrameINR
-from .offset import median_gradient_trend, offset_grid
+from .offset import offset_trend, offset_grid
 from .tonemap import display_shift, to_display
 from .training import train_frame_inr
 
@@ -160,13 +160,13 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     grid = offset_grid(t_start, t_end, len(windows), cfg.offset_solve)
     trend = None
     if cfg.offset_solve != "none":                                              # 4. offset solve
-        trend = median_gradient_trend(grid, blend_networks(model, windows, grid, offsets), cfg.offset_window,
+        trend = offset_trend(grid, blend_networks(model, windows, grid, offsets), cfg.offset_window,
                                       cfg.offset_solve)
         if len(trend.knots) == 1:   # one offset image for all networks: the alignment stays
             offsets += trend.images[0]
             trend = None
     L_grid = blend_networks(model, windows, grid, offsets)
-    if trend is not None:           # a slow per-pixel trend over a long span (offset.median_gradient_trend)
+    if trend is not None:           # a slow per-pixel trend over a long span (offset.offset_trend)
         trend.add_to(L_grid, grid)
         history["offset_knots_s"] = trend.knots.tolist()
     offsets += _level_shift(L_grid, cfg)                                        # 5. level anchor

@@ -47,7 +47,7 @@ from .prepare import prepare_source
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
-from .offset import OffsetTrend, median_gradient_trend, offset_grid, offset_image
+from .offset import OffsetTrend, offset_trend, offset_grid, offset_image
 from .tonemap import display_shift, to_display
 from .training import train_frame_inr
 
@@ -253,7 +253,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
             "first_window": from the grid over the first window; each window's frames are final
             (and handed out) as soon as it finishes; identical when the span is one window. It
             keeps one offset image for the whole recording: the slow trend of
-            ``config.offset_window`` (:func:`~evinr_lite.method.offset.median_gradient_trend`)
+            ``config.offset_window`` (:func:`~evinr_lite.method.offset.offset_trend`)
             needs the whole span, so only mode "span" applies it.
         workdir: folder for the spill file (mode "span"; default: a temporary folder, removed at the
             end). To resume, pass the same folder and the saved ``state``.
@@ -315,7 +315,7 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times) -> Off
     offset = np.zeros((H, W), np.float32)
     trend = None
     if config.offset_solve != "none":
-        trend = median_gradient_trend(grid_times, grid_frames, config.offset_window, config.offset_solve)
+        trend = offset_trend(grid_times, grid_frames, config.offset_window, config.offset_solve)
         if len(trend.knots) == 1:
             offset += trend.images[0]
             trend = None
