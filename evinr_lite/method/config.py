@@ -86,7 +86,9 @@ class EvINRConfig:
       0.595 (0.01), long_ijrr_60s 0.699 against 0.664 (0.01). Again with the background filter (the
       rule counts what it leaves): zoo 0.634 against 0.631 (0.005, 0.01), real chunk 0.360 (0.366 at
       0.005), held-out 0.523 against 0.527 (0.005, 0.01), long_pan_20s 0.643 against 0.651 (0.005),
-      long_ijrr_60s 0.698 against 0.663 (0.01; 0.700 at 0.001).
+      long_ijrr_60s 0.698 against 0.663 (0.01; 0.700 at 0.001). Again with the L1 offset solve: zoo
+      0.637 against 0.634 (0.005, 0.01), real chunk 0.357 (0.361 at 0.005), held-out 0.526 against
+      0.530 (0.005, 0.01), long_pan_20s 0.647 against 0.655 (0.005), long_ijrr_60s 0.698 (0.700 at 0.001).
     - hidden_features=128 (issue 21; 256 before, 512 in the paper): the same scores as 256 at about half
       the time. Seven full-size zoo scenes (noisy_gravel, unequal_onhot, camera_240x180,
       astronaut_rotzoom, lowtex_light, text_shake, drift_clock), mean CLAHE-SSIM / SSIM / MSE 0.6401 /
