@@ -13,6 +13,7 @@ import os
 from ..core.events import EventDataError
 from .config import EvINRConfig
 from .ensemble import split_windows
+from .offset import MIN_TREND_FRAMES, offset_grid
 
 __all__ = ["estimate_memory", "check_memory", "check_times_memory", "available_bytes"]
 
@@ -42,6 +43,16 @@ def available_bytes(device: str = "cpu") -> int:
 PROCESS_BYTES = 370e6   # the evinr-lite process with its libraries loaded (peak RSS 0.35 GiB on a 32x24 recording)
 EVENT_BYTES = 17.0      # one event in memory: t float64, x, y int32, p int8
 READ_BYTES = 2 * EVENT_BYTES   # while a window is read and converted (the file's columns, then Events)
+
+
+def _offset_solve_frames(span: float, n_windows: int, config: EvINRConfig) -> int:
+    """Grid frames that one offset solve looks at (method/offset.py: offset_grid, offset_trend): the
+    whole grid for one image, else the frames within ``offset_window`` of a knot (at least 8)."""
+    G = len(offset_grid(0.0, max(span, 1e-9), n_windows, config.offset_solve))
+    window = config.offset_window
+    if window is None or span <= 0 or max(1, round(span / window)) == 1:
+        return G
+    return int(min(G, max(MIN_TREND_FRAMES, math.floor(2 * window / span * (G - 1)) + 1)))
 
 
 def _n_windows(span: float, config: EvINRConfig) -> int:
@@ -79,7 +90,8 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
       freed before it, so the larger of the two phases counts; beside them, all run long: the offset
       grid (max(64, 8 N) frames), the overlap's partial blends and ``n_kept`` frames kept in memory
       (those at ground-truth times), counted with ``process``;
-    - ``offset``: with ``offset_solve="l1_gradient"``, the ADMM's work arrays over the offset grid (0 otherwise).
+    - ``offset``: with ``offset_solve="l1_gradient"``, the ADMM's work arrays over the grid frames of its
+      largest single solve (the whole grid, or a trend knot's frames; 0 otherwise).
 
     Measured against peak RSS in ``benchmarks/scale.py`` (the target: within 25 %).
 
@@ -120,11 +132,12 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
         parts = {"process": PROCESS_BYTES, "events": EVENT_BYTES * float(n_events),
                  "networks": (head + trunk) * N, "bins": bins * N,
                  "frames": Q * P * (2 * 4 * N + 8 + 16 + 4 + 4)}
-    # offset_solve "l1_gradient": its ADMM holds each edge's K sorted values (float32, x and y edges) and a
-    # few per-edge vectors beside the grid, for the moment of the solve (method/offset.py; measured with
-    # tracemalloc: 12.1 bytes per grid frame and pixel at 64 x 360 x 640); counted for the whole grid (an
-    # upper bound for a trend, whose knots each look at part of it)
-    parts["offset"] = 13.0 * float(max(64, 8 * N)) * P if config.offset_solve == "l1_gradient" else 0.0
+    # offset_solve "l1_gradient": its ADMM holds each edge's values over the frames of one solve (float32,
+    # x and y edges) and a few per-edge vectors, for the moment of the solve (method/offset.py; measured
+    # with tracemalloc: 12.1 bytes per frame and pixel at 64 x 360 x 640), plus the copy of those frames
+    # that a trend's knot takes: 17 bytes per frame and pixel of the largest single solve
+    parts["offset"] = (17.0 * _offset_solve_frames(span, N, config) * P
+                       if config.offset_solve == "l1_gradient" else 0.0)
     return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
             "span_s": span, "streaming": bool(streaming)}
 
