@@ -90,13 +90,15 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
       freed before it, so the larger of the two phases counts; beside them, all run long: the offset
       grid (max(64, 8 N) frames), the overlap's partial blends and ``n_kept`` frames kept in memory
       (those at ground-truth times), counted with ``process``;
-    - ``offset``: with ``offset_solve="l1_gradient"``, the ADMM's work arrays over the grid frames of its
-      largest single solve (the whole grid, or a trend knot's frames; 0 otherwise).
+    - ``offset``: with ``offset_solve="l1_gradient"``, how far its phase (the ADMM's work arrays over the
+      grid frames of its largest single solve, ``offset_solve_bytes``, beside what is alive then) exceeds
+      the parts above; 0 otherwise.
 
     Measured against peak RSS in ``benchmarks/scale.py`` (the target: within 25 %).
 
     Returns:
-        {"total": bytes, "parts": {...}, "n_windows", "n_bins" (per window), "n_frames", "span_s", "streaming"}.
+        {"total": bytes, "parts": {...}, "n_windows", "n_bins" (per window), "n_frames", "span_s", "streaming",
+        "offset_solve_bytes" (the L1 offset solve's work arrays alone)}.
     """
     span = max(float(t_end) - float(t_start), 0.0)
     H, W = sensor_size
@@ -133,13 +135,20 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
                  "networks": (head + trunk) * N, "bins": bins * N,
                  "frames": Q * P * (2 * 4 * N + 8 + 16 + 4 + 4)}
     # offset_solve "l1_gradient": its ADMM holds each edge's values over the frames of one solve (float32,
-    # x and y edges) and a few per-edge vectors, for the moment of the solve (method/offset.py; measured
-    # with tracemalloc: 12.1 bytes per frame and pixel at 64 x 360 x 640), plus the copy of those frames
-    # that a trend's knot takes: 17 bytes per frame and pixel of the largest single solve
-    parts["offset"] = (17.0 * _offset_solve_frames(span, N, config) * P
-                       if config.offset_solve == "l1_gradient" else 0.0)
+    # x and y edges) and a few per-edge vectors (method/offset.py; measured with tracemalloc: 12.1 bytes
+    # per frame and pixel at 64 x 360 x 640), plus the copy of those frames that a trend's knot takes: 17
+    # bytes per frame and pixel of the largest single solve. It runs in a phase of its own, after training
+    # (streaming: after the last window, beside what lives through the run; whole solve: beside the events,
+    # the networks and the offset grid), so it counts only as far as that phase exceeds the others.
+    offset_work = (17.0 * _offset_solve_frames(span, N, config) * P if config.offset_solve == "l1_gradient" else 0.0)
+    if streaming:
+        offset_phase = persistent + offset_work
+    else:
+        offset_phase = (parts["process"] + parts["events"] + parts["networks"]
+                        + 4.0 * len(offset_grid(0.0, max(span, 1e-9), N, config.offset_solve)) * P + offset_work)
+    parts["offset"] = max(0.0, offset_phase - sum(parts.values()))
     return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
-            "span_s": span, "streaming": bool(streaming)}
+            "span_s": span, "streaming": bool(streaming), "offset_solve_bytes": offset_work}
 
 
 def _gib(n_bytes: float) -> str:
