@@ -131,7 +131,8 @@ def test_the_proximal_step_per_edge_is_exact(rho):
     rng = np.random.default_rng(int(rho * 10))
     b = rng.normal(size=(300, 7)).astype(np.float32)
     values = np.sort(b, axis=1)
-    prox = offset.SumAbsProx(np.concatenate([b, np.zeros((300, 1), np.float32)], axis=1), rho)
+    spare = np.zeros((300, 1), np.float32)
+    prox = offset.SumAbsProx(np.concatenate([spare, b, spare], axis=1), rho)      # values in columns 1..K
     grid = np.linspace(-9, 9, 180_001)
     for _ in range(3):
         w = (2 * rng.normal(size=300)).astype(np.float32)

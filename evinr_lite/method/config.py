@@ -55,7 +55,7 @@ class EvINRConfig:
       before). Same run of ``python benchmarks/quality_zoo.py`` against the committed median run
       (CLAHE-SSIM / SSIM / MSE): zoo mean 0.634 / 0.692 / 0.0366 -> 0.637 / 0.697 / 0.0354, real
       chunk 0.360 / 0.429 / 0.0690 -> 0.357 / 0.426 / 0.0649; held-out and long recordings in
-      docs/defaults.md. About the median's time (0.16 s for a 64 x 180 x 240 grid).
+      docs/defaults.md. 0.12 s against the median's 0.08 s for a 64 x 180 x 240 grid.
     - offset_window=5.0 (issue 21): on spans longer than 7.5 s the offset is a slow per-pixel trend
       (one median-gradient image per 5 s, linear between), which follows what builds up at every
       pixel over a long recording; shorter spans keep the single image. ``python

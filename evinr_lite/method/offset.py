@@ -65,9 +65,9 @@ def poisson_integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
     div[1:, :] += gy
     mu = laplacian_eigenvalues((H, W))
     mu[0, 0] = 1.0
-    g = scipy.fft.dctn(div, type=2, norm="ortho") / mu
+    g = scipy.fft.dctn(div, type=2, norm="ortho", workers=cpu_threads()) / mu
     g[0, 0] = 0.0
-    return scipy.fft.idctn(g, type=2, norm="ortho")
+    return scipy.fft.idctn(g, type=2, norm="ortho", workers=cpu_threads())
 
 
 def median_gradient_offset(frames) -> np.ndarray:
@@ -107,25 +107,30 @@ class SumAbsProx:
     Between two sorted breakpoints, z = w - (2 j - K) / rho, with j the number of b_ek below z; the answer
     is that z for the smallest j with z <= b_(j+1) (the sorted values, 1-based), pushed up to b_(j) when it
     falls below it. Put c_j = b_(j+1) + (2 j - K) / rho, increasing in j: then j is the number of c_j below
-    w, found by bisection. Between ADMM iterations w moves little, so last iteration's j is checked first
-    and only the edges whose j moved are searched again. Memory: c, float32 [E, K + 1]."""
+    w (c_(j-1) < w <= c_j), found by bisection. Between ADMM iterations w moves little, so last iteration's
+    j is checked first and only the edges whose j moved are searched again. Memory: float32 [E, K + 2],
+    each row -inf, c_0 .. c_(K-1), +inf (the two ends spare every test for j = 0 and j = K)."""
 
-    def __init__(self, minus_diffs: np.ndarray, rho: float):
-        # minus_diffs: float32 [E, K + 1], the K values -D F_k per edge in the first K columns (sorted here, in place)
-        E, K1 = minus_diffs.shape
-        self.K = K1 - 1
-        self.steps = ((2 * np.arange(K1) - self.K) / rho).astype(np.float32)   # (2 j - K) / rho, j = 0..K
-        self.c = minus_diffs
-        self.c[:, :self.K].sort(axis=1)
-        self.median = 0.5 * (self.c[:, (self.K - 1) // 2].astype(np.float64) + self.c[:, self.K // 2])
-        self.c[:, :self.K] += self.steps[:self.K]
-        self.c[:, self.K] = np.inf                                              # c_K: every w is below it
-        self.flat = self.c.reshape(-1)
-        self.row = np.arange(E, dtype=np.int64) * K1
+    def __init__(self, values: np.ndarray, rho: float):
+        # values: float32 [E, K + 2], each edge's K values b_ek in columns 1..K (sorted here, in place)
+        E, K2 = values.shape
+        self.K = K = K2 - 2
+        steps = (2 * np.arange(K + 1) - K) / rho                               # (2 j - K) / rho, j = 0..K
+        self.steps = steps.astype(np.float32)
+        self.steps_before = np.concatenate([[0.0], steps[:-1]]).astype(np.float32)   # (2 (j - 1) - K) / rho
+        self.s = values
+        self.s[:, 1:K + 1].sort(axis=1)
+        self.median = 0.5 * (self.s[:, 1 + (K - 1) // 2].astype(np.float64) + self.s[:, 1 + K // 2])
+        self.s[:, 1:K + 1] += self.steps[:K]
+        self.s[:, 0], self.s[:, K + 1] = -np.inf, np.inf
+        self.flat = self.s.reshape(-1)
+        self.row = np.arange(E, dtype=np.int64) * K2
         self.j = None
 
     def _bisect(self, w: np.ndarray, row: np.ndarray) -> np.ndarray:
+        # the smallest j in [0, K] with w <= c_j (c_j sits in column j + 1)
         lo, hi = np.zeros(len(w), np.int64), np.full(len(w), self.K, np.int64)
+        row = row + 1
         for _ in range(int(np.ceil(np.log2(self.K + 1)))):
             mid = (lo + hi) >> 1
             below = w <= self.flat[row + mid]
@@ -135,26 +140,51 @@ class SumAbsProx:
     def __call__(self, w: np.ndarray) -> np.ndarray:
         w = np.asarray(w, np.float32)
         if self.j is None:
-            j = self._bisect(w, self.row)
+            self.j = self._bisect(w, self.row)
+            idx = self.row + self.j
+            c_before = self.flat[idx]
         else:                                       # last iteration's j where it still holds: c_(j-1) < w <= c_j
-            j = self.j
-            moved = np.flatnonzero((w > self.flat[self.row + j]) |
-                                   ((j > 0) & (w <= self.flat[self.row + np.maximum(j - 1, 0)])))
-            j[moved] = self._bisect(w[moved], self.row[moved])
-        self.j = j
-        below = np.maximum(j - 1, 0)
-        b_j = np.where(j > 0, self.flat[self.row + below] - self.steps[below], -np.inf)   # b_(j), -inf for j = 0
-        return np.maximum(w - self.steps[j], b_j)
+            idx = self.row + self.j
+            c_before = self.flat[idx]
+            moved = np.flatnonzero((w <= c_before) | (w > self.flat[idx + 1]))
+            if moved.size:
+                self.j[moved] = self._bisect(w[moved], self.row[moved])
+                idx[moved] = self.row[moved] + self.j[moved]
+                c_before[moved] = self.flat[idx[moved]]
+        # z = w - (2 j - K) / rho, pushed up to b_(j) = c_(j-1) - (2 (j - 1) - K) / rho (-inf for j = 0)
+        return np.maximum(w - self.steps[self.j], c_before - self.steps_before[self.j])
 
 
-def _minus_diffs(F: np.ndarray, axis: int) -> np.ndarray:
-    """float32 [E, K + 1]: the K frames' -(forward differences along ``axis`` of F [K, H, W]) per edge
-    (E edges, row-major), with one spare column; a block of frames at a time (no float64 copy of F)."""
+class _EdgeSplit:
+    """One direction's ADMM variables (z, the scaled dual u) over its edges, float32 [E]."""
+
+    def __init__(self, prox: SumAbsProx, dg: np.ndarray):
+        self.prox, self.z = prox, dg.astype(np.float32).ravel()
+        self.u = np.zeros_like(self.z)
+
+    def step(self, dg: np.ndarray) -> np.ndarray:
+        """One iteration from D g (this direction's differences of the current offset): returns z - u
+        (float64 [E]), what the Poisson step integrates."""
+        # over-relaxed ADMM (h = a D g + (1 - a) z, a = L1_RELAX): the same fixed point, fewer iterations
+        h = L1_RELAX * dg.astype(np.float32).ravel() + (1 - L1_RELAX) * self.z
+        self.z = self.prox(h + self.u)
+        self.u += h - self.z
+        return (self.z - self.u).astype(np.float64)
+
+
+def _edge_values(F: np.ndarray, axis: int) -> np.ndarray:
+    """float32 [E, K + 2]: the K frames' -(forward differences along ``axis`` of F [K, H, W]) per edge
+    (E edges, row-major) in columns 1..K, the two end columns left for :class:`SumAbsProx`; a block of
+    image rows at a time (no float64 copy of F, and each block's transpose stays in cache)."""
     K, H, W = F.shape
-    E = H * (W - 1) if axis == 2 else (H - 1) * W
-    out = np.empty((E, K + 1), np.float32)
-    for k in range(K):
-        out[:, k] = -np.diff(np.asarray(F[k], np.float32), axis=axis - 1).reshape(-1)
+    width = W - 1 if axis == 2 else W
+    n_rows = H if axis == 2 else H - 1
+    out = np.empty((n_rows * width, K + 2), np.float32)
+    rows = max(1, (1 << 18) // max(K * width, 1))
+    for r0 in range(0, n_rows, rows):
+        r1 = min(n_rows, r0 + rows)
+        block = np.asarray(F[:, r0:r1 + (axis == 1)], np.float32)
+        out[r0 * width:r1 * width, 1:K + 1] = -np.diff(block, axis=axis).reshape(K, -1).T
     return out
 
 
@@ -169,39 +199,37 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
     integral of z - u (:func:`poisson_integrate`). It starts from the median answer and stops after
     ``max_iters`` iterations or once no pixel moves by more than ``tol`` x the mean |gradient|. rho and a
     set how fast it gets there, not where (the problem is convex). Cost: one sort of each edge's K values,
-    then per iteration a few passes over the edges and one DCT solve; about the median's time. Memory:
-    float32 [K + 1] per edge in x and y, about 8 bytes per frame and pixel."""
+    then per iteration a few passes over the edges (x and y on two threads) and one DCT solve; 1.5-2.5x
+    the median's time (0.12 s against 0.08 s at 64 x 180 x 240, 3.3 s against 1.3 s at 64 x 720 x 1280).
+    Memory: float32 [K + 2] per edge in x and y, 12 bytes per frame and pixel at its peak (tracemalloc)."""
     F = np.asarray(frames)
     if F.ndim != 3 or F.shape[0] < 1:
         raise ValueError(f"frames must be [K, H, W] log intensities, got shape {F.shape}")
     K, H, W = F.shape
     if H < 2 or W < 2:                              # no edges in one direction: the median answer
         return median_gradient_offset(F)
-    bx, by = _minus_diffs(F, 2), _minus_diffs(F, 1)
+    # x and y edges are independent until the Poisson step: two threads (numpy releases the GIL), the
+    # same numbers on any count
+    pool = ThreadPoolExecutor(2 if cpu_threads() >= 2 else 1)
+    both = lambda fx, fy: [f.result() for f in (pool.submit(fx), pool.submit(fy))]   # noqa: E731
+    bx, by = both(lambda: _edge_values(F, 2), lambda: _edge_values(F, 1))
     # the mean, not the median: integrated events are flat at most pixels, so their median |gradient| is 0
-    scale = float(np.abs(bx[:, :K]).mean(dtype=np.float64) + np.abs(by[:, :K]).mean(dtype=np.float64)) / 2
+    scale = float(np.abs(bx[:, 1:K + 1]).mean(dtype=np.float64) + np.abs(by[:, 1:K + 1]).mean(dtype=np.float64)) / 2
     rho = K * L1_RHO / scale if scale > 0 else 1.0
-    px, py = SumAbsProx(bx, rho), SumAbsProx(by, rho)
+    px, py = both(lambda: SumAbsProx(bx, rho), lambda: SumAbsProx(by, rho))
     g = poisson_integrate(px.median.reshape(H, W - 1), py.median.reshape(H - 1, W))   # the per-edge medians
     if not scale > 0:                               # flat frames: nothing to make sparser
+        pool.shutdown()
         return g
-    dgx, dgy = np.diff(g, axis=1).astype(np.float32).ravel(), np.diff(g, axis=0).astype(np.float32).ravel()
-    zx, zy = dgx, dgy
-    ux, uy = np.zeros_like(zx), np.zeros_like(zy)
+    x, y = _EdgeSplit(px, np.diff(g, axis=1)), _EdgeSplit(py, np.diff(g, axis=0))
     for _ in range(max_iters):
-        # over-relaxed ADMM (h = a D g + (1 - a) z, a = L1_RELAX): the same fixed point, fewer iterations
-        hx = L1_RELAX * dgx + (1 - L1_RELAX) * zx
-        hy = L1_RELAX * dgy + (1 - L1_RELAX) * zy
-        zx, zy = px(hx + ux), py(hy + uy)
-        ux += hx - zx
-        uy += hy - zy
-        g_new = poisson_integrate((zx - ux).reshape(H, W - 1).astype(np.float64),
-                                  (zy - uy).reshape(H - 1, W).astype(np.float64))
+        tx, ty = both(lambda: x.step(np.diff(g, axis=1)), lambda: y.step(np.diff(g, axis=0)))
+        g_new = poisson_integrate(tx.reshape(H, W - 1), ty.reshape(H - 1, W))
         moved = float(np.abs(g_new - g).max())
         g = g_new
-        dgx, dgy = np.diff(g, axis=1).astype(np.float32).ravel(), np.diff(g, axis=0).astype(np.float32).ravel()
         if moved <= tol * scale:
             break
+    pool.shutdown()
     return g
 
 
