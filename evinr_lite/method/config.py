@@ -57,8 +57,9 @@ class EvINRConfig:
       chunk 0.360 / 0.429 / 0.0690 -> 0.357 / 0.426 / 0.0649; held-out and long recordings in
       docs/defaults.md. 0.12 s against the median's 0.08 s for a 64 x 180 x 240 grid.
     - offset_window=5.0 (issue 21): on spans longer than 7.5 s the offset is a slow per-pixel trend
-      (one median-gradient image per 5 s, linear between), which follows what builds up at every
-      pixel over a long recording; shorter spans keep the single image. ``python
+      (one offset image per 5 s, linear between; measured below with the median solve, the default
+      then), which follows what builds up at every pixel over a long recording; shorter spans keep
+      the single image. ``python
       benchmarks/quality_zoo.py --long --scenes drift_clock,long_pan_20s,long_ijrr_60s --methods
       kit,one_image --variant one_image=offset_window=None``: long_pan_20s 0.514 / 0.576 / 0.0349 ->
       0.545 / 0.591 / 0.0343, long_ijrr_60s 0.489 / 0.471 / 0.0161 -> 0.516 / 0.483 / 0.0157,

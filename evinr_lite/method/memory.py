@@ -45,10 +45,9 @@ EVENT_BYTES = 17.0      # one event in memory: t float64, x, y int32, p int8
 READ_BYTES = 2 * EVENT_BYTES   # while a window is read and converted (the file's columns, then Events)
 
 
-def _offset_solve_frames(span: float, n_windows: int, config: EvINRConfig) -> int:
-    """Grid frames that one offset solve looks at (method/offset.py: offset_grid, offset_trend): the
+def _offset_solve_frames(span: float, G: int, config: EvINRConfig) -> int:
+    """Of the G grid frames, those that one offset solve looks at (method/offset.py: offset_trend): the
     whole grid for one image, else the frames within ``offset_window`` of a knot (at least 8)."""
-    G = len(offset_grid(0.0, max(span, 1e-9), n_windows, config.offset_solve))
     window = config.offset_window
     if window is None or span <= 0 or max(1, round(span / window)) == 1:
         return G
@@ -140,12 +139,12 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
     # bytes per frame and pixel of the largest single solve. It runs in a phase of its own, after training
     # (streaming: after the last window, beside what lives through the run; whole solve: beside the events,
     # the networks and the offset grid), so it counts only as far as that phase exceeds the others.
-    offset_work = (17.0 * _offset_solve_frames(span, N, config) * P if config.offset_solve == "l1_gradient" else 0.0)
+    G = len(offset_grid(0.0, max(span, 1e-9), N, config.offset_solve))
+    offset_work = 17.0 * _offset_solve_frames(span, G, config) * P if config.offset_solve == "l1_gradient" else 0.0
     if streaming:
         offset_phase = persistent + offset_work
     else:
-        offset_phase = (parts["process"] + parts["events"] + parts["networks"]
-                        + 4.0 * len(offset_grid(0.0, max(span, 1e-9), N, config.offset_solve)) * P + offset_work)
+        offset_phase = parts["process"] + parts["events"] + parts["networks"] + 4.0 * G * P + offset_work
     parts["offset"] = max(0.0, offset_phase - sum(parts.values()))
     return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
             "span_s": span, "streaming": bool(streaming), "offset_solve_bytes": offset_work}
