@@ -26,13 +26,16 @@ def recording(tmp_path_factory):
 
 
 def _guard_installed(pid: int) -> bool:
-    """The guard handles SIGTERM (Python alone does not): seen in the kernel's caught-signal mask."""
+    """The guard handles SIGTERM and SIGHUP (Python alone handles neither): both seen in the kernel's
+    caught-signal mask. It installs its handlers one after another (SIGINT, SIGTERM, SIGHUP), so
+    seeing SIGTERM's alone left a moment in which a SIGHUP still met the default action (CI saw it:
+    exit -1 instead of 129)."""
     try:
         with open(f"/proc/{pid}/status") as f:
             mask = next(int(line.split()[1], 16) for line in f if line.startswith("SigCgt"))
     except (OSError, StopIteration):
         return False
-    return bool(mask & (1 << (signal.SIGTERM - 1)))
+    return all(mask & (1 << (sig - 1)) for sig in (signal.SIGTERM, signal.SIGHUP))
 
 
 def _start(argv, cwd=None, **kw):
