@@ -13,7 +13,7 @@ import os
 from ..core.events import EventDataError
 from .config import EvINRConfig
 from .ensemble import split_windows
-from .offset import MIN_TREND_FRAMES, offset_grid
+from .offset import MIN_TREND_FRAMES, offset_grid, trend_intervals
 
 __all__ = ["estimate_memory", "check_memory", "check_times_memory", "available_bytes"]
 
@@ -49,7 +49,7 @@ def _offset_solve_frames(span: float, G: int, config: EvINRConfig) -> int:
     """Of the G grid frames, those that one offset solve looks at (method/offset.py: offset_trend): the
     whole grid for one image, else the frames within ``offset_window`` of a knot (at least 8)."""
     window = config.offset_window
-    if window is None or span <= 0 or max(1, round(span / window)) == 1:
+    if span <= 0 or trend_intervals(span, window) == 1:
         return G
     return int(min(G, max(MIN_TREND_FRAMES, math.floor(2 * window / span * (G - 1)) + 1)))
 

@@ -44,7 +44,7 @@ from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues
 
 __all__ = ["median_gradient_offset", "l1_gradient_offset", "SumAbsProx", "offset_image", "poisson_integrate",
-           "offset_trend", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES"]
+           "offset_trend", "trend_intervals", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES"]
 
 MIN_TREND_FRAMES = 8     # a knot's median looks at least at this many grid frames (the nearest, if its window holds fewer)
 OFFSET_SOLVES = ("none", "median_gradient", "l1_gradient")
@@ -266,6 +266,12 @@ class OffsetTrend:
         return self.add_to(np.zeros((len(t), *self.images.shape[1:]), np.float32), t)
 
 
+def trend_intervals(span: float, window: float | None) -> int:
+    """How many intervals between knots :func:`offset_trend` puts over ``span`` seconds: 1 (one image)
+    for ``window`` None or a span under 1.5 windows, else round(span / window)."""
+    return 1 if window is None else max(1, int(round(span / window)))
+
+
 def offset_trend(times, frames, window: float | None, method: str = "l1_gradient") -> OffsetTrend:
     """The slowly varying offset that makes the frames' gradients sparsest locally in time
     (:func:`l1_gradient_offset`; or, with ``method="median_gradient"``, each pixel's median gradient zero).
@@ -287,7 +293,7 @@ def offset_trend(times, frames, window: float | None, method: str = "l1_gradient
     if window is not None and not window > 0:
         raise ValueError(f"window must be positive seconds or None, got {window!r}")
     span = float(t[-1] - t[0])
-    n = 1 if window is None else max(1, int(round(span / window)))
+    n = trend_intervals(span, window)
     if n == 1:
         return OffsetTrend(t[:1].copy(), offset_image(frames, method).astype(np.float32)[None])
     knots = np.linspace(t[0], t[-1], n + 1)

@@ -160,8 +160,7 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     grid = offset_grid(t_start, t_end, len(windows), cfg.offset_solve)
     trend = None
     if cfg.offset_solve != "none":                                              # 4. offset solve
-        trend = offset_trend(grid, blend_networks(model, windows, grid, offsets), cfg.offset_window,
-                                      cfg.offset_solve)
+        trend = offset_trend(grid, blend_networks(model, windows, grid, offsets), cfg.offset_window, cfg.offset_solve)
         if len(trend.knots) == 1:   # one offset image for all networks: the alignment stays
             offsets += trend.images[0]
             trend = None
