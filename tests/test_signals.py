@@ -96,6 +96,29 @@ def test_sigterm_during_training_of_a_new_folder(recording, tmp_path):
     assert list(tmp_path.iterdir()) == []          # the parents it created are gone too
 
 
+
+@pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: signal.Signals(s).name)
+def test_signal_as_the_resume_folder_is_made_leaves_nothing(capsys, recording, tmp_path, monkeypatch, sig):
+    """The instant after "reconstructing": the streamed run makes its resume folder beside the output;
+    a signal then (here: as its marker is put in place) must not leave it, nor the parents made for it."""
+    from evinr_lite.apps.stream_job import RESUME_MARKER
+
+    real_replace = Path.replace
+    seen = []
+
+    def replace_with_signal(self, target):
+        if Path(target).name == RESUME_MARKER:
+            seen.append(Path(target).parent.name)
+            os.kill(os.getpid(), sig)
+        return real_replace(self, target)
+
+    monkeypatch.setattr(Path, "replace", replace_with_signal)
+    code, _, err = run(capsys, "reconstruct", recording, "--out", tmp_path / "a" / "b" / "new", *FAST)
+    assert seen == [".new.resume"] and code == 128 + sig, err
+    assert "was not written" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []          # no resume folder, and the parents it created are gone
+
+
 # ---- signals during export and during replacement (in-process, the command's own handlers) ----------
 
 @pytest.mark.parametrize("sig", SIGNALS, ids=lambda s: signal.Signals(s).name)

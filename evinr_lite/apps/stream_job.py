@@ -30,6 +30,7 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
+from ..core.guard import signals_deferred
 from ..core.recording import Recording
 
 __all__ = ["streamable", "run_streaming", "check_disk", "resume_folder", "video_fps", "RESUME_MARKER", "GIF_LIMIT_BYTES"]
@@ -174,19 +175,23 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
             f"{config.n_iters} Adam iterations{' + the closed-form output layer' if config.head_solve else ''}, "
             f"{device_name}), window by window")
         folder = resume_folder(target.path)
-        state = _prepare_resume(folder, _key(path, config, times, (lo, hi)), resume, log)
-        writer = _FrameWriter(target.staging, times, query, gt_t, options.video, log)
-        parts = stream_reconstruct(source, query, config, t_start=lo, t_end=hi, workdir=folder, state=state,
-                                   on_state=lambda s: s.save(folder / "state.npz"), progress=options.progress)
+        made = False   # the resume folder is this run's to keep or remove once _prepare_resume has returned
         history = {}
         try:
+            with signals_deferred():   # a signal here is acted on after `made` is set, inside this try
+                state = _prepare_resume(folder, _key(path, config, times, (lo, hi)), resume, log)
+                made = True
+            writer = _FrameWriter(target.staging, times, query, gt_t, options.video, log)
+            parts = stream_reconstruct(source, query, config, t_start=lo, t_end=hi, workdir=folder, state=state,
+                                       on_state=lambda s: s.save(folder / "state.npz"), progress=options.progress)
             for part in parts:
                 writer.add(part)
                 history = part.history
         except BaseException:   # interrupted or failed: finished windows stay for --resume, else nothing stays
-            if (folder / "state.npz").is_file():
+            # (not made: refused before the folder was ready, e.g. one that is not this job's; left untouched)
+            if made and (folder / "state.npz").is_file():
                 log(f"the finished windows are kept in {folder}; the same command with --resume continues from them")
-            else:
+            elif made:
                 shutil.rmtree(folder, ignore_errors=True)
             raise
     # every frame is in the staging folder: nothing is left to resume, and from here on an interruption
