@@ -65,7 +65,7 @@ def compare(setting: str, n_models: int = 10, repeats: int = 2, device="cpu", it
     cfg = EvINRConfig.v0_1(C=0.2, hidden_features=s["hidden"], hidden_layers=s["layers"], n_iters=iters,
                       coarse_to_fine=s["c2f"], c2f_iters=c2f, tau=s["tau"], overlap=s["overlap"],
                       device=device, progress=False)
-    init = FrameINR(s["size"], windows, s["hidden"], s["layers"], cfg.omega_0, cfg.first_omega_0, seed=0).to(device)
+    init = FrameINR(s["size"], windows, s["hidden"], s["layers"], cfg.omega_0, cfg.first_layer_omega(windows), seed=0).to(device)
 
     def batched():
         model = copy.deepcopy(init)

@@ -206,8 +206,8 @@ def _initial_model(sensor_size, windows: np.ndarray, cfg: EvINRConfig) -> FrameI
     from ..core.runtime import default_device
 
     solve_only = cfg.head_solve and cfg.n_iters == 0
-    return FrameINR(sensor_size, windows, cfg.hidden_features, cfg.hidden_layers, cfg.omega_0, cfg.first_omega_0,
-                    seed=cfg.seed, init_head=not solve_only).to(default_device(cfg.device))
+    return FrameINR(sensor_size, windows, cfg.hidden_features, cfg.hidden_layers, cfg.omega_0,
+                    cfg.first_layer_omega(windows), seed=cfg.seed, init_head=not solve_only).to(default_device(cfg.device))
 
 
 def _checked_span(events: Events, query_times, t_start, t_end):

@@ -180,7 +180,7 @@ def train_window(events: Events, windows: np.ndarray, k: int, config: EvINRConfi
     device = default_device(config.device)
     solve_only = config.head_solve and config.n_iters == 0   # the head is solved, never trained: no draws
     model = FrameINR(events.sensor_size, windows[k:k + 1], config.hidden_features, config.hidden_layers,
-                     config.omega_0, config.first_omega_0, seed=config.seed, first_index=k,
+                     config.omega_0, config.first_layer_omega(windows), seed=config.seed, first_index=k,
                      init_head=not solve_only).to(device)
     model, history = train_frame_inr(events, windows[k:k + 1], config, model=model)
     model.eval()

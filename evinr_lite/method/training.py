@@ -130,7 +130,7 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
     if model is None:
         device = default_device(cfg.device)
         model = FrameINR(events.sensor_size, windows, cfg.hidden_features, cfg.hidden_layers,
-                         cfg.omega_0, cfg.first_omega_0, seed=cfg.seed).to(device)
+                         cfg.omega_0, cfg.first_layer_omega(windows), seed=cfg.seed).to(device)
     device = model.head_weight.device
     if cfg.lam == "auto":   # reconstruct() resolves it over the whole span; a direct call, from these events
         from dataclasses import replace
