@@ -50,7 +50,11 @@ def _scores(summary):
 
 def _close(a, b, clahe=False):
     """Equal up to float rounding: the closed-form solve runs on BLAS, whose thread count differs
-    between a worker process and this one (float32 sums in another order: relative differences near 1e-7).
+    between a worker process and this one (float32 sums in another order). The solve amplifies them by
+    its conditioning, which grows as the features get smoother in time: with the kit's first layer at
+    5 per second (first_omega_0 = 1 on these 0.4 s recordings) the log intensities of 1 and 2 threads
+    differ by up to 7e-4 (3e-4 at first_omega_0 = 10, a session measurement), and one pooled SSIM by
+    1.2e-5 relative, so non-CLAHE scores get rel 1e-4.
     CLAHE scores (under a "clahe" key, or a pooled row of that equalisation) get abs 2e-3: CLAHE equalises
     the uint8-rounded frame, so a 1e-7 difference that crosses one rounding boundary moves a tile's whole
     mapping (measured: 6e-4 relative on one recording in four, both processes otherwise equal)."""
@@ -61,18 +65,20 @@ def _close(a, b, clahe=False):
     if isinstance(a, (list, tuple)):
         return isinstance(b, (list, tuple)) and len(a) == len(b) and all(_close(x, y, clahe) for x, y in zip(a, b))
     if isinstance(a, float) and isinstance(b, float):
-        return a == pytest.approx(b, rel=1e-5, abs=2e-3 if clahe else 1e-9)
+        return a == pytest.approx(b, rel=1e-4, abs=2e-3 if clahe else 1e-9)
     return a == b
 
 
 def _differences(a, b, path=""):
     if isinstance(a, dict) and isinstance(b, dict):
         return [d for k in a for d in _differences(a[k], b.get(k), f"{path}/{k}")]
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in _differences(x, y, f"{path}/{i}")]
     return [] if _close(a, b) else [f"{path}: {str(a)[:80]} != {str(b)[:80]}"]
 
 
 def _assert_same_results(summary, reference):
-    assert _close(summary["pooled"], reference["pooled"]), (summary["pooled"], reference["pooled"])
+    assert _close(summary["pooled"], reference["pooled"]), _differences(summary["pooled"], reference["pooled"])
     assert _close(_scores(summary), _scores(reference)), _differences(_scores(summary), _scores(reference))
     assert [f["name"] for f in summary["failed"]] == [f["name"] for f in reference["failed"]] == ["broken"]
 

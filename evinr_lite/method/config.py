@@ -39,8 +39,8 @@ class EvINRConfig:
 
     The kit's default departs from the paper in these fields. Zoo means (CLAHE-SSIM / SSIM / MSE; wall
     time per scene; every method shown by the kit's display):
-    ``python benchmarks/quality_zoo.py`` (13 short scenes, 2 cores): kit 0.619 / 0.687 / 0.0364 in
-    0.4 s, paper 0.392 / 0.481 / 0.0578, v0.1 0.571 / 0.624 / 0.0482 (about 25 s each on quiet cores),
+    ``python benchmarks/quality_zoo.py`` (13 short scenes, 2 cores): kit 0.641 / 0.699 / 0.0355 in
+    0.5 s, paper 0.392 / 0.481 / 0.0578, v0.1 0.571 / 0.624 / 0.0482 (about 25 s each on quiet cores),
     integration 0.415 / 0.453 / 0.0641, high-pass filter 0.489 / 0.556 / 0.0557. The figures in the
     bullets before ``tonemap`` were measured with the paper's Eq. 12 display, the kit's until then.
 
@@ -49,6 +49,13 @@ class EvINRConfig:
       the zoo means by less than 0.002 at 4x the time, so no Adam step is taken.
     - temporal_loss="difference": the closed form fits the exact integral form; the mid-point
       derivative is a first-order approximation.
+    - first_omega_per_s=5.0: the first layer's frequency per second of the events' clock
+      (first_omega_0 = 5 x the window's length / 2), the closed-form model's only temporal prior.
+      The fixed 10 per window before (v0_1's) was 10 per second on the zoo's 2 s scenes and 4.2 on a
+      60 s recording's 4.75 s windows; the sweep (docs/defaults.md) wants 4-7 per window on the short
+      scenes and 10-15 on the long ones, and 4-6 per second on both. Zoo mean 0.637 / 0.697 / 0.0354
+      -> 0.641 / 0.699 / 0.0355, held-out 0.526 / 0.574 / 0.0665 -> 0.530 / 0.576 / 0.0661, real
+      chunk 0.357 / 0.426 / 0.0649 -> 0.365 / 0.442 / 0.0568, the 20 s and 60 s recordings within 0.001.
     - offset_solve="l1_gradient": the per-pixel offset that events never fix is solved explicitly
       instead of drifting under the regularizer (the ghost): the one image that makes all frames'
       gradients sparsest together, by ADMM from the per-edge medians ("median_gradient", the default
@@ -136,10 +143,10 @@ class EvINRConfig:
       sparse fine texture, where some signal events have no neighbour).
 
     With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 cores):
-    kit 0.637 / 0.697 / 0.0354, integration + the same L1 offset 0.559 / 0.635 / 0.0364 (the INR:
-    1.14x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
-    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.357 / 0.426 / 0.0649 (1.10x integration +
-    offset); camera_240x180 (2 s at 180x240) in 0.65 s, 0.5 s unfiltered in the same run.
+    kit 0.641 / 0.699 / 0.0355, integration + the same L1 offset 0.559 / 0.635 / 0.0364 (the INR:
+    1.15x in CLAHE-SSIM), HF with its cutoff swept per scene 0.532 / 0.586 / 0.0535, leaky
+    integration swept 0.518 / 0.576 / 0.0543; real chunk 0.365 / 0.442 / 0.0568 (1.13x integration +
+    offset); camera_240x180 (2 s at 180x240) in 0.61 s.
     - min_bins=64: short windows get shorter bins (at least 64 per window). The zoo's windows are
       2-3 s, so at 1/32 s they hold 64-96 bins and nothing changes there; on the 0.17 s real chunk
       (5 bins at 1/32 s) CLAHE-SSIM / SSIM go from 0.272 / 0.339 to 0.349 / 0.415. The cost: on the
