@@ -51,3 +51,10 @@ def test_the_networks_get_it_in_both_solvers():
         # d(first-layer argument)/dt in rad/s: first_omega_0 x weight x (2 / window length)
         rates.append(model.first_omega_0 * model.weights[0].detach().numpy() * 2.0 / span)
     np.testing.assert_allclose(rates[0], rates[1], rtol=1e-5)
+
+
+def test_a_frequency_per_window_that_would_be_ignored_is_refused_with_the_fix():
+    with pytest.raises(EventDataError, match="first_omega_per_s=None"):
+        EvINRConfig(first_omega_0=30.0)
+    assert EvINRConfig(first_omega_per_s=None, first_omega_0=30.0).first_layer_omega([[0.0, 2.0]]) == 30.0
+    assert EvINRConfig.v0_1(first_omega_0=30.0).first_layer_omega([[0.0, 2.0]]) == 30.0   # presets: per window

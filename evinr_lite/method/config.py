@@ -25,6 +25,9 @@ from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEM
 __all__ = ["EvINRConfig"]
 
 
+FIRST_OMEGA_0 = 10.0   # first_omega_0's default; used only where first_omega_per_s is None
+
+
 @dataclass
 class EvINRConfig:
     """Every setting of the frame-based solver.
@@ -180,7 +183,8 @@ class EvINRConfig:
             wrong (notebook 01 shows the same in 1-D); 10 keeps F smooth at the scale of a bin.
             Each network maps its own window to [-1, 1], so shorter ensemble windows allow faster
             wiggles per second: with short windows prefer temporal_loss="difference" (notebook 06).
-            Used as given when ``first_omega_per_s`` is None (the paper's recipe, v0_1).
+            Used as given when ``first_omega_per_s`` is None (the paper's recipe, v0_1); another value
+            while first_omega_per_s is set is refused, since it would be ignored.
         first_omega_per_s: the first layer's frequency factor per second of the events' clock (the
             kit's default 5.0; None: ``first_omega_0`` as given). Each network's first_omega_0 is then
             first_omega_per_s x its window's length / 2 (:meth:`first_layer_omega`), so F may vary as
@@ -262,7 +266,7 @@ class EvINRConfig:
     hidden_features: int = 128
     hidden_layers: int = 3
     omega_0: float = 30.0
-    first_omega_0: float | None = 10.0
+    first_omega_0: float | None = FIRST_OMEGA_0
     first_omega_per_s: float | None = 5.0
     n_iters: int = 0
     lr: float = 1e-4
@@ -329,6 +333,10 @@ class EvINRConfig:
             raise EventDataError(f"first_omega_0 must be positive (or None), got {self.first_omega_0}")
         if self.first_omega_per_s is not None and not number("first_omega_per_s", self.first_omega_per_s) > 0:
             raise EventDataError(f"first_omega_per_s must be positive (or None), got {self.first_omega_per_s}")
+        if self.first_omega_per_s is not None and self.first_omega_0 != FIRST_OMEGA_0:   # it would be ignored
+            raise EventDataError(f"first_omega_0={self.first_omega_0!r} is a frequency per window, but first_omega_per_s="
+                                 f"{self.first_omega_per_s!r} (per second) sets the first layer; pass first_omega_per_s=None "
+                                 "to use first_omega_0, or change first_omega_per_s instead")
         for name, low in (("n_iters", 0 if self.head_solve else 1), ("min_bins", 0), ("hidden_features", 1), ("hidden_layers", 0), ("lr_decay_every", 1),
                           ("events_per_bin", 1)):
             if number(name, getattr(self, name), integer=True) < low:
