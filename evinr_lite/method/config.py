@@ -191,10 +191,7 @@ class EvINRConfig:
             fast per second in a 2 s window as in a 4.75 s one. With the closed-form head the hidden
             layers are never trained, so this frequency is the model's only temporal prior: lower is
             smoother in time. Chosen on the zoo, the held-out scenes, the long recordings and the real
-            chunk (docs/defaults.md): 5 per second against the fixed 10 per window before, which was
-            10 per second on the zoo's 2 s scenes and 4.2 on the 60 s recording's 4.75 s windows
-            (CLAHE-SSIM: zoo mean 0.637 -> 0.641, held-out 0.526 -> 0.530, real chunk 0.357 -> 0.365,
-            the 20 s and 60 s recordings within 0.001).
+            chunk: the figures are in the list of departures above and in docs/defaults.md.
     Optimisation:
         n_iters: iterations (paper: 300). lr, lr_decay, lr_decay_every: Adam with lr x lr_decay
             every lr_decay_every iterations (paper: 1e-4, 0.95, 10).
