@@ -232,3 +232,49 @@ def test_an_interrupt_raised_where_python_ignores_exceptions_is_not_lost(capsys)
     assert ref() is None and time.monotonic() < deadline
     err = capsys.readouterr().err
     assert "Exception ignored" not in err and "Traceback" not in err, err
+
+
+def _signal_once_installed(monkeypatch, sig):
+    """signal.signal that sends ``sig`` to this process as soon as the guard's last handler is in place
+    (the moment the start-up test hits at random: the guard's loop has not finished yet)."""
+    from evinr_lite.core.guard import TERMINATION_SIGNALS
+
+    real, sent = signal.signal, []
+
+    def install(signum, handler):
+        previous = real(signum, handler)
+        if signum == TERMINATION_SIGNALS[-1] and getattr(handler, "__name__", "") == "handler" and not sent:
+            sent.append(signum)
+            os.kill(os.getpid(), sig)
+            for _ in range(1000):   # the handler runs here, before the guard's loop goes on
+                pass
+        return previous
+
+    monkeypatch.setattr(signal, "signal", install)
+    return sent
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_as_the_guard_installs_its_handlers_is_caught(monkeypatch, capsys, sig):
+    """CI once saw `reconstruct` end with a traceback (status 1) when SIGINT came right after the guard's
+    handlers were seen in /proc: the handlers were installed before the guard's `try`. The signal now
+    arrives at exactly that moment: the guard reports it (128 + n) and leaves the handlers as they were."""
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    ran = []
+    sent = _signal_once_installed(monkeypatch, sig)
+    assert run_guarded("prog", lambda: ran.append(1), []) == 128 + sig
+    assert sent and ran == []
+    assert f"interrupted by {signal.Signals(sig).name}" in capsys.readouterr().err
+    monkeypatch.undo()
+    assert {s: signal.getsignal(s) for s in before} == before
+
+
+def test_a_signal_as_termination_signals_installs_its_handlers_restores_them(monkeypatch):
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    ran = []
+    _signal_once_installed(monkeypatch, signal.SIGTERM)
+    with pytest.raises(Interrupted):
+        with termination_signals():
+            ran.append(1)
+    monkeypatch.undo()
+    assert ran == [] and {s: signal.getsignal(s) for s in before} == before

@@ -101,15 +101,15 @@ def termination_signals():
         return
     outer, _state = _state, _SignalState()
     previous = {}
-    for sig in TERMINATION_SIGNALS:
-        current = signal.getsignal(sig)
-        if sig == signal.SIGINT and current in (signal.SIG_IGN, None):
-            continue
-        previous[sig] = current
-        signal.signal(sig, _state.handler)
     state, hook = _state, sys.unraisablehook
-    sys.unraisablehook = lambda unraisable: state.unraisable(unraisable, hook)
-    try:
+    try:   # handlers are installed inside the try: a signal right after the first one still restores them all
+        for sig in TERMINATION_SIGNALS:
+            current = signal.getsignal(sig)
+            if sig == signal.SIGINT and current in (signal.SIG_IGN, None):
+                continue
+            previous[sig] = current
+            signal.signal(sig, state.handler)
+        sys.unraisablehook = lambda unraisable: state.unraisable(unraisable, hook)
         yield
     finally:
         sys.unraisablehook = hook
@@ -231,15 +231,17 @@ def run_guarded(prog: str, body, argv, *, expected=(), describe=str, interrupted
     code = None
     outer, state = _state, _SignalState()
     previous = {}
-    if _main_thread():
-        _state = state
-        for sig in TERMINATION_SIGNALS:
-            current = signal.getsignal(sig)
-            if sig == signal.SIGINT and current in (signal.SIG_IGN, None):
-                continue                  # a background job ignores Ctrl-C: so do we
-            previous[sig] = current
-            signal.signal(sig, state.handler)
     try:
+        # The handlers are installed inside the try: a signal that arrives as soon as one is in place
+        # (the loop has not finished yet) is still an Interrupted that this function catches.
+        if _main_thread():
+            _state = state
+            for sig in TERMINATION_SIGNALS:
+                current = signal.getsignal(sig)
+                if sig == signal.SIGINT and current in (signal.SIG_IGN, None):
+                    continue                  # a background job ignores Ctrl-C: so do we
+                previous[sig] = current
+                signal.signal(sig, state.handler)
         protect_streams()
         check_cwd()
         code = body()
