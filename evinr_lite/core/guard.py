@@ -128,13 +128,13 @@ def signals_deferred():
         yield
         return
     pending, previous = [], {}
-    for sig in TERMINATION_SIGNALS:
-        handler = signal.getsignal(sig)
-        if handler in (signal.SIG_IGN, None):
-            continue
-        previous[sig] = handler
-        signal.signal(sig, lambda signum, frame: pending.append(signum))
-    try:
+    try:   # inside the try: a signal between two installations still gets every handler restored
+        for sig in TERMINATION_SIGNALS:
+            handler = signal.getsignal(sig)
+            if handler in (signal.SIG_IGN, None):
+                continue
+            previous[sig] = handler
+            signal.signal(sig, lambda signum, frame: pending.append(signum))
         yield
     finally:
         for sig, handler in previous.items():
