@@ -53,9 +53,11 @@ def _close(a, b, clahe=False):
     between a worker process and this one (float32 sums in another order). How far that moves a
     reconstruction grows as the first layer's frequency falls: with the kit's first layer at 5 per
     second (first_omega_0 = 1 on these 0.4 s recordings) the log intensities of 1 and 2 threads differ
-    by up to 7e-4 (3e-4 at first_omega_0 = 10; a session measurement, which float64 features in the
-    head solve did not change, so the amplification is elsewhere), and one pooled SSIM by 1.2e-5
-    relative, so non-CLAHE scores get rel 1e-4.
+    by up to 7e-4 (3e-4 at first_omega_0 = 10), and one pooled SSIM by 1.2e-5 relative, so non-CLAHE
+    scores get rel 1e-4. The cause: the solved head's weights are large and cancel (rms 31 on
+    camera_translate), so float32 rounding in the features and in the head product is amplified.
+    Predictions now compute the features in float64 (tests/test_exact_features.py: camera_translate's
+    1-vs-2-thread difference 9.6e-4 -> 2.0e-4); the head product stays float32.
     CLAHE scores (under a "clahe" key, or a pooled row of that equalisation) get abs 2e-3: CLAHE equalises
     the uint8-rounded frame, so a 1e-7 difference that crosses one rounding boundary moves a tile's whole
     mapping (measured: 6e-4 relative on one recording in four, both processes otherwise equal)."""

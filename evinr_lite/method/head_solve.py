@@ -128,12 +128,12 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
     device, dtype = model.head_weight.device, model.head_weight.dtype
     edges = boundaries.to(device)
     if temporal_loss == "difference":
-        h, _ = model.features(edges)                                     # [N, B + 1, d]
+        h, _ = model.features(edges, dtype=model.exact_dtype())          # [N, B + 1, d], float64 (features())
         A = h[:, 1:] - h[:, :-1]
         reg_h = h
     else:
         centers = 0.5 * (edges[:, 1:] + edges[:, :-1])
-        h, dh = model.features(centers, with_derivative=True)
+        h, dh = model.features(centers, with_derivative=True, dtype=model.exact_dtype())
         A = dh * (edges[:, 1:] - edges[:, :-1]).to(dh.dtype)[..., None]
         reg_h = h
     N, B, d = A.shape

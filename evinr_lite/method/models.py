@@ -98,28 +98,43 @@ class FrameINR(nn.Module):
         self.head_bias = nn.Parameter(values["head_b"])
 
     # ---- time mapping -------------------------------------------------------------------
-    def normalize_time(self, t: torch.Tensor) -> torch.Tensor:
-        """Seconds [N, T] -> [-1, 1] within each network's window (float32)."""
+    def normalize_time(self, t: torch.Tensor, dtype: torch.dtype | None = None) -> torch.Tensor:
+        """Seconds [N, T] -> [-1, 1] within each network's window (computed in float64; returned in
+        ``dtype``, default the model's: float32)."""
         lo, hi = self.windows[:, :1], self.windows[:, 1:]
-        return (2 * (t.double() - lo) / (hi - lo) - 1).to(self.head_weight.dtype)
+        return (2 * (t.double() - lo) / (hi - lo) - 1).to(self.head_weight.dtype if dtype is None else dtype)
 
-    def _time_scale(self) -> torch.Tensor:
-        """d tau / d t per network, [N, 1, 1] (1/seconds)."""
-        return (2 / (self.windows[:, 1] - self.windows[:, 0])).to(self.head_weight.dtype)[:, None, None]
+    def _time_scale(self, dtype: torch.dtype | None = None) -> torch.Tensor:
+        """d tau / d t per network, [N, 1, 1] (1/seconds), in ``dtype`` (default the model's)."""
+        return (2 / (self.windows[:, 1] - self.windows[:, 0])).to(self.head_weight.dtype if dtype is None
+                                                                   else dtype)[:, None, None]
 
     # ---- forward ------------------------------------------------------------------------
-    def features(self, t: torch.Tensor, with_derivative: bool = False):
-        """Last hidden layer h [N, T, d] (and dh/dt [N, T, d] per second if asked)."""
-        tau = self.normalize_time(t)[..., None]                                  # [N, T, 1]
-        z = self.first_omega_0 * (tau * self.weights[0] + self.biases[0])        # [N, T, d]
+    def features(self, t: torch.Tensor, with_derivative: bool = False, dtype: torch.dtype | None = None):
+        """Last hidden layer h [N, T, d] (and dh/dt [N, T, d] per second if asked), in ``dtype`` (default:
+        the model's). :meth:`forward` without gradients and the closed-form head ask for
+        :meth:`exact_dtype`: the solved head's weights are large and cancel (rms 31 at 180x240 with the
+        kit's default), so a float32 rounding of h (1e-6, and different for 1 and 2 BLAS threads)
+        moved F by up to 1e-3 (about 2e-4 now; the rest is the float32 head product's own rounding).
+        The hidden layers are d x d, so float64 costs nothing next to the head."""
+        dtype = self.head_weight.dtype if dtype is None else dtype
+        cast = (lambda x: x) if dtype == self.head_weight.dtype else (lambda x: x.to(dtype))
+        tau = self.normalize_time(t, dtype)[..., None]                           # [N, T, 1]
+        w0, b0 = cast(self.weights[0]), cast(self.biases[0])
+        z = self.first_omega_0 * (tau * w0 + b0)                                 # [N, T, d]
         h = torch.sin(z)
-        dh = torch.cos(z) * (self.first_omega_0 * self.weights[0] * self._time_scale()) if with_derivative else None
+        dh = torch.cos(z) * (self.first_omega_0 * w0 * self._time_scale(dtype)) if with_derivative else None
         for w, b in zip(self.weights[1:], self.biases[1:]):
+            w, b = cast(w), cast(b)
             z = self.omega_0 * torch.baddbmm(b, h, w)
             h = torch.sin(z)
             if with_derivative:
                 dh = torch.cos(z) * (self.omega_0 * torch.bmm(dh, w))
         return h, dh
+
+    def exact_dtype(self) -> torch.dtype:
+        """float64 for the hidden features where the model's device has it (not Apple's MPS), else the model's."""
+        return self.head_weight.dtype if self.head_weight.device.type == "mps" else torch.float64
 
     def forward(self, t: torch.Tensor, out: torch.Tensor | None = None) -> torch.Tensor:
         """Log intensity F at times t [N, T] (seconds) -> [N, T, H, W].
@@ -127,7 +142,11 @@ class FrameINR(nn.Module):
         ``out``: optional float32 tensor [N, T, H, W] to write into (no gradient), so that a long
         query fills one preallocated result instead of allocating and copying every batch.
         """
-        h, _ = self.features(t)
+        if torch.is_grad_enabled():       # training: float32 through autograd
+            h, _ = self.features(t)
+        else:                             # a prediction: exact features, rounded once for the head (features())
+            h, _ = self.features(t, dtype=self.exact_dtype())
+            h = h.to(self.head_weight.dtype)
         if out is not None:
             torch.baddbmm(self.head_bias, h, self.head_weight, out=out.view(*out.shape[:2], -1))
             return out
