@@ -117,6 +117,11 @@ def _header(path, options, log):
     first, last = source.t_span
     lo = first if options.t_start is None else float(options.t_start)
     hi = last if options.t_end is None else float(options.t_end)
+    if source.n_events is not None and source.n_events < 2:   # not a window problem: say what the file holds
+        source.close()
+        held = "no events" if source.n_events == 0 else f"only 1 event (at t = {first:.6f} s)"
+        raise EventDataError(f"{path}: the recording holds {held}; a reconstruction needs at least 2 events at "
+                             "different times: use a longer recording (see `evinr-lite info`)")
     if source.n_events == 0 or not (hi > lo) or lo > last or hi < first:
         source.close()
         raise EventDataError(f"{path}: no events in the window [{options.t_start}, {options.t_end}) s; the events "

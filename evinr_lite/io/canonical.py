@@ -206,6 +206,8 @@ def _attr(value):
 
 
 def _info_from(f, path) -> dict:
+    from .formats.base import MAX_SENSOR_SIDE   # here: the formats package imports this module
+
     info = {k: _attr(v) for k, v in f.attrs.items() if k != "meta_json"}
     try:
         info["meta"] = json.loads(_attr(f.attrs["meta_json"])) if "meta_json" in f.attrs else {}
@@ -217,9 +219,11 @@ def _info_from(f, path) -> dict:
     if "sensor_size" not in f.attrs:
         raise EventDataError(f"{path}: no attribute sensor_size (H, W); the file is incomplete: convert it again")
     size = np.asarray(f.attrs["sensor_size"]).ravel()
-    if size.size != 2 or size.dtype.kind not in "iuf" or not np.all(np.isfinite(size)) or np.any(size <= 0):
-        raise EventDataError(f"{path}: the attribute sensor_size must be (H, W), two positive numbers; got "
-                             f"{f.attrs['sensor_size']!r}: convert the file again")
+    if size.size != 2 or size.dtype.kind not in "iuf" or not np.all(np.isfinite(size)) or np.any(size <= 0) \
+            or np.any(size != np.round(size)) or np.any(size > MAX_SENSOR_SIDE):
+        raise EventDataError(f"{path}: the attribute sensor_size must be (H, W), two positive whole numbers of at most "
+                             f"{MAX_SENSOR_SIDE} (no event camera is larger); got {f.attrs['sensor_size']!r}: convert "
+                             "the file again")
     info["sensor_size"] = tuple(int(v) for v in size)
     try:
         origin = float(np.asarray(f.attrs.get("t_origin", 0.0)).reshape(()))
@@ -332,6 +336,10 @@ def _events(f, lo: int, hi: int, sensor_size, origin: float, source) -> Events:
     try:
         return Events(t, x, y, p, sensor_size, t_origin=origin, polarity_encoding="pm1")
     except EventDataError as err:
+        if "polarity" in str(err):   # the layout fixes -1/+1: the reader takes no other encoding
+            values = sorted(set(np.unique(np.asarray(p)).tolist()) - {-1, 1})[:6]
+            raise EventDataError(f"{source}: events/p must hold -1/+1 (the canonical layout) but holds {values}; the "
+                                 "file is damaged: convert it again with python -m data_fetch convert RAW") from None
         raise EventDataError(f"{source}: {err}") from None
 
 
@@ -454,8 +462,9 @@ class CanonicalSource(RecordingSource):
                 else None
         except BaseException as err:
             self.close()
-            if isinstance(err, (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError)):
-                raise _damaged(path, err) from None
+            if not isinstance(err, EventDataError) and isinstance(err, (OSError, KeyError, RuntimeError, TypeError,
+                                                                         ValueError, IndexError)):
+                raise _damaged(path, err) from None   # an EventDataError already names the problem and the fix
             raise
         self.path, self.format, self.frames, self.n_events = path, "canonical", gt, int(n)
         self.sensor_size, self.t_origin = info["sensor_size"], float(info["t_origin"])

@@ -15,7 +15,7 @@ import numpy as np
 from ..core.events import EventDataError
 from ..core.frames import Frames
 from ..core.recording import Recording
-from .formats.base import FileFormat
+from .formats.base import FileFormat, check_frame_times, same_time_message
 from .formats.registry import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,
                                TIME_UNIT_FORMATS, detect_format, get_format)
 from .source import MemorySource, RecordingSource
@@ -79,6 +79,9 @@ def open_recording(path, *, sensor_size=None, time_unit: str | None = None, **op
             raise EventDataError(f"{path}: the timestamps are damaged ({what}): the first event is at {first!r} s "
                                  f"and the last at {last!r} s, where they must be finite and increasing; "
                                  "re-export the recording, or convert the original with python -m data_fetch convert RAW")
+        if source.n_events is not None and source.n_events >= 2 and first == last:   # formats whose reader cannot tell
+            raise EventDataError(same_time_message(path, source.n_events, first))
+        check_frame_times(source.frames, path)
     except EventDataError:
         source.close()
         raise
@@ -139,6 +142,10 @@ def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_en
     if len(events) < 2:
         raise EventDataError(f"{path}: only {len(events)} event(s) in the window [{t_start}, {t_end}) s; "
                              "choose a longer window (see `evinr-lite info` for the time span)")
+    if events.t[0] == events.t[-1]:   # sorted: every event at one instant
+        window = None if t_start is None and t_end is None else (t_start, t_end)
+        raise EventDataError(same_time_message(path, len(events), float(events.t[0]), window))
+    check_frame_times(frames, path)
     start = float(events.t[0]) if t_start is None else float(t_start)
     end = float(events.t[-1]) if t_end is None else float(t_end)
     if frames is not None:  # only frames the events can reach: inside [start, end]

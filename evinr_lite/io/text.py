@@ -31,6 +31,8 @@ NS = 10**9              # nanoseconds per second
 NS_PER_UNIT = {"s": NS, "ms": 10**6, "us": 10**3, "ns": 1}   # nanoseconds per unit of a timestamp token
 CHUNK_BYTES = 1 << 20   # the text parser works on 1 MiB of whole lines at a time (cache-friendly)
 EVENT_COLUMNS = "`t x y p` (time in seconds, x = column, y = row, polarity)"
+MAX_PIXEL = 1 << 31     # a coordinate at or beyond this is no pixel of any sensor (nor fits the int64 cast exactly)
+MAX_CLOCK_S = 2.0**53   # seconds (285 million years): a timestamp beyond it is no clock, whatever its unit
 FRAME_COLUMNS = "`t images/frame_%08d.png`"
 
 
@@ -319,6 +321,10 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     nonfinite = np.flatnonzero(~np.isfinite(t))
     if nonfinite.size:
         fail(row_line(nonfinite[0]), "the timestamp is not finite; drop or repair that line")
+    far = np.flatnonzero(np.abs(t + origin_ns / NS) > MAX_CLOCK_S)   # absolute seconds
+    if far.size:
+        fail(row_line(far[0]), f"the timestamp is beyond any clock (over {MAX_CLOCK_S:.3g} s when read in "
+             f"{time_unit!r}); the time column is damaged, or its unit is wrong (pass time_unit=)")
     if t_last is not None:
         back = np.flatnonzero(np.diff(t, prepend=t_last) < 0)
         if back.size:
@@ -330,6 +336,10 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
             not_whole = np.flatnonzero(~np.isfinite(v) | (v != np.round(v)))
             if not_whole.size:
                 fail(row_line(not_whole[0]), f"{name} must be a whole pixel index")
+            huge = np.flatnonzero(np.abs(v) >= MAX_PIXEL)   # too many digits for int64 parsing: read as floats
+            if huge.size:
+                fail(row_line(huge[0]), f"{name} = {v[huge[0]]:.6g} is no pixel index of any sensor (at most 65536 "
+                     "per side); the line is damaged: repair or drop it")
     if np.all(np.isin(p, (-1, 0, 1))):
         p = p.astype(np.int8)
     return EventBlock(t, x.astype(np.int64), y.astype(np.int64), p, header, origin_ns, n_lines, time_unit)

@@ -8,6 +8,7 @@ its reader accepts. :mod:`.registry` collects them; detection, ``read_recording`
 from __future__ import annotations
 
 import json
+import math
 import stat
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -20,7 +21,10 @@ from ..text import read_text_bytes
 
 __all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
            "json_file", "size_value", "plain_attr", "check_declared_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
-           "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE"]
+           "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE", "MAX_SENSOR_SIDE",
+           "check_time_spread", "same_time_message", "check_frame_times", "check_finite_images"]
+
+MAX_SENSOR_SIDE = 1 << 16   # pixels; no event camera is larger per side (the command line's --sensor limit too)
 
 
 @dataclass(frozen=True)
@@ -95,11 +99,54 @@ def load_npy(path: Path, *, mmap: bool = False):
 
 def to_seconds(source, t, time_unit):
     """Timestamps in their unit (detected when time_unit is 'auto'/None) -> (seconds relative to origin,
-    origin, unit), the span checked for plausibility."""
+    origin, unit), the span checked for plausibility (and refused when every timestamp is the same)."""
     unit = resolve_time_unit(t, time_unit, source)
     t, origin = relative_seconds(t, unit)
+    if t.size >= 2 and np.all(np.isfinite(t)):
+        check_time_spread(float(np.min(t)), float(np.max(t)), t.size, source)
     check_time_span(t, source, unit)
     return t, origin, unit
+
+
+def same_time_message(source, n: int, t: float, window=None) -> str:
+    """The message for ``n`` >= 2 events that all have the timestamp ``t`` (seconds): they span no time."""
+    if window is not None:
+        return (f"{source}: the {n:,} events in the window [{window[0]}, {window[1]}) s all have the same timestamp "
+                f"({t!r} s), so they span no time and nothing can be reconstructed; choose a longer window (see "
+                "`evinr-lite info` for the time span)")
+    return (f"{source}: all {n:,} events have the same timestamp ({t!r} s on the recording's clock), so they span no "
+            "time and nothing can be reconstructed; the timestamps are damaged (or another column was read as the "
+            "time): re-export the recording with each event's own timestamp")
+
+
+def check_time_spread(first: float, last: float, n: int, source) -> None:
+    """Refuse ``n`` >= 2 events whose earliest and latest timestamps (seconds) are equal: every event at one
+    instant is a damaged time column (or another column read as the time), not a recording. Checked before
+    :func:`~evinr_lite.core.events.check_time_span`, whose advice (another time unit) would not help."""
+    if n >= 2 and first == last:
+        raise EventDataError(same_time_message(source, n, first))
+
+
+def check_frame_times(frames, source) -> None:
+    """Refuse ground-truth frames two of which share a timestamp (seconds): each frame is scored against the
+    reconstruction at its own time, so two frames at one instant are a damaged frame list."""
+    if frames is None or len(frames) < 2:
+        return
+    t = np.sort(np.asarray(frames.t, dtype=np.float64))
+    same = np.flatnonzero(np.diff(t) == 0)
+    if same.size:
+        verb = "repeats" if same.size == 1 else "repeat"
+        raise EventDataError(f"{source}: {same.size} of the {len(t)} frames {verb} the timestamp of another frame "
+                             f"(e.g. two frames at t = {t[same[0]]:.6f} s); each ground-truth frame needs its own "
+                             "time: correct the frame timestamps or remove the duplicated frames")
+
+
+def check_finite_images(images, source) -> None:
+    """Refuse floating-point frames holding NaN or infinity (a damaged image; uint8 frames cannot)."""
+    images = np.asarray(images)
+    if images.dtype.kind == "f" and not np.all(np.isfinite(images)):
+        raise EventDataError(f"{source}: the frame holds NaN or infinite pixel values; the image is damaged: "
+                             "replace it, or remove the frame")
 
 
 def build_events(source, t, x, y, p, sensor_size, *, polarity, t_origin=0.0, sort=False) -> Events:
@@ -120,7 +167,13 @@ def size_hint(x, y) -> str:
 
 
 def sensor_from_header(path, header, sensor_size):
-    """Reconcile a `W H` header (given as (H, W)) with a sensor_size argument."""
+    """Reconcile a `W H` header (given as (H, W)) with a sensor_size argument; a header of 0 or beyond
+    :data:`MAX_SENSOR_SIDE` pixels per side is refused (a damaged first line)."""
+    if header is not None and not all(0 < v <= MAX_SENSOR_SIDE for v in header):
+        H, W = header
+        raise EventDataError(f"{path}: the header line `{W} {H}` (width first) gives a sensor of {H}x{W} (H x W), "
+                             f"which no event camera has (1 to {MAX_SENSOR_SIDE} pixels per side); the first line is "
+                             "damaged: write the camera's `W H` there, or remove it and pass sensor_size=(H, W)")
     if header is None or sensor_size is None:
         return sensor_size if header is None else header
     if tuple(int(v) for v in sensor_size) != header:
@@ -161,11 +214,15 @@ def size_value(source, value, name) -> tuple[int, int]:
     try:
         a = np.asarray(value).ravel()
         if a.size != 2 or a.dtype.kind not in "iuf" or not np.all(np.isfinite(a)) or np.any(a != np.round(a)) \
-                or np.any(a <= 0) or np.any(a > 1 << 20):
+                or np.any(a <= 0):
             raise ValueError
-        return int(a[0]), int(a[1])
     except (ValueError, TypeError):
         raise EventDataError(f"{source}: {name} must be (H, W), two positive whole numbers; got {value!r}") from None
+    if np.any(a > MAX_SENSOR_SIDE):
+        raise EventDataError(f"{source}: {name} is {int(a[0])}x{int(a[1])} (H x W), larger than any event camera (at "
+                             f"most {MAX_SENSOR_SIDE} pixels per side); the value is damaged: write the camera's real "
+                             "size (H, W)")
+    return int(a[0]), int(a[1])
 
 
 def plain_attr(value):
@@ -216,12 +273,19 @@ class Clock:
         return raw.astype(np.float64) / self.per_s - self.origin
 
 
-def bisect_seconds(column, clock: Clock, value: float, lo: int, hi: int) -> int:
+def bisect_seconds(column, clock: Clock, value: float, lo: int, hi: int, source=None) -> int:
     """First index in [lo, hi) whose time (in seconds, through ``clock``) is >= ``value``, reading
-    single elements of ``column`` (an on-disk dataset or memory map: O(log N) reads, not N)."""
+    single elements of ``column`` (an on-disk dataset or memory map: O(log N) reads, not N). A non-finite
+    element met on the way is refused (it compares as neither earlier nor later, so the search would silently
+    cut the window there and skip the events after it)."""
     while lo < hi:
         mid = (lo + hi) // 2
-        if float(clock.seconds(column[mid])) < value:
+        seconds = float(clock.seconds(column[mid]))
+        if not math.isfinite(seconds):
+            where = f"{source}: " if source is not None else ""
+            raise EventDataError(f"{where}timestamp {mid} is {seconds} (non-finite); drop or repair those events "
+                                 "before loading")
+        if seconds < value:
             lo = mid + 1
         else:
             hi = mid
@@ -236,6 +300,10 @@ def probe_sorted(column, source, n_probe: int = 1025) -> None:
         return
     idx = np.unique(np.linspace(0, n - 1, min(n, n_probe)).astype(np.int64))
     values = np.array([column[int(i)] for i in idx])
+    if values.dtype.kind == "f" and not np.all(np.isfinite(values)):   # a window search would stop at it
+        bad = int(idx[np.flatnonzero(~np.isfinite(values))[0]])
+        raise EventDataError(f"{source}: timestamp {bad} is {float(column[bad])} (non-finite); drop or repair those "
+                             "events before loading")
     down = np.flatnonzero(np.diff(values) < 0)
     if down.size:
         a, b = int(idx[down[0]]), int(idx[down[0] + 1])

@@ -10,8 +10,8 @@ from ...core.events import TIME_UNITS, EventDataError
 from ...core.frames import Frames
 from ...core.recording import Recording
 from ..notes import note
-from .base import (FileFormat, build_events, existing, frames_on_event_clock, json_file, load_npy,
-                   note_decimal_seconds, size_value, to_seconds)
+from .base import (FileFormat, build_events, check_finite_images, existing, frames_on_event_clock, json_file,
+                   load_npy, note_decimal_seconds, size_value, to_seconds)
 
 __all__ = ["read_evreal_folder", "FORMAT"]
 
@@ -63,6 +63,12 @@ def read_evreal_folder(folder, *, time_unit="auto") -> Recording:
             raise EventDataError(f"{folder / 'images_ts.npy'}: expected a 1-D numeric array, got shape "
                                  f"{images_ts.shape} dtype {images_ts.dtype}")
         stamps = np.asarray(images_ts, np.float64)
+        bad = np.flatnonzero(~np.isfinite(stamps))
+        if bad.size:
+            raise EventDataError(f"{folder / 'images_ts.npy'}: frame {int(bad[0])}'s timestamp is {stamps[bad[0]]} "
+                                 f"({bad.size} non-finite in all); repair those timestamps, or remove the frames "
+                                 "(images.npy and images_ts.npy together)")
+        check_finite_images(images, folder / "images.npy")
         frame_t, _ = frames_on_event_clock(lambda u: stamps * TIME_UNITS[u] - origin, unit, span,
                                            folder / "images_ts.npy", meta)
         if np.any(np.diff(frame_t) < 0):

@@ -15,8 +15,9 @@ from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
 from ..source import RecordingSource
 from ..notes import note
-from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, existing,
-                   frames_on_event_clock, note_decimal_seconds, plain_attr, probe_sorted, size_value)
+from .base import (Clock, FileFormat, bisect_seconds, build_events, check_finite_images, check_reader_window,
+                   check_time_spread, existing, frames_on_event_clock, note_decimal_seconds, plain_attr, probe_sorted,
+                   size_value)
 
 __all__ = ["read_h5", "HqfSource", "FORMAT"]
 
@@ -73,6 +74,8 @@ class _Layout:
                                      "them as float64 (or integer microseconds)")
         self.clock = Clock(ts[0] if n else 0, self.unit, ts.dtype.kind in "iu")
         self.origin = self.clock.origin
+        if n >= 2:   # every event at one instant: a damaged events/ts, refused before any window is read
+            check_time_spread(*self.span(), n, f"{path}: events/ts")
 
     def note_units(self, time_unit, meta) -> None:
         """A note when decimal timestamps detected as seconds come too slowly for seconds."""
@@ -85,8 +88,8 @@ class _Layout:
         return float(self.clock.seconds(self.ts[0])), float(self.clock.seconds(self.ts[self.n - 1]))
 
     def window(self, t_start, t_end) -> tuple[int, int]:
-        lo = 0 if t_start is None else bisect_seconds(self.ts, self.clock, t_start, 0, self.n)
-        hi = self.n if t_end is None else bisect_seconds(self.ts, self.clock, t_end, lo, self.n)
+        lo = 0 if t_start is None else bisect_seconds(self.ts, self.clock, t_start, 0, self.n, self.path)
+        hi = self.n if t_end is None else bisect_seconds(self.ts, self.clock, t_end, lo, self.n, self.path)
         return lo, hi
 
     def events(self, lo: int, hi: int) -> Events:
@@ -141,7 +144,11 @@ class _Layout:
         keys, stamps = keys[keep][order], stamps[keep][order]
         if not len(keys):
             return None
-        images = [to_grey_uint8(group[k][()], f"{path}:images/{k}") for k in keys]
+        images = []
+        for k in keys:
+            image = group[k][()]
+            check_finite_images(image, f"{path}:images/{k}")
+            images.append(to_grey_uint8(image, f"{path}:images/{k}"))
         if len({im.shape for im in images}) > 1:
             raise EventDataError(f"{path}: the frames have different sizes {sorted({im.shape for im in images})}")
         frames = Frames(np.stack(images), stamps, self.origin)

@@ -16,10 +16,31 @@ from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
 from ..text import NS, origin_to_ns, parse_event_text, parse_frame_list, read_text_bytes
 from ..notes import note
-from .base import (FileFormat, build_events, existing, frames_on_event_clock, note_decimal_seconds, sensor_from_header,
-                   size_hint)
+from .base import (FileFormat, build_events, check_time_spread, existing, frames_on_event_clock, note_decimal_seconds,
+                   sensor_from_header, size_hint)
 
-__all__ = ["read_ijrr_folder", "read_frames_ijrr", "FORMAT"]
+__all__ = ["read_ijrr_folder", "read_frames_ijrr", "FORMAT", "IMAGE_SIGNATURES"]
+
+IMAGE_SIGNATURES = {   # first bytes of the image files a frame list may name -> their kind
+    b"\x89PNG\r\n\x1a\n": "PNG", b"\xff\xd8\xff": "JPEG", b"II*\x00": "TIFF", b"MM\x00*": "TIFF", b"BM": "BMP",
+    b"GIF87a": "GIF", b"GIF89a": "GIF", b"P2": "PGM", b"P5": "PGM", b"P3": "PPM", b"P6": "PPM",
+}
+
+
+def _check_image_file(image_path: Path, listing: Path) -> None:
+    """Refuse a listed frame that is empty, or text where an image belongs (the common mistakes), by its
+    first bytes, before an image library tries each of its plugins on it (and prints their notes). Binary
+    files of a kind not listed in IMAGE_SIGNATURES are left to the image library, which may know them."""
+    with open(image_path, "rb") as f:
+        head = f.read(16)
+    if not head:
+        raise EventDataError(f"{image_path}: the image file is empty (0 bytes); copy it again, or remove its line "
+                             f"from {listing.name}")
+    text_like = all(32 <= b < 127 or b in b"\t\r\n" for b in head)
+    if text_like and not any(head.startswith(magic) for magic in IMAGE_SIGNATURES):
+        raise EventDataError(f"{image_path}: not an image file (it starts with {head[:8]!r}, no PNG, JPEG, TIFF, "
+                             f"BMP, GIF or PGM signature); replace it with the frame, or remove its line from "
+                             f"{listing.name}")
 
 
 def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s", events_span=None, meta: dict | None = None) -> Frames:
@@ -66,6 +87,7 @@ def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s", events_span=
         image_path = folder / name
         if not image_path.is_file():
             raise EventDataError(f"{listing} lists {image_path.name}, but {image_path} does not exist (or is not a file)")
+        _check_image_file(image_path, listing)
         try:
             image = imread(image_path)
         except Exception as err:   # Pillow / imageio raise many types on a damaged image
@@ -82,6 +104,9 @@ def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s", events_span=
 
 
 def _read_calib(path: Path) -> dict | list:
+    """calib.txt's numbers: {fx, fy, cx, cy, k1, k2, p1, p2, k3} when there are nine, else the list ([] when empty)."""
+    if not path.read_bytes().strip():   # np.loadtxt would warn (a note on the command line) and give the same []
+        return []
     values = np.loadtxt(path, ndmin=1).ravel().tolist()
     names = ("fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3")
     return dict(zip(names, values)) if len(values) == len(names) else values
@@ -108,6 +133,7 @@ def read_ijrr_folder(folder, *, t_origin=None, sensor_size=None, time_unit="auto
         raise EventDataError(f"{folder}: no events.txt; an IJRR folder holds events.txt, "
                              "images.txt, images/, calib.txt")
     raw = parse_event_text(events_path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
+    check_time_spread(float(raw.t[0]), float(raw.t[-1]), len(raw.t), events_path)   # sorted by the parser
     check_time_span(raw.t, events_path, raw.time_unit)
     meta = {"format": "ijrr", "path": str(folder), "time_unit": raw.time_unit}
     note_decimal_seconds(raw.t[0], raw.t[-1], len(raw.t), time_unit, raw.time_unit, events_path, meta)

@@ -14,8 +14,8 @@ import numpy as np
 from ...core.events import EventDataError, Events, check_time_span, resolve_time_unit
 from ...core.recording import Recording
 from ..source import RecordingSource
-from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, existing, load_npy,
-                   note_decimal_seconds, probe_sorted, size_hint, to_seconds)
+from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, check_time_spread, existing,
+                   load_npy, note_decimal_seconds, probe_sorted, size_hint, to_seconds)
 
 __all__ = ["read_events_npy", "read_npy", "NpySource", "FORMAT", "MAGIC"]
 
@@ -95,6 +95,8 @@ class _Opened:
         if n and not np.isfinite(float(self.t[0])):
             raise EventDataError(f"{path}: the first timestamp is {float(self.t[0])} (non-finite); repair or drop it")
         self.clock = Clock(self.t[0] if n else 0, self.unit, a.dtype.kind in "iu")
+        if n >= 2:   # every event at one instant: a damaged time column, refused before any window is read
+            check_time_spread(float(self.clock.seconds(self.t[0])), float(self.clock.seconds(self.t[n - 1])), n, path)
 
     def note_units(self, time_unit, meta) -> None:
         """A note when decimal timestamps detected as seconds come too slowly for seconds."""
@@ -113,8 +115,8 @@ class _Opened:
 
     def window(self, t_start, t_end) -> tuple[int, int]:
         n = len(self.array)
-        lo = 0 if t_start is None else bisect_seconds(self.t, self.clock, t_start, 0, n)
-        hi = n if t_end is None else bisect_seconds(self.t, self.clock, t_end, lo, n)
+        lo = 0 if t_start is None else bisect_seconds(self.t, self.clock, t_start, 0, n, self.path)
+        hi = n if t_end is None else bisect_seconds(self.t, self.clock, t_end, lo, n, self.path)
         return lo, hi
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from ...core.events import Events, EventDataError, check_time_span
 from ...core.recording import Recording
 from ..text import NS, origin_to_ns, parse_event_text
-from .base import FileFormat, build_events, note_decimal_seconds, sensor_from_header, size_hint
+from .base import FileFormat, build_events, check_time_spread, note_decimal_seconds, sensor_from_header, size_hint
 
 __all__ = ["read_events_txt", "read_txt", "looks_like_event_text", "FORMAT"]
 
@@ -33,6 +33,7 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, t
     """
     path = Path(path)
     raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
+    check_time_spread(float(raw.t[0]), float(raw.t[-1]), len(raw.t), path)   # sorted by the parser
     check_time_span(raw.t, path, raw.time_unit)
     note_decimal_seconds(raw.t[0], raw.t[-1], len(raw.t), time_unit, raw.time_unit, path, meta)
     sensor_size = sensor_from_header(path, raw.header, sensor_size)
