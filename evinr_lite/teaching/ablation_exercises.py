@@ -45,7 +45,7 @@ def _time_times_ssim(table):
 
 
 exercises.register(
-    "time_fps_products", time_fps_products, _inputs_products, rtol=1e-9,
+    "time_fps_products", time_fps_products, _inputs_products, rtol=1e-6,
     hints={"FPS is frames per second: frames = seconds x (frames / second), multiply time_s by fps": _time_over_fps,
            "fps / time_s has units frames per second squared; the frame count is time_s * fps": _fps_over_time,
            "use the row's 'fps' entry (the FPS column), not its quality": _time_times_ssim})

@@ -98,8 +98,10 @@ def _inputs_bisect(rng):
     b = np.concatenate([[0.0], np.sort(rng.uniform(0.1, 1.9, 6)), [2.0]])
     cases.append(dict(t_events=t, boundaries=b))
     # the boundary rule: events exactly on the edges. Those at b_1 = 1 and b_2 = 2 belong to the bin that
-    # ends there, those at b_0 = 0 to bin 0; a half-open [b_i, b_{i+1}) or a strict t < b_{i+1} moves them
-    cases.append(dict(t_events=np.array([0.0, 0.2, 0.6, 1.0, 1.0, 1.5, 2.0, 2.5, 2.9, 3.0]),
+    # ends there, those at b_0 = 0 to bin 0; a half-open [b_i, b_{i+1}) or a strict t < b_{i+1} moves them.
+    # Bin (1, 2] holds 1.5 and three events at 2.0: its cut between events 1 and 2 would land on the edge 2.0,
+    # so the bin is cut at its time mid-point instead
+    cases.append(dict(t_events=np.array([0.0, 0.2, 0.6, 1.0, 1.0, 1.5, 2.0, 2.0, 2.0, 2.5, 2.9, 3.0]),
                       boundaries=np.array([0.0, 1.0, 2.0, 3.0])))
     return cases
 

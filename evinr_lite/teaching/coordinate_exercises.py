@@ -27,8 +27,9 @@ def _inputs_split(rng):
 def _inputs_tikhonov(rng):
     cases = []
     for M in (5, 64):
-        gx = torch.as_tensor(rng.normal(0, 0.3, M), dtype=torch.float32)
-        gy = torch.as_tensor(rng.normal(0, 0.5, M), dtype=torch.float32)
+        # leaves that require grad, as autograd's derivatives do in training: the result must stay differentiable
+        gx = torch.as_tensor(rng.normal(0, 0.3, M), dtype=torch.float32).requires_grad_(True)
+        gy = torch.as_tensor(rng.normal(0, 0.5, M), dtype=torch.float32).requires_grad_(True)
         cases.append(dict(dF_dx=gx, dF_dy=gy))
     return cases
 
@@ -43,6 +44,11 @@ def _split_by_height(index, sensor_size):
     return index // (H * W), index % H, (index // H) % W
 
 
+def _split_size_unpacked_wh(index, sensor_size):
+    W, H = sensor_size
+    return index // (H * W), (index // W) % H, index % W
+
+
 exercises.register(
     "split_index", split_index, _inputs_split,
     hints={
@@ -50,6 +56,8 @@ exercises.register(
             _split_swapped,
         "rows are W pixels long: the column is index % W (not % H), the row (index // W) % H":
             _split_by_height,
+        "sensor_size is (H, W), height first: unpack it as `H, W = sensor_size`":
+            _split_size_unpacked_wh,
     })
 
 exercises.register(

@@ -60,9 +60,16 @@ def _decay_after_adding(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return state * np.exp(-alpha * (t_end - t_last))
 
 
+def _state_transposed(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """The state indexed [x, y] (shape (W, H)) instead of [y, x]."""
+    return highpass_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start).T
+
+
 exercises.register(
-    "highpass_per_event", highpass_per_event, _inputs_highpass, rtol=1e-7, atol=1e-10,
+    "highpass_per_event", highpass_per_event, _inputs_highpass, rtol=1e-6, atol=1e-10,
     hints={
+        "images are indexed [y, x] (row, column): the state is np.zeros((H, W)) with H, W = sensor_size, "
+        "updated at state[y, x]": _state_transposed,
         "after the last event, decay every pixel to t_end (exp(-alpha (t_end - t_last)))": _no_final_decay,
         "each pixel decays since its own last event: keep one t_last per pixel, not one for the stream":
             _global_last_time,

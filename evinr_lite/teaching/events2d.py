@@ -185,9 +185,7 @@ def _frames_abs(events, boundaries, C):
 
 
 def _frames_xy_swapped(events, boundaries, C):
-    H, W = events.sensor_size
-    if H != W:
-        raise ValueError("only a square sensor can be indexed both ways")   # the check skips this hint
+    """Frames indexed [bin, x, y]: the transposed frames (on a sensor that is not square, an IndexError or this)."""
     return events_to_frames_fixed(events, boundaries, C).transpose(0, 2, 1)
 
 

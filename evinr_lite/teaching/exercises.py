@@ -39,6 +39,12 @@ tried: a flipped sign, a constant factor or offset, a shift by one position (``<
 differences along the wrong image axis (the reference run on transposed images), and a
 scatter-add that kept one contribution per repeated index (fancy-index ``+=`` for ``np.add.at``).
 
+A hint is shown only when the learner's output also matches the wrong version on the other inputs
+where that mistake shows, so that one input cannot make two different mistakes look alike. Beyond the
+values, a check fails a function that changes an input array in place (even when its result is right),
+a tensor result cut off from the autograd graph where the reference's is differentiable (cases mark such
+inputs with ``requires_grad``), and a list or a tensor where the reference returns a numpy array.
+
 ``use`` says "not finished" for a stub that still raises ``NotImplementedError`` and "does not
 pass the check yet" for a finished function that gives wrong results. For a function with side
 effects (one optimiser step, say), ``register(..., observe=...)`` says what to compare after the call.
@@ -225,8 +231,21 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
                 return p
         return None
     if _is_tensor(expected) and not _is_tensor(got):
-        return _Problem(f"returned a {type(got).__name__}{at}, expected a torch.Tensor: keep the computation "
-                        "in torch so that it can be back-propagated")
+        if expected.is_floating_point():
+            return _Problem(f"returned a {type(got).__name__}{at}, expected a torch.Tensor: keep the computation "
+                            "in torch so that it can be back-propagated")
+        return _Problem(f"returned a {type(got).__name__}{at}, expected a torch.Tensor like the input: use torch "
+                        "operations on the tensor (no .numpy() or Python lists)")
+    if _is_tensor(expected) and expected.requires_grad and not got.requires_grad:
+        return _Problem(f"the result{at} is cut off from the autograd graph (it does not require grad): keep the "
+                        "computation in torch operations on the inputs, without .item(), float(), .numpy(), "
+                        ".detach() or torch.tensor(...) on an intermediate value, so that it can be back-propagated")
+    if isinstance(expected, np.ndarray) and _is_tensor(got):
+        return _Problem(f"returned a torch.Tensor{at}, expected a numpy array: compute with numpy, or convert "
+                        "with `.detach().cpu().numpy()`")
+    if isinstance(expected, np.ndarray) and isinstance(got, (list, tuple)):
+        return _Problem(f"returned a {type(got).__name__}{at}, expected a numpy array: return "
+                        "`np.asarray(...)` of it (later cells use array methods such as .shape)")
     if isinstance(expected, (np.ndarray, np.generic, int, float, bool)) or _is_tensor(expected):
         try:
             g = _to_numpy(got)
@@ -270,14 +289,18 @@ def _generic_hint(got, expected, indexed: bool = False) -> str | None:
         e = _to_numpy(expected).astype(np.float64).ravel()
     except Exception:
         return None
-    if g.shape != e.shape or g.size == 0 or not (np.all(np.isfinite(g)) and np.all(np.isfinite(e))):
+    if g.shape != e.shape or g.size == 0 or not np.all(np.isfinite(e)):
         return None
+    if not np.all(np.isfinite(g)):
+        return ("the result holds NaN or inf where every expected value is finite: a division by zero, or the log "
+                "of zero or of a negative number?")
     scale = max(np.abs(e).max(), 1e-12)
     tol = 1e-6 * scale
     if np.all(np.abs(g + e) <= tol) and np.any(np.abs(e) > tol):
         return "the sign is flipped everywhere"
     nz = np.abs(e) > tol
-    if nz.any() and np.all(np.abs(g[~nz]) <= tol):
+    # one number (or one non-zero entry) is always some factor of another: say so only when several agree
+    if nz.sum() >= 2 and np.all(np.abs(g[~nz]) <= tol):
         ratios = g[nz] / e[nz]
         if np.ptp(ratios) <= 1e-6 * max(1.0, abs(ratios[0])) and abs(ratios[0] - 1) > 1e-6:
             return f"off by a constant factor: got {ratios[0]:.4g} x the expected values"
@@ -285,7 +308,9 @@ def _generic_hint(got, expected, indexed: bool = False) -> str | None:
         d = g - e
         if np.ptp(d) <= tol and abs(d[0]) > tol:
             return f"off by a constant offset of {d[0]:.4g}"
-        if np.allclose(g[1:], e[:-1], atol=tol) or np.allclose(g[:-1], e[1:], atol=tol):
+        # a shift is recognisable only in a series of several distinct values (not in a short mask)
+        if g.size >= 4 and np.unique(e).size > 2 and (np.allclose(g[1:], e[:-1], atol=tol)
+                                                      or np.allclose(g[:-1], e[1:], atol=tol)):
             return "the values are shifted by one position; check the window/boundary indexing (< versus <=)"
     axes = _axes_hint(_to_numpy(got), _to_numpy(expected), tol)
     if axes:
@@ -304,8 +329,8 @@ def _axes_hint(g: np.ndarray, e: np.ndarray, tol: float) -> str | None:
     if g.shape != e.shape or g.ndim < 2 or g.shape[0] != 2 or g[0].size < 2:
         return None
     if np.allclose(g[::-1], e, atol=tol) and not np.allclose(g, e, atol=tol):
-        return ("the two outputs are swapped: x is the column axis (axis -1, `np.diff(a, axis=-1)`), "
-                "y the row axis (axis -2)")
+        return ("the two outputs are swapped: return them in the order the docstring gives (for image "
+                "differences, x is the column axis (axis -1, `np.diff(a, axis=-1)`), y the row axis (axis -2))")
     return None
 
 
@@ -332,10 +357,11 @@ def _has_image(v) -> bool:
     return False
 
 
-def _wrong_axes_hint(ex: "Exercise", args: tuple, kwargs: dict, got) -> str | None:
+def _wrong_axes_hint(ex: "Exercise", args: tuple, kwargs: dict, got, expected=None) -> str | None:
     """The learner's output equals the reference run on transposed images, transposed back.
 
     That is the sign of differences (or sums) taken along the wrong image axis: rows for columns.
+    A candidate that equals the expected output itself (an exercise symmetric under the swap) says nothing.
     """
     if not (any(_has_image(a) for a in args) or any(_has_image(v) for v in kwargs.values())):
         return None
@@ -347,6 +373,8 @@ def _wrong_axes_hint(ex: "Exercise", args: tuple, kwargs: dict, got) -> str | No
     candidates = [w] + ([type(w)(reversed(w))] if isinstance(w, (tuple, list)) and len(w) == 2 else [])
     for c in candidates:
         try:
+            if expected is not None and _compare(c, expected, ex.rtol, ex.atol) is None:
+                continue
             if _compare(got, c, ex.rtol, ex.atol) is None:
                 return ("the differences (or sums) run along the wrong image axis: x is the column "
                         "index (axis -1), y the row index (axis -2)")
@@ -363,7 +391,7 @@ def _one_contribution_per_entry(g: np.ndarray, e: np.ndarray, tol: float) -> boo
     least one entry made of several contributions (a larger magnitude).
     """
     nzg = np.abs(g) > tol
-    if nzg.sum() < 1 or g.size < 2:
+    if nzg.sum() < 2 or g.size < 2:      # a single non-zero entry always has "one magnitude"
         return False
     mags = np.abs(g[nzg])
     unit = mags[0]
@@ -416,12 +444,53 @@ def _deepcopy_with_grads(x):
     return y
 
 
-def _run(fn, args, kwargs, observe=None):
+def _run(fn, args, kwargs, observe=None, inputs_after: list | None = None):
     """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
-    e.g. a model and its optimiser); with ``observe``, what it says to compare."""
+    e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
+    receives the copied ``(args, kwargs)`` as they are after the call."""
     args, kwargs = _deepcopy_with_grads((args, kwargs))
     result = fn(*args, **kwargs)
+    if inputs_after is not None:
+        inputs_after.append((args, kwargs))
     return result if observe is None else observe(result, args, kwargs)
+
+
+def _arrays_of(v) -> list[tuple[str, Any]]:
+    """The arrays (or tensors) an input holds: itself, or the array fields of an object such as ``Events``."""
+    if isinstance(v, np.ndarray) or _is_tensor(v):
+        return [("", v)]
+    fields = getattr(v, "__dict__", None)
+    if isinstance(fields, dict) and not hasattr(v, "parameters"):
+        return [(f".{k}", a) for k, a in fields.items() if isinstance(a, np.ndarray) or _is_tensor(a)]
+    return []
+
+
+def _same_array(a, b) -> bool:
+    try:
+        a, b = _to_numpy(a), _to_numpy(b)
+        return a.shape == b.shape and a.dtype == b.dtype and bool(np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"))
+    except Exception:
+        return True          # cannot tell: say nothing
+
+
+def _changed_inputs(before: tuple[tuple, dict], after: tuple[tuple, dict]) -> list[str]:
+    """Names of the array inputs (or array fields of an input) that the call changed in place."""
+    (args0, kwargs0), (args1, kwargs1) = before, after
+    pairs = [(f"argument {k + 1}", a, b) for k, (a, b) in enumerate(zip(args0, args1))]
+    pairs += [(name, kwargs0[name], kwargs1[name]) for name in kwargs0 if name in kwargs1]
+    changed = []
+    for name, v0, v1 in pairs:
+        for (field_name, a0), (_, a1) in zip(_arrays_of(v0), _arrays_of(v1)):
+            if not _same_array(a0, a1):
+                changed.append(f"{name}{field_name}")
+    return changed
+
+
+def _in_place_message(changed: list[str]) -> str:
+    names = ", ".join(f"`{n}`" for n in changed)
+    return (f"changed its input {names} in place (`x += ...`, `x[...] = ...`, `np.exp(x, out=x)`; "
+            "`np.asarray(x, dtype=...)` is x itself when the dtype already matches): the caller's data must "
+            "stay as it was, so compute a new array (`x = x + ...`) or work on a copy (`np.array(x, dtype=float)`)")
 
 
 def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
@@ -435,42 +504,99 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
     n = len(cases)
     for k, (args, kwargs) in enumerate(cases):
         where = f"input #{k + 1} of {n} ({_describe_case(args, kwargs)})"
+        after: list = []
         try:
-            got = _run(fn, args, kwargs, ex.observe)
+            got = _run(fn, args, kwargs, ex.observe, inputs_after=after)
         except NotImplementedError:
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except Exception as err:
-            return False, f"raised {type(err).__name__} on {where}", [f"{type(err).__name__}: {err}"] + _where_raised(err)
+            details = [f"{type(err).__name__}: {err}"] + _where_raised(err)
+            if isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
+                names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
+                details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
+                               "stub's parameter names and order")
+            return False, f"raised {type(err).__name__} on {where}", details
         expected = _run(ex.reference, args, kwargs, ex.observe)
         if ex.compare is not None:
-            msg = ex.compare(got, expected)
+            try:
+                msg = ex.compare(got, expected)
+            except Exception as err:     # a return value the comparison cannot read at all
+                msg = f"returned a {type(got).__name__} that cannot be compared ({type(err).__name__}: {err})"
             problem = None if msg is None else _Problem(msg, values=True)
         else:
             problem = _compare(got, expected, ex.rtol, ex.atol)
-        if problem is None:
+        # inputs changed in place (a function with side effects says what to compare through `observe`)
+        changed = _changed_inputs((args, kwargs), after[0]) if ex.observe is None and after else []
+        if problem is None and not changed:
             continue
+        if problem is None:
+            return False, f"changed its input on {where}", [_in_place_message(changed)]
         details = [problem.message]
         hint = None
         # a known mistake is recognised by its output, whatever the first difference is (a wrong
-        # count of events is a wrong shape, not wrong values)
+        # count of events is a wrong shape, not wrong values), and confirmed on the other inputs where
+        # it shows: one input alone can make two different mistakes look alike
         for message, wrong in ex.hints.items():
             try:
                 w = _run(wrong, args, kwargs, ex.observe)
-                if _compare(got, w, ex.rtol, ex.atol) is None:
+                if _compare(got, w, ex.rtol, ex.atol) is None and _same_mistake_elsewhere(ex, fn, wrong, cases, k):
                     hint = message
                     break
             except Exception:
                 continue
         if problem.values:
             if hint is None:
-                hint = _wrong_axes_hint(ex, args, kwargs, got)
+                hint = _wrong_axes_hint(ex, args, kwargs, got, expected)
             if hint is None:
-                hint = _generic_hint(got, expected, indexed=_has_repeated_index(args, kwargs))
+                indexed = _has_repeated_index(args, kwargs)
+                hint = _generic_hint(got, expected, indexed=indexed)
+                if hint is None and isinstance(expected, (tuple, list, dict)):
+                    hint = _generic_hint(*_differing_leaf(got, expected, ex.rtol, ex.atol), indexed=indexed)
         if hint:
             details.append(f"hint: {hint}")
+        if changed:
+            details.append("also: " + _in_place_message(changed))
         return False, f"does not match the reference on {where}", details
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
+
+
+def _differing_leaf(got, expected, rtol: float, atol: float):
+    """The (got, expected) pair, inside nested tuples, lists and dicts, where the two first differ."""
+    try:
+        if isinstance(expected, (tuple, list)) and isinstance(got, (tuple, list)) and len(got) == len(expected):
+            for g, e in zip(got, expected):
+                if _compare(g, e, rtol, atol) is not None:
+                    return _differing_leaf(g, e, rtol, atol)
+        if isinstance(expected, dict) and isinstance(got, dict) and set(got) == set(expected):
+            for k in expected:
+                if _compare(got[k], expected[k], rtol, atol) is not None:
+                    return _differing_leaf(got[k], expected[k], rtol, atol)
+    except Exception:
+        pass
+    return got, expected
+
+
+def _same_mistake_elsewhere(ex: Exercise, fn: Callable, wrong: Callable, cases: list, skip: int) -> bool:
+    """On every case but ``skip`` where the wrong version ``wrong`` shows its mistake (differs from the
+    reference), ``fn`` gives the same output. Cases where either raises say nothing, and so do cases where
+    the wrong version happens to be right (the learner's variant of the mistake may be broader)."""
+    for j, (args, kwargs) in enumerate(cases):
+        if j == skip:
+            continue
+        try:
+            w = _run(wrong, args, kwargs, ex.observe)
+            if _compare(w, _run(ex.reference, args, kwargs, ex.observe), ex.rtol, ex.atol) is None:
+                continue
+            g = _run(fn, args, kwargs, ex.observe)
+        except Exception:
+            continue
+        try:
+            if _compare(g, w, ex.rtol, ex.atol) is not None:
+                return False
+        except Exception:
+            return False
+    return True
 
 
 def check(name: str, fn: Callable, *, verbose: bool = True) -> bool:

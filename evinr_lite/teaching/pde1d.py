@@ -115,6 +115,8 @@ def _inputs_integrate(rng):
     for n, q, C in ((5, 6, 0.2), (12, 7, 0.5), (40, 9, 0.25)):
         t, p = _sorted_events(rng, n)
         tq = np.sort(np.concatenate([[-0.1, 1.1], rng.uniform(0, 1, q - 2)]))
+        if n == 40:
+            tq = tq[rng.permutation(q)]         # query times in any order (a sweep that assumes them sorted fails)
         cases.append(dict(t_events=t, p_events=p, C=C, t_query=tq))
     # the boundary rule t_i <= t_q: queries exactly at event times (and at a repeated time) count
     # the event, so side="left" or a strict `<` fails here
@@ -126,10 +128,15 @@ def _inputs_integrate(rng):
 
 def _inputs_rate(rng):
     cases = []
-    for n, B, C in ((6, 3, 0.2), (30, 5, 0.5), (80, 8, 0.25)):
+    # events in [0, 1]; the second case's last window (1.1, 1.3] holds no event (a sum per window even when
+    # it is 0: np.bincount needs minlength), the third's windows cover [0.1, 0.9] only (events outside every
+    # window count nowhere, not in the first or last one)
+    for n, B, C, (lo, hi), empty_end in ((6, 3, 0.2, (0.0, 1.0), False), (30, 5, 0.5, (0.0, 1.3), True),
+                                         (80, 8, 0.25, (0.1, 0.9), False)):
         t, p = _sorted_events(rng, n)
-        inner = np.sort(rng.uniform(0.05, 0.95, B - 1))
-        cases.append(dict(t_events=t, p_events=p, C=C, boundaries=np.concatenate([[0.0], inner, [1.0]])))
+        inner = np.sort(rng.uniform(lo + 0.05, min(hi, 1.0) - 0.05, B - 1 - empty_end))
+        b = np.concatenate([[lo], inner, [1.1] if empty_end else [], [hi]])
+        cases.append(dict(t_events=t, p_events=p, C=C, boundaries=b))
     # the boundary rule (b_k, b_{k+1}]: events exactly on an inner edge and on the last edge belong to
     # the window that ends there, so `<` in place of `<=` (or side="left" / "right" swapped) fails here
     b = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
@@ -165,7 +172,7 @@ def _inputs_loss(rng):
     g = torch.Generator().manual_seed(0)
     cases = []
     for B in (4, 9):
-        dF = torch.randn(B, generator=g) * 5
+        dF = (torch.randn(B, generator=g) * 5).requires_grad_(True)   # the loss must stay differentiable
         dur = torch.rand(B, generator=g) * 0.05 + 0.01
         dL = torch.randint(-3, 4, (B,), generator=g).float() * 0.2
         cases.append(dict(dF_dt=dF, delta_L=dL, durations=dur))
@@ -189,6 +196,9 @@ exercises.register(
     hints={
         "did you forget to divide by the window length t2 - t1 (Eq. 4)?":
             lambda t_events, p_events, C, boundaries: window_sums(t_events, p_events, C, boundaries),
+        "divide each window's sum by its own length (np.diff(boundaries)): the windows differ in length":
+            lambda t_events, p_events, C, boundaries: window_sums(t_events, p_events, C, boundaries)
+            / np.mean(np.diff(np.asarray(boundaries, dtype=np.float64))),
         "did you forget the sign of the polarity? (count ON minus OFF, not all events)":
             lambda t_events, p_events, C, boundaries: event_rate_derivative(t_events, np.abs(p_events), C, boundaries),
         "did you forget to multiply by the contrast threshold C?":

@@ -116,6 +116,10 @@ def _hot_mean(x, y, sensor_size, factor=10.0):
     return counts > factor * counts[counts > 0].mean()
 
 
+def _hot_factor_ignored(x, y, sensor_size, factor=10.0):
+    return hot_pixel_mask(x, y, sensor_size)
+
+
 def _hot_fancy_index(x, y, sensor_size, factor=10.0):
     counts = np.zeros(sensor_size, np.int64)
     counts[np.asarray(y), np.asarray(x)] += 1
@@ -123,10 +127,8 @@ def _hot_fancy_index(x, y, sensor_size, factor=10.0):
 
 
 def _hot_rows_columns_swapped(x, y, sensor_size, factor=10.0):
-    H, W = sensor_size
-    if H != W:
-        return np.zeros((H, W), bool)
-    return hot_pixel_mask(y, x, sensor_size, factor)
+    """Counts indexed [x, y]: the transposed map (on a sensor that is not square, an IndexError or this)."""
+    return hot_pixel_mask(x, y, sensor_size, factor).T
 
 
 exercises.register(
@@ -140,6 +142,7 @@ exercises.register(
         "repeated indices): use np.add.at(counts, (y, x), 1) or np.bincount(y * W + x, minlength=H * W)":
             _hot_fancy_index,
         "rows are y and columns are x: count into counts[y, x]": _hot_rows_columns_swapped,
+        "use the `factor` argument, not a fixed 10 (its default)": _hot_factor_ignored,
     })
 
 
@@ -164,7 +167,11 @@ def _inputs_windows(rng):
 
 
 def _compare_windows(got, expected) -> str | None:
-    got = np.asarray(got)
+    if got is None:
+        return "returned None; did you forget the `return` statement?"
+    if not isinstance(got, np.ndarray):     # a list or a tensor: later cells use array methods
+        return (f"returned a value of type {type(got).__name__}, expected a numpy array of event indices: return "
+                "`np.asarray(...)` of it, or build it with numpy (np.arange ...)")
     if got.ndim != 1 or got.dtype.kind not in "iu":
         return f"expected a 1-D integer array of event indices, got {got.dtype} of shape {list(got.shape)}"
     if len(got) != len(expected):
@@ -263,6 +270,14 @@ def _filter_own_pixel(t, x, y, dt):
     return np.any((cheb <= 1) & others & (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
 
 
+def _filter_later_neighbours(t, x, y, dt):
+    """A window on both sides, |t_i - t_j| <= dt: a neighbour that fires later keeps the event too."""
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    return np.any((cheb == 1) & (np.abs(t[:, None] - t[None, :]) <= dt), axis=1)
+
+
 def _filter_four_neighbours(t, x, y, dt):
     t = np.asarray(t, np.float64)
     x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
@@ -280,6 +295,8 @@ exercises.register(
         "the pixel's own events never count (else a hot pixel keeps itself): max(|dx|, |dy|) == 1, not <= 1":
             _filter_own_pixel,
         "the 8 neighbours include the diagonals: max(|dx|, |dy|) == 1, not |dx| + |dy| == 1": _filter_four_neighbours,
+        "only earlier neighbours count (t_j <= t_i): the filter decides when event i arrives, before any later "
+        "event exists, so |t_i - t_j| <= dt is too wide": _filter_later_neighbours,
     })
 
 

@@ -67,11 +67,19 @@ def _inputs_step(rng):
     return cases
 
 
+def _as_float(value):
+    """A returned loss as a float; anything that is not one number stays as it is (the comparison names it)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError, RuntimeError):
+        return value
+
+
 def _observe_step(result, args, kwargs):
     """The step's three losses (as floats) and the model's parameters after the step."""
     model = kwargs["model"] if "model" in kwargs else args[0]
     if isinstance(result, (tuple, list)):
-        result = tuple(float(r) for r in result)
+        result = tuple(_as_float(r) for r in result)
     params = {name: p.detach().clone() for name, p in model.named_parameters()}
     return {"losses": result, "parameters after the step": params}
 
