@@ -406,3 +406,20 @@ def test_check_cases_sit_on_the_new_rules():
 def test_a_custom_comparison_names_what_it_cannot_read(wrong, words):
     ok, out = _report("offset_gradients", wrong)
     assert ok is False and words in out and "check itself failed" not in out, out
+
+
+# ---- (W, H) unpacked where the sensor size is (H, W) ------------------------------------------------
+
+def _frames_w_h(events, boundaries, C):
+    W, H = events.sensor_size                     # the mistake: sensor_size is (H, W)
+    B = len(boundaries) - 1
+    out = np.zeros((B, H, W))
+    k = np.clip(np.searchsorted(boundaries, events.t, side="right") - 1, 0, B - 1)
+    np.add.at(out, (k, events.y, events.x), C * events.p)
+    return out
+
+
+def test_an_index_error_on_a_non_square_sensor_names_the_axis_order():
+    ok, out = _report("events_to_frames_fixed", _frames_w_h)
+    assert ok is False and "IndexError" in out, out
+    assert "sensor_size is (H, W)" in out and "[y, x]" in out, out

@@ -421,6 +421,16 @@ def _has_repeated_index(args: tuple, kwargs: dict) -> bool:
     return False
 
 
+def _non_square(args, kwargs) -> bool:
+    """True when an input names a sensor (a ``sensor_size`` argument, or events carrying one) with H != W."""
+    for v in (*args, *kwargs.values(), kwargs.get("sensor_size")):
+        size = v if isinstance(v, tuple) and len(v) == 2 and all(isinstance(a, (int, np.integer)) for a in v) \
+            else getattr(v, "sensor_size", None)
+        if size is not None and len(size) == 2 and int(size[0]) != int(size[1]):
+            return True
+    return False
+
+
 def _where_raised(err: BaseException) -> list[str]:
     """The line of the learner's code that raised (the last frame outside this module)."""
     frames = [f for f in traceback.extract_tb(err.__traceback__) if f.filename != __file__]
@@ -516,6 +526,10 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                 names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
                 details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
                                "stub's parameter names and order")
+            if isinstance(err, IndexError) and _non_square(args, kwargs):
+                details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
+                               "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
+                               "`np.zeros((H, W))`, `frame[y, x]`")
             return False, f"raised {type(err).__name__} on {where}", details
         expected = _run(ex.reference, args, kwargs, ex.observe)
         if ex.compare is not None:
