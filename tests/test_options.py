@@ -162,6 +162,29 @@ def test_the_command_line_maps_each_flag_to_its_option(monkeypatch, tmp_path):
     assert defaults.recipe == RunOptions().recipe and defaults.seed == RunOptions().seed
 
 
+def test_keep_background_turns_off_the_kit_filter_from_the_command_line(monkeypatch, tmp_path):
+    """--keep-background (reconstruct and batch) gives EvINRConfig(background="keep"); the method's error when
+    the filter leaves too few events names the flag on the command line."""
+    import evinr_lite.apps.recon_job as job
+    from evinr_lite.apps.cli import _message
+    from evinr_lite.method.prepare import _check_left
+
+    seen = {}
+    monkeypatch.setattr(job, "run_reconstruct", lambda path, out, options, **kw: seen.update(options=options))
+    assert main(["reconstruct", "rec", "--out", str(tmp_path / "o"), "--keep-background", "--quiet"]) == 0
+    o = seen["options"]
+    assert o.keep_background and o.config(0.2).background == "keep"
+    assert RunOptions().config(0.2).background == "filter" and not RunOptions().keep_background
+    assert build_parser().parse_args(["batch", "a", "--out", "o", "--keep-background"]).keep_background
+    settings = json.loads(json.dumps(o.to_dict(BATCH_FIELDS)))
+    assert RunOptions.from_settings(settings).keep_background is True   # a batch's settings carry it
+    with pytest.raises(EventDataError) as err:
+        _check_left(0, 2)
+    assert "--keep-background" in _message(err.value) and "EvINRConfig" not in _message(err.value)
+    with pytest.raises(EventDataError, match="keep_background"):
+        RunOptions(keep_background="yes")
+
+
 # ---- method: the default C and the memory estimate -------------------------------------------------
 
 def test_default_C_is_the_configs():

@@ -110,6 +110,9 @@ TONEMAP_HELP = ("how frames are shown: linear (the intensity itself, clip(exp(F)
                 "the kit's) or reinhard (the paper's Eq. 12, (I / (I + 1))^0.6 with the mean log intensity at 0.5: "
                 "compresses contrast and keeps the highlights of a high-dynamic-range scene on screen); "
                 "default: the recipe's own")
+KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-activity filter (an event is kept "
+                        "when a neighbouring pixel fired one of the same polarity within 50 ms; EvINRConfig.background); "
+                        "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
 ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose output layer is solved in closed "
               "form; 300 for paper and v0_1, with coarse-to-fine at a third and two thirds)")
 
@@ -173,6 +176,7 @@ def build_parser() -> argparse.ArgumentParser:
                           "reconstructing, for any recipe (evinr_lite.method.denoise defaults); run.json records "
                           "what was removed. The kit recipe filters them anyway, inside the method "
                           "(EvINRConfig.background), without the report")
+    rec.add_argument("--keep-background", action="store_true", help=KEEP_BACKGROUND_HELP)
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--resume", action="store_true",
@@ -214,6 +218,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                   "recording from its APS frames) (default: each file's, else 1)")
     batch.add_argument("--denoise", action="store_true", help="remove hot pixels and background activity first "
                                                               "(as reconstruct --denoise)")
+    batch.add_argument("--keep-background", action="store_true", help=KEEP_BACKGROUND_HELP)
     batch.add_argument("--anchor", choices=("none", "first", "all"), default="none",
                        help="use each recording's APS frames as anchors (as reconstruct --anchor; anchor frames "
                             "are not scored)")
@@ -246,6 +251,7 @@ def _run_options(args):
                       t_start=getattr(args, "start", None), t_end=getattr(args, "end", None),
                       time_unit=getattr(args, "time_unit", None), device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
+                      keep_background=args.keep_background,
                       colour=getattr(args, "colour", False), tonemap=args.tonemap, video=video,
                       progress=not args.quiet)
 
@@ -295,6 +301,7 @@ FLAG_FOR = [
     (re.compile(r"\bdevice='(\w+)'"), r"--device \1"),
     (re.compile(r"\btime_unit='(\w+)'"), r"--time-unit \1"),
     (re.compile(r"\banchor='(\w+)'"), r"--anchor \1"),
+    (re.compile(r"\bEvINRConfig\(background='keep'\)"), "--keep-background"),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)=(?=[\w'\"(.+-])"),
      lambda m: FLAGS[m.group(1)] + " "),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)="), lambda m: FLAGS[m.group(1)]),

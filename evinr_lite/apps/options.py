@@ -31,7 +31,8 @@ __all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "BA
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
-BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap")
+BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap",
+                "keep_background")
 MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
 _INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
 
@@ -134,6 +135,9 @@ class RunOptions:
             iterations (None: the recipe's own); seed: seeds the networks.
         anchor: "none", "first" or "all" (:mod:`evinr_lite.method.anchor`); denoise: denoise the
             window's events first; colour: one EvINR per colour channel (not with an anchor).
+        keep_background: train on every event, skipping the kit recipe's background-activity filter
+            (``EvINRConfig(background="keep")``; paper and v0_1 keep every event anyway): for sparse
+            recordings whose isolated events are signal.
         tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
             paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
         video: also write MP4 / GIF; progress: show a progress bar.
@@ -152,6 +156,7 @@ class RunOptions:
     seed: int = 0
     anchor: str = "none"
     denoise: bool = False
+    keep_background: bool = False
     colour: bool = False
     tonemap: str | None = None
     video: bool = True
@@ -194,7 +199,7 @@ class RunOptions:
                                          for v in size):
                 raise EventDataError(f"sensor_size=(H, W) must be two positive whole numbers, got {self.sensor_size!r}")
             checked["sensor_size"] = (int(size[0]), int(size[1]))
-        for name in ("denoise", "colour", "video", "progress"):
+        for name in ("denoise", "keep_background", "colour", "video", "progress"):
             checked[name] = _flag(name, getattr(self, name))
         if self.anchor != "none" and checked["colour"]:
             raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
@@ -232,7 +237,7 @@ class RunOptions:
         """The EvINRConfig of this run's recipe with the resolved threshold ``C`` (a number or a pair).
         With ``denoise`` the events were filtered before (and reported), so the recipe's own background
         filter is not run a second time."""
-        extra = {"background": "keep"} if self.denoise else {}
+        extra = {"background": "keep"} if self.denoise or self.keep_background else {}
         return recipe_config(self.recipe, self.n_iters, self.tonemap, C=C, seed=self.seed, device=self.device,
                              progress=self.progress, anchor=self.anchor, **extra)
 
