@@ -17,7 +17,7 @@ from .events import EventDataError
 from .guard import InputError
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
-           "TypeFix"]
+           "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice"]
 
 # (expected class name, given class name) -> how to turn the one into the other
 TypeFix = {
@@ -49,6 +49,57 @@ def require(value, kind, name: str, *, none_ok: bool = False):
     fix = next((TypeFix[(k.__name__, got)] for k in kinds if (k.__name__, got) in TypeFix), None)
     raise EventDataError(f"{name}= must be {want}, got {got}" + (f"; {fix}" if fix else "")
                      + (" (or None)" if none_ok and not fix else ""))
+
+
+class ArgumentTypeError(EventDataError, TypeError):
+    """An argument of the wrong kind (an unknown keyword, frames where none are taken): an InputError whose
+    message names the fix, and still a TypeError, as Python raises for a wrong argument."""
+
+
+def seconds_array(value, name: str, *, allow_empty: bool = False) -> np.ndarray:
+    """``value`` (a number, a list or a 1-D array of seconds) as float64 [Q]; else an InputError naming ``name``.
+
+    Refused: text, objects and booleans (not seconds), arrays of 2 or more dimensions (a column [Q, 1] is not
+    taken as Q times: pass ``np.ravel(times)``), NaN or inf, and no times at all (unless ``allow_empty``)."""
+    arr = np.asarray(value) if not isinstance(value, (str, bytes)) else np.asarray([value])
+    if arr.dtype.kind not in "iuf" or arr.dtype == bool:
+        raise EventDataError(f"{name}= must be seconds (a number, a list or a 1-D array of numbers), got "
+                             f"{_short(value)}")
+    arr = np.atleast_1d(arr.astype(np.float64))
+    if arr.size == 0 and not allow_empty:
+        raise EventDataError(f"{name}= is empty (shape {arr.shape}); pass a non-empty 1-D array: at least one time in "
+                             "seconds")
+    if arr.ndim != 1:
+        raise EventDataError(f"{name}= must be a 1-D array of seconds [Q], got shape {arr.shape}; flatten it "
+                             f"with np.ravel({name}) if it holds one time per row")
+    finite = np.isfinite(arr)
+    if not finite.all():
+        bad = int(np.flatnonzero(~finite)[0])
+        raise EventDataError(f"{name}= must be finite seconds, but {name}[{bad}] is {arr[bad]}; drop or repair it")
+    return arr
+
+
+def optional_seconds(value, name: str) -> float | None:
+    """``value`` as a finite float (seconds), or None when None; else an InputError naming ``name``."""
+    if value is None:
+        return None
+    return real_number(value, name, hint="pass seconds on the events' clock (or None for the default)")
+
+
+def choice(value, allowed, name: str):
+    """``value`` when it is one of ``allowed``; else an InputError listing them."""
+    try:
+        ok = value in allowed
+    except TypeError:   # an unhashable value (a list) against a set
+        ok = False
+    if not ok:
+        raise EventDataError(f"{name} must be one of {tuple(allowed)}, got {_short(value)}")
+    return value
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else f"{type(value).__name__} {text[:50]}..."
 
 
 def whole_number(value, name: str, *, lo: int | None = None, hi: int | None = None) -> int:

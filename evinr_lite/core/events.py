@@ -24,7 +24,7 @@ import math
 from .guard import InputError   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
-           "TimeUnitWarning", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S"]
+           "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S"]
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
@@ -206,6 +206,19 @@ def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
     return ts - origin, origin
 
 
+def _is_number(value) -> bool:
+    """A real number: a Python or numpy int or float, or a 0-d numeric array (not a bool, not text)."""
+    return not isinstance(value, (str, bytes)) and np.ndim(value) == 0 and np.asarray(value).dtype.kind in "iuf"
+
+
+def check_t_origin(t_origin) -> float:
+    """``t_origin`` (seconds, the absolute time of t = 0) as a finite float, or an EventDataError."""
+    if not _is_number(t_origin) or not math.isfinite(float(t_origin)):
+        raise EventDataError(f"t_origin must be a finite number of seconds (the absolute time of t = 0; 0 when the "
+                             f"times are already relative), got {t_origin!r}")
+    return float(t_origin)
+
+
 def check_sensor_size(sensor_size) -> tuple[int, int]:
     """(H, W) as two positive ints, or an EventDataError that says what is wrong."""
     try:
@@ -304,7 +317,7 @@ class Events:
         object.__setattr__(self, "y", y.astype(np.int32, copy=False))
         object.__setattr__(self, "p", p)
         object.__setattr__(self, "sensor_size", (H, W))
-        object.__setattr__(self, "t_origin", float(self.t_origin))
+        object.__setattr__(self, "t_origin", check_t_origin(self.t_origin))
         object.__setattr__(self, "polarity_encoding", "pm1")
 
     # ---- construction -------------------------------------------------------------
@@ -358,10 +371,17 @@ class Events:
         """Merge event streams on the same sensor and clock (sorted by time, stable)."""
         if not parts:
             raise EventDataError("nothing to concatenate: pass at least one Events")
+        parts = list(parts)
+        for i, e in enumerate(parts):
+            if not isinstance(e, Events):
+                raise EventDataError(f"concatenate: parts[{i}] is a {type(e).__name__}, not Events; pass a list of "
+                                     "Events (build each with Events.from_arrays(t, x, y, p, sensor_size))")
         size, origin = parts[0].sensor_size, parts[0].t_origin
         for e in parts[1:]:
             if e.sensor_size != size or e.t_origin != origin:
-                raise EventDataError("cannot concatenate events with different sensor_size or t_origin")
+                raise EventDataError(f"cannot concatenate events with different sensor_size or t_origin (got "
+                                     f"{size}, t_origin {origin} and {e.sensor_size}, t_origin {e.t_origin}); put "
+                                     "them on one clock first (t + t_origin - common_origin) and one sensor")
         cat = [np.concatenate([getattr(e, k) for e in parts]) for k in "txyp"]
         return cls.from_arrays(*cat, size, sort=sort, t_origin=origin)
 
@@ -394,6 +414,10 @@ class Events:
         Raises:
             EventDataError: if the window is empty or reversed (unless ``allow_empty``).
         """
+        for name, value in (("t_start", t_start), ("t_end", t_end)):
+            if value is not None and (not _is_number(value) or math.isnan(float(value))):
+                raise EventDataError(f"slice_time: {name} must be seconds (a number, or None for no bound), got "
+                                     f"{value!r}")
         lo = 0 if t_start is None else int(np.searchsorted(self.t, t_start, side="left"))
         hi = len(self) if t_end is None else int(np.searchsorted(self.t, t_end, side="left"))
         if t_start is not None and t_end is not None and t_end <= t_start:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .checks import check_image_values
-from .events import EventDataError, InputError
+from .events import EventDataError, InputError, check_t_origin
 
 __all__ = ["Frames", "to_grey_uint8", "to_uint8", "GREY_WEIGHTS"]
 
@@ -48,7 +48,7 @@ class Frames:
             raise EventDataError("frame timestamps contain NaN or inf; repair or drop those frames")
         object.__setattr__(self, "images", images)
         object.__setattr__(self, "t", t)
-        object.__setattr__(self, "t_origin", float(self.t_origin))
+        object.__setattr__(self, "t_origin", check_t_origin(self.t_origin))
 
     def __len__(self) -> int:
         return int(self.images.shape[0])

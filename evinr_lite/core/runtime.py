@@ -14,9 +14,16 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["default_device", "cpu_threads", "fast_mode", "pick", "cache_dir", "weights_dir", "FAST_ENV_VAR", "CACHE_ENV_VAR"]
+from .guard import InputError   # standard library only: the command's start-up stays light
+
+__all__ = ["default_device", "DeviceUnavailable", "cpu_threads", "fast_mode", "pick", "cache_dir", "weights_dir", "FAST_ENV_VAR", "CACHE_ENV_VAR"]
 
 CACHE_ENV_VAR = "EVINR_DATA"
+
+
+class DeviceUnavailable(InputError, RuntimeError):
+    """A device was asked for that this machine does not have (a bad input: the message names the device to
+    use instead); still a RuntimeError, as it was."""
 
 
 def default_device(preference: str | None = None) -> "torch.device":
@@ -28,7 +35,8 @@ def default_device(preference: str | None = None) -> "torch.device":
             explicitly, but it has no float64, which event timestamps need, so auto never picks it.)
 
     Raises:
-        RuntimeError: if a device is asked for that this machine does not have.
+        DeviceUnavailable (an InputError and a RuntimeError): a device this machine does not have
+        ("cuda" without a CUDA GPU, "cuda:N" beyond the GPUs, "mps" without an Apple GPU).
     """
     import torch   # here, not at the top: data_fetch and the command's --help stay light
 
@@ -38,7 +46,14 @@ def default_device(preference: str | None = None) -> "torch.device":
             return torch.device("cuda")
         return torch.device("cpu")
     if preference.startswith("cuda") and not torch.cuda.is_available():
-        raise RuntimeError("device 'cuda' requested but no CUDA GPU is available here; use device='cpu'")
+        raise DeviceUnavailable(f"device {preference!r} requested but no CUDA GPU is available here; use device='cpu' "
+                                "(or None: a GPU when present)")
+    if preference.startswith("cuda:") and preference[5:].isdigit() and int(preference[5:]) >= torch.cuda.device_count():
+        raise DeviceUnavailable(f"device {preference!r} requested but this machine has {torch.cuda.device_count()} CUDA "
+                                f"GPU(s), numbered from 0; use device='cuda:0' (or 'cuda')")
+    if preference == "mps" and not (hasattr(torch.backends, "mps") and torch.backends.mps.is_available()):
+        raise DeviceUnavailable("device 'mps' requested but no Apple GPU (MPS) is available here; use device='cpu' "
+                                "(or None: a GPU when present)")
     return torch.device(preference)
 
 

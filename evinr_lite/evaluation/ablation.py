@@ -42,7 +42,7 @@ from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
 from ..method.integration import integrate_events
 from ..method.solver import EvINRConfig, reconstruct
-from ..method.tonemap import anchor_mean, tonemap_reinhard
+from ..method.tonemap import reinhard_unchecked, anchor_mean, tonemap_reinhard
 from .metrics import SCORE_PROTOCOLS
 from .scoring import measure_inference_fps, score_sequence
 
@@ -165,7 +165,7 @@ def integration_baseline(C: float, gamma: float = 0.6):
     """Direct event integration from L0 = 0, anchored and tone-mapped as the solver's output is:
     a variant ``method(events, times) -> frames [Q, H, W]`` in [0, 1]."""
     def method(events: Events, times: np.ndarray) -> np.ndarray:
-        return tonemap_reinhard(anchor_mean(integrate_events(events, times, C=C), gamma), gamma).astype(np.float32)
+        return reinhard_unchecked(anchor_mean(integrate_events(events, times, C=C), gamma), gamma).astype(np.float32)
     method.__name__ = f"integration (C = {C:g})"
     return method
 

@@ -20,6 +20,7 @@ import numpy as np
 from skimage.metrics import structural_similarity
 
 from ..core.checks import check_image_values
+from ..core.events import EventDataError
 from ..core.frames import to_uint8
 
 __all__ = ["mse", "ssim", "equalize", "score_pairs", "score_frames", "protocol_description", "PROTOCOLS",
@@ -49,15 +50,33 @@ PROTOCOLS = {
 def protocol_description(equalization: str = "none") -> str:
     """The full scoring protocol (equalisation and metric parameters) as one line of text."""
     if equalization not in PROTOCOLS:
-        raise ValueError(f"equalization must be one of {EQUALIZATIONS}, got {equalization!r}")
+        raise EventDataError(f"equalization must be one of {EQUALIZATIONS}, got {equalization!r}")
     return PROTOCOLS[equalization]
 
 
+def _image(a, name: str) -> np.ndarray:
+    """An image as float64: uint8 divided by 255 (as :func:`equalize` reads it), floats as they are; NaN, inf,
+    text and empty images are refused (a metric of them would be NaN or meaningless)."""
+    a = np.asarray(a)
+    if a.dtype.kind not in "uif" or a.dtype == bool:
+        raise EventDataError(f"{name} must be an image of numbers (uint8 0..255 or float in [0, 1]), got dtype {a.dtype}")
+    if a.size == 0:
+        raise EventDataError(f"{name} is empty (shape {a.shape}); pass an image [H, W]")
+    if a.dtype == np.uint8:
+        return a.astype(np.float64) / 255.0
+    a = a.astype(np.float64)
+    if not np.all(np.isfinite(a)):
+        raise EventDataError(f"{name} contains NaN or inf; repair or drop that frame (an image must be finite to be "
+                             "scored)")
+    return a
+
+
 def _pair(pred, gt):
-    pred = np.clip(np.asarray(pred, dtype=np.float64), 0.0, 1.0)
-    gt = np.asarray(gt, dtype=np.float64)
+    pred = np.clip(_image(pred, "prediction"), 0.0, 1.0)
+    gt = _image(gt, "ground truth")
+    check_image_values(gt, "ground-truth images")   # floats on the 0..255 scale are refused, not scored
     if pred.shape != gt.shape:
-        raise ValueError(f"prediction {pred.shape} and ground truth {gt.shape} differ in shape")
+        raise EventDataError(f"prediction {pred.shape} and ground truth {gt.shape} differ in shape")
     return pred, gt
 
 
@@ -71,7 +90,7 @@ def ssim(pred, gt) -> float:
     """SSIM of two grey images [H, W] in [0, 1] (prediction clipped first); see the module docstring."""
     pred, gt = _pair(pred, gt)
     if min(pred.shape) < 11:
-        raise ValueError(f"SSIM needs images of at least 11 x 11 pixels (its gaussian window), got {pred.shape}")
+        raise EventDataError(f"SSIM needs images of at least 11 x 11 pixels (its gaussian window), got {pred.shape}")
     return float(structural_similarity(pred, gt, gaussian_weights=True, sigma=1.5,
                                        use_sample_covariance=False, data_range=1.0))
 
@@ -87,10 +106,13 @@ def equalize(img, method: str = "none") -> np.ndarray:
         float64 [H, W] in [0, 1].
     """
     if method not in EQUALIZATIONS:
-        raise ValueError(f"equalization must be one of {EQUALIZATIONS}, got {method!r}")
+        raise EventDataError(f"equalization must be one of {EQUALIZATIONS}, got {method!r}")
     img = np.asarray(img)
     if img.ndim != 2:
-        raise ValueError(f"equalize takes one grey image [H, W], got shape {img.shape}")
+        raise EventDataError(f"equalize takes one grey image [H, W], got shape {img.shape}")
+    if img.dtype.kind == "f" and not np.all(np.isfinite(img)):   # NaN would become 0 silently
+        raise EventDataError("the image to equalise contains NaN or inf; repair or drop that frame (an image must be "
+                             "finite to be scored)")
     if method == "none":
         if img.dtype == np.uint8:
             return img.astype(np.float64) / 255.0
@@ -121,7 +143,7 @@ def score_pairs(pred, gt, equalization: str = "none") -> tuple[np.ndarray, np.nd
         per-frame scores float64 [F].
     """
     if len(pred) == 0 or len(pred) != len(gt):
-        raise ValueError(f"need one or more matched frame pairs, got {len(pred)} predictions and {len(gt)} "
+        raise EventDataError(f"need one or more matched frame pairs, got {len(pred)} predictions and {len(gt)} "
                          "ground-truth frames; pass stacks [F, H, W] of the same length F >= 1")
     # the plausibility rule of Frames and the readers: NaN, and floats on the 0..255 scale, are refused
     check_image_values(gt, "ground-truth frames")
@@ -144,7 +166,7 @@ def score_frames(pred, gt, equalization: str = "none") -> dict:
     """
     pred, gt = np.asarray(pred), np.asarray(gt)
     if pred.shape != gt.shape or pred.ndim != 3:
-        raise ValueError(f"expected two [F, H, W] stacks of the same shape, got {pred.shape} and {gt.shape}")
+        raise EventDataError(f"expected two [F, H, W] stacks of the same shape, got {pred.shape} and {gt.shape}")
     _, _, m, s = score_pairs(pred, gt, equalization)
     return {"mse": float(np.mean(m)), "ssim": float(np.mean(s)),
             "n_frames": len(m), "protocol": f"equalization={equalization}: " + protocol_description(equalization)}

@@ -21,9 +21,10 @@ import time
 
 import numpy as np
 
+from ..core.checks import check_image_values, real_number, require, seconds_array, whole_number
 from ..core.events import EventDataError, Events
-from ..method.baselines import BASELINES, reconstruct_baseline
-from .metrics import SCORE_PROTOCOLS, protocol_description, score_pairs
+from ..method.baselines import BASELINE_PARAMS, BASELINES, reconstruct_baseline
+from .metrics import EQUALIZATIONS, SCORE_PROTOCOLS, protocol_description, score_pairs
 
 __all__ = ["frames_to_score", "match_frames", "score_sequence", "pool", "evaluate", "results_table",
            "resolve_lpips", "measure_inference_fps", "METHODS"]
@@ -44,12 +45,9 @@ def match_frames(pred_times, gt_times, tol: float = 1e-3) -> tuple[np.ndarray, n
     Returns:
         (pred_idx, gt_idx): int64 [M] each, sorted by gt_idx; unmatched GT frames are left out.
     """
-    pt = np.asarray(pred_times, dtype=np.float64).ravel()
-    gt = np.asarray(gt_times, dtype=np.float64).ravel()
-    if not (np.isfinite(tol) and tol >= 0):
-        raise ValueError(f"tol must be a finite number of seconds >= 0, got {tol!r}")
-    if not (np.all(np.isfinite(pt)) and np.all(np.isfinite(gt))):
-        raise ValueError("timestamps contain NaN or inf; pass finite seconds")
+    tol = real_number(tol, "tol", lo=0, hint="seconds between a ground-truth frame and its prediction (e.g. 1e-3)")
+    pt = seconds_array(np.ravel(pred_times), "pred_times", allow_empty=True)
+    gt = seconds_array(np.ravel(gt_times), "gt_times", allow_empty=True)
     order = np.argsort(pt, kind="stable")
     ps = pt[order]
     lo = np.searchsorted(ps, gt - tol, side="left")
@@ -95,7 +93,10 @@ def _as_float_frames(frames) -> np.ndarray:
         frames = frames.images
     a = np.asarray(frames)
     if a.ndim != 3:
-        raise ValueError(f"frames must be a stack [F, H, W], got shape {a.shape}")
+        raise EventDataError(f"frames must be a stack [F, H, W], got shape {a.shape}" +
+                             ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else ""))
+    if a.dtype.kind not in "uif" or a.dtype == bool:
+        raise EventDataError(f"frames must be uint8 (0..255) or float in [0, 1], got dtype {a.dtype}")
     return a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else a.astype(np.float64)
 
 
@@ -121,15 +122,15 @@ def score_sequence(pred_frames, pred_times, gt_frames, gt_times, equalization: s
     """
     pred = _as_float_frames(pred_frames)
     gt = _as_float_frames(gt_frames)
-    pt, gtt = np.atleast_1d(np.asarray(pred_times, np.float64)), np.atleast_1d(np.asarray(gt_times, np.float64))
+    pt, gtt = seconds_array(pred_times, "pred_times"), seconds_array(gt_times, "gt_times")
     if len(pt) != len(pred) or len(gtt) != len(gt):
-        raise ValueError(f"{len(pred)} predictions with {len(pt)} times, {len(gt)} GT frames with {len(gtt)} times; "
+        raise EventDataError(f"{len(pred)} predictions with {len(pt)} times, {len(gt)} GT frames with {len(gtt)} times; "
                          "give one timestamp per frame")
     if pred.shape[1:] != gt.shape[1:]:
-        raise ValueError(f"prediction frames are {pred.shape[1:]} but GT frames are {gt.shape[1:]} (H, W)")
+        raise EventDataError(f"prediction frames are {pred.shape[1:]} but GT frames are {gt.shape[1:]} (H, W)")
     p_idx, g_idx = match_frames(pt, gtt, tol)
     if p_idx.size == 0:
-        raise ValueError(f"no ground-truth frame has a prediction within {tol} s; query the reconstruction at "
+        raise EventDataError(f"no ground-truth frame has a prediction within {tol} s; query the reconstruction at "
                          "the ground-truth timestamps (rec.frames_at(gt_times)) on the same clock")
     P, G, m, s = score_pairs(pred[p_idx], gt[g_idx], equalization)
     model, note = resolve_lpips(lpips_model)
@@ -144,6 +145,24 @@ def score_sequence(pred_frames, pred_times, gt_frames, gt_times, equalization: s
             "per_frame": {"gt_index": g_idx, "mse": m, "ssim": s, "lpips": lp}}
 
 
+def _result_rows(rows, keys, what: str, source: str) -> list[dict]:
+    """``rows`` as a list of dicts that each hold ``keys``; else an InputError naming the function that makes them."""
+    if isinstance(rows, dict):
+        rows = [rows]
+    if isinstance(rows, (str, bytes)) or not hasattr(rows, "__iter__"):
+        raise EventDataError(f"{what} takes a list of result rows (the dicts {source} returns), got "
+                             f"{type(rows).__name__}")
+    rows = list(rows)
+    for i, r in enumerate(rows):
+        if not isinstance(r, dict):
+            raise EventDataError(f"{what}: row {i} is a {type(r).__name__}, not a dict; pass the dicts {source} returns")
+        missing = [k for k in keys if k not in r]
+        if missing:
+            raise EventDataError(f"{what}: row {i} has no {', '.join(map(repr, missing))}; pass the dicts {source} "
+                                 "returns")
+    return rows
+
+
 def pool(rows) -> dict:
     """Frame-count-weighted means over sequences (EVREAL's pooled per-frame mean).
 
@@ -154,16 +173,16 @@ def pool(rows) -> dict:
         {"mse", "ssim", "lpips" (None unless every row has it), "lpips_note", "n_frames",
         "n_sequences", "equalization", "protocol"}.
     """
-    rows = list(rows)
+    rows = _result_rows(rows, ("protocol", "n_frames", "mse", "ssim"), "pool", "score_sequence")
     if not rows:
-        raise ValueError("pool needs at least one scored sequence")
+        raise EventDataError("pool needs at least one scored sequence")
     protocols = {r["protocol"] for r in rows}
     if len(protocols) > 1:
-        raise ValueError("cannot pool results scored with different protocols (equalisation differs); "
+        raise EventDataError("cannot pool results scored with different protocols (equalisation differs); "
                          "pool each protocol separately")
     n = np.array([r["n_frames"] for r in rows], dtype=np.float64)
     if np.any(n <= 0):
-        raise ValueError("every pooled row needs n_frames > 0")
+        raise EventDataError("every pooled row needs n_frames > 0")
 
     def mean(key):
         return float(np.sum(n * np.array([r[key] for r in rows], dtype=np.float64)) / n.sum())
@@ -202,15 +221,36 @@ def evaluate(events: Events, gt_frames, gt_times=None, methods=("evinr", "integr
     from ..core.frames import Frames
     from ..method.solver import EvINRConfig, reconstruct
 
+    # every argument checked here, before any reconstruction (EvINR trains for seconds to minutes)
+    events = require(events, Events, "events")
+    cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")
     if isinstance(gt_frames, Frames) and gt_times is None:
         gt_times = gt_frames.t
     if gt_times is None:
-        raise ValueError("give gt_times (seconds), or gt_frames as a Frames object")
-    gt_times = np.atleast_1d(np.asarray(gt_times, np.float64))
-    unknown = [m for m in methods if m not in METHODS]
-    if unknown:
-        raise ValueError(f"unknown method {unknown[0]!r}; choose from {METHODS}")
-    cfg = config or EvINRConfig()
+        raise EventDataError("give gt_times (seconds), or gt_frames as a Frames object")
+    gt_times = seconds_array(gt_times, "gt_times")
+    gt = _as_float_frames(gt_frames)
+    check_image_values(gt, "ground-truth frames")
+    if len(gt) != len(gt_times):
+        raise EventDataError(f"{len(gt)} ground-truth frames but {len(gt_times)} gt_times; give one timestamp per frame")
+    if gt.shape[1:] != tuple(events.sensor_size):
+        raise EventDataError(f"the ground-truth frames are {gt.shape[1:]} (H, W) but the events' sensor_size is "
+                             f"{tuple(events.sensor_size)}; score frames of the events' sensor (crop or resize them, or "
+                             "check the sensor size: it is (H, W), rows first)")
+    methods, equalizations = _names(methods, METHODS, "methods"), _names(equalizations, EQUALIZATIONS, "equalizations")
+    real_number(tol, "tol", lo=0, hint="seconds between a ground-truth frame and its prediction (e.g. 1e-3)")
+    if baseline_params is not None:
+        if not isinstance(baseline_params, dict) or not all(isinstance(v, dict) for v in baseline_params.values()):
+            raise EventDataError(f"baseline_params must be {{method: {{param: value}}}}, e.g. {{'hf': {{'cutoff_hz': 2.0}}}}, "
+                                 f"got {baseline_params!r}")
+        stray = sorted(set(baseline_params) - set(BASELINES))
+        if stray:
+            raise EventDataError(f"baseline_params names {stray}, not baselines; use keys among {BASELINES}")
+        for method, extra in baseline_params.items():
+            allowed = BASELINE_PARAMS.get(method, ())
+            if set(extra) - set(allowed):
+                raise EventDataError(f"baseline_params[{method!r}] has {sorted(set(extra) - set(allowed))}; baseline "
+                                     f"{method!r} takes {allowed}")
     model, note = resolve_lpips(lpips_model)
     lpips_arg = model if model is not None else False
     rows = []
@@ -241,6 +281,22 @@ def evaluate(events: Events, gt_frames, gt_times=None, methods=("evinr", "integr
     return rows
 
 
+def _names(value, allowed, name: str) -> tuple:
+    """A non-empty tuple of names, each one of ``allowed``; else an InputError (one name alone is a tuple of one)."""
+    if isinstance(value, str):
+        raise EventDataError(f"{name} must be a tuple of names, got the text {value!r}; pass ({value!r},)")
+    try:
+        value = tuple(value)
+    except TypeError:
+        raise EventDataError(f"{name} must be a tuple of names among {allowed}, got {value!r}") from None
+    if not value:
+        raise EventDataError(f"{name} is empty: nothing would be scored; pass one or more of {allowed}")
+    unknown = [v for v in value if not isinstance(v, str) or v not in allowed]
+    if unknown:
+        raise EventDataError(f"unknown {name[:-1]} {unknown[0]!r}; choose from {allowed}")
+    return value
+
+
 def _fmt(v, digits=3) -> str:
     return "n/a" if v is None else f"{v:.{digits}f}"
 
@@ -248,9 +304,10 @@ def _fmt(v, digits=3) -> str:
 def results_table(rows, digits: int = 3) -> str:
     """A markdown table of result rows (from :func:`evaluate`, or any dicts with the same keys),
     with the protocol(s) and any LPIPS notes printed under it."""
-    rows = list(rows)
+    rows = _result_rows(rows, ("mse", "ssim"), "results_table", "evaluate")
+    digits = whole_number(digits, "digits", lo=0)
     if not rows:
-        raise ValueError("no rows to tabulate")
+        raise EventDataError("no rows to tabulate: pass the rows evaluate() returns (it returned none)")
     has_seq = any(r.get("sequence") for r in rows)
     head = (["sequence"] if has_seq else []) + ["method", "equalisation", "MSE", "SSIM", "LPIPS", "frames",
                                                 "train (s)", "inference (s)"]

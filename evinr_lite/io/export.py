@@ -13,7 +13,9 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from ..core.frames import to_uint8
+from ..core.checks import check_image_values, real_number, seconds_array
+from ..core.events import EventDataError
+from ..core.frames import Frames, to_uint8
 from .output import save_png
 
 __all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv"]
@@ -22,9 +24,15 @@ __all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_c
 def _stack_uint8(frames) -> np.ndarray:
     """[F, H, W] or [F, H, W, 3] floats in [0, 1] (clipped) or uint8 -> uint8 of the same shape
     (:func:`~evinr_lite.core.frames.to_uint8`, after checking that it is a stack of frames)."""
+    if isinstance(frames, Frames):
+        frames = frames.images
     frames = np.asarray(frames)
     if not (frames.ndim == 3 or (frames.ndim == 4 and frames.shape[-1] == 3)):
-        raise ValueError(f"frames must have shape [F, H, W] (grey) or [F, H, W, 3] (colour), got {frames.shape}")
+        raise EventDataError(f"frames must have shape [F, H, W] (grey) or [F, H, W, 3] (colour), got {frames.shape}"
+                             + ("; one image [H, W] is a stack of one: image[None]" if frames.ndim == 2 else ""))
+    if frames.shape[0] == 0 or frames.size == 0:
+        raise EventDataError(f"no frames to write (shape {frames.shape}); pass at least one frame")
+    check_image_values(frames, "frames to write", clipped=True)   # uint8, or finite floats in [0, 1] (clipped)
     return to_uint8(frames)
 
 
@@ -43,8 +51,8 @@ def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
 def save_gif(path, frames, fps: float) -> Path:
     """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (to the GIF's 10 ms
     resolution, at most 50 per second), looping."""
-    if not fps > 0:
-        raise ValueError(f"fps must be positive, got {fps}")
+    if isinstance(fps, (bool, np.bool_, str, bytes)) or not (np.isscalar(fps) and np.isfinite(fps) and fps > 0):
+        raise EventDataError(f"fps must be positive: a finite number of frames per second (e.g. 10), got {fps!r}")
     images = [Image.fromarray(img) for img in _stack_uint8(frames)]
     delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
     images[0].save(path, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
@@ -59,8 +67,8 @@ def save_mp4(path, frames, fps: float) -> Path:
     """
     import cv2
 
-    if not fps > 0:
-        raise ValueError(f"fps must be positive, got {fps}")
+    if isinstance(fps, (bool, np.bool_, str, bytes)) or not (np.isscalar(fps) and np.isfinite(fps) and fps > 0):
+        raise EventDataError(f"fps must be positive: a finite number of frames per second (e.g. 10), got {fps!r}")
     frames = _stack_uint8(frames)
     colour = frames.ndim == 4
     F, H, W = frames.shape[:3]
@@ -81,7 +89,8 @@ def save_mp4(path, frames, fps: float) -> Path:
 
 def save_timestamps(path, times, t_origin: float = 0.0) -> Path:
     """One line per frame: `index t_seconds` (relative to t_origin), with a header comment."""
-    times = np.asarray(times, np.float64)
+    times = seconds_array(times, "times", allow_empty=True)
+    t_origin = real_number(t_origin, "t_origin", hint="seconds: the absolute time of t = 0 (0 when relative)")
     with open(path, "w") as f:
         f.write(f"# frame index, time in seconds relative to t_origin = {t_origin!r} s\n")
         for i, t in enumerate(times):
@@ -91,8 +100,19 @@ def save_timestamps(path, times, t_origin: float = 0.0) -> Path:
 
 def save_csv(path, rows: list[dict]) -> Path:
     """A CSV file with one row per dict (columns: the keys of the first row)."""
+    if isinstance(rows, dict) or isinstance(rows, (str, bytes)) or not hasattr(rows, "__iter__"):
+        raise EventDataError(f"rows must be a list of dicts (one per CSV row), got {type(rows).__name__}"
+                             + ("; wrap one row in a list: [row]" if isinstance(rows, dict) else ""))
+    rows = list(rows)
     if not rows:
-        raise ValueError("no rows to write")
+        raise EventDataError("no rows to write; pass a list of one or more dicts")
+    for i, r in enumerate(rows):
+        if not isinstance(r, dict):
+            raise EventDataError(f"rows[{i}] is a {type(r).__name__}, not a dict; every row is a dict of column: value")
+        extra = [k for k in r if k not in rows[0]]
+        if extra:
+            raise EventDataError(f"rows[{i}] has column(s) {extra} that the first row lacks (the columns are the first "
+                                 "row's keys); give every row the same keys")
     with open(path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()

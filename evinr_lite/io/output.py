@@ -413,8 +413,16 @@ PNG_COMPRESS_LEVEL = 1   # zlib level (OpenCV's default): 3.6x faster than PIL's
 
 
 def save_png(path, image) -> None:
-    """Save a grey image [H, W] (float in [0, 1] or uint8) as an 8-bit PNG (lossless at any level)."""
+    """Save a grey image [H, W] or an RGB image [H, W, 3] (float in [0, 1], clipped, or uint8) as an 8-bit PNG
+    (lossless at any level)."""
+    from ..core.checks import check_image_values
+    from ..core.events import EventDataError
+
     image = np.asarray(image)
+    if not (image.ndim == 2 or (image.ndim == 3 and image.shape[-1] in (3, 4))) or image.size == 0:
+        raise EventDataError(f"save_png writes one image [H, W] (grey) or [H, W, 3] (RGB), got shape {image.shape}"
+                             + ("; for a stack of frames use save_frames_png(folder, frames)" if image.ndim == 3 else ""))
+    check_image_values(image, "the image to write", clipped=True)   # uint8, or finite floats in [0, 1]
     if image.dtype != np.uint8:
         image = (np.clip(image, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
     Image.fromarray(image).save(path, compress_level=PNG_COMPRESS_LEVEL)

@@ -194,6 +194,9 @@ def balance_from_counts(n_on, n_off, C, *, min_events: int = MIN_EVENTS, max_imb
 
 def estimate_balance(events: Events, C, **kw) -> BalanceFit:
     """:func:`balance_from_counts` on the counts of ``events`` (one span, e.g. one window)."""
+    from ..core.checks import require
+
+    events = require(events, Events, "events")
     if len(events) == 0:
         raise EventDataError("no events to estimate the ON/OFF balance from; pass a span with events")
     return balance_from_counts(*polarity_counts(events), C, **kw)

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.checks import ArgumentTypeError, choice, optional_seconds, real_number, require
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from .anchor import frame_log, linear_frames
@@ -38,22 +39,27 @@ from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, TONEMAPS, display_sh
 
 __all__ = ["leaky_integration", "highpass_filter", "highpass_per_event", "reconstruct_baseline",
            "BaselineReconstruction", "BASELINES", "DEFAULT_CUTOFF_HZ", "complementary_filter", "DEFAULT_GAIN",
-           "FRAME_BASELINES"]
+           "FRAME_BASELINES", "BASELINE_PARAMS"]
 
 BASELINES = ("integration", "leaky", "hf")
 FRAME_BASELINES = ("complementary",)   # baselines that need APS frames (reconstruct_baseline(frames=...))
+BASELINE_PARAMS = {"integration": ("L0",), "leaky": ("leak_hz", "L0"), "hf": ("cutoff_hz", "L0"),
+                   "complementary": ("gain",)}   # the keyword parameters each baseline takes
 DEFAULT_CUTOFF_HZ = 1.0   # alpha = 2 pi rad/s; a tunable choice (Scheerlinck et al. expose it as a parameter)
 
 
 # ---- argument checks -------------------------------------------------------------------------
 
 def _rate(value, name: str) -> float:
-    if not (np.isscalar(value) and np.isfinite(value) and value >= 0):
+    if isinstance(value, (str, bytes, bool, np.bool_)) or not (np.isscalar(value) and np.isfinite(value) and value >= 0):
         raise EventDataError(f"{name} must be a finite number >= 0 (per second), got {value!r}")
     return float(value)
 
 
 def _query(t_query) -> np.ndarray:
+    if isinstance(t_query, (str, bytes)) or np.asarray(t_query).dtype.kind not in "iuf":
+        raise EventDataError(f"query times must be seconds (a number, a list or a 1-D array of numbers), got "
+                             f"{t_query!r:.60}")
     tq = np.asarray(t_query, dtype=np.float64)
     if tq.ndim > 1 or tq.size == 0 or not np.all(np.isfinite(tq)):
         raise EventDataError(f"query times must be a finite scalar or a non-empty 1-D array of seconds, got shape {tq.shape}")
@@ -168,7 +174,7 @@ def highpass_filter(events: Events, query_times, C=0.2, cutoff_hz: float = DEFAU
         def fn(u):
             return _highpass_loop(events, u, C_pos, C_neg, alpha, t0, L0)
     else:
-        raise ValueError(f"method must be 'vectorised' or 'per_event', got {method!r}")
+        raise EventDataError(f"method must be 'vectorised' or 'per_event', got {method!r}")
     return _per_query(fn, tq)
 
 
@@ -277,7 +283,7 @@ def complementary_filter(events: Events, frames, query_times, C=0.2, gain: float
         def fn(u):
             return _complementary_loop(events, ft, LF, u, C_pos, C_neg, alpha, t0)
     else:
-        raise ValueError(f"method must be 'vectorised' or 'per_event', got {method!r}")
+        raise EventDataError(f"method must be 'vectorised' or 'per_event', got {method!r}")
     return _per_query(fn, tq)
 
 
@@ -382,19 +388,27 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
     Returns:
         BaselineReconstruction with ``.frames`` [Q, H, W] in [0, 1].
     """
-    allowed = {"integration": ("L0",), "leaky": ("leak_hz", "L0"), "hf": ("cutoff_hz", "L0"), "complementary": ("gain",)}
-    if tonemap not in TONEMAPS:
-        raise ValueError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
-    if method not in allowed:
-        raise ValueError(f"method must be one of {BASELINES + FRAME_BASELINES}, got {method!r}")
+    events = require(events, Events, "events")                 # every argument checked before any work
+    allowed = BASELINE_PARAMS
+    choice(tonemap, TONEMAPS, "tonemap")
+    choice(method, BASELINES + FRAME_BASELINES, "method")
+    choice(offset_solve, OFFSET_SOLVES, "offset_solve")
+    t_start, t_end = optional_seconds(t_start, "t_start"), optional_seconds(t_end, "t_end")
+    if t_start is not None and t_end is not None and not t_end > t_start:
+        raise EventDataError(f"the span [t_start, t_end] = [{t_start}, {t_end}] s is empty or reversed; t_end must "
+                             "exceed t_start (or leave both out)")
+    if tonemap == "reinhard":
+        real_number(gamma, "gamma", lo=0, lo_open=True, hint="Reinhard's exponent (the paper's 0.6)")
+    real_number(display_mean, "display_mean", lo=0, hi=1, lo_open=True, hint="the mean displayed level (e.g. 0.4)")
     if method == "complementary":
         return _complementary_reconstruction(events, query_times, C, frames, params.get("gain", DEFAULT_GAIN),
                                              t_start, offset_solve, gamma, display_mean, set(params) - {"gain"})
     if frames is not None:
-        raise TypeError(f"baseline {method!r} takes no frames (events only); frames= is for method='complementary'")
+        raise ArgumentTypeError(f"baseline {method!r} takes no frames (events only); frames= is for "
+                                "method='complementary'")
     extra = set(params) - set(allowed[method])
     if extra:
-        raise TypeError(f"baseline {method!r} takes parameters {allowed[method]}, not {sorted(extra)}")
+        raise ArgumentTypeError(f"baseline {method!r} takes parameters {allowed[method]}, not {sorted(extra)}")
     q = _query(query_times)
     q = np.atleast_1d(q)
     first, last = (events.t[0], events.t[-1]) if len(events) else (q.min(), q.max())
@@ -413,8 +427,6 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
     t0 = time.perf_counter()
     grid = np.linspace(lo, hi, 64)
     L_all = fn(np.concatenate([grid, q]))
-    if offset_solve not in OFFSET_SOLVES:
-        raise ValueError(f"offset_solve must be one of {OFFSET_SOLVES}, got {offset_solve!r}")
     g = offset_image(L_all[:len(grid)], offset_solve) if offset_solve != "none" else 0.0
     offset = g + display_shift(L_all[:len(grid)] + g, tonemap, gamma, display_mean)
     L = L_all[len(grid):] + offset
@@ -430,9 +442,9 @@ def _complementary_reconstruction(events, query_times, C, frames, gain, t_start,
                                   extra) -> BaselineReconstruction:
     """reconstruct_baseline(method="complementary"): the filter's log intensity, in the frames' own level."""
     if extra:
-        raise TypeError(f"baseline 'complementary' takes parameters ('gain',), not {sorted(extra)}")
+        raise ArgumentTypeError(f"baseline 'complementary' takes parameters ('gain',), not {sorted(extra)}")
     if offset_solve != "none":
-        raise ValueError("offset_solve must be 'none' for the complementary filter: the frames fix its offset")
+        raise EventDataError("offset_solve must be 'none' for the complementary filter: the frames fix its offset")
     q = np.atleast_1d(_query(query_times))
 
     def fn(t):

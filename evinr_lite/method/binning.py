@@ -78,6 +78,9 @@ class EventFrames:
         return int(self.frames.shape[0])
 
 
+MAX_BINS = 10**9   # edges of more bins than this would not fit in memory (8 GB); refused before they are made
+
+
 def fixed_duration_boundaries(t_start: float, t_end: float, bin_duration: float = 1 / 32) -> np.ndarray:
     """Edges of consecutive bins of ``bin_duration`` seconds covering [t_start, t_end].
 
@@ -87,7 +90,11 @@ def fixed_duration_boundaries(t_start: float, t_end: float, bin_duration: float 
         raise EventDataError(f"bin range [{t_start}, {t_end}] is empty or reversed; t_end must exceed t_start")
     if not bin_duration > 0:
         raise EventDataError(f"bin_duration must be positive seconds, got {bin_duration}")
-    n = int(np.ceil((t_end - t_start) / bin_duration - 1e-9))
+    n = (t_end - t_start) / bin_duration
+    if not n <= MAX_BINS:   # checked before the edges are allocated (1e-12 s over 1000 s: 7 PiB of edges)
+        raise EventDataError(f"bins of {bin_duration:g} s over [{t_start}, {t_end}] s would be {n:,.0f} bins (at most "
+                             f"{MAX_BINS:,}); use a longer bin_duration or a shorter range")
+    n = int(np.ceil(n - 1e-9))
     edges = t_start + bin_duration * np.arange(n + 1, dtype=np.float64)
     edges[-1] = t_end
     return edges
@@ -125,6 +132,8 @@ def _check_boundaries(boundaries) -> np.ndarray:
     b = np.asarray(boundaries, dtype=np.float64)
     if b.ndim != 1 or b.size < 2:
         raise EventDataError(f"boundaries must be a 1-D array of at least 2 edges, got shape {b.shape}")
+    if not np.all(np.isfinite(b)):
+        raise EventDataError("boundaries contain NaN or inf; bin edges must be finite seconds")
     if np.any(np.diff(b) <= 0):
         raise EventDataError("boundaries must be strictly increasing")
     return b

@@ -368,6 +368,9 @@ class EvINRConfig:
                                             re.fullmatch(r"cpu|mps|cuda(:\d+)?", self.device)):
             raise EventDataError(f"device must be 'cpu', 'cuda', 'cuda:N', 'mps' or None (a GPU when present), "
                                  f"got {self.device!r}")
+        if not isinstance(self.c2f_iters, (tuple, list, np.ndarray)):
+            raise EventDataError(f"c2f_iters must be a tuple of iterations (e.g. (100, 200), or () for none), got "
+                                 f"{self.c2f_iters!r}")
         self.c2f_iters = tuple(number("c2f_iters", i, integer=True) for i in self.c2f_iters)
         if self.coarse_to_fine:
             if any(i < 1 for i in self.c2f_iters) or list(self.c2f_iters) != sorted(set(self.c2f_iters)):

@@ -51,7 +51,7 @@ from .binning import events_to_frames, fixed_duration_boundaries
 from ..core.runtime import default_device
 from ..core.events import EventDataError, Events, check_sensor_size, check_time_range
 from .siren import Siren
-from .tonemap import anchor_level, tonemap_reinhard
+from .tonemap import reinhard_unchecked, anchor_level, tonemap_reinhard
 
 __all__ = ["CoordinateINR", "CoordinateConfig", "CoordinateBins", "CoordinateReconstruction",
            "bin_events", "split_index", "temporal_loss", "tikhonov_autograd", "train_coordinate_inr",
@@ -421,7 +421,7 @@ class CoordinateReconstruction:
 
     def frames_at(self, times) -> np.ndarray:
         """Tone-mapped frames in [0, 1] at any times: float32 [Q, H, W]."""
-        return tonemap_reinhard(self.at(times), self.config.gamma).astype(np.float32)
+        return reinhard_unchecked(self.at(times), self.config.gamma).astype(np.float32)
 
 
 def reconstruct_coordinate(events: Events, query_times, config: CoordinateConfig | None = None, *,
@@ -451,6 +451,6 @@ def reconstruct_coordinate(events: Events, query_times, config: CoordinateConfig
                              f"[{t_start}, {t_end}] s; widen the span or drop those times")
     model, history = train_coordinate_inr(events, cfg, (t_start, t_end), callback=callback)
     L, offset = predict_anchored(model, q, cfg.gamma, cfg.display_mean)
-    frames = tonemap_reinhard(L, cfg.gamma).astype(np.float32)
+    frames = reinhard_unchecked(L, cfg.gamma).astype(np.float32)
     history["config"] = asdict(cfg)
     return CoordinateReconstruction(q, L, frames, model, offset, cfg, history)

@@ -41,7 +41,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..core.checks import check_result_frames, require, whole_number
+from ..core.checks import check_result_frames, optional_seconds, require, seconds_array, whole_number
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from .anchor import fit_anchor, frames_in_window, linear_frames
@@ -140,9 +140,11 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     events = require(events, Events, "events")                                 # every argument where it enters
     cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")
     require(frames, Frames, "frames", none_ok=True)
+    _check_device(cfg)                                                          # before any work: a GPU that is not here
     q, events, t_start, t_end = _checked_span(events, query_times, t_start, t_end)
     events, cfg = prepare_events(events, cfg, (t_start, t_end))                 # 0. hot pixels, background, ON/OFF balance, lam
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)               # 1. windows
+    _check_events_per_network(len(events), windows, cfg)
     frames = _checked_anchor_frames(frames, events.sensor_size, t_start, t_end, cfg)   # before training
     if memory_guard:                                                            # before anything large is allocated
         check_memory(events.sensor_size, t_start, t_end, len(events), len(q), cfg, _device_name(cfg),
@@ -200,6 +202,31 @@ def _device_name(cfg: EvINRConfig) -> str:
         return "cpu"
 
 
+MIN_EVENTS_PER_NETWORK = 2   # on average over the windows: as for the whole span (_checked_span), a network needs 2
+
+
+def _check_events_per_network(n_events: int, windows: np.ndarray, cfg: EvINRConfig) -> None:
+    """Refuse, before training, windows (``windows`` [N, 2] s, one network each) that hold fewer than
+    :data:`MIN_EVENTS_PER_NETWORK` events on average: a tau far below the span (tau=1e-4 over 0.3 s makes
+    about 3,000 networks) leaves the networks nothing to learn from and trains for minutes."""
+    n = len(windows)
+    if n > 1 and n_events < MIN_EVENTS_PER_NETWORK * n:
+        span = float(windows[-1, 1] - windows[0, 0])
+        raise EventDataError(f"tau={cfg.tau!r} s cuts the span of {span:.6g} s into {n:,} windows (one network each) "
+                             f"but only {n_events:,} events are there ({n_events / n:.2g} per network; each needs at "
+                             f"least {MIN_EVENTS_PER_NETWORK}); use a longer tau (the default is 5.0 s) or tau=None (one "
+                             "network for the whole span), or a shorter span (t_start=/t_end=, and query times near the "
+                             "events)")
+
+
+def _check_device(cfg: EvINRConfig) -> None:
+    """Refuse (DeviceUnavailable, an InputError) a ``cfg.device`` this machine does not have, before any work."""
+    from ..core.runtime import default_device
+
+    if cfg.device is not None:
+        default_device(cfg.device)
+
+
 def _initial_model(sensor_size, windows: np.ndarray, cfg: EvINRConfig) -> FrameINR:
     """The N networks to train, on the config's device; a head that is only solved in closed form
     (head_solve with no Adam step) is not drawn (saves d x H*W random numbers per network)."""
@@ -213,13 +240,15 @@ def _initial_model(sensor_size, windows: np.ndarray, cfg: EvINRConfig) -> FrameI
 def _checked_span(events: Events, query_times, t_start, t_end):
     """(query times float64 [Q], the events inside the span, t_start, t_end): every input checked
     before any work; the span defaults to the events' widened to include the query times."""
-    q = np.atleast_1d(np.asarray(query_times, dtype=np.float64))
+    q = seconds_array(query_times, "query_times")   # float64 [Q]: a number or a 1-D array, finite, not empty
+    t_start, t_end = optional_seconds(t_start, "t_start"), optional_seconds(t_end, "t_end")
+    if t_start is not None and t_end is not None and not t_end > t_start:
+        raise EventDataError(f"the span [t_start, t_end] = [{t_start}, {t_end}] s is empty or reversed; t_end must "
+                             "exceed t_start (or leave both out: the events' span, widened to the query times)")
     if len(events) < 2:
         raise EventDataError(f"need at least 2 events to reconstruct, got {len(events)}; choose a longer window")
-    if q.size == 0 or not np.all(np.isfinite(q)):
-        raise EventDataError("query_times must be a non-empty array of finite seconds")
-    t_start = min(events.t[0], q.min()) if t_start is None else float(t_start)
-    t_end = max(events.t[-1], q.max()) if t_end is None else float(t_end)
+    t_start = min(events.t[0], q.min()) if t_start is None else t_start
+    t_end = max(events.t[-1], q.max()) if t_end is None else t_end
     if q.min() < t_start or q.max() > t_end:
         raise EventDataError(f"query times span [{q.min()}, {q.max()}] s, outside [t_start, t_end] = "
                              f"[{t_start}, {t_end}] s; widen the span or drop those times")

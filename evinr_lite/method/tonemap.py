@@ -30,8 +30,10 @@ import math
 
 import numpy as np
 
+from ..core.events import EventDataError
+
 __all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "DISPLAY_MEANS", "tonemap_reinhard", "tonemap_linear", "to_display", "display_shift", "anchor_level",
-           "anchor_mean"]
+           "anchor_mean", "reinhard_unchecked"]
 
 TONEMAPS = ("linear", "reinhard")
 DEFAULT_TONEMAP = "linear"  # the kit's display (EvINRConfig and the baselines share it)
@@ -49,8 +51,21 @@ def tonemap_reinhard(L, gamma: float = 0.6):
     Returns:
         Same type and shape as ``L``, values in (0, 1).
     """
-    if not gamma > 0:
-        raise ValueError(f"gamma must be positive, got {gamma}")
+    if isinstance(gamma, (bool, np.bool_, str, bytes)) or not np.isscalar(gamma) or not gamma > 0 or \
+            not np.isfinite(gamma):
+        raise EventDataError(f"gamma must be a positive finite number (the paper's 0.6), got {gamma!r}")
+    if not hasattr(L, "sigmoid"):   # numpy: numbers only, and no NaN (it would come out as NaN frames)
+        L = np.asarray(L) if not isinstance(L, (str, bytes)) else np.asarray([L])
+        if L.dtype.kind not in "iuf" or L.dtype == bool:
+            raise EventDataError(f"L must be log intensities (numbers), got dtype {L.dtype}")
+        if np.isnan(L).any():
+            raise EventDataError(f"L contains {int(np.isnan(L).sum()):,} NaN value(s); a log intensity must be a number "
+                                 "(log of an intensity clipped above 0)")
+    return reinhard_unchecked(L, gamma)
+
+
+def reinhard_unchecked(L, gamma: float):
+    """:func:`tonemap_reinhard` without its argument checks (the solver's own, already checked values)."""
     if hasattr(L, "sigmoid"):  # torch tensor
         return L.sigmoid() ** gamma
     L = np.asarray(L, dtype=np.float64)
@@ -71,8 +86,8 @@ def to_display(L, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6):
     if tonemap == "linear":
         return tonemap_linear(L)
     if tonemap == "reinhard":
-        return tonemap_reinhard(L, gamma)
-    raise ValueError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
+        return reinhard_unchecked(L, gamma)
+    raise EventDataError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
 
 
 def display_shift(reference, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6,
@@ -86,15 +101,15 @@ def display_shift(reference, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6,
       sorted values (at most SHIFT_SAMPLES of them, an even stride through ``reference``).
     """
     if not 0 < display_mean < 1:
-        raise ValueError(f"display_mean must be in (0, 1), got {display_mean}")
+        raise EventDataError(f"display_mean must be in (0, 1), got {display_mean}")
     if tonemap == "reinhard":
         return anchor_level(gamma, display_mean) - float(np.mean(reference))
     if tonemap != "linear":
-        raise ValueError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
+        raise EventDataError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
     v = np.asarray(reference).reshape(-1)
     v = np.sort(v[::max(1, -(-v.size // SHIFT_SAMPLES))].astype(np.float64))
     if v.size == 0 or not np.isfinite(v[0]) or not np.isfinite(v[-1]):
-        raise ValueError("display_shift needs finite log intensities")
+        raise EventDataError("display_shift needs finite log intensities")
     top = v[-1]
     below = np.concatenate([[0.0], np.cumsum(np.exp(v - top))])   # below[k] = sum of exp(v_i - top), i < k
     n = v.size
@@ -117,7 +132,7 @@ def anchor_level(gamma: float = 0.6, display_mean: float = 0.5) -> float:
     mean sits at this level (mid-grey on screen by default).
     """
     if not 0 < display_mean < 1:
-        raise ValueError(f"display_mean must be in (0, 1), got {display_mean}")
+        raise EventDataError(f"display_mean must be in (0, 1), got {display_mean}")
     s = display_mean ** (1.0 / gamma)
     return math.log(s / (1.0 - s))
 

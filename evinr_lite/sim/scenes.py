@@ -16,9 +16,13 @@ Coordinates: x is the column, y the row (pointing down); sizes are (H, W).
 """
 from __future__ import annotations
 
+import inspect
+import numbers
+
 import numpy as np
 from scipy import ndimage
 
+from ..core.checks import ArgumentTypeError
 from ..core.events import EventDataError, check_sensor_size
 from ..core.frames import Frames
 
@@ -57,7 +61,8 @@ class Scene:
 
     def __init__(self, sensor_size=(120, 160), duration: float = 2.0):
         self.sensor_size = check_sensor_size(sensor_size)
-        if not (np.isfinite(duration) and duration > 0):
+        if isinstance(duration, (bool, np.bool_)) or not isinstance(duration, numbers.Real) or \
+                not (np.isfinite(duration) and duration > 0):
             raise EventDataError(f"duration must be a positive number of seconds, got {duration!r}")
         self.duration = float(duration)
 
@@ -475,8 +480,16 @@ def make_scene(name="camera", sensor_size=(120, 160), duration=2.0, **kwargs) ->
         **kwargs: passed to the scene class (e.g. velocity, rotation, zoom, blur for images;
             speed, angle, width for the bar).
     """
+    if not isinstance(name, str) or (name != "bar" and name not in IMAGE_NAMES):
+        raise EventDataError(f"unknown scene {name!r}; use one of {SCENE_NAMES}")
+    cls = MovingBarScene if name == "bar" else MovingImageScene
+    signature = inspect.signature(cls.__init__).parameters
+    params = [k for k, v in signature.items() if k not in ("self", "image", "sensor_size", "duration")
+              and v.kind is inspect.Parameter.KEYWORD_ONLY]
+    unknown = sorted(set(kwargs) - set(params))
+    if unknown:
+        raise ArgumentTypeError(f"make_scene({name!r}) got unknown parameter(s) {unknown}; a {cls.__name__} takes "
+                                f"{', '.join(params)} (and sensor_size, duration)")
     if name == "bar":
         return MovingBarScene(sensor_size, duration, **kwargs)
-    if name in IMAGE_NAMES:
-        return MovingImageScene(name, sensor_size, duration, **kwargs)
-    raise EventDataError(f"unknown scene {name!r}; use one of {SCENE_NAMES}")
+    return MovingImageScene(name, sensor_size, duration, **kwargs)

@@ -44,6 +44,8 @@ from __future__ import annotations
 
 from typing import Callable, Iterable, Iterator
 
+import numbers
+
 import numpy as np
 
 from ..core.events import EventDataError, Events
@@ -53,6 +55,8 @@ __all__ = ["simulate_events_1d", "pixel_events", "add_background_noise", "add_ho
 
 MIN_THRESHOLD_FRACTION = 0.1   # mismatched thresholds are clipped below at this x nominal
 MAX_PX_PER_SAMPLE = 0.5        # simulate_scene's default sampling: at most this motion per sample
+MAX_SAMPLE_RATE = 1e6          # samples per second: 1 us, the timestamp resolution of event cameras
+MIN_C = 1e-3                   # log units; sensors have about 0.05 to 1.5, and events grow as 1 / C
 N_BISECTION = 50               # halvings when refining a crossing of a callable L
 _REFINE_CHUNK = 1 << 22        # values of L evaluated per call during refinement (bounds memory)
 _SCENE_CHUNK = 1 << 21         # pixels x samples rendered per scene.log_intensity call
@@ -63,9 +67,14 @@ _SCENE_CHUNK = 1 << 21         # pixels x samples rendered per scene.log_intensi
 def _as_rng(seed) -> np.random.Generator:
     if isinstance(seed, np.random.Generator):
         return seed
-    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)):
-        raise EventDataError(f"seed must be an int or a np.random.Generator, got {seed!r}")
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise EventDataError(f"seed must be a whole number >= 0 or a np.random.Generator, got {seed!r}")
     return np.random.default_rng(int(seed))
+
+
+def _is_real(value) -> bool:
+    """A real number (int or float, numpy's too; not a bool, not text, not an array)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
 
 
 def _check_times(t) -> np.ndarray:
@@ -83,14 +92,20 @@ def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
     C_pos = C if C_pos is None else C_pos
     C_neg = C if C_neg is None else C_neg
     for name, value in (("C_pos", C_pos), ("C_neg", C_neg)):
-        if not (np.isscalar(value) and np.isreal(value) and np.isfinite(value) and value > 0):
-            raise EventDataError(f"contrast threshold {name} (or C) must be a positive number in log units, got {value!r}")
+        if not (_is_real(value) and np.isfinite(value) and value > 0):
+            pair = " (for two thresholds pass C_pos= and C_neg=)" if isinstance(value, (tuple, list)) else ""
+            raise EventDataError(f"contrast threshold {name} (or C) must be a positive number in log units, got "
+                                 f"{value!r}{pair}")
+        if value < MIN_C:
+            raise EventDataError(f"contrast threshold {name} (or C) = {value!r} log units is far below any sensor's "
+                                 f"(about 0.05 to 1.5): each pixel would fire |change of log intensity| / C events, "
+                                 f"millions of them; use C >= {MIN_C:g} (e.g. C=0.2)")
     return float(C_pos), float(C_neg)
 
 
 def _check_nonnegative(**values) -> None:
     for name, value in values.items():
-        if not (np.isscalar(value) and np.isreal(value) and np.isfinite(value) and value >= 0):
+        if not (_is_real(value) and np.isfinite(value) and value >= 0):
             raise EventDataError(f"{name} must be a finite number >= 0, got {value!r}")
 
 
@@ -390,6 +405,9 @@ def _check_video(log_frames, t) -> tuple[np.ndarray, np.ndarray]:
             f"log_frames must have shape [T, H, W] with T = len(t) = {t.size}, got {log_frames.shape}")
     if log_frames.dtype.kind not in "fiu":
         raise EventDataError(f"log_frames must be numbers (log intensity), got dtype {log_frames.dtype}")
+    if log_frames.dtype in (np.uint8, np.uint16):   # camera images, not their log
+        raise EventDataError(f"log_frames are {log_frames.dtype} (images as a camera stores them), not log intensities; "
+                             f"pass np.log(frames / {np.iinfo(log_frames.dtype).max} + 1e-3) (float)")
     if not np.all(np.isfinite(log_frames)):
         raise EventDataError("log_frames contain NaN or inf; take the log of intensities clipped above 0")
     return log_frames, t
@@ -399,7 +417,7 @@ def _video_events(t, frames: Iterable[np.ndarray], sensor_size, C, C_pos, C_neg,
                   refractory, noise_rate, seed, threshold_drift=0.0) -> Events:
     C_pos, C_neg = _check_thresholds(C, C_pos, C_neg)
     _check_nonnegative(threshold_sigma=threshold_sigma, refractory=refractory, noise_rate=noise_rate)
-    if not (np.isscalar(threshold_drift) and np.isfinite(threshold_drift)):
+    if not (_is_real(threshold_drift) and np.isfinite(threshold_drift)):
         raise EventDataError(f"threshold_drift must be a finite relative change, got {threshold_drift!r}")
     H, W = sensor_size
     t_ev, pix, p = _simulate_samples(t, frames, H * W, C_pos, C_neg, threshold_sigma, refractory,
@@ -457,13 +475,24 @@ def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, *
     Returns:
         Events on ``scene.sensor_size``. Frames are rendered in chunks, never all at once.
     """
+    missing = [a for a in ("sensor_size", "duration", "log_intensity", "max_speed") if not hasattr(scene, a)]
+    if missing:
+        raise EventDataError(f"scene= must be a Scene (it has no {', '.join(missing)}), got {type(scene).__name__}; "
+                             f"build one with make_scene(name, sensor_size=(H, W), duration=seconds)")
     t_end = scene.duration if t_end is None else t_end
+    if not (_is_real(t_start) and _is_real(t_end)):
+        raise EventDataError(f"t_start and t_end must be seconds (numbers), got {t_start!r} and {t_end!r}")
     if not (np.isfinite(t_start) and np.isfinite(t_end) and t_end > t_start):
         raise EventDataError(f"time range [{t_start}, {t_end}] s is empty or reversed; t_end must exceed t_start")
     if sample_rate is None:
         sample_rate = max(100.0, float(scene.max_speed) / MAX_PX_PER_SAMPLE)
-    if not (np.isfinite(sample_rate) and sample_rate > 0):
+    if not (_is_real(sample_rate) and np.isfinite(sample_rate) and sample_rate > 0):
         raise EventDataError(f"sample_rate must be a positive number of samples per second, got {sample_rate!r}")
+    if sample_rate > MAX_SAMPLE_RATE:
+        raise EventDataError(f"sample_rate={sample_rate!r} samples per second is finer than the 1 us timestamps of event "
+                             f"cameras and would render {sample_rate * (t_end - t_start):,.0f} frames; use at most "
+                             f"{MAX_SAMPLE_RATE:g} (or None: fine enough that the image moves at most "
+                             f"{MAX_PX_PER_SAMPLE} px between samples)")
     n = max(2, int(np.ceil((t_end - t_start) * sample_rate - 1e-9)) + 1)
     t = np.linspace(t_start, t_end, n)
     unknown = set(kwargs) - {"C_pos", "C_neg", "threshold_sigma", "refractory", "noise_rate", "seed",
