@@ -90,8 +90,11 @@ def _size(text: str) -> tuple[int, int]:
         raise argparse.ArgumentTypeError(f"size must be HxW (rows x columns), e.g. 120x160; got {text!r}") from None
     if h <= 0 or w <= 0:
         raise argparse.ArgumentTypeError(f"size must be positive, got {text!r}")
-    if h > 1 << 16 or w > 1 << 16:
-        raise argparse.ArgumentTypeError(f"size {text!r} is larger than any event camera (at most 65536 per side)")
+    from ..core.events import MAX_SENSOR_SIDE   # here: numpy only when --sensor is given
+
+    if h > MAX_SENSOR_SIDE or w > MAX_SENSOR_SIDE:
+        raise argparse.ArgumentTypeError(f"size {text!r} is larger than any event camera (at most {MAX_SENSOR_SIDE} "
+                                         "per side)")
     return h, w
 
 

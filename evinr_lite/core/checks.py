@@ -17,7 +17,7 @@ from .events import EventDataError
 from .guard import InputError
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
-           "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice"]
+           "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number"]
 
 # (expected class name, given class name) -> how to turn the one into the other
 TypeFix = {
@@ -116,10 +116,15 @@ def whole_number(value, name: str, *, lo: int | None = None, hi: int | None = No
     return value
 
 
+def is_real_number(value) -> bool:
+    """A real number: an int or a float, numpy's too (not a bool, not text, not an array)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
 def real_number(value, name: str, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
                 hint: str = "") -> float:
     """``value`` as a float when it is a finite number in [lo, hi] (``lo_open``: (lo, hi]); else an InputError."""
-    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    ok = is_real_number(value)
     v = float(value) if ok else math.nan
     if not ok or not math.isfinite(v) or (lo is not None and (v <= lo if lo_open else v < lo)) or \
             (hi is not None and v > hi):

@@ -24,11 +24,13 @@ import math
 from .guard import InputError   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
-           "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S"]
+           "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S",
+           "MAX_SENSOR_SIDE"]
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 LARGE_T = 1e5  # seconds; clocks whose first timestamp is at least this large get a whole-second t_origin
+MAX_SENSOR_SIDE = 1 << 16   # pixels per side; no event camera is larger (headers, file attributes, --sensor)
 
 
 class EventDataError(InputError):

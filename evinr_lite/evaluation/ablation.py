@@ -42,7 +42,7 @@ from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
 from ..method.integration import integrate_events
 from ..method.solver import EvINRConfig, reconstruct
-from ..method.tonemap import reinhard_unchecked, anchor_mean, tonemap_reinhard
+from ..method.tonemap import anchor_mean, reinhard_unchecked
 from .metrics import SCORE_PROTOCOLS
 from .scoring import measure_inference_fps, score_sequence
 

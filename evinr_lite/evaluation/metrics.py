@@ -82,17 +82,30 @@ def _pair(pred, gt):
 
 def mse(pred, gt) -> float:
     """Mean squared error of images in [0, 1] (prediction clipped first). Shapes [H, W]."""
-    pred, gt = _pair(pred, gt)
-    return float(np.mean((pred - gt) ** 2))
+    return _mse(*_pair(pred, gt))
 
 
 def ssim(pred, gt) -> float:
     """SSIM of two grey images [H, W] in [0, 1] (prediction clipped first); see the module docstring."""
     pred, gt = _pair(pred, gt)
-    if min(pred.shape) < 11:
-        raise EventDataError(f"SSIM needs images of at least 11 x 11 pixels (its gaussian window), got {pred.shape}")
+    _check_ssim_size(pred.shape)
+    return _ssim(pred, gt)
+
+
+def _mse(pred: np.ndarray, gt: np.ndarray) -> float:
+    """MSE of two float64 images already checked (:func:`_pair`, or :func:`score_pairs`' stacks)."""
+    return float(np.mean((pred - gt) ** 2))
+
+
+def _ssim(pred: np.ndarray, gt: np.ndarray) -> float:
+    """SSIM of two float64 images already checked, of at least 11 x 11 pixels."""
     return float(structural_similarity(pred, gt, gaussian_weights=True, sigma=1.5,
                                        use_sample_covariance=False, data_range=1.0))
+
+
+def _check_ssim_size(shape) -> None:
+    if min(shape) < 11:
+        raise EventDataError(f"SSIM needs images of at least 11 x 11 pixels (its gaussian window), got {shape}")
 
 
 def equalize(img, method: str = "none") -> np.ndarray:
@@ -148,10 +161,14 @@ def score_pairs(pred, gt, equalization: str = "none") -> tuple[np.ndarray, np.nd
     # the plausibility rule of Frames and the readers: NaN, and floats on the 0..255 scale, are refused
     check_image_values(gt, "ground-truth frames")
     check_image_values(pred, "predicted frames", clipped=True)   # clipped to [0, 1] below: small overshoot is fine
-    pred_eq = np.stack([equalize(a, equalization) for a in pred])
+    pred_eq = np.stack([equalize(a, equalization) for a in pred])   # float64 in [0, 1], finite
     gt_eq = np.stack([equalize(b, equalization) for b in gt])
-    m = np.array([mse(a, b) for a, b in zip(pred_eq, gt_eq)])
-    s = np.array([ssim(a, b) for a, b in zip(pred_eq, gt_eq)])
+    if pred_eq.shape != gt_eq.shape:
+        raise EventDataError(f"prediction {pred_eq.shape[1:]} and ground truth {gt_eq.shape[1:]} differ in shape")
+    _check_ssim_size(pred_eq.shape[1:])
+    # the stacks were checked above, once: the per-frame metrics need not check every frame again
+    m = np.array([_mse(a, b) for a, b in zip(pred_eq, gt_eq)])
+    s = np.array([_ssim(a, b) for a, b in zip(pred_eq, gt_eq)])
     return pred_eq, gt_eq, m, s
 
 

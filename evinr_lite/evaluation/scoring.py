@@ -97,7 +97,7 @@ def _as_float_frames(frames) -> np.ndarray:
                              ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else ""))
     if a.dtype.kind not in "uif" or a.dtype == bool:
         raise EventDataError(f"frames must be uint8 (0..255) or float in [0, 1], got dtype {a.dtype}")
-    return a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else a.astype(np.float64)
+    return a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else a.astype(np.float64, copy=False)
 
 
 def score_sequence(pred_frames, pred_times, gt_frames, gt_times, equalization: str = "none",
@@ -270,7 +270,7 @@ def evaluate(events: Events, gt_frames, gt_times=None, methods=("evinr", "integr
             frames, train, infer = rec.frames, 0.0, time.perf_counter() - t0
             params = dict(rec.params)
         for eq in equalizations:
-            r = score_sequence(frames, gt_times, gt_frames, gt_times, eq, lpips_arg, tol)
+            r = score_sequence(frames, gt_times, gt, gt_times, eq, lpips_arg, tol)   # gt: read and checked above
             r.pop("per_frame")
             if model is None:
                 r["lpips_note"] = note

@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.cfa import CFA_NAMES, cfa_phase, check_cfa  # the colour filter's one home (names kept here)
-from ..core.events import EventDataError, Events
+from ..core.events import MAX_SENSOR_SIDE, EventDataError, Events
 from ..core.frames import Frames, to_grey_uint8
 from .notes import note
 from .source import RecordingSource
@@ -206,8 +206,6 @@ def _attr(value):
 
 
 def _info_from(f, path) -> dict:
-    from .formats.base import MAX_SENSOR_SIDE   # here: the formats package imports this module
-
     info = {k: _attr(v) for k, v in f.attrs.items() if k != "meta_json"}
     try:
         info["meta"] = json.loads(_attr(f.attrs["meta_json"])) if "meta_json" in f.attrs else {}

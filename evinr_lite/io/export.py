@@ -48,11 +48,15 @@ def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
     return paths
 
 
+def _check_fps(fps) -> None:
+    if isinstance(fps, (bool, np.bool_, str, bytes)) or not (np.isscalar(fps) and np.isfinite(fps) and fps > 0):
+        raise EventDataError(f"fps must be positive: a finite number of frames per second (e.g. 10), got {fps!r}")
+
+
 def save_gif(path, frames, fps: float) -> Path:
     """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (to the GIF's 10 ms
     resolution, at most 50 per second), looping."""
-    if isinstance(fps, (bool, np.bool_, str, bytes)) or not (np.isscalar(fps) and np.isfinite(fps) and fps > 0):
-        raise EventDataError(f"fps must be positive: a finite number of frames per second (e.g. 10), got {fps!r}")
+    _check_fps(fps)
     images = [Image.fromarray(img) for img in _stack_uint8(frames)]
     delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
     images[0].save(path, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
@@ -67,8 +71,7 @@ def save_mp4(path, frames, fps: float) -> Path:
     """
     import cv2
 
-    if isinstance(fps, (bool, np.bool_, str, bytes)) or not (np.isscalar(fps) and np.isfinite(fps) and fps > 0):
-        raise EventDataError(f"fps must be positive: a finite number of frames per second (e.g. 10), got {fps!r}")
+    _check_fps(fps)
     frames = _stack_uint8(frames)
     colour = frames.ndim == 4
     F, H, W = frames.shape[:3]

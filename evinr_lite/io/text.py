@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.events import LARGE_T, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit
+from ..core.events import LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit
 
 __all__ = ["EventBlock", "parse_event_block", "parse_event_text", "parse_frame_list", "line_blocks",
            "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
@@ -338,8 +338,8 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
                 fail(row_line(not_whole[0]), f"{name} must be a whole pixel index")
             huge = np.flatnonzero(np.abs(v) >= MAX_PIXEL)   # too many digits for int64 parsing: read as floats
             if huge.size:
-                fail(row_line(huge[0]), f"{name} = {v[huge[0]]:.6g} is no pixel index of any sensor (at most 65536 "
-                     "per side); the line is damaged: repair or drop it")
+                fail(row_line(huge[0]), f"{name} = {v[huge[0]]:.6g} is no pixel index of any sensor (at most "
+                     f"{MAX_SENSOR_SIDE} per side); the line is damaged: repair or drop it")
     if np.all(np.isin(p, (-1, 0, 1))):
         p = p.astype(np.int8)
     return EventBlock(t, x.astype(np.int64), y.astype(np.int64), p, header, origin_ns, n_lines, time_unit)

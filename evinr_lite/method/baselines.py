@@ -389,7 +389,6 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
         BaselineReconstruction with ``.frames`` [Q, H, W] in [0, 1].
     """
     events = require(events, Events, "events")                 # every argument checked before any work
-    allowed = BASELINE_PARAMS
     choice(tonemap, TONEMAPS, "tonemap")
     choice(method, BASELINES + FRAME_BASELINES, "method")
     choice(offset_solve, OFFSET_SOLVES, "offset_solve")
@@ -406,9 +405,9 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
     if frames is not None:
         raise ArgumentTypeError(f"baseline {method!r} takes no frames (events only); frames= is for "
                                 "method='complementary'")
-    extra = set(params) - set(allowed[method])
+    extra = set(params) - set(BASELINE_PARAMS[method])
     if extra:
-        raise ArgumentTypeError(f"baseline {method!r} takes parameters {allowed[method]}, not {sorted(extra)}")
+        raise ArgumentTypeError(f"baseline {method!r} takes parameters {BASELINE_PARAMS[method]}, not {sorted(extra)}")
     q = _query(query_times)
     q = np.atleast_1d(q)
     first, last = (events.t[0], events.t[-1]) if len(events) else (q.min(), q.max())

@@ -51,7 +51,7 @@ from .binning import events_to_frames, fixed_duration_boundaries
 from ..core.runtime import default_device
 from ..core.events import EventDataError, Events, check_sensor_size, check_time_range
 from .siren import Siren
-from .tonemap import reinhard_unchecked, anchor_level, tonemap_reinhard
+from .tonemap import anchor_level, reinhard_unchecked
 
 __all__ = ["CoordinateINR", "CoordinateConfig", "CoordinateBins", "CoordinateReconstruction",
            "bin_events", "split_index", "temporal_loss", "tikhonov_autograd", "train_coordinate_inr",

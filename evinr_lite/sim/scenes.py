@@ -17,12 +17,11 @@ Coordinates: x is the column, y the row (pointing down); sizes are (H, W).
 from __future__ import annotations
 
 import inspect
-import numbers
 
 import numpy as np
 from scipy import ndimage
 
-from ..core.checks import ArgumentTypeError
+from ..core.checks import ArgumentTypeError, is_real_number
 from ..core.events import EventDataError, check_sensor_size
 from ..core.frames import Frames
 
@@ -61,8 +60,7 @@ class Scene:
 
     def __init__(self, sensor_size=(120, 160), duration: float = 2.0):
         self.sensor_size = check_sensor_size(sensor_size)
-        if isinstance(duration, (bool, np.bool_)) or not isinstance(duration, numbers.Real) or \
-                not (np.isfinite(duration) and duration > 0):
+        if not (is_real_number(duration) and np.isfinite(duration) and duration > 0):
             raise EventDataError(f"duration must be a positive number of seconds, got {duration!r}")
         self.duration = float(duration)
 

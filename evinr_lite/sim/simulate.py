@@ -44,10 +44,9 @@ from __future__ import annotations
 
 from typing import Callable, Iterable, Iterator
 
-import numbers
-
 import numpy as np
 
+from ..core.checks import is_real_number
 from ..core.events import EventDataError, Events
 
 __all__ = ["simulate_events_1d", "pixel_events", "add_background_noise", "add_hot_pixels", "add_light_noise", "simulate_video", "simulate_scene", "sample_thresholds",
@@ -72,11 +71,6 @@ def _as_rng(seed) -> np.random.Generator:
     return np.random.default_rng(int(seed))
 
 
-def _is_real(value) -> bool:
-    """A real number (int or float, numpy's too; not a bool, not text, not an array)."""
-    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-
-
 def _check_times(t) -> np.ndarray:
     t = np.asarray(t, dtype=np.float64)
     if t.ndim != 1 or t.size < 2:
@@ -92,7 +86,7 @@ def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
     C_pos = C if C_pos is None else C_pos
     C_neg = C if C_neg is None else C_neg
     for name, value in (("C_pos", C_pos), ("C_neg", C_neg)):
-        if not (_is_real(value) and np.isfinite(value) and value > 0):
+        if not (is_real_number(value) and np.isfinite(value) and value > 0):
             pair = " (for two thresholds pass C_pos= and C_neg=)" if isinstance(value, (tuple, list)) else ""
             raise EventDataError(f"contrast threshold {name} (or C) must be a positive number in log units, got "
                                  f"{value!r}{pair}")
@@ -105,7 +99,7 @@ def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
 
 def _check_nonnegative(**values) -> None:
     for name, value in values.items():
-        if not (_is_real(value) and np.isfinite(value) and value >= 0):
+        if not (is_real_number(value) and np.isfinite(value) and value >= 0):
             raise EventDataError(f"{name} must be a finite number >= 0, got {value!r}")
 
 
@@ -417,7 +411,7 @@ def _video_events(t, frames: Iterable[np.ndarray], sensor_size, C, C_pos, C_neg,
                   refractory, noise_rate, seed, threshold_drift=0.0) -> Events:
     C_pos, C_neg = _check_thresholds(C, C_pos, C_neg)
     _check_nonnegative(threshold_sigma=threshold_sigma, refractory=refractory, noise_rate=noise_rate)
-    if not (_is_real(threshold_drift) and np.isfinite(threshold_drift)):
+    if not (is_real_number(threshold_drift) and np.isfinite(threshold_drift)):
         raise EventDataError(f"threshold_drift must be a finite relative change, got {threshold_drift!r}")
     H, W = sensor_size
     t_ev, pix, p = _simulate_samples(t, frames, H * W, C_pos, C_neg, threshold_sigma, refractory,
@@ -480,13 +474,13 @@ def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, *
         raise EventDataError(f"scene= must be a Scene (it has no {', '.join(missing)}), got {type(scene).__name__}; "
                              f"build one with make_scene(name, sensor_size=(H, W), duration=seconds)")
     t_end = scene.duration if t_end is None else t_end
-    if not (_is_real(t_start) and _is_real(t_end)):
+    if not (is_real_number(t_start) and is_real_number(t_end)):
         raise EventDataError(f"t_start and t_end must be seconds (numbers), got {t_start!r} and {t_end!r}")
     if not (np.isfinite(t_start) and np.isfinite(t_end) and t_end > t_start):
         raise EventDataError(f"time range [{t_start}, {t_end}] s is empty or reversed; t_end must exceed t_start")
     if sample_rate is None:
         sample_rate = max(100.0, float(scene.max_speed) / MAX_PX_PER_SAMPLE)
-    if not (_is_real(sample_rate) and np.isfinite(sample_rate) and sample_rate > 0):
+    if not (is_real_number(sample_rate) and np.isfinite(sample_rate) and sample_rate > 0):
         raise EventDataError(f"sample_rate must be a positive number of samples per second, got {sample_rate!r}")
     if sample_rate > MAX_SAMPLE_RATE:
         raise EventDataError(f"sample_rate={sample_rate!r} samples per second is finer than the 1 us timestamps of event "

@@ -423,7 +423,7 @@ def _has_repeated_index(args: tuple, kwargs: dict) -> bool:
 
 def _non_square(args, kwargs) -> bool:
     """True when an input names a sensor (a ``sensor_size`` argument, or events carrying one) with H != W."""
-    for v in (*args, *kwargs.values(), kwargs.get("sensor_size")):
+    for v in (*args, *kwargs.values()):
         size = v if isinstance(v, tuple) and len(v) == 2 and all(isinstance(a, (int, np.integer)) for a in v) \
             else getattr(v, "sensor_size", None)
         if size is not None and len(size) == 2 and int(size[0]) != int(size[1]):

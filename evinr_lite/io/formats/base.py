@@ -16,15 +16,14 @@ from typing import Callable
 
 import numpy as np
 
-from ...core.events import EventDataError, Events, check_time_span, relative_seconds, resolve_time_unit
+from ...core.events import MAX_SENSOR_SIDE, EventDataError, Events, check_time_span, relative_seconds, resolve_time_unit
 from ..text import read_text_bytes
 
 __all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
            "json_file", "size_value", "plain_attr", "check_declared_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
-           "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE", "MAX_SENSOR_SIDE",
+           "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE",
            "check_time_spread", "same_time_message", "check_frame_times", "check_finite_images"]
 
-MAX_SENSOR_SIDE = 1 << 16   # pixels; no event camera is larger per side (the command line's --sensor limit too)
 
 
 @dataclass(frozen=True)
