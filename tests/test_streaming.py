@@ -77,8 +77,9 @@ def test_many_windows_give_the_whole_sequence_result(scene_events, tmp_path):
     np.testing.assert_allclose(frames, whole.frames, rtol=0, atol=1e-4)
     # each window read only its own events and the background filter's reach (never the whole
     # recording); before them, the two counting passes of method/prepare.prepare_source (raw counts for
-    # the hot pixels, filtered ones for the ON/OFF balance and lam) read the span in chunks of tau
-    assert len(source.asked) == 4 + 3 + 3
+    # the hot pixels, filtered ones for the ON/OFF balance and lam) read the span in chunks of tau, and
+    # after them, on a span of at most 3 s, the static image's coarse part (method/coarse.py) reads it once more
+    assert len(source.asked) == 4 + 3 + 3 + 3
     assert all(t1 - t0 <= cfg.tau + 2 * REACH + 1e-6 for t0, t1 in source.asked)
     assert (tmp_path / "log_intensity.f32").stat().st_size == len(q) * SIZE[0] * SIZE[1] * 4   # the spill
 

@@ -218,6 +218,10 @@ class EvINRConfig:
             is solved: on spans longer than 1.5 windows the offset becomes a slow per-pixel trend,
             one image per ``offset_window`` seconds, linear in time between them
             (:func:`~evinr_lite.method.offset.offset_trend`); None: one image for any span.
+        offset_coarse_px: with an offset solve, on spans of at most 3 s, the static image's spatial
+            frequencies below this scale (a Gaussian's sigma, pixels) come from the integrated
+            events' own offset solve, the finer ones and every change in time from the INR
+            (:mod:`evinr_lite.method.coarse`); None: the static image from the INR's frames alone.
         balance: "none" (ON and OFF events weigh C as given) or "events": when C is one number, C+ and
             C- are estimated from the events' ON/OFF counts, their mean kept at C, shrunk towards C as
             far as the span carries little evidence (:mod:`evinr_lite.method.balance`); a given pair is
@@ -280,6 +284,7 @@ class EvINRConfig:
     head_solve: bool = True
     offset_solve: str = "l1_gradient"
     offset_window: float | None = 5.0
+    offset_coarse_px: float | None = 8.0
     balance: str = "events"
     hot_pixels: str = "drop"
     background: str = "filter"
@@ -357,6 +362,10 @@ class EvINRConfig:
             raise EventDataError(f"offset_window must be positive seconds or None (one offset image for the whole "
                                  f"span), got {self.offset_window!r}")
         self.offset_window = None if self.offset_window is None else float(self.offset_window)
+        if self.offset_coarse_px is not None and not number("offset_coarse_px", self.offset_coarse_px) > 0:
+            raise EventDataError(f"offset_coarse_px must be a positive number of pixels or None (the static image "
+                                 f"from the INR's frames alone), got {self.offset_coarse_px!r}")
+        self.offset_coarse_px = None if self.offset_coarse_px is None else float(self.offset_coarse_px)
         if self.tau is not None and not number("tau", self.tau) > number("overlap", self.overlap) >= 0:
             raise EventDataError(f"need tau > overlap >= 0 seconds, got tau={self.tau}, overlap={self.overlap}")
         for name in ("head_solve", "coarse_to_fine", "progress"):
@@ -395,7 +404,7 @@ class EvINRConfig:
                       "min_bins": 0, "regularizer": "tikhonov", "lam": 0.05, "hidden_features": 512, "hidden_layers": 3,
                       "omega_0": 30.0, "first_omega_0": None, "first_omega_per_s": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
-                      "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": DISPLAY_MEANS["reinhard"], "head_solve": False, "offset_solve": "none",
+                      "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": DISPLAY_MEANS["reinhard"], "head_solve": False, "offset_solve": "none", "offset_coarse_px": None,
                       "balance": "none", "hot_pixels": "keep", "background": "keep", **overrides})
 
     @classmethod

@@ -13,6 +13,7 @@ import os
 from ..core.events import EventDataError
 from .config import EvINRConfig
 from .ensemble import split_windows
+from .coarse import coarse_applies
 from .offset import MIN_TREND_FRAMES, offset_grid, trend_intervals
 
 __all__ = ["estimate_memory", "check_memory", "check_times_memory", "available_bytes"]
@@ -90,8 +91,9 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
       grid (max(64, 8 N) frames), the overlap's partial blends and ``n_kept`` frames kept in memory
       (those at ground-truth times), counted with ``process``;
     - ``offset``: with ``offset_solve="l1_gradient"``, how far its phase (the ADMM's work arrays over the
-      grid frames of its largest single solve, ``offset_solve_bytes``, beside what is alive then) exceeds
-      the parts above; 0 otherwise.
+      grid frames of its largest single solve, ``offset_solve_bytes``, beside what is alive then, and on
+      spans up to 3 s the integrated events on the grid: :mod:`evinr_lite.method.coarse`) exceeds the
+      parts above; 0 otherwise.
 
     Measured against peak RSS in ``benchmarks/scale.py`` (the target: within 25 %).
 
@@ -141,10 +143,14 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
     # the networks and the offset grid), so it counts only as far as that phase exceeds the others.
     G = len(offset_grid(0.0, max(span, 1e-9), N, config.offset_solve))
     offset_work = 17.0 * _offset_solve_frames(span, G, config) * P if config.offset_solve == "l1_gradient" else 0.0
+    # the static image's coarse part (method/coarse.py, spans up to 3 s): the integrated events on the grid
+    # (float32) beside the grid, solved as one image (offset_work); streaming reads the span's events again,
+    # a window's length at a time, each chunk's frames beside the sum
+    coarse = 4.0 * G * P if coarse_applies(config, 0.0, span) else 0.0
     if streaming:
-        offset_phase = persistent + offset_work
+        offset_phase = persistent + offset_work + (2 * coarse + READ_BYTES * per_window_events if coarse else 0.0)
     else:
-        offset_phase = parts["process"] + parts["events"] + parts["networks"] + 4.0 * G * P + offset_work
+        offset_phase = parts["process"] + parts["events"] + parts["networks"] + 4.0 * G * P + offset_work + coarse
     parts["offset"] = max(0.0, offset_phase - sum(parts.values()))
     return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
             "span_s": span, "streaming": bool(streaming), "offset_solve_bytes": offset_work}

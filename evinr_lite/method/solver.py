@@ -50,6 +50,7 @@ from .config import EvINRConfig
 from .memory import check_memory
 from .ensemble import alignment_offsets, blend_networks, blend_weights, predict_networks, split_windows
 from .models import FrameINR
+from .coarse import coarse_applies, coarse_correction
 from .offset import offset_trend, offset_grid
 from .tonemap import display_shift, to_display
 from .training import train_frame_inr
@@ -170,6 +171,10 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     if trend is not None:           # a slow per-pixel trend over a long span (offset.offset_trend)
         trend.add_to(L_grid, grid)
         history["offset_knots_s"] = trend.knots.tolist()
+    if coarse_applies(cfg, t_start, t_end):      # 4b. the static image's coarse part from the integrated events
+        coarse = coarse_correction([events], cfg.C, grid, L_grid, cfg.offset_coarse_px, cfg.offset_solve)
+        offsets += coarse
+        L_grid += coarse
     offsets += _level_shift(L_grid, cfg)                                        # 5. level anchor
     del L_grid
     L = blend_networks(model, windows, q, offsets)

@@ -47,6 +47,7 @@ from .prepare import prepare_source
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
+from .coarse import coarse_applies, coarse_correction
 from .offset import OffsetTrend, offset_trend, offset_grid, offset_image
 from .tonemap import display_shift, to_display
 from .training import train_frame_inr
@@ -194,19 +195,27 @@ def chain_offset(previous_align: np.ndarray, previous_samples: np.ndarray, model
     return previous_align + (previous_samples - network_at(model, times)).mean(axis=0)
 
 
-def first_window_offset(model: FrameINR, window, config: EvINRConfig) -> np.ndarray:
+def first_window_offset(model: FrameINR, window, config: EvINRConfig, events=None) -> np.ndarray:
     """The offset image + level [H, W] float32 that every network gets, from the first window.
 
     Same grid, same steps and same float32 order as the whole-sequence solve over one window
-    (:func:`offset_grid`, the offset image, the level anchor), so a one-window span gives
-    the identical result."""
-    grid = offset_grid(float(window[0]), float(window[1]), 1, config.offset_solve)
+    (:func:`offset_grid`, the offset image, the static image's coarse part from ``events``, the
+    window's prepared events, when :func:`~evinr_lite.method.coarse.coarse_applies`, the level
+    anchor), so a one-window span gives the identical result."""
+    lo, hi = float(window[0]), float(window[1])
+    grid = offset_grid(lo, hi, 1, config.offset_solve)
     F = network_at(model, grid)
     H, W = model.sensor_size
     offset = np.zeros((H, W), np.float32)
     if config.offset_solve != "none":
         offset += offset_image(F, config.offset_solve).astype(np.float32)
     F += offset
+    if coarse_applies(config, lo, hi):
+        if events is None:
+            raise ValueError("first_window_offset needs the window's events for the static image's coarse part")
+        coarse = coarse_correction([events], config.C, grid, F, config.offset_coarse_px, config.offset_solve)
+        offset += coarse
+        F += coarse
     offset += np.float32(display_shift(F, config.tonemap, config.gamma, config.display_mean))
     return offset
 
@@ -288,7 +297,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
         spill = _spill_path(folder)
         for _, state in _windows(source, q, grid, cfg, state, spill, on_state, progress):
             pass
-        offset = span_offset(state.grid, cfg, grid)
+        offset = span_offset(state.grid, cfg, grid, _chunks(source, t_start, t_end, cfg.tau or t_end - t_start))
         yield from _final_pass(spill, q, offset, cfg, source.sensor_size, _history(state))
 
 
@@ -306,11 +315,13 @@ class _nothing:
         return False
 
 
-def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times) -> OffsetTrend:
+def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times, chunks=None) -> OffsetTrend:
     """The offset + level from the aligned log intensities on the whole span's grid [G, H, W] at
     ``grid_times`` [G] (s), by the steps and float32 order of the whole-sequence solve: an
     :class:`~evinr_lite.method.offset.OffsetTrend` whose images include the level (one knot, one
-    image, unless ``config.offset_window`` makes the offset a trend over a long span)."""
+    image, unless ``config.offset_window`` makes the offset a trend over a long span). ``chunks``:
+    the span's prepared events in time-ordered chunks (an iterable of Events), read for the static
+    image's coarse part when :func:`~evinr_lite.method.coarse.coarse_applies` to the span."""
     H, W = grid_frames.shape[1:]
     offset = np.zeros((H, W), np.float32)
     trend = None
@@ -322,10 +333,24 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times) -> Off
     shifted = grid_frames + offset
     if trend is not None:
         trend.add_to(shifted, grid_times)
+    if coarse_applies(config, float(grid_times[0]), float(grid_times[-1])):
+        if chunks is None:
+            raise ValueError("span_offset needs the span's events for the static image's coarse part")
+        coarse = coarse_correction(chunks, config.C, grid_times, shifted, config.offset_coarse_px, config.offset_solve)
+        offset += coarse
+        shifted += coarse
     offset += np.float32(display_shift(shifted, config.tonemap, config.gamma, config.display_mean))
     if trend is None:
         return OffsetTrend(np.zeros(1), offset[None])
     return OffsetTrend(trend.knots, trend.images + offset)
+
+
+def _chunks(source, t_start: float, t_end: float, chunk_s: float):
+    """The source's events over [t_start, t_end] (the end inclusive) in time-ordered chunks of ``chunk_s``
+    seconds, read one at a time (as method/prepare.py counts them)."""
+    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
+    for a, b in zip(edges[:-1], edges[1:]):
+        yield source.events(a, np.nextafter(b, np.inf) if b == edges[-1] else b)
 
 
 def _history(state: StreamState) -> dict:
@@ -359,14 +384,14 @@ def _windows(source, q, grid, cfg, state, spill, on_state, progress):
             t0 = time.perf_counter()
             model, history = train_window(events, windows, k, quiet)
             n_events = len(events)
-            del events
             align = state.align if k == 0 else chain_offset(state.align, state.samples, model,
                                                             alignment_times(windows, k)).astype(np.float32)
             if spill is None:
-                offset = first_window_offset(model, windows[0], cfg) if k == 0 else state.offset
+                offset = first_window_offset(model, windows[0], cfg, events) if k == 0 else state.offset
                 total = offset.copy() if k == 0 else align + offset      # k = 0: align is zero
             else:
                 offset, total = None, align
+            del events                                 # the first window's offset solve was its last use
             q_idx, q_L, q_pending, q_sum = _blend_window(model, windows, k, q, total, state.q_pending, state.q_sum)
             g_idx, g_L, g_pending, g_sum = _blend_window(model, windows, k, grid, total, state.g_pending, state.g_sum)
             samples = network_at(model, alignment_times(windows, k + 1)) if k + 1 < N else None

@@ -1,0 +1,89 @@
+"""The static image's coarse structure from the integrated events (``EvINRConfig.offset_coarse_px``).
+
+Events never fix a pixel's offset, so the solver picks the static image, the one image added to
+every frame, as the one that makes the frames' gradients sparsest (:mod:`evinr_lite.method.offset`).
+That solve reads the static image best from the integrated events' staircase: each pixel stays
+exactly constant until a threshold is crossed, sparse in time as its prior assumes. From the INR's
+smooth frames it recovers less of it: on camera_translate the least-squares gain from the solved
+static image to the truth's is 0.89 from the integrated events and 0.71 from the kit's frames
+(docs/defaults.md). The integrated events carry their noise at fine scales, where the INR's frames
+are clean. So :func:`coarse_correction` gives the static image its spatial frequencies below
+``coarse_px`` from the integrated events and keeps the finer ones, and every change in time, from
+the INR:
+
+    correction = lowpass( mean_t(I) + offset(I) - mean_t(F) ),
+
+with I the events integrated at G times over the span and F the INR's frames there with their own
+offset. Integration drifts as the span grows (noise, threshold mismatch and drift): on spans longer
+than ``MAX_SPAN_S`` the INR's static image was the better one on every recording measured (drift_clock,
+8 s, and the 20 s and 60 s recordings; docs/defaults.md), so the correction is applied only up to it.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft
+
+from ..core.runtime import cpu_threads
+from .binning import events_to_frames
+from .offset import offset_image
+
+__all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "integrated_frames", "MAX_SPAN_S"]
+
+MAX_SPAN_S = 3.0     # seconds: longer spans keep the INR's static image (integration drifts; docs/defaults.md)
+
+
+def coarse_applies(config, t_start: float, t_end: float) -> bool:
+    """Whether :func:`coarse_correction` is part of a reconstruction of [t_start, t_end] (s) with ``config``:
+    an offset solve, ``offset_coarse_px`` set, and a span of at most ``MAX_SPAN_S``."""
+    return (config.offset_solve != "none" and config.offset_coarse_px is not None
+            and t_end - t_start <= MAX_SPAN_S + 1e-9)
+
+
+def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
+    """``image`` [H, W] blurred by a Gaussian of ``sigma_px`` pixels, its borders mirrored: float64. In the
+    DCT-II basis (the mirrored image's Fourier basis) each coefficient is multiplied by the Gaussian's
+    transfer function exp(-sigma^2 (wx^2 + wy^2) / 2), w = pi k / N the frequency along each axis."""
+    img = np.asarray(image, np.float64)
+    H, W = img.shape
+    wy, wx = np.pi * np.arange(H) / H, np.pi * np.arange(W) / W
+    gain = np.exp(-0.5 * sigma_px ** 2 * (wy[:, None] ** 2 + wx[None, :] ** 2))
+    c = scipy.fft.dctn(img, type=2, norm="ortho", workers=cpu_threads())
+    return scipy.fft.idctn(c * gain, type=2, norm="ortho", workers=cpu_threads())
+
+
+def integrated_frames(chunks, times, C) -> np.ndarray | None:
+    """float32 [G, H, W]: the events weighed +C+ (ON) and -C- (OFF), summed up to each of ``times`` [G]
+    (increasing seconds; from times[0] - 1 s on: what came before is the same constant in every frame).
+    ``chunks``: time-ordered :class:`~evinr_lite.core.events.Events` (a list of one, or a recording read
+    window by window); None when they hold no event. 8 bytes per frame and pixel at the peak."""
+    t = np.asarray(times, np.float64)
+    edges = np.concatenate([[t[0] - 1.0], t])
+    out = None
+    for events in chunks:
+        if len(events):
+            f = events_to_frames(events, edges, C=C).frames
+            out = f if out is None else np.add(out, f, out=out)
+    return None if out is None else np.cumsum(out, axis=0, out=out)
+
+
+def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -> np.ndarray:
+    """The image [H, W] (float32, mean 0) to add to every frame so that the static image's spatial
+    frequencies below ``coarse_px`` come from the integrated events (the module's docstring).
+
+    Args:
+        chunks: the (prepared) events the INR was trained on over the span, as time-ordered
+            :class:`~evinr_lite.core.events.Events` chunks (``[events]`` when they are in memory).
+        C: the thresholds the INR used (one C or the pair C+, C-).
+        times: float64 [G] increasing seconds of ``frames``.
+        frames: [G, H, W] the INR's log intensities with their offset added (the offset grid).
+        coarse_px: the Gaussian's sigma (pixels) below which the integrated events set the static image.
+        method: the integrated events' offset solve ("median_gradient" or "l1_gradient").
+    """
+    F = np.asarray(frames)
+    I = integrated_frames(chunks, times, C)
+    if I is None:
+        return np.zeros(F.shape[1:], np.float32)
+    d = I.mean(axis=0, dtype=np.float64) + offset_image(I, method)
+    del I
+    d = gaussian_lowpass(d - F.mean(axis=0, dtype=np.float64), coarse_px)
+    return (d - d.mean()).astype(np.float32)
