@@ -42,7 +42,8 @@ def coarse_applies(config, t_start: float, t_end: float) -> bool:
 def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
     """``image`` [H, W] blurred by a Gaussian of ``sigma_px`` pixels, its borders mirrored: float64. In the
     DCT-II basis (the mirrored image's Fourier basis) each coefficient is multiplied by the Gaussian's
-    transfer function exp(-sigma^2 (wx^2 + wy^2) / 2), w = pi k / N the frequency along each axis."""
+    transfer function exp(-sigma^2 (wx^2 + wy^2) / 2), w = pi k / N the frequency along each axis. From
+    2 px on it is scipy.ndimage.gaussian_filter(mode="reflect") to 1e-9 (below, sampling its kernel aliases)."""
     img = np.asarray(image, np.float64)
     H, W = img.shape
     wy, wx = np.pi * np.arange(H) / H, np.pi * np.arange(W) / W

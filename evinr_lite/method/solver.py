@@ -28,7 +28,9 @@ The recipe (paper Sec. 3-4; defaults in :class:`EvINRConfig`):
    (``config.anchor``), the frames set the offset and the level and their linear intensity is returned.
 
 The kit's default (:class:`EvINRConfig`) replaces the Adam iterations of step 3 by the output
-layer's closed-form optimum and solves the per-pixel offset of step 5 explicitly.
+layer's closed-form optimum and solves the per-pixel offset of step 5 explicitly
+(:mod:`~evinr_lite.method.offset`); on spans up to 3 s that offset's coarse part comes from the
+integrated events (:mod:`~evinr_lite.method.coarse`).
 
 Where each part lives: the settings in :mod:`~evinr_lite.method.config`; windows, predictions,
 blending and alignment in :mod:`~evinr_lite.method.ensemble`; bins, Adam and the closed-form head
