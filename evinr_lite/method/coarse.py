@@ -29,6 +29,8 @@ from .offset import offset_image
 
 __all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "integrated_frames", "MAX_SPAN_S"]
 
+FRAMES = 32          # the integrated events are solved at every other time of the 64-frame offset grid: half the
+                     # L1 solve's time, the same zoo mean as all 64 (16 cost camera_240x180's MSE 0.0114 -> 0.0117)
 MAX_SPAN_S = 3.0     # seconds: longer spans keep the INR's static image (integration drifts; docs/defaults.md)
 
 
@@ -81,10 +83,13 @@ def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -
         method: the integrated events' offset solve ("median_gradient" or "l1_gradient").
     """
     F = np.asarray(frames)
-    I = integrated_frames(chunks, times, C)
+    H, W = F.shape[1:]
+    t = np.asarray(times, np.float64)
+    I = integrated_frames(chunks, t[::max(1, len(t) // FRAMES)], C)
     if I is None:
-        return np.zeros(F.shape[1:], np.float32)
-    d = I.mean(axis=0, dtype=np.float64) + offset_image(I, method)
+        return np.zeros((H, W), np.float32)
+    static = I.mean(axis=0, dtype=np.float64) + offset_image(I, method)
     del I
-    d = gaussian_lowpass(d - F.mean(axis=0, dtype=np.float64), coarse_px)
+    d = gaussian_lowpass(static - F.mean(axis=0, dtype=np.float64), coarse_px)
     return (d - d.mean()).astype(np.float32)
+
