@@ -32,19 +32,19 @@ def test_integrated_frames_are_the_integrated_events_in_any_chunks(translating):
     _, events = translating
     t = np.linspace(0.0, 2.0, 17)
     for C in (0.2, (0.25, 0.15)):
-        whole = integrated_frames([events], t, C)
+        whole = integrated_frames([events], t, C, (48, 64))
         assert whole.dtype == np.float32 and whole.shape == (17, 48, 64)
         want = integrate_events(events, t, C=C)
         np.testing.assert_allclose(whole - whole[0], want - want[0], rtol=0, atol=1e-4)
         chunks = [events.slice_time(a, b, allow_empty=True) for a, b in ((0.0, 0.7), (0.7, 0.71), (0.71, 2.1))]
-        np.testing.assert_allclose(integrated_frames(chunks, t, C), whole, rtol=0, atol=1e-4)
-    assert integrated_frames([events.slice_time(5.0, 6.0, allow_empty=True)], t, 0.2) is None
+        np.testing.assert_allclose(integrated_frames(chunks, t, C, (48, 64)), whole, rtol=0, atol=1e-4)
+    assert integrated_frames([events.slice_time(5.0, 6.0, allow_empty=True)], t, 0.2, (48, 64)) is None
 
 
 def test_the_correction_is_smooth_has_mean_zero_and_is_zero_without_events(translating):
     _, events = translating
     t = np.linspace(0.0, 2.0, 64)
-    frames = integrated_frames([events], t, 0.2) * 0.5          # a static image with too little contrast
+    frames = integrated_frames([events], t, 0.2, (48, 64)) * 0.5          # a static image with too little contrast
     corr = coarse_correction([events], 0.2, t, frames, 8.0, "l1_gradient")
     assert corr.dtype == np.float32 and corr.shape == (48, 64)
     assert abs(float(corr.mean())) < 1e-6 and float(np.abs(corr).max()) > 0.01

@@ -24,7 +24,7 @@ import numpy as np
 import scipy.fft
 
 from ..core.runtime import cpu_threads
-from .binning import events_to_frames
+from .binning import events_to_frames_chunked
 from .offset import offset_image
 
 __all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "integrated_frames", "MAX_SPAN_S"]
@@ -54,19 +54,14 @@ def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
     return scipy.fft.idctn(c * gain, type=2, norm="ortho", workers=cpu_threads())
 
 
-def integrated_frames(chunks, times, C) -> np.ndarray | None:
+def integrated_frames(chunks, times, C, sensor_size) -> np.ndarray | None:
     """float32 [G, H, W]: the events weighed +C+ (ON) and -C- (OFF), summed up to each of ``times`` [G]
     (increasing seconds; from times[0] - 1 s on: what came before is the same constant in every frame).
-    ``chunks``: time-ordered :class:`~evinr_lite.core.events.Events` (a list of one, or a recording read
-    window by window); None when they hold no event. 8 bytes per frame and pixel at the peak."""
+    ``chunks``: time-ordered :class:`~evinr_lite.core.events.Events` on a sensor of ``sensor_size``
+    (a list of one, or a recording read window by window); None when they hold no event."""
     t = np.asarray(times, np.float64)
-    edges = np.concatenate([[t[0] - 1.0], t])
-    out = None
-    for events in chunks:
-        if len(events):
-            f = events_to_frames(events, edges, C=C).frames
-            out = f if out is None else np.add(out, f, out=out)
-    return None if out is None else np.cumsum(out, axis=0, out=out)
+    ef = events_to_frames_chunked(chunks, np.concatenate([[t[0] - 1.0], t]), C=C, sensor_size=sensor_size)
+    return np.cumsum(ef.frames, axis=0, out=ef.frames) if ef.counts.sum() else None
 
 
 def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -> np.ndarray:
@@ -85,7 +80,7 @@ def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -
     F = np.asarray(frames)
     H, W = F.shape[1:]
     t = np.asarray(times, np.float64)
-    I = integrated_frames(chunks, t[::max(1, len(t) // FRAMES)], C)
+    I = integrated_frames(chunks, t[::max(1, len(t) // FRAMES)], C, (H, W))
     if I is None:
         return np.zeros((H, W), np.float32)
     static = I.mean(axis=0, dtype=np.float64) + offset_image(I, method)

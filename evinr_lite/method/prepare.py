@@ -130,12 +130,19 @@ class _Prepared:
         return drop_pixels(wide.take(inside), self._then)
 
 
-def _counts(source, t_start: float, t_end: float, chunk_s: float) -> PolarityCounts:
-    counts = PolarityCounts(tuple(source.sensor_size))
+def read_chunks(source, t_start: float, t_end: float, chunk_s: float):
+    """The source's events over [t_start, t_end] in time-ordered chunks of ``chunk_s`` seconds, read one
+    at a time (a generator of Events); the span's end is inclusive, as in reconstruct."""
     edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
     for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
-        last = i == len(edges) - 2                               # the span's end is inclusive, as in reconstruct
-        counts.update(source.events(a, np.nextafter(b, np.inf) if last else b))
+        last = i == len(edges) - 2
+        yield source.events(a, np.nextafter(b, np.inf) if last else b)
+
+
+def _counts(source, t_start: float, t_end: float, chunk_s: float) -> PolarityCounts:
+    counts = PolarityCounts(tuple(source.sensor_size))
+    for events in read_chunks(source, t_start, t_end, chunk_s):
+        counts.update(events)
     return counts
 
 

@@ -43,7 +43,7 @@ import torch
 
 from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
-from .prepare import prepare_source
+from .prepare import prepare_source, read_chunks
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
@@ -297,7 +297,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
         spill = _spill_path(folder)
         for _, state in _windows(source, q, grid, cfg, state, spill, on_state, progress):
             pass
-        offset = span_offset(state.grid, cfg, grid, _chunks(source, t_start, t_end, cfg.tau or t_end - t_start))
+        offset = span_offset(state.grid, cfg, grid, read_chunks(source, t_start, t_end, cfg.tau or t_end - t_start))
         yield from _final_pass(spill, q, offset, cfg, source.sensor_size, _history(state))
 
 
@@ -343,14 +343,6 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times, chunks
     if trend is None:
         return OffsetTrend(np.zeros(1), offset[None])
     return OffsetTrend(trend.knots, trend.images + offset)
-
-
-def _chunks(source, t_start: float, t_end: float, chunk_s: float):
-    """The source's events over [t_start, t_end] (the end inclusive) in time-ordered chunks of ``chunk_s``
-    seconds, read one at a time (as method/prepare.py counts them)."""
-    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
-    for a, b in zip(edges[:-1], edges[1:]):
-        yield source.events(a, np.nextafter(b, np.inf) if b == edges[-1] else b)
 
 
 def _history(state: StreamState) -> dict:
