@@ -189,6 +189,9 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
         "events": (f"the events in memory ({est['span_s']:.6g} s of them); shorten the window with t_start=/t_end= "
                    f"(the events cover [{ev_lo:.6f}, {ev_hi:.6f}] s)"),
         "process": "the libraries alone; free some memory first",
+        "offset": (f"the offset solve over {H}x{W} pixels (its grid of frames, and on spans up to 3 s the integrated "
+                   "events beside it); check the sensor size (sensor_size=(H, W)), or pass offset_coarse_px=None "
+                   "or offset_solve=\"median_gradient\""),
     }[worst]
     if est.get("streaming") and worst in ("networks", "bins"):   # one window at a time: the window sets it
         fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.bin_duration:g} s, "
