@@ -93,9 +93,26 @@ def test_the_setting_is_checked_and_the_paper_recipes_leave_it_out():
             EvINRConfig(offset_coarse_px=bad)
 
 
-def test_the_memory_estimate_counts_the_integrated_grid_on_short_spans_only():
-    cfg, off = EvINRConfig(), EvINRConfig(offset_coarse_px=None)
+def test_the_memory_estimate_counts_what_the_coarse_part_allocates(translating):
+    """estimate_memory's coarse_bytes against coarse_correction's own peak (tracemalloc sees numpy's
+    buffers), for a pair of thresholds (ON and OFF sums apart) on a 64-frame grid; and nothing on
+    spans over MAX_SPAN_S, where it does not run."""
+    import tracemalloc
+
+    _, events = translating
+    grid = np.linspace(0.0, 2.0, 64)
+    frames = np.zeros((64, 48, 64), np.float32)
+    est = estimate_memory((48, 64), 0.0, 2.0, len(events), 10, EvINRConfig())["coarse_bytes"]
+    tracemalloc.start()
+    coarse_correction([events], (0.22, 0.18), grid, frames, 8.0, "l1_gradient")
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert 0.75 * peak <= est <= 1.25 * peak, (est, peak)
     for streaming in (False, True):
-        short = [estimate_memory((720, 1280), 0.0, 2.0, 10_000_000, 10, c, streaming=streaming)["total"] for c in (cfg, off)]
-        long = [estimate_memory((720, 1280), 0.0, 4.0, 20_000_000, 10, c, streaming=streaming)["total"] for c in (cfg, off)]
-        assert short[0] > short[1] and long[0] == long[1]
+        long = [estimate_memory((720, 1280), 0.0, MAX_SPAN_S + 1, 20_000_000, 10, c, streaming=streaming)
+                for c in (EvINRConfig(), EvINRConfig(offset_coarse_px=None))]
+        assert long[0]["coarse_bytes"] == 0 and long[0]["total"] == long[1]["total"]
+        short = estimate_memory((720, 1280), 0.0, 2.0, 10_000_000, 10, EvINRConfig(), streaming=streaming)
+        assert 0 < short["coarse_bytes"] < short["offset_solve_bytes"]   # half the grid: within the grid's solve
+
+

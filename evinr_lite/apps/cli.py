@@ -307,6 +307,8 @@ FLAG_FOR = [
     (re.compile(r"\bEvINRConfig\(background='keep'\)"), "--keep-background"),
     # solver settings with no flag: the command line keeps the advice it can follow
     (re.compile(r",? or pass offset_coarse_px=None or offset_solve=\"median_gradient\""), ""),
+    (re.compile(r"use a longer bin_duration, a shorter tau or fewer hidden_features, or "), ""),
+    (re.compile(r" or use a longer bin_duration"), ""),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)=(?=[\w'\"(.+-])"),
      lambda m: FLAGS[m.group(1)] + " "),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)="), lambda m: FLAGS[m.group(1)]),

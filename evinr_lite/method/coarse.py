@@ -27,7 +27,7 @@ from ..core.runtime import cpu_threads
 from .binning import events_to_frames_chunked
 from .offset import offset_image
 
-__all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "integrated_frames", "MAX_SPAN_S"]
+__all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "coarse_times", "integrated_frames", "MAX_SPAN_S"]
 
 FRAMES = 32          # the integrated events are solved at every other time of the 64-frame offset grid: half the
                      # L1 solve's time, the same zoo mean as all 64 (16 cost camera_240x180's MSE 0.0114 -> 0.0117)
@@ -39,6 +39,13 @@ def coarse_applies(config, t_start: float, t_end: float) -> bool:
     an offset solve, ``offset_coarse_px`` set, and a span of at most ``MAX_SPAN_S``."""
     return (config.offset_solve != "none" and config.offset_coarse_px is not None
             and t_end - t_start <= MAX_SPAN_S + 1e-9)
+
+
+def coarse_times(times) -> np.ndarray:
+    """The times (float64 [G'], s) of the offset grid ``times`` [G] at which the events are integrated: about
+    ``FRAMES`` of them, evenly spread (every other one of a 64-frame grid)."""
+    t = np.asarray(times, np.float64)
+    return t[::max(1, len(t) // FRAMES)]
 
 
 def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
@@ -80,7 +87,7 @@ def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -
     F = np.asarray(frames)
     H, W = F.shape[1:]
     t = np.asarray(times, np.float64)
-    I = integrated_frames(chunks, t[::max(1, len(t) // FRAMES)], C, (H, W))
+    I = integrated_frames(chunks, coarse_times(t), C, (H, W))
     if I is None:
         return np.zeros((H, W), np.float32)
     static = I.mean(axis=0, dtype=np.float64) + offset_image(I, method)

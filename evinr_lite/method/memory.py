@@ -10,10 +10,12 @@ from __future__ import annotations
 import math
 import os
 
+import numpy as np
+
 from ..core.events import EventDataError
 from .config import EvINRConfig
 from .ensemble import split_windows
-from .coarse import coarse_applies
+from .coarse import coarse_applies, coarse_times
 from .offset import MIN_TREND_FRAMES, offset_grid, trend_intervals
 
 __all__ = ["estimate_memory", "check_memory", "check_times_memory", "available_bytes"]
@@ -91,15 +93,16 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
       grid (max(64, 8 N) frames), the overlap's partial blends and ``n_kept`` frames kept in memory
       (those at ground-truth times), counted with ``process``;
     - ``offset``: with ``offset_solve="l1_gradient"``, how far its phase (the ADMM's work arrays over the
-      grid frames of its largest single solve, ``offset_solve_bytes``, beside what is alive then, and on
-      spans up to 3 s the integrated events on the grid: :mod:`evinr_lite.method.coarse`) exceeds the
-      parts above; 0 otherwise.
+      grid frames of its largest single solve, ``offset_solve_bytes``, or on spans up to 3 s the
+      static image's coarse part if larger: the events summed on half the grid's times and their own
+      solve, :mod:`evinr_lite.method.coarse`; beside what is alive then) exceeds the parts above; 0 otherwise.
 
     Measured against peak RSS in ``benchmarks/scale.py`` (the target: within 25 %).
 
     Returns:
         {"total": bytes, "parts": {...}, "n_windows", "n_bins" (per window), "n_frames", "span_s", "streaming",
-        "offset_solve_bytes" (the L1 offset solve's work arrays alone)}.
+        "offset_solve_bytes" (the L1 offset solve's work arrays alone), "coarse_bytes" (the static image's
+        coarse part's, alone; 0 where it does not run)}.
     """
     span = max(float(t_end) - float(t_start), 0.0)
     H, W = sensor_size
@@ -143,17 +146,25 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
     # the networks and the offset grid), so it counts only as far as that phase exceeds the others.
     G = len(offset_grid(0.0, max(span, 1e-9), N, config.offset_solve))
     offset_work = 17.0 * _offset_solve_frames(span, G, config) * P if config.offset_solve == "l1_gradient" else 0.0
-    # the static image's coarse part (method/coarse.py, spans up to 3 s): the integrated events on the grid
-    # (float32) beside the grid, solved as one image (offset_work); streaming reads the span's events again,
-    # a window's length at a time, each chunk's frames beside the sum
-    coarse = 4.0 * G * P if coarse_applies(config, 0.0, span) else 0.0
+    # the static image's coarse part (method/coarse.py, spans up to 3 s) runs after that solve, in two steps:
+    # the events summed on its Gc (about coarse.FRAMES) times, exactly (int32 ON and OFF sums, then float32
+    # frames; streaming reads the span again a window's length at a time), then the L1 solve over those Gc
+    # frames beside them. Gc is half the grid, so it raises the phase only where the grid's solve is small.
+    coarse = 0.0
+    if coarse_applies(config, 0.0, span) and config.offset_solve == "l1_gradient":
+        Gc = float(len(coarse_times(np.arange(G))))
+        binning = 12.0 * (Gc + 1) * P + (READ_BYTES * per_window_events if streaming else 0.0)
+        coarse = max(binning, 4.0 * (Gc + 1) * P + 17.0 * Gc * P)
+    elif coarse_applies(config, 0.0, span):   # the median solve: its own work is a sort of the Gc frames
+        coarse = 12.0 * (len(coarse_times(np.arange(G))) + 1) * P
+    work = max(offset_work, coarse)
     if streaming:
-        offset_phase = persistent + offset_work + (2 * coarse + READ_BYTES * per_window_events if coarse else 0.0)
+        offset_phase = persistent + work
     else:
-        offset_phase = parts["process"] + parts["events"] + parts["networks"] + 4.0 * G * P + offset_work + coarse
+        offset_phase = parts["process"] + parts["events"] + parts["networks"] + 4.0 * G * P + work
     parts["offset"] = max(0.0, offset_phase - sum(parts.values()))
     return {"total": sum(parts.values()), "parts": parts, "n_windows": N, "n_bins": B, "n_frames": int(n_frames),
-            "span_s": span, "streaming": bool(streaming), "offset_solve_bytes": offset_work}
+            "span_s": span, "streaming": bool(streaming), "offset_solve_bytes": offset_work, "coarse_bytes": coarse}
 
 
 def _gib(n_bytes: float) -> str:
@@ -195,7 +206,7 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
     }[worst]
     if est.get("streaming") and worst in ("networks", "bins"):   # one window at a time: the window sets it
         fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.bin_duration:g} s, "
-               f"hidden_features={config.hidden_features}); use a longer bin_duration, a shorter tau or fewer "
+               f"{config.hidden_features} hidden features); use a longer bin_duration, a shorter tau or fewer "
                "hidden_features, or check the sensor size (sensor_size=(H, W))")
     raise EventDataError(f"this reconstruction needs about {_gib(est['total'])} of memory but about {_gib(free)} is "
                          f"free on {device}: most of it for {fix}")
