@@ -7,6 +7,8 @@ and its report names the problem. The correct alternatives (float32 arithmetic, 
 pass, and garbage (None, a string, NaN, an exception, an object) fails every check without a traceback.
 """
 import contextlib
+import copy
+import inspect
 import io
 import math
 import warnings
@@ -423,3 +425,37 @@ def test_an_index_error_on_a_non_square_sensor_names_the_axis_order():
     ok, out = _report("events_to_frames_fixed", _frames_w_h)
     assert ok is False and "IndexError" in out, out
     assert "sensor_size is (H, W)" in out and "[y, x]" in out, out
+
+
+# ---- an argument ignored ---------------------------------------------------------------------------
+
+def _arguments(ex):
+    """(label, freeze) for every argument of every case: freeze(args, kwargs) puts the first case's value
+    of that argument in place of the given one (a version that hard-codes it, or ignores it)."""
+    cases = ex.cases()
+    (a0, k0), out = cases[0], []
+    for key in (k for k in k0 if all(k in kw for _, kw in cases)):
+        out.append((repr(key), lambda a, kw, _k=key: (a, {**kw, _k: copy.deepcopy(k0[_k])})))
+    if all(len(a) == len(a0) for a, _ in cases):
+        for i in range(len(a0)):
+            out.append((f"positional {i}", lambda a, kw, _i=i: (
+                tuple(copy.deepcopy(a0[_i]) if j == _i else v for j, v in enumerate(a)), kw)))
+    return out
+
+
+@pytest.mark.parametrize("name", exercises.names())
+def test_a_version_that_ignores_an_argument_fails(name):
+    """Each check's cases vary every argument in a way the result shows: a learner's version that uses
+    one fixed value (the first case's) for any argument fails. (highpass_per_event's cases once all had
+    C = 0.2 and t_end = 1.2, so a version with C fixed at 0.2 passed.)"""
+    ex = exercises.get(name)
+    passed = []
+    for label, freeze in _arguments(ex):
+        def fixed(*args, _freeze=freeze, **kwargs):
+            a, kw = _freeze(args, kwargs)
+            return ex.reference(*a, **kw)
+        fixed.__signature__ = inspect.signature(ex.reference)
+        ok, _ = _report(name, fixed)
+        if ok:
+            passed.append(label)
+    assert not passed, f"{name}: a version that ignores {passed} passes the check"

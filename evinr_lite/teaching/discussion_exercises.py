@@ -23,10 +23,12 @@ __all__: list[str] = []
 
 def _inputs_highpass(rng):
     cases = []
-    for n, (H, W), alpha in ((12, (2, 3), 2 * math.pi), (40, (3, 4), 5.0), (25, (1, 5), 0.0)):
+    # C and t_end differ between cases too: a version that fixes either to one value fails
+    for n, (H, W), alpha, C, t_end in ((12, (2, 3), 2 * math.pi, 0.2, 1.2), (40, (3, 4), 5.0, 0.35, 1.5),
+                                       (25, (1, 5), 0.0, 0.15, 1.0)):
         t = np.sort(rng.uniform(0.0, 1.0, n))
         cases.append(dict(t=t, x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=rng.choice([-1, 1], n),
-                          sensor_size=(H, W), C=0.2, alpha=alpha, t_end=1.2))
+                          sensor_size=(H, W), C=C, alpha=alpha, t_end=t_end))
     return cases
 
 
