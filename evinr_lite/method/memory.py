@@ -151,12 +151,11 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
     # frames; streaming reads the span again a window's length at a time), then the L1 solve over those Gc
     # frames beside them. Gc is half the grid, so it raises the phase only where the grid's solve is small.
     coarse = 0.0
-    if coarse_applies(config, 0.0, span) and config.offset_solve == "l1_gradient":
+    if coarse_applies(config, 0.0, span):
         Gc = float(len(coarse_times(np.arange(G))))
         binning = 12.0 * (Gc + 1) * P + (READ_BYTES * per_window_events if streaming else 0.0)
-        coarse = max(binning, 4.0 * (Gc + 1) * P + 17.0 * Gc * P)
-    elif coarse_applies(config, 0.0, span):   # the median solve: its own work is a sort of the Gc frames
-        coarse = 12.0 * (len(coarse_times(np.arange(G))) + 1) * P
+        solve = 4.0 * (Gc + 1) * P + 17.0 * Gc * P if config.offset_solve == "l1_gradient" else 0.0
+        coarse = max(binning, solve)
     work = max(offset_work, coarse)
     if streaming:
         offset_phase = persistent + work
