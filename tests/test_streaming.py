@@ -84,6 +84,26 @@ def test_many_windows_give_the_whole_sequence_result(scene_events, tmp_path):
     assert (tmp_path / "log_intensity.f32").stat().st_size == len(q) * SIZE[0] * SIZE[1] * 4   # the spill
 
 
+def test_every_long_phase_shows_progress_and_quiet_shows_none(scene_events, tmp_path, capsys):
+    """A long recording spends much of its time outside training (at 1280x720 for 20 s: 29 s counting and
+    filtering before the first window, 24 s on the offset and the frames after the last): each phase has
+    its own bar, each runs to its end, and progress=False prints none of them."""
+    _, events = scene_events
+    q = np.linspace(0.05, 2.95, 12)
+    cfg = _config(tau=1.0, overlap=0.25)                 # 4 windows: the counting passes read in chunks
+    ends = {"counting events": "3.0/3.0 s", "filtering background activity": "3.0/3.0 s",
+            "EvINR windows": "4/4", "EvINR offset": "2/2",   # one offset image, then the coarse part (3 s span)
+            "EvINR frames": "12/12"}
+    for progress in (True, False):
+        list(stream_reconstruct(MemorySource(events), q, cfg, t_start=0.0, t_end=3.0, workdir=tmp_path / str(progress),
+                                progress=progress))
+        lines = capsys.readouterr().err.replace("\r", "\n").splitlines()
+        for bar, end in ends.items():
+            shown = [line for line in lines if line.startswith(bar)]
+            assert bool(shown) == progress, (bar, progress, lines[-20:])
+            assert not progress or any(end in line for line in shown), (bar, end, shown[-3:])
+
+
 def test_first_window_offset_differs_from_the_whole_sequence_solve_by_one_image(scene_events):
     scene, events = scene_events
     q = np.linspace(0.05, 2.95, 40)

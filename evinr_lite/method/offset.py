@@ -272,7 +272,7 @@ def trend_intervals(span: float, window: float | None) -> int:
     return 1 if window is None else max(1, int(round(span / window)))
 
 
-def offset_trend(times, frames, window: float | None, method: str = "l1_gradient") -> OffsetTrend:
+def offset_trend(times, frames, window: float | None, method: str = "l1_gradient", on_image=None) -> OffsetTrend:
     """The slowly varying offset that makes the frames' gradients sparsest locally in time
     (:func:`l1_gradient_offset`; or, with ``method="median_gradient"``, each pixel's median gradient zero).
 
@@ -281,6 +281,7 @@ def offset_trend(times, frames, window: float | None, method: str = "l1_gradient
         window: seconds between knots, and how far from its knot a frame counts; None, or a span
             shorter than 1.5 windows: one image for the whole span (:func:`offset_image`).
         method: each image's solve, "median_gradient" or "l1_gradient" (:func:`offset_image`).
+        on_image: called with no argument after each image is solved (a progress bar's update), or None.
 
     Returns:
         :class:`OffsetTrend` with K = max(1, round(span / window)) + 1 knots evenly over the span
@@ -294,8 +295,11 @@ def offset_trend(times, frames, window: float | None, method: str = "l1_gradient
         raise ValueError(f"window must be positive seconds or None, got {window!r}")
     span = float(t[-1] - t[0])
     n = trend_intervals(span, window)
+    done = on_image or (lambda: None)
     if n == 1:
-        return OffsetTrend(t[:1].copy(), offset_image(frames, method).astype(np.float32)[None])
+        image = offset_image(frames, method).astype(np.float32)[None]
+        done()
+        return OffsetTrend(t[:1].copy(), image)
     knots = np.linspace(t[0], t[-1], n + 1)
     images = []
     for k in knots:
@@ -303,6 +307,7 @@ def offset_trend(times, frames, window: float | None, method: str = "l1_gradient
         if near.size < MIN_TREND_FRAMES:
             near = np.sort(np.argsort(np.abs(t - k), kind="stable")[:MIN_TREND_FRAMES])
         images.append(offset_image(frames[near], method).astype(np.float32))
+        done()
     return OffsetTrend(knots, np.stack(images))
 
 

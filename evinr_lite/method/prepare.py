@@ -133,26 +133,38 @@ class _Prepared:
 def read_chunks(source, t_start: float, t_end: float, chunk_s: float):
     """The source's events over [t_start, t_end] in time-ordered chunks of ``chunk_s`` seconds, read one
     at a time (a generator of Events); the span's end is inclusive, as in reconstruct."""
-    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
-    for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
-        last = i == len(edges) - 2
-        yield source.events(a, np.nextafter(b, np.inf) if last else b)
+    spans = _chunk_spans(t_start, t_end, chunk_s)
+    for i, (a, b) in enumerate(spans):
+        yield source.events(a, np.nextafter(b, np.inf) if i == len(spans) - 1 else b)
 
 
-def _counts(source, t_start: float, t_end: float, chunk_s: float) -> PolarityCounts:
+def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str | None = None) -> PolarityCounts:
+    """The per-pixel ON / OFF counts over the span, read a chunk at a time; ``progress``: a bar's title
+    (seconds of the recording read), or None for none."""
+    from tqdm.auto import tqdm
+
     counts = PolarityCounts(tuple(source.sensor_size))
-    for events in read_chunks(source, t_start, t_end, chunk_s):
-        counts.update(events)
+    with tqdm(total=round(t_end - t_start, 3), desc=progress, unit="s", disable=progress is None,
+              bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s of events [{elapsed}<{remaining}]") as bar:
+        for events, (a, b) in zip(read_chunks(source, t_start, t_end, chunk_s), _chunk_spans(t_start, t_end, chunk_s)):
+            counts.update(events)
+            bar.update(round(b - a, 3))
     return counts
 
 
-def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | None = None):
+def _chunk_spans(t_start: float, t_end: float, chunk_s: float):
+    """The [a, b] (s) of each chunk :func:`read_chunks` reads, in order."""
+    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
+    return list(zip(edges[:-1].tolist(), edges[1:].tolist()))
+
+
+def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | None = None, progress: bool = False):
     """:func:`prepare_events` for a streamed recording (a hook in
     :func:`~evinr_lite.method.streaming.stream_reconstruct`): ``(cfg, source)``. The counts are read
     over [t_start, t_end] in chunks of ``chunk_s`` seconds (default ``cfg.tau``, so memory stays that
     of one window): once, or twice with ``cfg.background == "filter"`` (raw counts for the hot
     pixels, then the filtered events' counts). So every window is trained with the same C pair, lam
-    and events as the whole-span solve."""
+    and events as the whole-span solve. ``progress``: a bar for each pass over the recording."""
     if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto" and cfg.background == "keep":
         return cfg, source
     chunk_s = chunk_s or cfg.tau or (t_end - t_start)
@@ -162,12 +174,13 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         # whole-span solve does, and hand the windows slices of it instead of reading and filtering again
         held, cfg = prepare_events(source.events(t_start, np.nextafter(t_end, np.inf)), cfg, span)
         return cfg, _Prepared(source, span, held=held)
-    counts = _counts(source, t_start, t_end, chunk_s)
+    counts = _counts(source, t_start, t_end, chunk_s, "counting events" if progress else None)
     if filtered:
         if cfg.hot_pixels == "drop":
             first = _hot_mask(counts.n_on + counts.n_off)
         n_in = int((counts.n_on + counts.n_off).sum())
-        counts = _counts(_Prepared(source, span, first, background=True), t_start, t_end, chunk_s)
+        counts = _counts(_Prepared(source, span, first, background=True), t_start, t_end, chunk_s,
+                         "filtering background activity" if progress else None)
         _check_left(int((counts.n_on + counts.n_off).sum()), n_in)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap))
     if not filtered and not hot.any():

@@ -48,7 +48,7 @@ from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
 from .coarse import coarse_applies, coarse_correction
-from .offset import OffsetTrend, offset_trend, offset_grid, offset_image
+from .offset import OffsetTrend, offset_trend, offset_grid, offset_image, trend_intervals
 from .tonemap import display_shift, to_display
 from .training import train_frame_inr
 
@@ -281,7 +281,9 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
 
     source = as_source(source)
     cfg, q, t_start, t_end = _check(source, query_times, config, t_start, t_end, offset_from)
-    cfg, source = prepare_source(source, t_start, t_end, cfg)    # hot pixels, background, ON/OFF balance, lam (method/prepare.py)
+    show = cfg.progress if progress is None else bool(progress)
+    # hot pixels, background, ON/OFF balance, lam (method/prepare.py)
+    cfg, source = prepare_source(source, t_start, t_end, cfg, progress=show)
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
     if state is None:
         state = StreamState.start(windows, source.sensor_size)
@@ -297,8 +299,9 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
         spill = _spill_path(folder)
         for _, state in _windows(source, q, grid, cfg, state, spill, on_state, progress):
             pass
-        offset = span_offset(state.grid, cfg, grid, read_chunks(source, t_start, t_end, cfg.tau or t_end - t_start))
-        yield from _final_pass(spill, q, offset, cfg, source.sensor_size, _history(state))
+        offset = span_offset(state.grid, cfg, grid, read_chunks(source, t_start, t_end, cfg.tau or t_end - t_start),
+                             progress=show)
+        yield from _final_pass(spill, q, offset, cfg, source.sensor_size, _history(state), progress=show)
 
 
 class _nothing:
@@ -315,30 +318,41 @@ class _nothing:
         return False
 
 
-def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times, chunks=None) -> OffsetTrend:
+def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times, chunks=None,
+                progress: bool = False) -> OffsetTrend:
     """The offset + level from the aligned log intensities on the whole span's grid [G, H, W] at
     ``grid_times`` [G] (s), by the steps and float32 order of the whole-sequence solve: an
     :class:`~evinr_lite.method.offset.OffsetTrend` whose images include the level (one knot, one
     image, unless ``config.offset_window`` makes the offset a trend over a long span). ``chunks``:
     the span's prepared events in time-ordered chunks (an iterable of Events), read for the static
-    image's coarse part when :func:`~evinr_lite.method.coarse.coarse_applies` to the span."""
+    image's coarse part when :func:`~evinr_lite.method.coarse.coarse_applies` to the span. ``progress``:
+    a bar counting the solves (each offset image, then the coarse part)."""
+    from tqdm.auto import tqdm
+
     H, W = grid_frames.shape[1:]
     offset = np.zeros((H, W), np.float32)
     trend = None
-    if config.offset_solve != "none":
-        trend = offset_trend(grid_times, grid_frames, config.offset_window, config.offset_solve)
-        if len(trend.knots) == 1:
-            offset += trend.images[0]
-            trend = None
-    shifted = grid_frames + offset
-    if trend is not None:
-        trend.add_to(shifted, grid_times)
-    if coarse_applies(config, float(grid_times[0]), float(grid_times[-1])):
-        if chunks is None:
-            raise ValueError("span_offset needs the span's events for the static image's coarse part")
-        coarse = coarse_correction(chunks, config.C, grid_times, shifted, config.offset_coarse_px, config.offset_solve)
-        offset += coarse
-        shifted += coarse
+    coarse_too = coarse_applies(config, float(grid_times[0]), float(grid_times[-1]))
+    n = trend_intervals(float(grid_times[-1] - grid_times[0]), config.offset_window)
+    n_solves = ((1 if n == 1 else n + 1) if config.offset_solve != "none" else 0) + int(coarse_too)
+    with tqdm(total=n_solves, desc="EvINR offset", unit="solve", disable=not (progress and n_solves)) as bar:
+        if config.offset_solve != "none":
+            trend = offset_trend(grid_times, grid_frames, config.offset_window, config.offset_solve,
+                                 on_image=lambda: bar.update(1))
+            if len(trend.knots) == 1:
+                offset += trend.images[0]
+                trend = None
+        shifted = grid_frames + offset
+        if trend is not None:
+            trend.add_to(shifted, grid_times)
+        if coarse_too:
+            if chunks is None:
+                raise ValueError("span_offset needs the span's events for the static image's coarse part")
+            coarse = coarse_correction(chunks, config.C, grid_times, shifted, config.offset_coarse_px,
+                                       config.offset_solve)
+            offset += coarse
+            shifted += coarse
+            bar.update(1)
     offset += np.float32(display_shift(shifted, config.tonemap, config.gamma, config.display_mean))
     if trend is None:
         return OffsetTrend(np.zeros(1), offset[None])
@@ -412,12 +426,15 @@ def _windows(source, q, grid, cfg, state, spill, on_state, progress):
         bar.close()
 
 
-def _final_pass(spill, q, offset: OffsetTrend, cfg, sensor_size, history):
-    """The spilled log intensities plus the offset (trend), tone-mapped, a bounded batch at a time."""
+def _final_pass(spill, q, offset: OffsetTrend, cfg, sensor_size, history, progress: bool = False):
+    """The spilled log intensities plus the offset (trend), tone-mapped, a bounded batch at a time;
+    ``progress``: a bar counting the frames handed out (and written by the caller)."""
+    from tqdm.auto import tqdm
+
     H, W = sensor_size
     P = H * W
     step = _batch(P)
-    with open(spill, "rb") as f:
+    with open(spill, "rb") as f, tqdm(total=len(q), desc="EvINR frames", unit="frame", disable=not progress) as bar:
         for i0 in range(0, len(q), step):
             n = min(step, len(q) - i0)
             L = np.fromfile(f, np.float32, n * P).reshape(n, H, W)
@@ -427,6 +444,7 @@ def _final_pass(spill, q, offset: OffsetTrend, cfg, sensor_size, history):
             idx = np.arange(i0, i0 + n, dtype=np.int64)
             offset.add_to(L, q[idx])
             yield StreamPart(q[idx], idx, L, tonemap(L, cfg), None, history)
+            bar.update(n)
 
 
 def _blend_window(model, windows, k, times, total_offset, pending, pending_sum):
