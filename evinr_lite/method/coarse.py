@@ -94,4 +94,3 @@ def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -
     del I
     d = gaussian_lowpass(static - F.mean(axis=0, dtype=np.float64), coarse_px)
     return (d - d.mean()).astype(np.float32)
-

@@ -44,7 +44,7 @@ from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues
 
 __all__ = ["median_gradient_offset", "l1_gradient_offset", "SumAbsProx", "offset_image", "poisson_integrate",
-           "offset_trend", "trend_intervals", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES"]
+           "offset_trend", "trend_intervals", "trend_knots", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES"]
 
 MIN_TREND_FRAMES = 8     # a knot's median looks at least at this many grid frames (the nearest, if its window holds fewer)
 OFFSET_SOLVES = ("none", "median_gradient", "l1_gradient")
@@ -270,6 +270,12 @@ def trend_intervals(span: float, window: float | None) -> int:
     """How many intervals between knots :func:`offset_trend` puts over ``span`` seconds: 1 (one image)
     for ``window`` None or a span under 1.5 windows, else round(span / window)."""
     return 1 if window is None else max(1, int(round(span / window)))
+
+
+def trend_knots(span: float, window: float | None) -> int:
+    """How many offset images :func:`offset_trend` solves over ``span`` seconds: 1, or one per knot."""
+    n = trend_intervals(span, window)
+    return 1 if n == 1 else n + 1
 
 
 def offset_trend(times, frames, window: float | None, method: str = "l1_gradient", on_image=None) -> OffsetTrend:

@@ -133,9 +133,14 @@ class _Prepared:
 def read_chunks(source, t_start: float, t_end: float, chunk_s: float):
     """The source's events over [t_start, t_end] in time-ordered chunks of ``chunk_s`` seconds, read one
     at a time (a generator of Events); the span's end is inclusive, as in reconstruct."""
-    spans = _chunk_spans(t_start, t_end, chunk_s)
-    for i, (a, b) in enumerate(spans):
-        yield source.events(a, np.nextafter(b, np.inf) if i == len(spans) - 1 else b)
+    return (events for _, events in _read_spans(source, t_start, t_end, chunk_s))
+
+
+def _read_spans(source, t_start: float, t_end: float, chunk_s: float):
+    """:func:`read_chunks` with each chunk's [a, b] (s): a generator of ((a, b), Events)."""
+    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
+    for i, (a, b) in enumerate(zip(edges[:-1].tolist(), edges[1:].tolist())):
+        yield (a, b), source.events(a, np.nextafter(b, np.inf) if i == len(edges) - 2 else b)
 
 
 def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str | None = None) -> PolarityCounts:
@@ -146,16 +151,10 @@ def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str 
     counts = PolarityCounts(tuple(source.sensor_size))
     with tqdm(total=round(t_end - t_start, 3), desc=progress, unit="s", disable=progress is None,
               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s of events [{elapsed}<{remaining}]") as bar:
-        for events, (a, b) in zip(read_chunks(source, t_start, t_end, chunk_s), _chunk_spans(t_start, t_end, chunk_s)):
+        for (a, b), events in _read_spans(source, t_start, t_end, chunk_s):
             counts.update(events)
             bar.update(round(b - a, 3))
     return counts
-
-
-def _chunk_spans(t_start: float, t_end: float, chunk_s: float):
-    """The [a, b] (s) of each chunk :func:`read_chunks` reads, in order."""
-    edges = np.append(np.arange(t_start, t_end, chunk_s), t_end)
-    return list(zip(edges[:-1].tolist(), edges[1:].tolist()))
 
 
 def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | None = None, progress: bool = False):

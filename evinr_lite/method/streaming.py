@@ -48,7 +48,7 @@ from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
 from .coarse import coarse_applies, coarse_correction
-from .offset import OffsetTrend, offset_trend, offset_grid, offset_image, trend_intervals
+from .offset import OffsetTrend, offset_trend, offset_grid, offset_image, trend_knots
 from .tonemap import display_shift, to_display
 from .training import train_frame_inr
 
@@ -292,12 +292,12 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
                              "overlap); start again without it")
     grid = offset_grid(t_start, t_end, len(windows), cfg.offset_solve) if offset_from == "span" else np.zeros(0)
     if offset_from == "first_window":
-        for part, _ in _windows(source, q, grid, cfg, state, None, on_state, progress):
+        for part, _ in _windows(source, q, grid, cfg, state, None, on_state, show):
             yield part
         return
     with tempfile.TemporaryDirectory(prefix="evinr-stream-") if workdir is None else _nothing(workdir) as folder:
         spill = _spill_path(folder)
-        for _, state in _windows(source, q, grid, cfg, state, spill, on_state, progress):
+        for _, state in _windows(source, q, grid, cfg, state, spill, on_state, show):
             pass
         offset = span_offset(state.grid, cfg, grid, read_chunks(source, t_start, t_end, cfg.tau or t_end - t_start),
                              progress=show)
@@ -333,8 +333,8 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times, chunks
     offset = np.zeros((H, W), np.float32)
     trend = None
     coarse_too = coarse_applies(config, float(grid_times[0]), float(grid_times[-1]))
-    n = trend_intervals(float(grid_times[-1] - grid_times[0]), config.offset_window)
-    n_solves = ((1 if n == 1 else n + 1) if config.offset_solve != "none" else 0) + int(coarse_too)
+    n_solves = ((trend_knots(float(grid_times[-1] - grid_times[0]), config.offset_window)
+                 if config.offset_solve != "none" else 0) + int(coarse_too))
     with tqdm(total=n_solves, desc="EvINR offset", unit="solve", disable=not (progress and n_solves)) as bar:
         if config.offset_solve != "none":
             trend = offset_trend(grid_times, grid_frames, config.offset_window, config.offset_solve,
@@ -372,12 +372,11 @@ def _windows(source, q, grid, cfg, state, spill, on_state, progress):
     windows = state.windows
     N = len(windows)
     quiet = dataclasses.replace(cfg, progress=False)   # one bar for the windows, none per window
-    show = cfg.progress if progress is None else progress
     if spill is not None:   # resume: drop frames spilled after the state was saved
         P = int(np.prod(source.sensor_size))
         with open(spill, "ab") as f:
             f.truncate(state.n_spilled * P * 4)
-    bar = tqdm(total=N, initial=state.next_window, desc="EvINR windows", unit="window", disable=not show)
+    bar = tqdm(total=N, initial=state.next_window, desc="EvINR windows", unit="window", disable=not progress)
     if state.next_window >= N:
         yield None, state
     try:
