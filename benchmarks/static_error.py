@@ -1,0 +1,155 @@
+"""Where the kit's error lives: the display level, the static image (its tilt, coarse and fine parts)
+and the changes in time, per zoo scene, in log units.
+
+    python benchmarks/static_error.py              # the 13 short zoo scenes (about 1 min on 2 cores)
+    python benchmarks/static_error.py --heldout    # the held-out scenes (zoo.HELDOUT, short ones)
+    python benchmarks/static_error.py --scenes noisy_gravel,camera_translate
+
+Events fix log intensity only up to one image that every frame shares (the static image, which the
+kit's offset solve chooses: :mod:`evinr_lite.method.offset`), and up to one constant (the display
+level). So the kit's log error e_k = L_k - L_true_k at the scored times splits exactly into
+
+    level    the mean of e over pixels and times (a choice of display, :mod:`evinr_lite.method.tonemap`);
+    tilt     the least-squares plane a x + b y of the static error mean_k e_k - level;
+    coarse   what is left of the static error below ``SIGMA`` px (a Gaussian's sigma);
+    fine     the rest of the static error;
+    changes  e_k - mean_k e_k: what differs between the frames.
+
+Each is reported as a root mean square (log units), beside the truth's own tilt (the plane of its
+mean log image), and the tilts as log units across the sensor (x: left to right, y: top to bottom).
+Two re-displays of the same reconstruction show what the tilt costs in the zoo's metrics (CLAHE-SSIM
+/ SSIM / MSE, the same display and level rule as the kit's): its tilt removed, and its tilt replaced
+by the truth's (an oracle: the truth is not known to any method). Writes
+benchmarks/static_error_results[_heldout].{json,md}.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+from scipy.ndimage import gaussian_filter
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.common import write_json  # noqa: E402
+from benchmarks.quality_zoo import score  # noqa: E402
+from evinr_lite.method.config import EvINRConfig  # noqa: E402
+from evinr_lite.method.solver import reconstruct  # noqa: E402
+from evinr_lite.method.tonemap import display_shift, to_display  # noqa: E402
+from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, get, simulate  # noqa: E402
+
+SIGMA = 8.0      # px: the scale of the kit's coarse part (EvINRConfig().offset_coarse_px)
+PARTS = ("level", "tilt", "coarse", "fine", "changes")
+
+
+def plane(image: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """(the least-squares plane a x + b y through ``image`` [H, W] with its mean removed, float64 [H, W];
+    its rise across the sensor along x (columns, left to right) and along y (rows, top to bottom)).
+    x and y are centred, so the plane has mean 0 and the two slopes are independent."""
+    H, W = image.shape
+    y, x = np.mgrid[0:H, 0:W].astype(np.float64)
+    x -= x.mean()
+    y -= y.mean()
+    a = float((image * x).sum() / max((x * x).sum(), 1e-30))
+    b = float((image * y).sum() / max((y * y).sum(), 1e-30))
+    return a * x + b * y, a * max(W - 1, 0), b * max(H - 1, 0)
+
+
+def decompose(L: np.ndarray, L_true: np.ndarray, sigma: float = SIGMA) -> dict:
+    """The error of log intensities ``L`` [K, H, W] against ``L_true`` [K, H, W], split into
+    :data:`PARTS` (arrays: level a float, tilt / coarse / fine [H, W], changes [K, H, W]) that add up
+    to it exactly: e = level + tilt + coarse + fine + changes."""
+    e = np.asarray(L, np.float64) - np.asarray(L_true, np.float64)
+    level = float(e.mean())
+    static = e.mean(axis=0) - level
+    tilt, _, _ = plane(static)
+    coarse = gaussian_filter(static - tilt, sigma, mode="nearest")
+    return {"level": level, "tilt": tilt, "coarse": coarse, "fine": static - tilt - coarse,
+            "changes": e - e.mean(axis=0)}
+
+
+def rms(x) -> float:
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
+def redisplay(L: np.ndarray, cfg: EvINRConfig) -> np.ndarray:
+    """Frames [K, H, W] in [0, 1] from log intensities ``L`` by ``cfg``'s display, level set by its rule
+    on these frames (:func:`~evinr_lite.method.tonemap.display_shift`)."""
+    c = display_shift(L, cfg.tonemap, cfg.gamma, cfg.display_mean)
+    return to_display(L + c, cfg.tonemap, cfg.gamma).astype(np.float32)
+
+
+def scene_row(name, scene, events, times, gt, C, log=print) -> dict:
+    cfg = EvINRConfig(C=C, progress=False)
+    rec = reconstruct(events, times, cfg)
+    L = rec.log_intensity.astype(np.float64)
+    L_true = np.stack([scene.log_intensity(t) for t in times]).astype(np.float64)
+    parts = decompose(L, L_true)
+    kit_tilt, kx, ky = plane(L.mean(axis=0))
+    true_tilt, tx, ty = plane(L_true.mean(axis=0))
+    pick = ("ssim_clahe", "ssim_none", "mse_none")
+    shown = {"kit": score(rec.frames, times, gt, times),
+             "tilt_removed": score(redisplay(L - kit_tilt, cfg), times, gt, times),
+             "truth_tilt": score(redisplay(L - kit_tilt + true_tilt, cfg), times, gt, times)}
+    row = {"rms": {k: (abs(v) if k == "level" else rms(v)) for k, v in parts.items()},
+           "kit_tilt_across": [kx, ky], "true_tilt_across": [tx, ty],
+           "true_tilt_rms": rms(true_tilt), "scores": {k: {m: v[m] for m in pick} for k, v in shown.items()}}
+    r, s = row["rms"], row["scores"]
+    log(f"{name:20s} " + "  ".join(f"{k} {r[k]:.3f}" for k in PARTS)
+        + f"  | tilt x/y kit {kx:+.2f} {ky:+.2f} truth {tx:+.2f} {ty:+.2f}"
+        + "  | MSE " + " ".join(f"{k} {v['mse_none']:.4f}" for k, v in s.items()))
+    return row
+
+
+def markdown(rows: dict) -> str:
+    lines = ["| scene | level | tilt | coarse | fine | changes | tilt across x / y: kit | truth | kit | tilt removed "
+             "| truth's tilt |", "|" + "---|" * 11]
+    for name, r in rows.items():
+        cells = [f"{r['rms'][k]:.3f}" for k in PARTS]
+        shown = [" / ".join(f"{r['scores'][k][m]:.{4 if m == 'mse_none' else 3}f}"
+                            for m in ("ssim_clahe", "ssim_none", "mse_none"))
+                 for k in ("kit", "tilt_removed", "truth_tilt")]
+        lines.append(f"| {name} | " + " | ".join(cells)
+                     + f" | {r['kit_tilt_across'][0]:+.2f} / {r['kit_tilt_across'][1]:+.2f}"
+                     + f" | {r['true_tilt_across'][0]:+.2f} / {r['true_tilt_across'][1]:+.2f} | "
+                     + " | ".join(shown) + " |")
+    if rows:
+        means = {k: np.mean([r["scores"][k]["ssim_clahe"] for r in rows.values()])
+                 for k in ("kit", "tilt_removed", "truth_tilt")}
+        lines.append(f"| **mean CLAHE-SSIM** | | | | | | | | {means['kit']:.3f} | {means['tilt_removed']:.3f} | "
+                     f"{means['truth_tilt']:.3f} |")
+    lines += ["", "Level ... changes: the kit's log-intensity error split into its parts (root mean square, log "
+              f"units; level: its absolute value; coarse: below a Gaussian sigma of {SIGMA:g} px after the tilt). "
+              "Tilt across: the rise of the static image's least-squares plane from the first to the last column "
+              "(x) and row (y), log units, for the kit and for the truth. The last three columns: CLAHE-SSIM / "
+              "SSIM / MSE of the kit as it is, re-displayed with its tilt removed, and with its tilt replaced by "
+              "the truth's (an oracle). Written by `python benchmarks/static_error.py`."]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--heldout", action="store_true", help="the held-out scenes instead (short ones)")
+    p.add_argument("--scenes", default=None, help="comma-separated scene names (default: every short scene)")
+    p.add_argument("--json", default=None, help="default benchmarks/static_error_results[_heldout].json")
+    p.add_argument("--md", default=None, help="default benchmarks/static_error_results[_heldout].md")
+    a = p.parse_args(argv)
+    suffix = "_heldout" if a.heldout else ""
+    a.json = a.json or f"benchmarks/static_error_results{suffix}.json"
+    a.md = a.md or f"benchmarks/static_error_results{suffix}.md"
+    scenes = ([get(n) for n in a.scenes.split(",")] if a.scenes else
+              [z for z in (HELDOUT if a.heldout else default_scenes()) if not z.long])
+    rows = {}
+    for z in scenes:
+        scene, events, times, gt = simulate(z)
+        rows[z.name] = scene_row(z.name, scene, events, times, gt, effective_C(z))
+    write_json(a.json, {"heldout": a.heldout, "sigma_px": SIGMA, "scenes": rows})
+    Path(a.md).write_text(markdown(rows))
+    print(f"json: {a.json}\nmarkdown: {a.md}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
