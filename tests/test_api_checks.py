@@ -63,7 +63,12 @@ def test_at_refuses_a_chunk_that_is_not_a_whole_number_of_at_least_one(small_rec
 
 def test_at_accepts_whole_chunks_and_gives_the_same_frames(small_rec):
     a, b = small_rec.at([0.1, 0.2], chunk=1), small_rec.at([0.1, 0.2], chunk=np.int64(256))
-    np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6)
+    # the same frames to float32's precision of the head product: the solved head's weights are large
+    # and cancel (rms 42 here), and one time at once (a matrix-vector product) sums in another order
+    # than two (matrix-matrix), which moved F by 3.5e-4 on the 2-core machine of 2026-12-04 and less on
+    # earlier ones (FrameINR.features);
+    # a wrong chunking (times dropped, shifted or repeated) moves it by tenths
+    np.testing.assert_allclose(a, b, rtol=0, atol=2e-3)
     with pytest.raises(InputError, match="times="):
         small_rec.at([0.1, np.nan])
 
