@@ -37,7 +37,7 @@ from benchmarks.common import write_json  # noqa: E402
 from benchmarks.quality_zoo import score  # noqa: E402
 from evinr_lite.method.config import EvINRConfig  # noqa: E402
 from evinr_lite.method.solver import reconstruct  # noqa: E402
-from evinr_lite.method.tonemap import display_shift, to_display  # noqa: E402
+from evinr_lite.method.tonemap import anchor_mean, to_display  # noqa: E402
 from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, get, simulate  # noqa: E402
 
 SIGMA = 8.0      # px: the scale of the kit's coarse part (EvINRConfig().offset_coarse_px)
@@ -75,10 +75,10 @@ def rms(x) -> float:
 
 
 def redisplay(L: np.ndarray, cfg: EvINRConfig) -> np.ndarray:
-    """Frames [K, H, W] in [0, 1] from log intensities ``L`` by ``cfg``'s display, level set by its rule
-    on these frames (:func:`~evinr_lite.method.tonemap.display_shift`)."""
-    c = display_shift(L, cfg.tonemap, cfg.gamma, cfg.display_mean)
-    return to_display(L + c, cfg.tonemap, cfg.gamma).astype(np.float32)
+    """Frames [K, H, W] in [0, 1] from log intensities ``L`` by ``cfg``'s display, the level set by the
+    kit's one brightness anchor on these frames (:func:`~evinr_lite.method.tonemap.anchor_mean`)."""
+    L = anchor_mean(L, cfg.gamma, cfg.display_mean, tonemap=cfg.tonemap)
+    return to_display(L, cfg.tonemap, cfg.gamma).astype(np.float32)
 
 
 def scene_row(name, scene, events, times, gt, C, log=print) -> dict:
