@@ -4,6 +4,8 @@ and the changes in time, per zoo scene, in log units.
     python benchmarks/static_error.py              # the 13 short zoo scenes (about 1 min on 2 cores)
     python benchmarks/static_error.py --heldout    # the held-out scenes (zoo.HELDOUT, short ones)
     python benchmarks/static_error.py --scenes noisy_gravel,camera_translate
+    python benchmarks/static_error.py --events signal --set balance=none    # what the tilt is not caused by
+    python benchmarks/static_error.py --true-thresholds                     # given the simulated C+ / C-
 
 Events fix log intensity only up to one image that every frame shares (the static image, which the
 kit's offset solve chooses: :mod:`evinr_lite.method.offset`), and up to one constant (the display
@@ -21,6 +23,13 @@ Two re-displays of the same reconstruction show what the tilt costs in the zoo's
 / SSIM / MSE, the same display and level rule as the kit's): its tilt removed, and its tilt replaced
 by the truth's (an oracle: the truth is not known to any method). Writes
 benchmarks/static_error_results[_heldout].{json,md}.
+
+Three options give the kit what events cannot tell it, or take a part of the method away, to find
+what causes a part of the error: ``--events signal`` keeps only the events of the scene's brightness
+changes (the zoo's labels: no background activity, no hot pixels), ``--true-thresholds`` gives the
+method the simulated C+ / C- instead of the nominal C, and ``--set FIELD=VALUE,...`` changes fields of
+``EvINRConfig`` (e.g. ``balance=none``). With any of them the table is printed and the committed
+results are left alone, unless ``--json`` / ``--md`` name the files.
 """
 from __future__ import annotations
 
@@ -34,11 +43,11 @@ from scipy.ndimage import gaussian_filter
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.common import write_json  # noqa: E402
-from benchmarks.quality_zoo import score  # noqa: E402
+from benchmarks.quality_zoo import parse_variant, score  # noqa: E402
 from evinr_lite.method.config import EvINRConfig  # noqa: E402
 from evinr_lite.method.solver import reconstruct  # noqa: E402
 from evinr_lite.method.tonemap import anchor_mean, to_display  # noqa: E402
-from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, get, simulate  # noqa: E402
+from evinr_lite.sim.zoo import SIGNAL, HELDOUT, default_scenes, effective_C, get, simulate  # noqa: E402
 
 SIGMA = 8.0      # px: the scale of the kit's coarse part (EvINRConfig().offset_coarse_px)
 PARTS = ("level", "tilt", "coarse", "fine", "changes")
@@ -81,8 +90,10 @@ def redisplay(L: np.ndarray, cfg: EvINRConfig) -> np.ndarray:
     return to_display(L, cfg.tonemap, cfg.gamma).astype(np.float32)
 
 
-def scene_row(name, scene, events, times, gt, C, log=print) -> dict:
-    cfg = EvINRConfig(C=C, progress=False)
+def scene_row(name, scene, events, times, gt, C, log=print, overrides=None) -> dict:
+    """One scene's parts, tilts and re-displayed scores (the module's docstring); ``overrides``: fields
+    of EvINRConfig set on top of the default (``C`` and ``progress=False``)."""
+    cfg = EvINRConfig(**{"C": C, "progress": False, **(overrides or {})})
     rec = reconstruct(events, times, cfg)
     L = rec.log_intensity.astype(np.float64)
     L_true = np.stack([scene.log_intensity(t) for t in times]).astype(np.float64)
@@ -133,22 +144,53 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--heldout", action="store_true", help="the held-out scenes instead (short ones)")
     p.add_argument("--scenes", default=None, help="comma-separated scene names (default: every short scene)")
+    p.add_argument("--events", choices=("all", "signal"), default="all",
+                   help="signal: only the events of brightness changes (no background activity, no hot pixels)")
+    p.add_argument("--true-thresholds", action="store_true",
+                   help="give the method the simulated C+ / C- (where they differ) instead of the nominal C")
+    p.add_argument("--set", default="", metavar="FIELD=VALUE,...", help="EvINRConfig fields to change, e.g. balance=none")
     p.add_argument("--json", default=None, help="default benchmarks/static_error_results[_heldout].json")
     p.add_argument("--md", default=None, help="default benchmarks/static_error_results[_heldout].md")
     a = p.parse_args(argv)
-    suffix = "_heldout" if a.heldout else ""
-    a.json = a.json or f"benchmarks/static_error_results{suffix}.json"
-    a.md = a.md or f"benchmarks/static_error_results{suffix}.md"
+    overrides = config_overrides(a.set, p.error)
     scenes = ([get(n) for n in a.scenes.split(",")] if a.scenes else
               [z for z in (HELDOUT if a.heldout else default_scenes()) if not z.long])
     rows = {}
     for z in scenes:
-        scene, events, times, gt = simulate(z)
-        rows[z.name] = scene_row(z.name, scene, events, times, gt, effective_C(z))
-    write_json(a.json, {"heldout": a.heldout, "sigma_px": SIGMA, "scenes": rows})
-    Path(a.md).write_text(markdown(rows))
-    print(f"json: {a.json}\nmarkdown: {a.md}")
+        scene, events, times, gt, labels, _ = simulate(z, labels=True)
+        if a.events == "signal":
+            events = events.take(np.flatnonzero(labels == SIGNAL))
+        C = (z.C_pos, z.C_neg) if a.true_thresholds and z.C_pos is not None else effective_C(z)
+        rows[z.name] = scene_row(z.name, scene, events, times, gt, C, overrides=overrides)
+    setup = {"heldout": a.heldout, "sigma_px": SIGMA, "events": a.events, "true_thresholds": a.true_thresholds,
+             "set": overrides}
+    changed = a.events != "all" or a.true_thresholds or overrides
+    suffix = "_heldout" if a.heldout else ""
+    if not changed:
+        a.json = a.json or f"benchmarks/static_error_results{suffix}.json"
+        a.md = a.md or f"benchmarks/static_error_results{suffix}.md"
+    if a.json:
+        write_json(a.json, {**setup, "scenes": rows})
+        print(f"json: {a.json}")
+    if a.md:
+        Path(a.md).write_text(markdown(rows))
+        print(f"markdown: {a.md}")
+    if changed and not a.md:
+        print(markdown(rows))
     return 0
+
+
+def config_overrides(text: str, error) -> dict:
+    """'FIELD=VALUE,...' -> {field: value} for EvINRConfig (values as Python literals); ``error(message)``
+    is called for a field EvINRConfig does not have or a value it refuses."""
+    _, fields = parse_variant("set=" + text)
+    try:
+        EvINRConfig(**fields)
+    except TypeError as exc:
+        error(f"--set {text!r}: {exc} (the fields are EvINRConfig's, e.g. balance=none, lam=0.1)")
+    except ValueError as exc:
+        error(f"--set {text!r}: {exc}")
+    return fields
 
 
 if __name__ == "__main__":
