@@ -80,3 +80,19 @@ def test_options_reach_the_method_and_leave_the_committed_results(tmp_path, caps
     mse = lambda rows: rows["coffee_warp"]["scores"]["kit"]["mse_none"]          # noqa: E731
     assert abs(mse(got["scenes"]) - mse(committed)) > 1e-3      # given C+ 0.24 / C- 0.16, the kit's error moves
     assert "| coffee_warp |" in capsys.readouterr().out          # the table is printed, no markdown file named
+
+
+def test_prior_tilt_error_of_a_plane_and_of_a_skewed_texture():
+    H, W, P, s = 4, 41, 8, 0.05
+    x = np.arange(W, dtype=np.float64)
+    plane = np.broadcast_to(0.01 * x, (3, H, W))                   # a static plane: invisible to every prior
+    err = se.prior_tilt_error(plane, C=0.2)
+    for k in ("median", "mean", "hybrid"):
+        np.testing.assert_allclose(err[k], [-0.01 * (W - 1), 0.0], atol=1e-12)
+    # a sawtooth (slow rise s per px, one sharp drop) moving one pixel per frame over a whole period:
+    # each edge's gradient is s in 7 of 8 frames, so the median says s, while the mean over time is 0
+    saw = np.stack([np.broadcast_to(s * ((x - t) % P), (H, W)) for t in range(P)])
+    err = se.prior_tilt_error(saw, C=0.2)
+    np.testing.assert_allclose(err["median"][0], -s * (W - 1), rtol=1e-12)
+    np.testing.assert_allclose(err["mean"][0], 0.0, atol=1e-12)
+    np.testing.assert_allclose(err["hybrid"][0], -s * (W - 1), rtol=1e-12)   # 7 of 8 frames at the median
