@@ -198,6 +198,13 @@ def main(argv=None) -> int:
             events = events.take(np.flatnonzero(labels == SIGNAL))
         C = (z.C_pos, z.C_neg) if a.true_thresholds and z.C_pos is not None else effective_C(z)
         rows[z.name] = scene_row(z.name, scene, events, times, gt, C, overrides=overrides)
+    agreement = prior_agreement(rows, {z.name for z in scenes if z.C_pos is not None})
+    summary = "".join(
+        f"\nC+ {'=' if group == 'equal' else '!='} C- ({a_['scenes']} scenes): the kit's tilt error against the median "
+        f"prior's on the true frames: correlation {a_['correlation']:.2f}, rms difference {a_['rms_difference']:.2f} "
+        f"(the error's own rms {a_['rms_kit_error']:.2f} log units; x and y tilts of every scene).\n"
+        for group, a_ in agreement.items())
+    print(summary)
     setup = {"heldout": a.heldout, "sigma_px": SIGMA, "events": a.events, "true_thresholds": a.true_thresholds,
              "set": overrides}
     changed = a.events != "all" or a.true_thresholds or overrides
@@ -206,14 +213,30 @@ def main(argv=None) -> int:
         a.json = a.json or f"benchmarks/static_error_results{suffix}.json"
         a.md = a.md or f"benchmarks/static_error_results{suffix}.md"
     if a.json:
-        write_json(a.json, {**setup, "scenes": rows})
+        write_json(a.json, {**setup, "prior_agreement": agreement, "scenes": rows})
         print(f"json: {a.json}")
     if a.md:
-        Path(a.md).write_text(markdown(rows))
+        Path(a.md).write_text(markdown(rows) + summary)
         print(f"markdown: {a.md}")
     if changed and not a.md:
-        print(markdown(rows))
+        print(markdown(rows) + summary)
     return 0
+
+
+def prior_agreement(rows: dict, unequal: set) -> dict:
+    """How well the median prior's error on the true frames explains the kit's tilt error: per group of
+    scenes ("equal": C+ = C-, "unequal"), the correlation of the two over the scenes' x and y tilts, the
+    root mean square of their difference and of the kit's error (log units across)."""
+    out = {}
+    for group in ("equal", "unequal"):
+        names = [n for n in rows if (n in unequal) == (group == "unequal")]
+        if len(names) < 2:
+            continue
+        e = np.concatenate([np.subtract(rows[n]["kit_tilt_across"], rows[n]["true_tilt_across"]) for n in names])
+        m = np.concatenate([rows[n]["prior_tilt_error_across"]["median"] for n in names])
+        out[group] = {"scenes": len(names), "correlation": float(np.corrcoef(e, m)[0, 1]),
+                      "rms_difference": rms(e - m), "rms_kit_error": rms(e)}
+    return out
 
 
 def config_overrides(text: str, error) -> dict:
