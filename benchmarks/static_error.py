@@ -91,17 +91,20 @@ def prior_tilt_error(L_true: np.ndarray, C: float) -> dict:
     ``mean`` for a least-squares one, and ``hybrid`` the median where the edge's gradient stays within
     C / 2 of it in 3 of 4 frames and the mean elsewhere. The joint solve's integrability is ignored,
     so these are what the priors assume, not what the solver returns."""
-    out = {}
-    g = {"x": np.diff(L_true, axis=2), "y": np.diff(L_true, axis=1)}
-    n = {"x": L_true.shape[2] - 1, "y": L_true.shape[1] - 1}
-    for name in ("median", "mean", "hybrid"):
-        out[name] = []
-        for ax in ("x", "y"):
-            med, mean = np.median(g[ax], axis=0), g[ax].mean(axis=0)
-            loc = {"median": med, "mean": mean,
-                   "hybrid": np.where((np.abs(g[ax] - med) < C / 2).mean(axis=0) >= 0.75, med, mean)}[name]
-            out[name].append(float(-loc.mean() * n[ax]))
+    out = {"median": [], "mean": [], "hybrid": []}
+    for axis in (2, 1):                                   # x (along a row), then y (down a column)
+        g = np.diff(L_true, axis=axis)                    # [T, ...] each edge's gradient at each time
+        med, mean = np.median(g, axis=0), g.mean(axis=0)
+        hybrid = np.where((np.abs(g - med) < C / 2).mean(axis=0) >= 0.75, med, mean)
+        across = L_true.shape[axis] - 1
+        for name, loc in (("median", med), ("mean", mean), ("hybrid", hybrid)):
+            out[name].append(float(-loc.mean() * across))
     return out
+
+
+def tilt_error(row: dict) -> np.ndarray:
+    """The kit's tilt error, kit minus truth, across x and y (log units) of one scene's row."""
+    return np.subtract(row["kit_tilt_across"], row["true_tilt_across"])
 
 
 def rms(x) -> float:
@@ -154,8 +157,7 @@ def markdown(rows: dict) -> str:
         lines.append(f"| {name} | " + " | ".join(cells)
                      + f" | {r['kit_tilt_across'][0]:+.2f} / {r['kit_tilt_across'][1]:+.2f}"
                      + f" | {r['true_tilt_across'][0]:+.2f} / {r['true_tilt_across'][1]:+.2f}"
-                     + f" | {r['kit_tilt_across'][0] - r['true_tilt_across'][0]:+.2f} / "
-                       f"{r['kit_tilt_across'][1] - r['true_tilt_across'][1]:+.2f}"
+                     + " | {:+.2f} / {:+.2f}".format(*tilt_error(r))
                      + "".join(f" | {r['prior_tilt_error_across'][k][0]:+.2f} / {r['prior_tilt_error_across'][k][1]:+.2f}"
                                for k in ("median", "mean"))
                      + " | " + " | ".join(shown) + " |")
@@ -204,7 +206,6 @@ def main(argv=None) -> int:
         f"prior's on the true frames: correlation {a_['correlation']:.2f}, rms difference {a_['rms_difference']:.2f} "
         f"(the error's own rms {a_['rms_kit_error']:.2f} log units; x and y tilts of every scene).\n"
         for group, a_ in agreement.items())
-    print(summary)
     setup = {"heldout": a.heldout, "sigma_px": SIGMA, "events": a.events, "true_thresholds": a.true_thresholds,
              "set": overrides}
     changed = a.events != "all" or a.true_thresholds or overrides
@@ -218,8 +219,7 @@ def main(argv=None) -> int:
     if a.md:
         Path(a.md).write_text(markdown(rows) + summary)
         print(f"markdown: {a.md}")
-    if changed and not a.md:
-        print(markdown(rows) + summary)
+    print(markdown(rows) + summary if changed and not a.md else summary)
     return 0
 
 
@@ -232,7 +232,7 @@ def prior_agreement(rows: dict, unequal: set) -> dict:
         names = [n for n in rows if (n in unequal) == (group == "unequal")]
         if len(names) < 2:
             continue
-        e = np.concatenate([np.subtract(rows[n]["kit_tilt_across"], rows[n]["true_tilt_across"]) for n in names])
+        e = np.concatenate([tilt_error(rows[n]) for n in names])
         m = np.concatenate([rows[n]["prior_tilt_error_across"]["median"] for n in names])
         out[group] = {"scenes": len(names), "correlation": float(np.corrcoef(e, m)[0, 1]),
                       "rms_difference": rms(e - m), "rms_kit_error": rms(e)}
