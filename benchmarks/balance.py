@@ -3,13 +3,15 @@
     python benchmarks/balance.py              # the zoo's scenes, long ones included (about 2 min on 2 cores)
     python benchmarks/balance.py --heldout    # the held-out scenes instead
 
-For each scene: the simulated imbalance b = (C+ - C-) / (C+ + C-), the pooled estimate from the
-counts (``raw``), the share of it that is used (``shrink``) and the result (``applied``), with the
-mean event count per usable pixel, and the truth's change of mean log intensity from the first to
-the last scored frame (what the pooled estimate cannot tell from an imbalance). The last lines give
-the root mean square of b and of that change over the scenes: the two prior spreads of
-:mod:`evinr_lite.method.balance` (PRIOR, NET_CHANGE) are set from the zoo's. Writes
-benchmarks/balance_results[_heldout].{json,md}.
+For each scene, on the events the kit trains on (hot pixels dropped, background filtered, as
+:mod:`evinr_lite.method.prepare` does): the simulated imbalance b = (C+ - C-) / (C+ + C-), the two
+estimates of :mod:`evinr_lite.method.balance` (the pooled counts, ``raw``, and the intervals between
+events of one polarity, ``interval``), the default's result (``applied``: their minmod), and the
+counts rule's (``counts_rule``: ``raw`` shrunk by ``shrink``), with the mean event count per usable
+pixel and the truth's change of mean log intensity from the first to the last scored frame (what the
+pooled counts cannot tell from an imbalance). The last lines give the root mean square of b and of
+that change over the scenes (the counts rule's prior spreads PRIOR and NET_CHANGE are the zoo's) and
+of each rule's error. Writes benchmarks/balance_results[_heldout].{json,md}.
 """
 from __future__ import annotations
 
@@ -22,7 +24,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from benchmarks.common import write_json  # noqa: E402
-from evinr_lite.method.balance import NET_CHANGE, PRIOR, balance_from_counts, polarity_counts  # noqa: E402
+from evinr_lite.method import EvINRConfig  # noqa: E402
+from evinr_lite.method.balance import NET_CHANGE, PRIOR, estimate_balance  # noqa: E402
+from evinr_lite.method.prepare import prepare_events  # noqa: E402
 from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, imbalance, simulate  # noqa: E402
 
 
@@ -30,22 +34,26 @@ def scene_row(z) -> dict:
     """The balance of one zoo scene against its simulated thresholds."""
     _, events, times, gt = simulate(z)
     C = effective_C(z)
-    fit = balance_from_counts(*polarity_counts(events), C)
+    events, _ = prepare_events(events, EvINRConfig(C=C, balance="none", progress=False))
+    fit, old = estimate_balance(events, C), estimate_balance(events, C, rule="counts")
     log_mean = np.log(np.clip(np.asarray(gt, np.float64), 1e-3, None)).mean(axis=(1, 2))
-    return {"span_s": float(times[-1] - times[0]), "b_true": imbalance(z),
-            "raw": fit.raw_imbalance, "shrink": fit.shrink, "applied": fit.imbalance,
-            "mean_events": fit.mean_events, "mean_log_change": float(log_mean[-1] - log_mean[0])}
+    return {"span_s": float(times[-1] - times[0]), "b_true": imbalance(z), "raw": fit.raw_imbalance,
+            "interval": fit.interval_imbalance, "applied": fit.imbalance, "shrink": old.shrink,
+            "counts_rule": old.imbalance, "mean_events": fit.mean_events,
+            "mean_log_change": float(log_mean[-1] - log_mean[0])}
 
 
 def markdown(rows: dict, rms: dict) -> str:
-    lines = ["| scene | span (s) | events per pixel | b simulated | b pooled (raw) | shrink | b applied | "
-             "truth's mean log change |", "|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene | span (s) | events per pixel | b simulated | counts (raw) | intervals | b applied (minmod) | "
+             "counts rule (shrink) | truth's mean log change |", "|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
         lines.append(f"| {name} | {r['span_s']:.1f} | {r['mean_events']:.1f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | "
-                     f"{r['shrink']:.2f} | {r['applied']:+.3f} | {r['mean_log_change']:+.3f} |")
+                     f"{r['interval']:+.3f} | {r['applied']:+.3f} | {r['counts_rule']:+.3f} ({r['shrink']:.2f}) | "
+                     f"{r['mean_log_change']:+.3f} |")
     lines += ["", f"Root mean square over these {len(rows)} scenes: simulated b {rms['b']:.3f}, mean log change "
-              f"{rms['log_change']:.2f} (the prior spreads in evinr_lite.method.balance: PRIOR {PRIOR}, NET_CHANGE "
-              f"{NET_CHANGE}). Written by `python benchmarks/balance.py`."]
+              f"{rms['log_change']:.2f} (the counts rule's prior spreads in evinr_lite.method.balance: PRIOR {PRIOR}, "
+              f"NET_CHANGE {NET_CHANGE}); error of the applied b {rms['applied_error']:.3f}, of the counts rule's "
+              f"{rms['counts_rule_error']:.3f}. Written by `python benchmarks/balance.py`."]
     return "\n".join(lines) + "\n"
 
 
@@ -57,11 +65,17 @@ def main(argv=None) -> int:
     rows = {}
     for z in (HELDOUT if a.heldout else default_scenes(long=True)):
         rows[z.name] = r = scene_row(z)
-        print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  b {r['b_true']:+.3f}  raw {r['raw']:+.3f}  "
-              f"shrink {r['shrink']:.2f}  applied {r['applied']:+.3f}  mean log change {r['mean_log_change']:+.3f}", flush=True)
-    rms = {"b": float(np.sqrt(np.mean([r["b_true"] ** 2 for r in rows.values()]))),
-           "log_change": float(np.sqrt(np.mean([r["mean_log_change"] ** 2 for r in rows.values()])))}
-    print(f"root mean square: b {rms['b']:.3f}, mean log change {rms['log_change']:.2f}")
+        print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  b {r['b_true']:+.3f}  counts {r['raw']:+.3f}  "
+              f"intervals {r['interval']:+.3f}  applied {r['applied']:+.3f}  counts rule {r['counts_rule']:+.3f}  "
+              f"mean log change {r['mean_log_change']:+.3f}", flush=True)
+
+    def rms_of(f):
+        return float(np.sqrt(np.mean([f(r) ** 2 for r in rows.values()])))
+    rms = {"b": rms_of(lambda r: r["b_true"]), "log_change": rms_of(lambda r: r["mean_log_change"]),
+           "applied_error": rms_of(lambda r: r["applied"] - r["b_true"]),
+           "counts_rule_error": rms_of(lambda r: r["counts_rule"] - r["b_true"])}
+    print(f"root mean square: b {rms['b']:.3f}, mean log change {rms['log_change']:.2f}; error of the applied b "
+          f"{rms['applied_error']:.3f}, of the counts rule's {rms['counts_rule_error']:.3f}")
     write_json(f"benchmarks/balance_results{suffix}.json", {"heldout": a.heldout, "scenes": rows, "rms": rms,
                                                              "prior": PRIOR, "net_change": NET_CHANGE})
     Path(f"benchmarks/balance_results{suffix}.md").write_text(markdown(rows, rms))

@@ -4,9 +4,10 @@ import pytest
 
 from evinr_lite.core.events import EventDataError, Events
 from evinr_lite.method import EvINRConfig, reconstruct
-from evinr_lite.method.balance import PolarityCounts, balance_from_counts, estimate_balance, polarity_counts
+from evinr_lite.method.balance import (PolarityCounts, balance_from_counts, estimate_balance, interval_sums, minmod,
+                                       polarity_counts)
 from evinr_lite.method.prepare import prepare_events
-from evinr_lite.sim.scenes import OscillatingScene
+from evinr_lite.sim.scenes import LightingScene, MovingImageScene, OscillatingScene
 from evinr_lite.sim.simulate import add_hot_pixels, simulate_scene
 
 SIZE = (30, 40)
@@ -44,9 +45,10 @@ def test_on_only_hot_pixels_are_left_out(unequal):
     assert abs(fit.raw_imbalance - 0.111) < 0.01 < abs(naive - 0.111)    # the naive pool is pulled towards ON
 
 
-def test_short_spans_are_shrunk_towards_the_nominal_C(unequal):
-    short = estimate_balance(unequal.slice_time(0.0, 0.5), 0.225)
-    whole = estimate_balance(unequal, 0.225)
+def test_the_counts_rule_shrinks_short_spans_towards_the_nominal_C(unequal):
+    short = estimate_balance(unequal.slice_time(0.0, 0.5), 0.225, rule="counts")
+    whole = estimate_balance(unequal, 0.225, rule="counts")
+    assert short.rule == "counts" and np.isnan(short.interval_imbalance)
     assert short.shrink < whole.shrink and abs(short.imbalance) < abs(whole.imbalance)
 
 
@@ -61,9 +63,12 @@ def test_a_given_pair_is_kept_and_bad_counts_are_refused(unequal):
 
 def test_running_counts_match_one_span(unequal):
     counts = PolarityCounts(SIZE)
-    for a in np.arange(0.0, 20.0, 5.0):
-        counts.update(unequal.slice_time(a, a + 5.0, allow_empty=True))
-    np.testing.assert_allclose(counts.fit(0.225).C, estimate_balance(unequal, 0.225).C)
+    for a in np.arange(0.0, 20.0, 3.0):
+        counts.update(unequal.slice_time(a, a + 3.0, allow_empty=True))
+    whole = interval_sums(unequal)
+    for chunked, one in zip((*counts.intervals, *counts.last), whole):   # intervals across chunk edges count
+        np.testing.assert_array_equal(chunked, one)
+    assert counts.fit(0.225).C == estimate_balance(unequal, 0.225).C
     with pytest.raises(EventDataError, match="decay"):
         PolarityCounts(SIZE, decay=0.0)
 
@@ -118,12 +123,70 @@ def test_the_priors_spread_is_the_zoos_imbalance():
 
 
 def test_balance_benchmark_row_reads_a_scene():
-    """benchmarks/balance.py on one quick zoo scene: the pooled estimate finds its C+ != C-."""
+    """benchmarks/balance.py on one quick zoo scene: both estimates find its C+ != C-."""
     from benchmarks.balance import scene_row
     from evinr_lite.sim.zoo import ZOO, quick
 
     z = quick(next(s for s in ZOO if s.name == "noisy_gravel"))
     row = scene_row(z)
     assert row["b_true"] == pytest.approx(0.1, abs=1e-9)
-    assert abs(row["raw"] - row["b_true"]) < 0.03 and 0 < row["shrink"] < 1
-    assert abs(row["applied"]) < abs(row["raw"])
+    assert abs(row["raw"] - row["b_true"]) < 0.03 and row["interval"] > 0 and 0 < row["shrink"] < 1
+    assert row["applied"] == min(row["raw"], row["interval"])            # they agree: the one nearer 0
+    assert abs(row["counts_rule"]) < abs(row["raw"])
+
+
+def _translation(duration=2.0):
+    return MovingImageScene("camera", SIZE, duration, velocity=(8.0, 3.0))
+
+
+def test_the_consensus_finds_an_imbalance_that_the_counts_rule_shrinks_away():
+    """2 s of translation, C+ 0.24 and C- 0.16 given as 0.2 (b = 0.2): few events per pixel, so the
+    counts rule keeps little of it; the counts and the intervals agree, and the consensus takes it."""
+    ev = simulate_scene(_translation(), C=0.2, C_pos=0.24, C_neg=0.16, seed=0)
+    fit, old = estimate_balance(ev, 0.2), estimate_balance(ev, 0.2, rule="counts")
+    assert fit.rule == "consensus" and fit.raw_imbalance > 0 and fit.interval_imbalance > 0
+    assert abs(fit.imbalance - 0.2) < 0.05 < abs(old.imbalance - 0.2)
+
+
+@pytest.mark.parametrize("scene", ["translation", "oscillation"])
+def test_a_change_of_light_is_not_read_as_an_imbalance(scene):
+    """Equal thresholds while the light falls by e^-0.8: more OFF than ON events, which the counts read
+    as C+ > C-; the slow falls of the light lengthen the OFF intervals, which the intervals read the
+    other way. The two disagree, and the consensus keeps the nominal C."""
+    base = _translation() if scene == "translation" else _scene(2.0)
+    ev = simulate_scene(LightingScene(base, global_change=-0.8, vignette=0.0), C=0.2, seed=0)
+    fit = estimate_balance(ev, 0.2)
+    assert fit.raw_imbalance > 0.2 and fit.interval_imbalance < 0
+    assert fit.imbalance == 0.0 and fit.C == (0.2, 0.2)
+    assert estimate_balance(ev, 0.2, rule="counts").imbalance > 0.05          # the counts rule applies some
+
+
+def test_interval_sums_time_the_runs_of_one_polarity():
+    """Pixel (0, 0): ON at 0, 0.1, 0.3, OFF at 0.4, 0.45: ON-ON intervals 0.1 and 0.2, OFF-OFF 0.05; the
+    ON -> OFF step is no interval. Pixel (0, 1): one event, no pair."""
+    ev = Events.from_arrays([0.0, 0.1, 0.2, 0.3, 0.4, 0.45], [0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 0],
+                            [1, 1, -1, 1, -1, -1], (2, 2))
+    log_on, k_on, log_off, k_off, last_t, last_p = interval_sums(ev)
+    assert k_on[0, 0] == 2 and k_off[0, 0] == 1 and k_on[0, 1] == k_off[0, 1] == 0
+    assert log_on[0, 0] == pytest.approx(np.log(0.1) + np.log(0.2), abs=1e-4)
+    assert log_off[0, 0] == pytest.approx(np.log(0.05), abs=1e-4)
+    assert last_t[0, 0] == 0.45 and last_p[0, 0] == -1 and last_p[0, 1] == -1 and np.isnan(last_t[1, 1])
+
+
+def test_minmod_and_bad_arguments():
+    assert minmod(0.2, 0.1) == 0.1 and minmod(-0.05, -0.3) == -0.05 and minmod(0.2, -0.1) == 0.0
+    n = np.ones((10, 10))
+    with pytest.raises(EventDataError, match="rule must be one of"):
+        balance_from_counts(n, n, 0.2, rule="frames")
+    with pytest.raises(EventDataError, match="intervals must be four arrays"):
+        balance_from_counts(n, n, 0.2, intervals=(n, n))
+    fit = balance_from_counts(n, n, 0.2)                    # counts alone: the consensus cannot be formed
+    assert fit.rule == "counts"
+
+
+def test_the_configs_balance_counts_is_the_rule_before_the_intervals():
+    ev = simulate_scene(_translation(), C=0.2, C_pos=0.24, C_neg=0.16, seed=0)
+    for mode, rule in (("events", "consensus"), ("counts", "counts")):
+        _, cfg = prepare_events(ev, EvINRConfig(C=0.2, balance=mode, background="keep", hot_pixels="keep",
+                                                progress=False))
+        assert cfg.C == estimate_balance(ev, 0.2, rule=rule).C

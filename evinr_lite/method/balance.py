@@ -4,51 +4,57 @@ Real sensors fire ON and OFF events at different thresholds (C+ != C-), while us
 nominal C. Integrated with one C, every event then carries a small error of the same sign for its
 polarity, and a busy pixel's level drifts linearly with its event count: on a 20 s recording with
 C+ 0.25 and C- 0.20 given as C = 0.225, the mean brightness error of the kit went from +0.45 to
--0.31 (issue 21). The drift is what events cannot tell apart from a real change of light, so it must
-be removed by an assumption, stated here:
+-0.31 (issue 21). Events cannot tell that drift from a real change of light, so it is removed by
+assumptions. Two are stated here, each giving an estimate of the imbalance
+``b = (C+ - C-) / (C+ + C-)`` (then ``C+ = C (1 + b)``, ``C- = C (1 - b)``, their mean kept at the
+nominal C: the nominal C sets the contrast, the balance only the drift):
 
-    a pixel that watches a moving scene keeps returning to log intensities it had before: over a
-    span its net change ``C+ n+ - C- n-`` is bounded (a few log units at most), while its event
-    count ``n+ + n-`` grows with the span.
+1. **Counts** (:func:`pooled_imbalance`): a pixel that watches a moving scene keeps returning to log
+   intensities it had before: over a span its net change ``C+ n+ - C- n-`` is bounded while its
+   event count grows. Pooled over pixels, ``b = sum(n- - n+) / sum(n- + n+)``. Its error is the
+   change of the *mean* log brightness over the span divided by C times the mean event count: new
+   content entering, a change of light (camera_translate: +0.20 for 0; dark_falling, light falling
+   7x: +0.61 for 0).
+2. **Intervals** (:func:`interval_imbalance`): within a run of ON events a pixel's log intensity
+   rises by C+ from one event to the next, so the interval is ``C+ / |dL/dt|``; within a run of OFF
+   events it is ``C- / |dL/dt|``. If the scene's rising and falling slopes have the same spread, the
+   mean log ON interval minus the mean log OFF interval is ``r = log(C+ / C-)``, and
+   ``b = tanh(r / 2)``. A change of the mean brightness does not enter (camera_translate: +0.02),
+   but textures whose rising and falling edges differ do (chelsea_speed +0.21 for 0; dark_falling,
+   whose falling light steepens every fall: -0.43 for 0).
 
-So over a long span ``C+ / C- -> n- / n+`` at every pixel. Pooled over pixels, the imbalance
-``b = (n- - n+) / (n- + n+)`` gives ``C+ = C (1 + b)`` and ``C- = C (1 - b)`` with their mean kept at
-the nominal C (the nominal C sets the contrast, the balance only the drift).
+The two assumptions fail on different scenes, and a real imbalance moves both estimates alike. So the
+default rule (``rule="consensus"``) takes their **minmod**: the one nearer 0 when they agree in sign,
+0 when they do not. Measured on the zoo's 13 scenes and the 10 held-out ones (their simulated b is
+0 on 14, 0.10-0.22 on 9): the estimate is within 0.05 of the truth on 22 and 0.10 short on
+unequal_onhot (+0.085 for +0.182); the counts rule (below) was up to 0.19 off on the scenes with
+C+ != C- and applied +0.19 to dark_falling. ``python benchmarks/balance.py`` prints both estimates
+per scene.
 
 How the estimate is made robust (:func:`balance_from_counts`):
 
 - hot pixels fire without a brightness change, often of one polarity (ON-only hot pixels climb
   without bound): pixels above :func:`~evinr_lite.method.denoise.hot_threshold` are left out, and so
-  are pixels whose net level, balanced with the first estimate, lies beyond OUTLIER_LOG = 4 log
+  are pixels whose net level, balanced with the counts' estimate, lies beyond OUTLIER_LOG = 4 log
   units (a 55x change of intensity: no pixel of a natural scene goes there and comes back), which
-  catches hot pixels that a busy texture hides from the count rule;
-- the imbalance is pooled over pixels, ``b = sum(n-  - n+) / sum(n- + n+)``: the pixels' real net
-  changes ``dL_i`` enter as ``-sum dL_i / (C sum n_i)``, i.e. the change of the *mean* log brightness
-  over the span divided by C times the mean event count. Pixel changes of both signs cancel; a
-  change of the mean brightness (new content entering a short window, a change of light) does not;
-- so the estimate is only trusted as far as the span carries evidence: with an uncertainty
-  ``s = NET_CHANGE / (C mean n)`` (NET_CHANGE = 0.5 log units: the spread of the change of the mean
-  log brightness over a span) and a prior spread ``PRIOR = 0.1`` of real sensors' imbalance (C+ / C-
-  about 1.2), the pooled value is shrunk by ``PRIOR^2 / (PRIOR^2 + s^2)`` (the posterior mean of a
-  normal prior and a normal error). Both spreads are the root mean square over the zoo's 15 scenes
-  (``evinr_lite.sim.zoo``, long ones included): the truth's mean log change from the first to the
-  last scored frame, 0.50 (dark_falling's -1.79 the largest, most below 0.1), and the simulated
-  imbalance, 0.084 (0 on nine scenes, 0.10-0.20 on six). On a 2 s window (mean n about 10-20
-  events per pixel at C 0.2) a quarter or less is corrected, where little drift builds up either;
-  on 20 s (mean n 50-90) 80-95 %;
-- background activity fires ON and OFF with equal probability: it dilutes the imbalance slightly
+  catches hot pixels that a busy texture hides from the count rule; both estimates use the pixels
+  left;
+- background activity fires ON and OFF with equal probability: it dilutes both estimates slightly
   towards 0 (less correction, never a wrong sign);
 - ``max_imbalance`` caps the correction (0.3: C+ / C- within 0.54 and 1.86).
 
-Measured on the zoo's scenes (``python benchmarks/balance.py`` prints the table,
-benchmarks/balance_results.md): the pooled imbalance is within 0.01 of the truth where the mean
-brightness does not change (noisy_gravel: +0.099 for +0.100; long_ijrr_60s +0.099 for +0.100) and
-off by the change of mean brightness where it does (camera_translate: +0.193 for 0, mean log change
--0.35 over 1.7 s with 13 events per pixel), which is what the shrinkage is for.
+``rule="counts"`` (``EvINRConfig(balance="counts")``) is the rule before the intervals, kept to
+compare with: the counts' estimate shrunk towards 0 as far as the span carries little evidence, with
+an uncertainty ``s = NET_CHANGE / (C mean n)`` and a prior spread ``PRIOR`` of real sensors'
+imbalance, by ``PRIOR^2 / (PRIOR^2 + s^2)`` (both spreads the zoo's root mean squares: 0.50 log
+units and 0.084). On 2 s it kept a quarter or less of a real imbalance (noisy_gravel +0.026 for
++0.100); the consensus needs no shrinkage, since neither estimate's error grows as the span gets
+shorter the way a drift does.
 
-Everything works from per-pixel counts, so a streamed recording can carry :class:`PolarityCounts`
-from window to window and estimate the balance from all the events seen so far. Where the solver
-applies it (with the hot pixels, the background filter and lam): :mod:`evinr_lite.method.prepare`.
+Everything works from per-pixel sums, so a streamed recording carries :class:`PolarityCounts` from
+window to window (with each pixel's last event, so intervals across a chunk's edge count) and
+estimates the balance from all the events seen so far. Where the solver applies it (with the hot
+pixels, the background filter and lam): :mod:`evinr_lite.method.prepare`.
 """
 from __future__ import annotations
 
@@ -60,10 +66,11 @@ from ..core.events import EventDataError, Events
 from .binning import as_thresholds
 from .denoise import hot_threshold
 
-__all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "balance_from_counts", "estimate_balance",
-           "BALANCE_MODES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
+__all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "balance_from_counts",
+           "estimate_balance", "pooled_imbalance", "interval_imbalance", "minmod", "BALANCE_MODES", "RULES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
 
-BALANCE_MODES = ("none", "events")
+BALANCE_MODES = ("none", "events", "counts")   # EvINRConfig.balance: "events" is the consensus rule
+RULES = ("consensus", "counts")
 HOT_PIXEL_MODES = ("keep", "drop")
 MIN_EVENTS = 1            # pixels with fewer events over the span are left out of the estimate
 MAX_IMBALANCE = 0.3       # |b| is capped here: C+ / C- within (0.7 / 1.3, 1.3 / 0.7)
@@ -71,6 +78,8 @@ MIN_PIXELS = 50           # fewer usable pixels: no estimate, the nominal C is k
 PRIOR = 0.1               # prior spread of real sensors' imbalance b (C+ / C- about 1.2)
 OUTLIER_LOG = 4.0         # log units: a pixel's balanced net level beyond this (55x in intensity) is left out
 NET_CHANGE = 0.5          # log units: spread of the change of the mean log brightness over a span
+MIN_INTERVAL = 1e-6       # s: intervals between events are floored here (the timestamp resolution)
+LOG_GRID = 2.0 ** 16      # log intervals are rounded to 1 / LOG_GRID (exact sums in any order)
 
 
 @dataclass
@@ -79,9 +88,12 @@ class BalanceFit:
 
     Attributes:
         C: (c_pos, c_neg) log units per event, mean = the nominal C.
-        imbalance: b applied, (C+ - C-) / (C+ + C-) = shrink x raw_imbalance, capped.
-        raw_imbalance: the pooled b = sum(n- - n+) / sum(n- + n+) over the usable pixels.
-        shrink: the weight given to the raw value (0: nominal C kept, 1: raw value used).
+        imbalance: b applied, (C+ - C-) / (C+ + C-), capped: minmod(raw_imbalance,
+            interval_imbalance) by the consensus rule, shrink x raw_imbalance by the counts rule.
+        raw_imbalance: the counts' pooled b = sum(n- - n+) / sum(n- + n+) over the usable pixels.
+        interval_imbalance: the intervals' b (NaN where not computed: the counts rule, no interval sums).
+        shrink: the counts rule's weight for the raw value (0: nominal C kept, 1: raw value used).
+        rule: the rule that gave ``imbalance`` ("consensus" or "counts").
         mean_events: mean event count of the usable pixels. n_pixels: usable pixels.
         n_hot: pixels left out as hot (by count, or by a net level beyond OUTLIER_LOG). applied: False when no estimate was made (a C pair was
         given, or too few pixels fired); C is then the given one.
@@ -95,9 +107,12 @@ class BalanceFit:
     n_pixels: int
     n_hot: int
     applied: bool
+    interval_imbalance: float = float("nan")
+    rule: str = "consensus"
 
     def summary(self) -> dict:
         return {"C": [float(c) for c in self.C], "imbalance": self.imbalance, "raw_imbalance": self.raw_imbalance,
+                "interval_imbalance": self.interval_imbalance, "rule": self.rule,
                 "shrink": self.shrink, "mean_events": self.mean_events, "n_pixels": self.n_pixels,
                 "n_hot": self.n_hot, "applied": self.applied}
 
@@ -112,9 +127,52 @@ def polarity_counts(events: Events) -> tuple[np.ndarray, np.ndarray]:
     return n_on, n_off
 
 
+def interval_sums(events: Events, last=None) -> tuple:
+    """Per-pixel sums of the log intervals between consecutive events of the same polarity.
+
+    Within a run of ON events a pixel's log intensity rises by C+ between two events, so the interval is
+    ``C+ / |dL/dt|``; within a run of OFF events it is ``C- / |dL/dt|`` (see the module docstring).
+
+    Args:
+        events: one span, time-ordered (as :class:`~evinr_lite.core.events.Events` always is).
+        last: (last_t, last_p) float64 [H, W] and int8 [H, W]: each pixel's event before this span
+            (NaN and 0 where none), so a streamed recording's chunks give the sums of the whole span.
+
+    Returns:
+        (log_on, k_on, log_off, k_off, last_t, last_p): [H, W] sums of log(interval / 1 s) and their
+        counts for ON-ON and OFF-OFF pairs, and each pixel's last event after the span. Intervals are
+        floored at MIN_INTERVAL (1 us, the timestamp resolution of event cameras).
+    """
+    H, W = events.sensor_size
+    last_t = np.full((H, W), np.nan) if last is None else np.array(last[0], np.float64)
+    last_p = np.zeros((H, W), np.int8) if last is None else np.array(last[1], np.int8)
+    flat = events.y.astype(np.int64) * W + events.x
+    order = np.argsort(flat, kind="stable")              # by pixel; time order kept within a pixel
+    f, t, p = flat[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    first = np.ones(len(f), bool)
+    first[1:] = f[1:] != f[:-1]
+    prev_t = np.empty(len(f))
+    prev_p = np.empty(len(f), np.int8)
+    prev_t[1:], prev_p[1:] = t[:-1], p[:-1]
+    prev_t[first], prev_p[first] = last_t.ravel()[f[first]], last_p.ravel()[f[first]]
+    pair = prev_p == p                                   # the same polarity as the pixel's event before
+    dt = np.log(np.maximum(t[pair] - prev_t[pair], MIN_INTERVAL))
+    # on a grid of 2^-16 log units the sums are exact whatever their order, so a recording counted in
+    # chunks gives the same C pair as the whole span, bit for bit
+    dt = np.rint(dt * LOG_GRID) / LOG_GRID
+    fp, on = f[pair], p[pair] > 0
+    sums = [np.bincount(fp[sel], w, minlength=H * W).reshape(H, W)
+            for sel in (on, ~on) for w in (dt[sel], None)]
+    end = np.ones(len(f), bool)
+    end[:-1] = f[1:] != f[:-1]
+    last_t.ravel()[f[end]], last_p.ravel()[f[end]] = t[end], p[end]
+    return (*sums, last_t, last_p)
+
+
 @dataclass
 class PolarityCounts:
-    """Running per-pixel ON / OFF counts, carried from window to window of a streamed recording.
+    """Running per-pixel ON / OFF counts (and interval sums), carried from window to window of a
+    streamed recording.
 
         counts = PolarityCounts((H, W))
         for window in windows:
@@ -122,13 +180,17 @@ class PolarityCounts:
             fit = counts.fit(C)          # the balance of everything seen so far
 
     ``decay`` in (0, 1]: the counts so far are multiplied by it before each update (1: all windows
-    count alike; < 1 follows a balance that changes over the recording).
+    count alike; < 1 follows a balance that changes over the recording). The interval sums
+    (:func:`interval_sums`) follow the last event of each pixel across updates, so chunks give the
+    sums of the whole span.
     """
 
     sensor_size: tuple
     decay: float = 1.0
     n_on: np.ndarray = field(default=None, repr=False)
     n_off: np.ndarray = field(default=None, repr=False)
+    intervals: tuple = field(default=None, repr=False)     # (log_on, k_on, log_off, k_off), [H, W] each
+    last: tuple = field(default=None, repr=False)          # (last_t, last_p), [H, W] each
 
     def __post_init__(self):
         if not (0 < float(self.decay) <= 1):
@@ -136,6 +198,8 @@ class PolarityCounts:
         H, W = self.sensor_size
         self.n_on = np.zeros((H, W)) if self.n_on is None else np.asarray(self.n_on, np.float64)
         self.n_off = np.zeros((H, W)) if self.n_off is None else np.asarray(self.n_off, np.float64)
+        if self.intervals is None:
+            self.intervals = tuple(np.zeros((H, W)) for _ in range(4))
 
     def update(self, events: Events) -> "PolarityCounts":
         if tuple(events.sensor_size) != tuple(self.sensor_size):
@@ -144,52 +208,94 @@ class PolarityCounts:
         on, off = polarity_counts(events)
         self.n_on = self.n_on * self.decay + on
         self.n_off = self.n_off * self.decay + off
+        *new, last_t, last_p = interval_sums(events, self.last)
+        self.intervals = tuple(old * self.decay + add for old, add in zip(self.intervals, new))
+        self.last = (last_t, last_p)
         return self
 
-    def fit(self, C) -> BalanceFit:
-        return balance_from_counts(self.n_on, self.n_off, C)
+    def fit(self, C, rule: str = "consensus") -> BalanceFit:
+        return balance_from_counts(self.n_on, self.n_off, C, intervals=self.intervals, rule=rule)
 
 
-def balance_from_counts(n_on, n_off, C, *, min_events: int = MIN_EVENTS, max_imbalance: float = MAX_IMBALANCE,
-                        prior: float = PRIOR, net_change: float = NET_CHANGE) -> BalanceFit:
-    """The balance from per-pixel counts (see the module docstring for the assumption and the shrinkage).
+def interval_imbalance(intervals, usable) -> float:
+    """The imbalance b read from the intervals of the ``usable`` pixels (bool [H, W]): with r the pooled
+    mean log ON interval minus the mean log OFF interval, an estimate of log(C+ / C-),
+    ``b = (e^r - 1) / (e^r + 1) = tanh(r / 2)``. NaN when either polarity has fewer than MIN_PIXELS pairs."""
+    log_on, k_on, log_off, k_off = (np.asarray(a, np.float64)[usable] for a in intervals)
+    if k_on.sum() < MIN_PIXELS or k_off.sum() < MIN_PIXELS:
+        return float("nan")
+    r = log_on.sum() / k_on.sum() - log_off.sum() / k_off.sum()
+    return float(np.tanh(r / 2))
+
+
+def minmod(a: float, b: float) -> float:
+    """The smaller in magnitude of two estimates that agree in sign, 0 when they disagree."""
+    return float(np.sign(a) * min(abs(a), abs(b))) if a * b > 0 else 0.0
+
+
+def pooled_imbalance(n_on, n_off, usable) -> float:
+    """The counts' estimate of b over the ``usable`` pixels (bool [H, W]): sum(n- - n+) / sum(n- + n+)."""
+    n = n_on[usable] + n_off[usable]
+    return float((n_off[usable] - n_on[usable]).sum() / n.sum())
+
+
+def balance_from_counts(n_on, n_off, C, *, intervals=None, rule: str = "consensus", min_events: int = MIN_EVENTS,
+                        max_imbalance: float = MAX_IMBALANCE, prior: float = PRIOR,
+                        net_change: float = NET_CHANGE) -> BalanceFit:
+    """The balance from per-pixel sums (see the module docstring for the assumptions and the rules).
 
     Args:
         n_on, n_off: [H, W] ON and OFF counts per pixel (floats allowed: decayed running sums).
         C: the nominal threshold (one number; a pair is returned unchanged with ``applied=False``,
             since whoever gave C+ and C- already knows the balance).
+        intervals: (log_on, k_on, log_off, k_off) [H, W] from :func:`interval_sums` (or
+            :attr:`PolarityCounts.intervals`). Without them the consensus cannot be formed and the
+            counts rule is used (``fit.rule`` says so).
+        rule: "consensus" (minmod of the counts' and the intervals' estimates) or "counts" (the counts'
+            estimate shrunk by its evidence).
         min_events: pixels with fewer events are left out. max_imbalance: cap on |b|.
-        prior, net_change: the shrinkage's prior spread of b and plausible mean log change (log units).
+        prior, net_change: the counts rule's prior spread of b and plausible mean log change (log units).
 
     Returns:
         :class:`BalanceFit` with C = (C (1 + b), C (1 - b)).
     """
+    if rule not in RULES:
+        raise EventDataError(f"rule must be one of {RULES}, got {rule!r}")
     n_on = np.asarray(n_on, np.float64)
     n_off = np.asarray(n_off, np.float64)
     if n_on.shape != n_off.shape:
         raise EventDataError(f"n_on {n_on.shape} and n_off {n_off.shape} must have the same shape")
+    if intervals is not None and (len(intervals) != 4 or any(np.shape(a) != n_on.shape for a in intervals)):
+        raise EventDataError(f"intervals must be four arrays of the counts' shape {n_on.shape} (log_on, k_on, "
+                             "log_off, k_off, as interval_sums returns)")
     c_pos, c_neg = as_thresholds(C)
     if np.ndim(C) != 0:
-        return BalanceFit((c_pos, c_neg), 0.0, 0.0, 0.0, 0.0, 0, 0, False)
+        return BalanceFit((c_pos, c_neg), 0.0, 0.0, 0.0, 0.0, 0, 0, False, rule=rule)
+    rule = rule if intervals is not None else "counts"
     n = n_on + n_off
     hot = n > hot_threshold(np.rint(n), rule="mad")
     usable = (n >= min_events) & ~hot
     if usable.sum() < MIN_PIXELS:
-        return BalanceFit((c_pos, c_neg), 0.0, 0.0, 0.0, 0.0, int(usable.sum()), int(hot.sum()), False)
-    raw = float((n_off[usable] - n_on[usable]).sum() / n[usable].sum())
+        return BalanceFit((c_pos, c_neg), 0.0, 0.0, 0.0, 0.0, int(usable.sum()), int(hot.sum()), False, rule=rule)
+    raw = pooled_imbalance(n_on, n_off, usable)
     # second pass: a pixel whose net level, once balanced, lies beyond any natural scene's range is not
     # watching the scene (a hot pixel below the count rule, a broken one): leave it out too
     stray = usable & (c_pos * np.abs((n_off - n_on) - raw * n) > OUTLIER_LOG)
     if stray.any() and (usable & ~stray).sum() >= MIN_PIXELS:
         usable &= ~stray
         hot |= stray
-        raw = float((n_off[usable] - n_on[usable]).sum() / n[usable].sum())
+        raw = pooled_imbalance(n_on, n_off, usable)
     mean_n = float(n[usable].mean())
     s = net_change / (c_pos * mean_n)
     shrink = prior ** 2 / (prior ** 2 + s ** 2)
-    b = float(np.clip(shrink * raw, -max_imbalance, max_imbalance))
+    if rule == "consensus":
+        ivl = interval_imbalance(intervals, usable)
+        b = minmod(raw, ivl) if np.isfinite(ivl) else 0.0      # no runs of one polarity to time: no evidence
+    else:
+        ivl, b = float("nan"), shrink * raw
+    b = float(np.clip(b, -max_imbalance, max_imbalance))
     return BalanceFit((c_pos * (1 + b), c_neg * (1 - b)), b, raw, shrink, mean_n, int(usable.sum()),
-                      int(hot.sum()), True)
+                      int(hot.sum()), True, ivl, rule)
 
 
 def estimate_balance(events: Events, C, **kw) -> BalanceFit:
@@ -199,4 +305,5 @@ def estimate_balance(events: Events, C, **kw) -> BalanceFit:
     events = require(events, Events, "events")
     if len(events) == 0:
         raise EventDataError("no events to estimate the ON/OFF balance from; pass a span with events")
-    return balance_from_counts(*polarity_counts(events), C, **kw)
+    counts = PolarityCounts(tuple(events.sensor_size)).update(events)
+    return balance_from_counts(counts.n_on, counts.n_off, C, intervals=counts.intervals, **kw)

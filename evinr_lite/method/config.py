@@ -238,10 +238,12 @@ class EvINRConfig:
             frequencies below this scale (a Gaussian's sigma, pixels) come from the integrated
             events' own offset solve, the finer ones and every change in time from the INR
             (:mod:`evinr_lite.method.coarse`); None: the static image from the INR's frames alone.
-        balance: "none" (ON and OFF events weigh C as given) or "events": when C is one number, C+ and
-            C- are estimated from the events' ON/OFF counts, their mean kept at C, shrunk towards C as
-            far as the span carries little evidence (:mod:`evinr_lite.method.balance`); a given pair is
-            used as it is.
+        balance: "none" (ON and OFF events weigh C as given), "events" or "counts": when C is one number,
+            C+ and C- are estimated from the events, their mean kept at C
+            (:mod:`evinr_lite.method.balance`). "events": the consensus (minmod) of two estimates with
+            different assumptions, the ON/OFF counts and the intervals between events of one polarity;
+            "counts": the counts' estimate alone, shrunk towards C as far as the span carries little
+            evidence (the rule before the intervals). A given pair is used as it is.
         hot_pixels: "keep" or "drop": the events of pixels firing far above the sensor's robust rate
             (:func:`evinr_lite.method.denoise.hot_pixel_mask`) are left out before training.
         background: "keep" or "filter": background activity (isolated events with no event of the same

@@ -10,8 +10,8 @@ In this order, each judged on what the step before left (``EvINRConfig`` fields 
    defaults). Hot pixels go first: their events would otherwise keep their neighbours' noise;
 3. the ON/OFF balance (``balance="events"``: C+ and C- from one nominal C,
    :mod:`~evinr_lite.method.balance`) and ``lam="auto"`` (:mod:`~evinr_lite.method.smoothing`),
-   both from the per-pixel ON / OFF counts of the events that are left; pixels still hot on those
-   counts are dropped too.
+   both from the per-pixel ON / OFF counts (and, for the balance, the intervals between events of one
+   polarity) of the events that are left; pixels still hot on those counts are dropped too.
 
 :func:`prepare_events` does this for events in memory (:func:`~evinr_lite.method.solver.reconstruct`),
 :func:`prepare_source` for a recording read window by window
@@ -30,7 +30,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..core.events import EventDataError, Events
-from .balance import PolarityCounts, balance_from_counts, polarity_counts
+from .balance import PolarityCounts, balance_from_counts
 from .denoise import DEFAULT_DT, denoise_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
@@ -41,9 +41,10 @@ BACKGROUND_MODES = ("keep", "filter")
 REACH = 2 * DEFAULT_DT    # s read beyond a streamed window's edges: more than the filter's DEFAULT_DT, so rounding never matters
 
 
-def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0):
-    """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance == "events"`` and
-    C is one number, ``lam="auto"`` replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
+def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None):
+    """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance`` is not "none" and
+    C is one number (``intervals``: the span's :attr:`~evinr_lite.method.balance.PolarityCounts.intervals`,
+    which the "events" rule needs; without them it falls back to the "counts" rule), ``lam="auto"`` replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
     for windows covering ``fraction`` of the span), and the hot pixels to drop (bool [H, W], all False
     unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
     changed (a copy)."""
@@ -53,8 +54,10 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0):
     hot = np.zeros(n.shape, bool)
     if cfg.hot_pixels == "drop":
         hot = _hot_mask(n)
-    if cfg.balance == "events" and np.ndim(cfg.C) == 0:
-        fit = balance_from_counts(np.where(hot, 0, n_on), np.where(hot, 0, n_off), cfg.C)
+    if cfg.balance != "none" and np.ndim(cfg.C) == 0:
+        fit = balance_from_counts(np.where(hot, 0, n_on), np.where(hot, 0, n_off), cfg.C,
+                                  intervals=None if intervals is None else [np.where(hot, 0, a) for a in intervals],
+                                  rule="counts" if cfg.balance == "counts" else "consensus")
         if fit.applied:
             cfg = replace(cfg, C=fit.C)
     if cfg.lam == "auto":
@@ -102,7 +105,9 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
         n_in = len(events)
         events = events.take(denoise_mask(events, hot_pixels=cfg.hot_pixels == "drop")[0])
         _check_left(len(events), n_in)
-    cfg, hot = plan_from_counts(*polarity_counts(events), cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap))
+    counts = PolarityCounts(tuple(events.sensor_size)).update(events)
+    cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap),
+                                counts.intervals)
     return drop_pixels(events, hot), cfg
 
 
@@ -181,7 +186,8 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         counts = _counts(_Prepared(source, span, first, background=True), t_start, t_end, chunk_s,
                          "filtering background activity" if progress else None)
         _check_left(int((counts.n_on + counts.n_off).sum()), n_in)
-    cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap))
+    cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap),
+                                counts.intervals)
     if not filtered and not hot.any():
         return cfg, source
     return cfg, _Prepared(source, span, first, background=filtered, then=hot)
