@@ -140,6 +140,15 @@ class EvINRConfig:
       0.567 / 0.664 / 0.0379 -> 0.569 / 0.669 / 0.0352 (level error per quarter -0.027 ... -0.153 ->
       -0.070 ... -0.116, the display level near -0.09 aside), cat_slider_20s 0.488 -> 0.494 (MSE 0.0552 ->
       0.0503).
+      Then the balance became the consensus (minmod) of the counts' estimate and the intervals'
+      (C+ / C- from the mean log interval within runs of ON and of OFF events), unshrunk. A change of
+      light biases the two in opposite directions, and a real imbalance moves both alike
+      (:mod:`evinr_lite.method.balance`, ``python benchmarks/balance.py [--heldout]``: within 0.05 of
+      the simulated b on 24 of the zoo's and held-out's 25 scenes; root mean square error 0.027 and
+      0.019 against the counts rule's 0.087 and 0.100). Zoo mean 0.643 / 0.703 / 0.0344 ->
+      0.648 / 0.710 / 0.0337, real chunk 0.377 / 0.461 / 0.0696 -> 0.377 / 0.457 / 0.0668, held-out
+      0.536 / 0.583 / 0.0629 -> 0.541 / 0.590 / 0.0608 (``python benchmarks/quality_zoo.py
+      [--heldout]``; docs/defaults.md, "The ON/OFF balance as a consensus"). ``balance="counts"`` keeps the rule before.
 
     - tonemap="linear", display_mean=0.4 (issue 21; the paper's Eq. 12 with the mean of F at 0.5
       before): frames are clip(exp(F), 0, 1), the intensity whose log changes fired the events, with
