@@ -4,8 +4,8 @@ import pytest
 
 from evinr_lite.core.events import EventDataError, Events
 from evinr_lite.method import EvINRConfig, reconstruct
-from evinr_lite.method.balance import (PolarityCounts, balance_from_counts, estimate_balance, interval_sums, minmod,
-                                       polarity_counts)
+from evinr_lite.method.balance import (MAX_INTERVAL_PIXELS, PolarityCounts, balance_from_counts, estimate_balance,
+                                       interval_stride, interval_sums, minmod, polarity_counts)
 from evinr_lite.method.prepare import prepare_events
 from evinr_lite.sim.scenes import LightingScene, MovingImageScene, OscillatingScene
 from evinr_lite.sim.simulate import add_hot_pixels, simulate_scene
@@ -190,3 +190,24 @@ def test_the_configs_balance_counts_is_the_rule_before_the_intervals():
         _, cfg = prepare_events(ev, EvINRConfig(C=0.2, balance=mode, background="keep", hot_pixels="keep",
                                                 progress=False))
         assert cfg.C == estimate_balance(ev, 0.2, rule=rule).C
+
+
+def test_large_sensors_time_a_grid_of_pixels():
+    """Above MAX_INTERVAL_PIXELS the intervals come from every s-th row and column: on a 2 x 2 tiling
+    of a small recording (300 x 400 pixels, stride 2) each tile's grid pixels give that tile's own
+    intervals, and chunks still add up to the whole span."""
+    assert interval_stride((180, 240)) == 1 and interval_stride((720, 1280)) == 4
+    assert -(-720 // 4) * -(-1280 // 4) <= MAX_INTERVAL_PIXELS
+    small = simulate_scene(_translation(), C=0.2, C_pos=0.24, C_neg=0.16, seed=0)      # 30 x 40
+    big = Events.from_arrays(small.t, small.x * 10, small.y * 10, small.p, (300, 400))  # every 10th pixel
+    assert interval_stride(big.sensor_size) == 2
+    log_on, k_on, log_off, k_off, *_ = interval_sums(big)
+    ref = interval_sums(small)
+    np.testing.assert_array_equal(k_on[::10, ::10], ref[1])
+    np.testing.assert_array_equal(log_off[::10, ::10], ref[2])
+    assert k_on.sum() == ref[1].sum()                       # every event sits on the stride-2 grid
+    counts = PolarityCounts(big.sensor_size)
+    for a in (0.0, 0.7, 1.4):
+        counts.update(big.slice_time(a, a + 0.7 if a < 1.4 else 2.1, allow_empty=True))
+    for chunked, one in zip(counts.intervals, interval_sums(big)):
+        np.testing.assert_array_equal(chunked, one)

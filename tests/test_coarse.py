@@ -103,11 +103,15 @@ def test_the_memory_estimate_counts_what_the_coarse_part_allocates(translating):
     grid = np.linspace(0.0, 2.0, 64)
     frames = np.zeros((64, 48, 64), np.float32)
     est = estimate_memory((48, 64), 0.0, 2.0, len(events), 10, EvINRConfig())["coarse_bytes"]
-    tracemalloc.start()
-    coarse_correction([events], (0.22, 0.18), grid, frames, 8.0, "l1_gradient")
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    assert 0.75 * peak <= est <= 1.25 * peak, (est, peak)
+    coarse_correction([events], (0.22, 0.18), grid, frames, 8.0, "l1_gradient")      # imports and caches first
+    peaks = []
+    for _ in range(3):       # tracemalloc also counts other threads' allocations (a worker's leftovers): the least of 3
+        tracemalloc.start()
+        coarse_correction([events], (0.22, 0.18), grid, frames, 8.0, "l1_gradient")
+        peaks.append(tracemalloc.get_traced_memory()[1])
+        tracemalloc.stop()
+    peak = min(peaks)
+    assert 0.75 * peak <= est <= 1.25 * peak, (est, peaks)
     for streaming in (False, True):
         long = [estimate_memory((720, 1280), 0.0, MAX_SPAN_S + 1, 20_000_000, 10, c, streaming=streaming)
                 for c in (EvINRConfig(), EvINRConfig(offset_coarse_px=None))]

@@ -68,7 +68,7 @@ from .binning import as_thresholds
 from .denoise import hot_threshold
 
 __all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "balance_from_counts",
-           "estimate_balance", "pooled_imbalance", "interval_imbalance", "minmod", "BALANCE_MODES", "RULES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
+           "estimate_balance", "pooled_imbalance", "interval_imbalance", "interval_stride", "minmod", "BALANCE_MODES", "RULES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
 
 BALANCE_MODES = ("none", "events", "counts")   # EvINRConfig.balance: "events" is the consensus rule
 RULES = ("consensus", "counts")
@@ -81,6 +81,7 @@ OUTLIER_LOG = 4.0         # log units: a pixel's balanced net level beyond this 
 NET_CHANGE = 0.5          # log units: spread of the change of the mean log brightness over a span
 MIN_INTERVAL = 1e-6       # s: intervals between events are floored here (the timestamp resolution)
 LOG_GRID = 2.0 ** 16      # log intervals are rounded to 1 / LOG_GRID (exact sums in any order)
+MAX_INTERVAL_PIXELS = 1 << 16   # pixels whose intervals are timed at most (interval_stride: a grid on larger sensors)
 
 
 @dataclass
@@ -128,11 +129,24 @@ def polarity_counts(events: Events) -> tuple[np.ndarray, np.ndarray]:
     return n_on, n_off
 
 
+def interval_stride(sensor_size) -> int:
+    """The stride s of the pixel grid whose intervals are timed: every pixel (s = 1) up to
+    MAX_INTERVAL_PIXELS pixels, else every s-th row and column, the least s that keeps the grid within
+    it (1280 x 720: s = 4, 57,600 pixels). The estimate pools their pairs; more pixels add time, not
+    evidence, and a grid below 2^16 pixels sorts in one 16-bit radix pass."""
+    H, W = sensor_size
+    s = 1
+    while -(-H // s) * -(-W // s) > MAX_INTERVAL_PIXELS:
+        s += 1
+    return s
+
+
 def interval_sums(events: Events, last=None) -> tuple:
     """Per-pixel sums of the log intervals between consecutive events of the same polarity.
 
     Within a run of ON events a pixel's log intensity rises by C+ between two events, so the interval is
     ``C+ / |dL/dt|``; within a run of OFF events it is ``C- / |dL/dt|`` (see the module docstring).
+    Pixels off the grid of :func:`interval_stride` get no pairs (large sensors only).
 
     Args:
         events: one span, time-ordered (as :class:`~evinr_lite.core.events.Events` always is).
@@ -145,28 +159,40 @@ def interval_sums(events: Events, last=None) -> tuple:
         floored at MIN_INTERVAL (1 us, the timestamp resolution of event cameras).
     """
     H, W = events.sensor_size
+    s = interval_stride((H, W))
+    Hs, Ws = -(-H // s), -(-W // s)
     last_t = np.full((H, W), np.nan) if last is None else np.array(last[0], np.float64)
     last_p = np.zeros((H, W), np.int8) if last is None else np.array(last[1], np.int8)
-    flat = events.y.astype(np.int64) * W + events.x
-    order = np.argsort(flat, kind="stable")              # by pixel; time order kept within a pixel
-    f, t, p = flat[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    x, y, t, p = events.x, events.y, np.asarray(events.t, np.float64), events.p
+    if s > 1:
+        on_grid = (x % s == 0) & (y % s == 0)
+        x, y, t, p = x[on_grid], y[on_grid], t[on_grid], p[on_grid]
+    grid_t, grid_p = last_t[::s, ::s].ravel(), last_p[::s, ::s].ravel()       # copies, written back below
+    cell = ((y // s) * Ws + x // s).astype(np.uint16 if Hs * Ws <= 1 << 16 else np.int64)
+    order = np.argsort(cell, kind="stable")              # by pixel; time order kept within a pixel
+    f, t, p = cell[order].astype(np.int64), t[order], p[order]
     first = np.ones(len(f), bool)
     first[1:] = f[1:] != f[:-1]
     prev_t = np.empty(len(f))
     prev_p = np.empty(len(f), np.int8)
     prev_t[1:], prev_p[1:] = t[:-1], p[:-1]
-    prev_t[first], prev_p[first] = last_t.ravel()[f[first]], last_p.ravel()[f[first]]
+    prev_t[first], prev_p[first] = grid_t[f[first]], grid_p[f[first]]
     pair = prev_p == p                                   # the same polarity as the pixel's event before
     dt = np.log(np.maximum(t[pair] - prev_t[pair], MIN_INTERVAL))
     # on a grid of 2^-16 log units the sums are exact whatever their order, so a recording counted in
     # chunks gives the same C pair as the whole span, bit for bit
     dt = np.rint(dt * LOG_GRID) / LOG_GRID
     fp, on = f[pair], p[pair] > 0
-    sums = [np.bincount(fp[sel], w, minlength=H * W).reshape(H, W)
-            for sel in (on, ~on) for w in (dt[sel], None)]
+    sums = []
+    for sel in (on, ~on):
+        for w in (dt[sel], None):
+            full = np.zeros((H, W))
+            full[::s, ::s] = np.bincount(fp[sel], w, minlength=Hs * Ws).reshape(Hs, Ws)
+            sums.append(full)
     end = np.ones(len(f), bool)
     end[:-1] = f[1:] != f[:-1]
-    last_t.ravel()[f[end]], last_p.ravel()[f[end]] = t[end], p[end]
+    grid_t[f[end]], grid_p[f[end]] = t[end], p[end]
+    last_t[::s, ::s], last_p[::s, ::s] = grid_t.reshape(Hs, Ws), grid_p.reshape(Hs, Ws)
     return (*sums, last_t, last_p)
 
 
