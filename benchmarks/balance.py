@@ -2,6 +2,7 @@
 
     python benchmarks/balance.py              # the zoo's scenes, long ones included (about 2 min on 2 cores)
     python benchmarks/balance.py --heldout    # the held-out scenes instead
+    python benchmarks/balance.py --speed      # what the intervals cost beside the counts, 1280 x 720 (about 10 s)
 
 For each scene, on the events the kit trains on (hot pixels dropped, background filtered, as
 :mod:`evinr_lite.method.prepare` does): the simulated imbalance b = (C+ - C-) / (C+ + C-), the two
@@ -57,10 +58,39 @@ def markdown(rows: dict, rms: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def speed(n_events: int = 20_000_000, sensor_size=(720, 1280), seed: int = 0) -> dict:
+    """Seconds of :func:`polarity_counts` and :func:`interval_sums` on the same random events (uniform
+    over the sensor and 2 s), and their ratio, measured in one run."""
+    import time
+
+    from evinr_lite.core.events import Events
+    from evinr_lite.method.balance import interval_stride, interval_sums, polarity_counts
+
+    rng = np.random.default_rng(seed)
+    H, W = sensor_size
+    events = Events(np.sort(rng.uniform(0.0, 2.0, n_events)), rng.integers(0, W, n_events, dtype=np.int32),
+                    rng.integers(0, H, n_events, dtype=np.int32), rng.choice(np.array([-1, 1], np.int8), n_events),
+                    (H, W))
+    seconds = {}
+    for name, f in (("polarity_counts", polarity_counts), ("interval_sums", interval_sums)):
+        t0 = time.perf_counter()
+        f(events)
+        seconds[name] = time.perf_counter() - t0
+    return {"n_events": n_events, "sensor_size": [H, W], "stride": interval_stride((H, W)), **seconds,
+            "ratio": seconds["interval_sums"] / seconds["polarity_counts"]}
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--heldout", action="store_true", help="the held-out scenes instead of the zoo's")
+    p.add_argument("--speed", action="store_true", help="only time the intervals against the counts (1280 x 720)")
     a = p.parse_args(argv)
+    if a.speed:
+        r = speed()
+        print(f"{r['n_events']:,} events at {r['sensor_size'][1]} x {r['sensor_size'][0]} (interval stride "
+              f"{r['stride']}): polarity_counts {r['polarity_counts']:.2f} s, interval_sums {r['interval_sums']:.2f} s "
+              f"({r['ratio']:.2f}x)")
+        return 0
     suffix = "_heldout" if a.heldout else ""
     rows = {}
     for z in (HELDOUT if a.heldout else default_scenes(long=True)):

@@ -211,3 +211,10 @@ def test_large_sensors_time_a_grid_of_pixels():
         counts.update(big.slice_time(a, a + 0.7 if a < 1.4 else 2.1, allow_empty=True))
     for chunked, one in zip(counts.intervals, interval_sums(big)):
         np.testing.assert_array_equal(chunked, one)
+
+
+def test_balance_benchmark_times_the_intervals_against_the_counts():
+    from benchmarks.balance import speed
+
+    r = speed(n_events=20_000, sensor_size=(300, 400))
+    assert r["stride"] == 2 and r["interval_sums"] > 0 and r["ratio"] == r["interval_sums"] / r["polarity_counts"]
