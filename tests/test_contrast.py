@@ -201,6 +201,28 @@ def test_cli_C_auto_records_the_fit(capsys, example, tmp_path):
     assert f"C+ = {fit['c_pos']:.3f} ± {fit['c_pos_se']:.3f}" in text
 
 
+def test_cli_reports_the_on_off_balance_it_applied(capsys, example, tmp_path):
+    """One C given: the run says which C+ / C- the events gave (their mean the given C) and records it;
+    a pair given is used as it is, with nothing to report."""
+    code = main(["reconstruct", str(example), "--out", str(tmp_path / "one"), "--C", "0.25", "--no-video", "--quiet"])
+    text = capsys.readouterr().out
+    run = json.loads((tmp_path / "one" / "run.json").read_text())
+    assert code == 0 and run["C"] == 0.25 and run["evinr_config"]["C"] == run["C_used"]
+    assert np.mean(run["C_used"]) == pytest.approx(0.25)
+    assert f"C+ = {run['C_used'][0]:.4f}, C- = {run['C_used'][1]:.4f}" in text and "--C 0.25,0.25" in text
+    code = main(["reconstruct", str(example), "--out", str(tmp_path / "pair"), "--C", "0.25,0.25", "--no-video",
+                 "--quiet"])
+    assert code == 0 and "ON/OFF balance" not in capsys.readouterr().out
+    assert "C_used" not in json.loads((tmp_path / "pair" / "run.json").read_text())
+    # the in-memory job (denoise: every event of the window at once) reports it the same way
+    code = main(["reconstruct", str(example), "--out", str(tmp_path / "mem"), "--C", "0.25", "--denoise",
+                 "--no-video", "--quiet"])
+    text = capsys.readouterr().out
+    run = json.loads((tmp_path / "mem" / "run.json").read_text())
+    assert code == 0 and run["evinr_config"]["C"] == run["C_used"] and "denoise" in run
+    assert f"C+ = {run['C_used'][0]:.4f}" in text
+
+
 def test_cli_C_auto_without_frames_says_what_to_do(capsys, example, tmp_path):
     folder = tmp_path / "events_only"
     shutil.copytree(example, folder)

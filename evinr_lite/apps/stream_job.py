@@ -23,7 +23,7 @@ import json
 import os
 import shutil
 import time
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +60,18 @@ def _identity(path) -> dict:
         ident["files"] = sorted((str(f.relative_to(p)), f.stat().st_size, f.stat().st_mtime_ns)
                                 for f in p.rglob("*") if f.is_file())
     return ident
+
+
+def report_balance(C, used, settings: dict, log) -> None:
+    """When one C was given and the ON/OFF balance (method/balance.py) made it a pair: log the pair and
+    record it in ``settings["C_used"]`` (the in-memory and the streamed job both)."""
+    from ..method.recipes import format_contrast
+
+    if np.ndim(C) != 0 or used is None or np.ndim(used) == 0 or len(used) != 2:
+        return
+    settings["C_used"] = [float(c) for c in used]
+    log(f"ON/OFF balance from the events: C+ = {used[0]:.4f}, C- = {used[1]:.4f}, their mean the given "
+        f"C = {format_contrast(C)} (pass --C {format_contrast(C)},{format_contrast(C)} to use it for both)")
 
 
 def _key(path, config, times, window) -> dict:
@@ -205,9 +217,12 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     save_timestamps(target.staging / "timestamps.txt", times, source.t_origin)
     written = ["frames/", "timestamps.txt"] + writer.finish()
     scores = score_predictions(writer.gt_frames(), gt.t, gt) if gt is not None else None
-    history = {**history, "config": asdict(config), "streamed": True}
+    used = history.get("C_used")
+    history = {**history, "config": asdict(config if used is None or len(used) != 2 else replace(config, C=tuple(used))),
+               "streamed": True}
     settings = {"C": C, "C_source": C_source, "times_source": times_source, "device": device_name,
                 "seed": options.seed, "memory_estimate_bytes": est["total"]}
+    report_balance(C, used, settings, log)
     if writer.video_fps is not None:
         settings["video_fps"] = writer.video_fps
     run = write_results(target.staging, rec, times, history, scores, settings=settings, written=written,
