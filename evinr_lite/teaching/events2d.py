@@ -9,6 +9,10 @@ The reference solutions of notebook 02's exercises live here and are registered 
 - :func:`events_to_frames_fixed`: Eq. 2 per pixel and bin, C times the sum of polarities of
   the events in (b_i, b_{i+1}], written with ``np.add.at``.
   :func:`evinr_lite.method.binning.events_to_frames` is the package's version (with ``np.bincount``).
+- :func:`interval_imbalance`: the ON/OFF imbalance from the intervals between consecutive events of
+  one polarity at each pixel, pooled over the sensor. :func:`evinr_lite.method.balance.interval_sums`
+  and :func:`~evinr_lite.method.balance.interval_imbalance` are the package's (per-pixel sums carried
+  across chunks, hot pixels left out), and the kit takes its minmod with the ON/OFF counts' estimate.
 
 Small helpers for the notebook: :func:`pixel_trace` (one pixel's events) and
 :func:`busiest_pixel`.
@@ -22,7 +26,7 @@ import numpy as np
 from . import exercises
 from ..core.events import Events
 
-__all__ = ["esim_interval", "events_to_frames_fixed", "pixel_trace", "busiest_pixel"]
+__all__ = ["esim_interval", "events_to_frames_fixed", "interval_imbalance", "pixel_trace", "busiest_pixel"]
 
 
 # ---- exercise 1: the simulator for one pixel and one frame interval ------------------------
@@ -111,7 +115,7 @@ exercises.register(
     })
 
 
-# ---- exercise 2: event frames over bins (Eq. 2) --------------------------------------------
+# ---- exercise 3: event frames over bins (Eq. 2) --------------------------------------------
 
 def events_to_frames_fixed(events: Events, boundaries, C):
     """Event frames: ``frames[i, y, x] = C * sum of p`` over the events at (x, y) with
@@ -211,6 +215,135 @@ exercises.register(
             _frames_no_first_edge,
         "images are indexed [y, x] (row, column)":
             _frames_xy_swapped,
+    })
+
+
+# ---- exercise 2: the ON/OFF balance from the intervals between events --------------------
+
+MIN_INTERVAL = 1e-6   # s: intervals are floored here (the timestamp resolution), as evinr_lite.method.balance does
+
+
+def interval_imbalance(events: Events) -> float:
+    """The imbalance b = (C+ - C-) / (C+ + C-) read from the intervals between events of one polarity.
+
+    At every pixel, an interval counts between two *consecutive* events of that pixel with the same
+    polarity (an ON run: C+ / |dL/dt|; an OFF run: C- / |dL/dt|). Pooled over all pixels,
+    r = mean log ON interval - mean log OFF interval estimates log(C+ / C-), and b = tanh(r / 2).
+
+    Args:
+        events: an :class:`Events` (t sorted, seconds; x column, y row; p +-1).
+
+    Returns:
+        b (float); NaN when the events hold no ON pair or no OFF pair.
+    """
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * W + events.x
+    order = np.argsort(pix, kind="stable")              # by pixel, time order kept within a pixel
+    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])   # consecutive at one pixel, same polarity
+    log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    r = log_dt[pair & on].mean() - log_dt[pair & ~on].mean()
+    return float(np.tanh(r / 2))
+
+
+def _inputs_intervals(rng):
+    from ..sim.scenes import OscillatingScene
+    from ..sim.simulate import simulate_scene
+
+    cases = []
+    for b in (0.2, -0.15):                             # a small picture moving to and fro, C+ != C-
+        scene = OscillatingScene("camera", (8, 10), 1.0, path=((3.0, 2.0, 3.0, 0.0), (1.0, 1.5, 2.0, 1.0)))
+        cases.append(dict(events=simulate_scene(scene, C=0.2, C_pos=0.2 * (1 + b), C_neg=0.2 * (1 - b), seed=0)))
+    # two OFF events at one pixel with the same timestamp (a sensor's burst): the floor at MIN_INTERVAL
+    t = np.array([0.0, 0.1, 0.2, 0.2, 0.3, 0.35])
+    cases.append(dict(events=Events(t, np.zeros(6, np.int64), np.zeros(6, np.int64),
+                                    np.array([1, 1, -1, -1, -1, 1]), (1, 1))))
+    # two pixels by hand: (0, 0) ON at 0, 0.1, 0.3, OFF at 0.4, 0.45, ON at 0.9; (0, 1) OFF at 0.05, 0.25;
+    # interleaved in time, so pairs must be taken per pixel
+    t = np.array([0.0, 0.05, 0.1, 0.25, 0.3, 0.4, 0.45, 0.9])
+    cases.append(dict(events=Events(t, np.array([0, 1, 0, 1, 0, 0, 0, 0]), np.zeros(8, np.int64),
+                                    np.array([1, -1, 1, -1, 1, -1, -1, 1]), (1, 2))))
+    cases.append(dict(events=_random_events(rng, 400, (3, 4))))
+    return cases
+
+
+def _intervals_unsorted(events):
+    """A wrong version (for the hint): consecutive events of the whole stream, not of one pixel."""
+    t, p = np.asarray(events.t, np.float64), events.p
+    pair = p[1:] == p[:-1]
+    log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
+def _intervals_no_floor(events):
+    """A wrong version (for the hint): log(0) for two events with the same timestamp."""
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * W + events.x
+    order = np.argsort(pix, kind="stable")
+    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_dt = np.log(np.diff(t))
+        on = p[1:] > 0
+        return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
+def _intervals_per_polarity(events):
+    """A wrong version (for the hint): each polarity's events of a pixel differenced on their own, so a
+    gap across a run of the other polarity counts as an interval."""
+    H, W = events.sensor_size
+    means = []
+    for sel in (events.p > 0, events.p < 0):
+        pix = events.y[sel].astype(np.int64) * W + events.x[sel]
+        order = np.argsort(pix, kind="stable")
+        pix, t = pix[order], np.asarray(events.t, np.float64)[sel][order]
+        same = pix[1:] == pix[:-1]
+        means.append(np.log(np.maximum(np.diff(t), MIN_INTERVAL))[same].mean())
+    return float(np.tanh((means[0] - means[1]) / 2))
+
+
+def _intervals_of_means(events):
+    """A wrong version (for the hint): the log of the ratio of the mean intervals."""
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * W + events.x
+    order = np.argsort(pix, kind="stable")
+    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    dt = np.maximum(np.diff(t), MIN_INTERVAL)
+    on = p[1:] > 0
+    return float(np.tanh(np.log(dt[pair & on].mean() / dt[pair & ~on].mean()) / 2))
+
+
+def _intervals_log_ratio(events):
+    """A wrong version (for the hint): r itself, log(C+ / C-), instead of b."""
+    return float(2 * np.arctanh(interval_imbalance(events)))
+
+
+exercises.register(
+    "interval_imbalance", interval_imbalance, _inputs_intervals, rtol=1e-6, atol=1e-9,
+    hints={
+        "take the pairs per pixel: sort the events by pixel first (a stable sort keeps their time order), "
+        "then pair each event with the one before it at the same pixel":
+            _intervals_unsorted,
+        "an interval counts only between two consecutive events of the pixel with the same polarity: "
+        "differencing the ON events alone also counts the gaps across OFF runs":
+            _intervals_per_polarity,
+        "average the log intervals, then subtract: the log of the ratio of mean intervals weighs the long "
+        "ones most":
+            _intervals_of_means,
+        "return b = tanh(r / 2) = (C+ - C-) / (C+ + C-), not r = log(C+ / C-)":
+            _intervals_log_ratio,
+        "ON minus OFF: longer ON intervals mean a larger C+, so b > 0":
+            lambda events: -interval_imbalance(events),
+        "floor each interval at MIN_INTERVAL (1 us) before its log: two events with the same timestamp "
+        "give log(0) = -inf":
+            _intervals_no_floor,
     })
 
 
