@@ -47,6 +47,8 @@ def _pairs(events, per_pixel=True, skip_other_polarity=False):
 
 
 def _b(on, off, floor=events2d.MIN_INTERVAL, of_means=False):
+    if not len(on) or not len(off):
+        return float("nan")
     with np.errstate(divide="ignore", invalid="ignore"):
         if of_means:
             r = np.log(np.maximum(on, floor).mean() / np.maximum(off, floor).mean())
@@ -63,6 +65,7 @@ def _b(on, off, floor=events2d.MIN_INTERVAL, of_means=False):
     (lambda events: -_b(*_pairs(events)), "ON minus OFF"),
     (lambda events: _b(*_pairs(events), floor=0.0), "MIN_INTERVAL"),
     (lambda events: float(np.tanh(np.log(np.mean(np.diff(events.t[events.p > 0]))) / 2)), "not match"),
+    (lambda events: 0.0 if np.isnan(_b(*_pairs(events))) else _b(*_pairs(events)), "not match"),   # 0 for "no estimate"
 ])
 def test_wrong_solutions_fail_with_their_hint(wrong, says):
     ok, text = _report(wrong)

@@ -267,6 +267,9 @@ def _inputs_intervals(rng):
     cases.append(dict(events=Events(t, np.array([0, 1, 0, 1, 0, 0, 0, 0]), np.zeros(8, np.int64),
                                     np.array([1, -1, 1, -1, 1, -1, -1, 1]), (1, 2))))
     cases.append(dict(events=_random_events(rng, 400, (3, 4))))
+    # ON runs only, and OFF events that never follow one another: no OFF pair, so no estimate (NaN)
+    cases.append(dict(events=Events(np.array([0.0, 0.1, 0.2, 0.3, 0.5]), np.zeros(5, np.int64),
+                                    np.zeros(5, np.int64), np.array([1, 1, -1, 1, 1]), (1, 1))))
     return cases
 
 
