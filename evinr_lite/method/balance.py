@@ -20,13 +20,14 @@ nominal C: the nominal C sets the contrast, the balance only the drift):
    events it is ``C- / |dL/dt|``. If the scene's rising and falling slopes have the same spread, the
    mean log ON interval minus the mean log OFF interval is ``r = log(C+ / C-)``, and
    ``b = tanh(r / 2)``. A change of the mean brightness does not enter (camera_translate: +0.02),
-   but textures whose rising and falling edges differ do (chelsea_speed +0.21 for 0; dark_falling,
-   whose falling light steepens every fall: -0.43 for 0).
+   but textures whose rising and falling edges differ do (chelsea_speed +0.21 for 0), and so does a
+   change of light (dark_falling: the falling light adds slow falls on flat regions, so the OFF
+   intervals grow: -0.43 for 0). Falling light biases the counts the other way (more OFF events).
 
 The two assumptions fail on different scenes, and a real imbalance moves both estimates alike. So the
 default rule (``rule="consensus"``) takes their **minmod**: the one nearer 0 when they agree in sign,
 0 when they do not. Measured on the zoo's 15 scenes and the 10 held-out ones, long ones included
-(their simulated b is 0 on 14, 0.10-0.22 on 11), on the events the kit trains on: the estimate is
+(their simulated b is 0 on 16, 0.10-0.22 on 9), on the events the kit trains on: the estimate is
 within 0.05 of the truth on 24 and 0.10 short on unequal_onhot (+0.085 for +0.182); its root mean
 square error is 0.027 on the zoo and 0.019 held out, against 0.087 and 0.100 for the counts rule
 (below), which was up to 0.19 off where C+ != C- and applied +0.19 to dark_falling.
@@ -67,8 +68,9 @@ from ..core.events import EventDataError, Events
 from .binning import as_thresholds
 from .denoise import hot_threshold
 
-__all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "balance_from_counts",
-           "estimate_balance", "pooled_imbalance", "interval_imbalance", "interval_stride", "minmod", "BALANCE_MODES", "RULES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
+__all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "interval_stride",
+           "balance_from_counts", "estimate_balance", "pooled_imbalance", "interval_imbalance", "minmod",
+           "BALANCE_MODES", "RULES", "HOT_PIXEL_MODES", "MIN_EVENTS", "MAX_IMBALANCE", "PRIOR", "NET_CHANGE"]
 
 BALANCE_MODES = ("none", "events", "counts")   # EvINRConfig.balance: "events" is the consensus rule
 RULES = ("consensus", "counts")

@@ -44,7 +44,8 @@ REACH = 2 * DEFAULT_DT    # s read beyond a streamed window's edges: more than t
 def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None):
     """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance`` is not "none" and
     C is one number (``intervals``: the span's :attr:`~evinr_lite.method.balance.PolarityCounts.intervals`,
-    which the "events" rule needs; without them it falls back to the "counts" rule), ``lam="auto"`` replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
+    which the "events" rule needs; without them it falls back to the "counts" rule), ``lam="auto"``
+    replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
     for windows covering ``fraction`` of the span), and the hot pixels to drop (bool [H, W], all False
     unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
     changed (a copy)."""
