@@ -3,6 +3,7 @@
     python benchmarks/balance.py              # the zoo's scenes, long ones included (about 2 min on 2 cores)
     python benchmarks/balance.py --heldout    # the held-out scenes instead
     python benchmarks/balance.py --speed      # what the intervals cost beside the counts, 1280 x 720 (about 10 s)
+    python benchmarks/balance.py --off-heavy  # every short scene of both sets with C- > C+ (about 3 min)
 
 For each scene, on the events the kit trains on (hot pixels dropped, background filtered, as
 :mod:`evinr_lite.method.prepare` does): the simulated imbalance b = (C+ - C-) / (C+ + C-), the two
@@ -13,6 +14,12 @@ pixel and the truth's change of mean log intensity from the first to the last sc
 pooled counts cannot tell from an imbalance). The last lines give the root mean square of b and of
 that change over the scenes (the counts rule's prior spreads PRIOR and NET_CHANGE are the zoo's) and
 of each rule's error. Writes benchmarks/balance_results[_heldout].{json,md}.
+
+Every simulated imbalance of the two sets is positive (C+ > C-). ``--off-heavy`` checks the other sign:
+each short scene of the zoo and the held-out set again, with C+ and C- swapped where they differ and
+C+ = 0.85 C, C- = 1.15 C (b = -0.15) where they are equal, another seed, the same nominal C; it also
+scores the kit (CLAHE-SSIM / SSIM / MSE) with the default balance, the counts rule and the true pair.
+Writes benchmarks/balance_results_off_heavy.{json,md}.
 """
 from __future__ import annotations
 
@@ -80,10 +87,58 @@ def speed(n_events: int = 20_000_000, sensor_size=(720, 1280), seed: int = 0) ->
             "ratio": seconds["interval_sums"] / seconds["polarity_counts"]}
 
 
+OFF_HEAVY_B = -0.15     # b given to the equal-threshold scenes in --off-heavy
+
+
+def off_heavy(z):
+    """The scene with C- > C+: its pair swapped, or C (1 -+ 0.15) when it has one C; another seed."""
+    from dataclasses import replace
+
+    if z.C_pos is not None and z.C_pos != z.C_neg:
+        c_pos, c_neg = min(z.C_pos, z.C_neg), max(z.C_pos, z.C_neg)
+    else:
+        c_pos, c_neg = z.C * (1 + OFF_HEAVY_B), z.C * (1 - OFF_HEAVY_B)
+    return replace(z, name=z.name + "_off_heavy", C_pos=c_pos, C_neg=c_neg, seed=z.seed + 1000)
+
+
+def off_heavy_row(z) -> dict:
+    """:func:`scene_row` of the off-heavy scene, with the kit's scores under each balance."""
+    from benchmarks.quality_zoo import score
+    from evinr_lite.method import reconstruct
+
+    row = scene_row(z)
+    _, events, times, gt = simulate(z)
+    C = effective_C(z)
+    for name, cfg in (("events", EvINRConfig(C=C, progress=False)),
+                      ("counts", EvINRConfig(C=C, balance="counts", progress=False)),
+                      ("true_pair", EvINRConfig(C=(z.C_pos, z.C_neg), progress=False))):
+        sc = score(reconstruct(events, times, cfg).frames, times, gt, times)
+        row[f"score_{name}"] = [sc["ssim_clahe"], sc["ssim_none"], sc["mse_none"]]
+    return row
+
+
+def off_heavy_markdown(rows: dict, rms: dict) -> str:
+    fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
+    lines = ["| scene (C- > C+) | b simulated | counts | intervals | b applied | counts rule | kit | kit, counts rule | "
+             "kit given the true pair |", "|---|---|---|---|---|---|---|---|---|"]
+    for name, r in rows.items():
+        lines.append(f"| {name} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['interval']:+.3f} | {r['applied']:+.3f} | "
+                     f"{r['counts_rule']:+.3f} | {fmt(r['score_events'])} | {fmt(r['score_counts'])} | "
+                     f"{fmt(r['score_true_pair'])} |")
+    mean = {k: np.mean([r[k] for r in rows.values()], axis=0) for k in ("score_events", "score_counts", "score_true_pair")}
+    lines.append(f"| **mean** | | | | | | {fmt(mean['score_events'])} | {fmt(mean['score_counts'])} | "
+                 f"{fmt(mean['score_true_pair'])} |")
+    lines += ["", f"Root mean square error of the applied b {rms['applied_error']:.3f}, of the counts rule's "
+              f"{rms['counts_rule_error']:.3f}. Kit cells: CLAHE-SSIM / SSIM / MSE at the zoo's scored times. "
+              "Written by `python benchmarks/balance.py --off-heavy`."]
+    return "\n".join(lines) + "\n"
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--heldout", action="store_true", help="the held-out scenes instead of the zoo's")
     p.add_argument("--speed", action="store_true", help="only time the intervals against the counts (1280 x 720)")
+    p.add_argument("--off-heavy", action="store_true", help="every short scene of both sets with C- > C+, and the kit's scores")
     a = p.parse_args(argv)
     if a.speed:
         r = speed()
@@ -91,10 +146,12 @@ def main(argv=None) -> int:
               f"{r['stride']}): polarity_counts {r['polarity_counts']:.2f} s, interval_sums {r['interval_sums']:.2f} s "
               f"({r['ratio']:.2f}x)")
         return 0
-    suffix = "_heldout" if a.heldout else ""
+    suffix = "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
+    scenes = (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \
+        [off_heavy(z) for z in default_scenes() + [h for h in HELDOUT if not h.long]]
     rows = {}
-    for z in (HELDOUT if a.heldout else default_scenes(long=True)):
-        rows[z.name] = r = scene_row(z)
+    for z in scenes:
+        rows[z.name] = r = off_heavy_row(z) if a.off_heavy else scene_row(z)
         print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  b {r['b_true']:+.3f}  counts {r['raw']:+.3f}  "
               f"intervals {r['interval']:+.3f}  applied {r['applied']:+.3f}  counts rule {r['counts_rule']:+.3f}  "
               f"mean log change {r['mean_log_change']:+.3f}", flush=True)
@@ -106,9 +163,10 @@ def main(argv=None) -> int:
            "counts_rule_error": rms_of(lambda r: r["counts_rule"] - r["b_true"])}
     print(f"root mean square: b {rms['b']:.3f}, mean log change {rms['log_change']:.2f}; error of the applied b "
           f"{rms['applied_error']:.3f}, of the counts rule's {rms['counts_rule_error']:.3f}")
-    write_json(f"benchmarks/balance_results{suffix}.json", {"heldout": a.heldout, "scenes": rows, "rms": rms,
-                                                             "prior": PRIOR, "net_change": NET_CHANGE})
-    Path(f"benchmarks/balance_results{suffix}.md").write_text(markdown(rows, rms))
+    write_json(f"benchmarks/balance_results{suffix}.json", {"heldout": a.heldout, "off_heavy": a.off_heavy,
+                                                             "scenes": rows, "rms": rms, "prior": PRIOR,
+                                                             "net_change": NET_CHANGE})
+    Path(f"benchmarks/balance_results{suffix}.md").write_text((off_heavy_markdown if a.off_heavy else markdown)(rows, rms))
     print(f"markdown: benchmarks/balance_results{suffix}.md")
     return 0
 

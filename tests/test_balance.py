@@ -218,3 +218,15 @@ def test_balance_benchmark_times_the_intervals_against_the_counts():
 
     r = speed(n_events=20_000, sensor_size=(300, 400))
     assert r["stride"] == 2 and r["interval_sums"] > 0 and r["ratio"] == r["interval_sums"] / r["polarity_counts"]
+
+
+def test_off_heavy_scenes_have_C_minus_above_C_plus():
+    """benchmarks/balance.py --off-heavy: a pair swapped where it differs, b = -0.15 where C+ = C-, the
+    nominal C kept and another seed."""
+    from benchmarks.balance import OFF_HEAVY_B, off_heavy
+    from evinr_lite.sim.zoo import effective_C, get, imbalance
+
+    for name in ("coffee_warp", "camera_translate"):
+        z, o = get(name), off_heavy(get(name))
+        assert o.C_neg > o.C_pos and o.seed != z.seed and effective_C(o) == pytest.approx(effective_C(z))
+        assert imbalance(o) == pytest.approx(-abs(imbalance(z)) if imbalance(z) else OFF_HEAVY_B)
