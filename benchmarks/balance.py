@@ -3,22 +3,25 @@
     python benchmarks/balance.py              # the zoo's scenes, long ones included (about 2 min on 2 cores)
     python benchmarks/balance.py --heldout    # the held-out scenes instead
     python benchmarks/balance.py --speed      # what the intervals cost beside the counts, 1280 x 720 (about 10 s)
-    python benchmarks/balance.py --off-heavy  # every short scene of both sets with C- > C+ (about 3 min)
+    python benchmarks/balance.py --off-heavy  # every short and 20 s scene of both sets with C- > C+ (about 4 min)
 
 For each scene, on the events the kit trains on (hot pixels dropped, background filtered, as
 :mod:`evinr_lite.method.prepare` does): the simulated imbalance b = (C+ - C-) / (C+ + C-), the two
 estimates of :mod:`evinr_lite.method.balance` (the pooled counts, ``raw``, and the intervals between
-events of one polarity, ``interval``), the default's result (``applied``: their minmod), and the
+events of one polarity, ``interval``), the default's result (``applied``: the counts alone where
+their error scale is small, else the minmod; ``chosen`` says which), and the
 counts rule's (``counts_rule``: ``raw`` shrunk by ``shrink``), with the mean event count per usable
-pixel and the truth's change of mean log intensity from the first to the last scored frame (what the
+pixel, the counts' error scale ``s = NET_CHANGE / (C mean n)`` (at most COUNTS_ALONE: the counts are
+taken alone) and the truth's change of mean log intensity from the first to the last scored frame (what the
 pooled counts cannot tell from an imbalance). The last lines give the root mean square of b and of
 that change over the scenes (the counts rule's prior spreads PRIOR and NET_CHANGE are the zoo's) and
 of each rule's error. Writes benchmarks/balance_results[_heldout].{json,md}.
 
 Every simulated imbalance of the two sets is positive (C+ > C-). ``--off-heavy`` checks the other sign:
-each short scene of the zoo and the held-out set again, with C+ and C- swapped where they differ and
-C+ = 0.85 C, C- = 1.15 C (b = -0.15) where they are equal, another seed, the same nominal C; it also
-scores the kit (CLAHE-SSIM / SSIM / MSE) with the default balance, the counts rule and the true pair.
+each short scene of the zoo and the held-out set, and the two 20 s ones, again, with C+ and C- swapped
+where they differ and C+ = 0.85 C, C- = 1.15 C (b = -0.15) where they are equal, another seed, the same
+nominal C; it also scores the kit (CLAHE-SSIM / SSIM / MSE, and the level error per quarter on the long
+ones) with the default balance, the counts rule and the true pair.
 Writes benchmarks/balance_results_off_heavy.{json,md}.
 """
 from __future__ import annotations
@@ -46,17 +49,19 @@ def scene_row(z) -> dict:
     fit, old = estimate_balance(events, C), estimate_balance(events, C, rule="counts")
     log_mean = np.log(np.clip(np.asarray(gt, np.float64), 1e-3, None)).mean(axis=(1, 2))
     return {"span_s": float(times[-1] - times[0]), "b_true": imbalance(z), "raw": fit.raw_imbalance,
-            "interval": fit.interval_imbalance, "applied": fit.imbalance, "shrink": old.shrink,
+            "interval": fit.interval_imbalance, "applied": fit.imbalance, "chosen": fit.chosen,
+            "counts_error": fit.counts_error, "shrink": old.shrink,
             "counts_rule": old.imbalance, "mean_events": fit.mean_events,
             "mean_log_change": float(log_mean[-1] - log_mean[0])}
 
 
 def markdown(rows: dict, rms: dict) -> str:
-    lines = ["| scene | span (s) | events per pixel | b simulated | counts (raw) | intervals | b applied (minmod) | "
-             "counts rule (shrink) | truth's mean log change |", "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene | span (s) | events per pixel | counts' error scale | b simulated | counts (raw) | intervals | "
+             "b applied (taken from) | counts rule (shrink) | truth's mean log change |", "|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
-        lines.append(f"| {name} | {r['span_s']:.1f} | {r['mean_events']:.1f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | "
-                     f"{r['interval']:+.3f} | {r['applied']:+.3f} | {r['counts_rule']:+.3f} ({r['shrink']:.2f}) | "
+        lines.append(f"| {name} | {r['span_s']:.1f} | {r['mean_events']:.1f} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | "
+                     f"{r['raw']:+.3f} | {r['interval']:+.3f} | {r['applied']:+.3f} ({r['chosen']}) | "
+                     f"{r['counts_rule']:+.3f} ({r['shrink']:.2f}) | "
                      f"{r['mean_log_change']:+.3f} |")
     lines += ["", f"Root mean square over these {len(rows)} scenes: simulated b {rms['b']:.3f}, mean log change "
               f"{rms['log_change']:.2f} (the counts rule's prior spreads in evinr_lite.method.balance: PRIOR {PRIOR}, "
@@ -103,7 +108,7 @@ def off_heavy(z):
 
 def off_heavy_row(z) -> dict:
     """:func:`scene_row` of the off-heavy scene, with the kit's scores under each balance."""
-    from benchmarks.quality_zoo import score
+    from benchmarks.quality_zoo import level_error, score
     from evinr_lite.method import reconstruct
 
     row = scene_row(z)
@@ -112,24 +117,38 @@ def off_heavy_row(z) -> dict:
     for name, cfg in (("events", EvINRConfig(C=C, progress=False)),
                       ("counts", EvINRConfig(C=C, balance="counts", progress=False)),
                       ("true_pair", EvINRConfig(C=(z.C_pos, z.C_neg), progress=False))):
-        sc = score(reconstruct(events, times, cfg).frames, times, gt, times)
+        frames = reconstruct(events, times, cfg).frames
+        sc = score(frames, times, gt, times)
         row[f"score_{name}"] = [sc["ssim_clahe"], sc["ssim_none"], sc["mse_none"]]
+        row[f"level_{name}"] = level_error(frames, gt, times, z.duration)
+    row["long"] = bool(z.long)
     return row
 
 
 def off_heavy_markdown(rows: dict, rms: dict) -> str:
     fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
-    lines = ["| scene (C- > C+) | b simulated | counts | intervals | b applied | counts rule | kit | kit, counts rule | "
-             "kit given the true pair |", "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene (C- > C+) | counts' error scale | b simulated | counts | intervals | b applied (taken from) | counts rule | "
+             "kit | kit, counts rule | kit given the true pair |", "|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
-        lines.append(f"| {name} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['interval']:+.3f} | {r['applied']:+.3f} | "
+        lines.append(f"| {name} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['interval']:+.3f} | "
+                     f"{r['applied']:+.3f} ({r['chosen']}) | "
                      f"{r['counts_rule']:+.3f} | {fmt(r['score_events'])} | {fmt(r['score_counts'])} | "
                      f"{fmt(r['score_true_pair'])} |")
-    mean = {k: np.mean([r[k] for r in rows.values()], axis=0) for k in ("score_events", "score_counts", "score_true_pair")}
-    lines.append(f"| **mean** | | | | | | {fmt(mean['score_events'])} | {fmt(mean['score_counts'])} | "
-                 f"{fmt(mean['score_true_pair'])} |")
-    lines += ["", f"Root mean square error of the applied b {rms['applied_error']:.3f}, of the counts rule's "
-              f"{rms['counts_rule_error']:.3f}. Kit cells: CLAHE-SSIM / SSIM / MSE at the zoo's scored times. "
+    short = [r for r in rows.values() if not r.get("long")]
+    mean = {k: np.mean([r[k] for r in short], axis=0) for k in ("score_events", "score_counts", "score_true_pair")}
+    lines.append(f"| **mean of the {len(short)} short scenes** | | | | | | {fmt(mean['score_events'])} | "
+                 f"{fmt(mean['score_counts'])} | {fmt(mean['score_true_pair'])} |")
+    long = {name: r for name, r in rows.items() if r.get("long")}
+    if long:
+        lv = lambda v: " ".join(f"{x:+.3f}" for x in v)          # noqa: E731
+        lines += ["", "Level error per quarter (mean prediction minus mean truth) on the long scenes:", "",
+                  "| scene | kit | kit, counts rule | kit given the true pair |", "|---|---|---|---|"]
+        lines += [f"| {name} | {lv(r['level_events'])} | {lv(r['level_counts'])} | {lv(r['level_true_pair'])} |"
+                  for name, r in long.items()]
+    err = lambda key: float(np.sqrt(np.mean([(r[key] - r["b_true"]) ** 2 for r in short])))      # noqa: E731
+    lines += ["", f"Root mean square error over all {len(rows)} scenes: of the applied b {rms['applied_error']:.3f}, of the "
+              f"counts rule's {rms['counts_rule_error']:.3f}; over the {len(short)} short ones {err('applied'):.3f} and "
+              f"{err('counts_rule'):.3f}. Kit cells: CLAHE-SSIM / SSIM / MSE at the zoo's scored times. "
               "Written by `python benchmarks/balance.py --off-heavy`."]
     return "\n".join(lines) + "\n"
 
@@ -148,12 +167,14 @@ def main(argv=None) -> int:
         return 0
     suffix = "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
     scenes = (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \
-        [off_heavy(z) for z in default_scenes() + [h for h in HELDOUT if not h.long]]
+        [off_heavy(z) for z in default_scenes() + [h for h in HELDOUT if not h.long] +
+         [z for z in default_scenes(long=True) + HELDOUT if z.long and z.duration <= 20]]
     rows = {}
     for z in scenes:
         rows[z.name] = r = off_heavy_row(z) if a.off_heavy else scene_row(z)
-        print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  b {r['b_true']:+.3f}  counts {r['raw']:+.3f}  "
-              f"intervals {r['interval']:+.3f}  applied {r['applied']:+.3f}  counts rule {r['counts_rule']:+.3f}  "
+        print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  s {r['counts_error']:.3f}  b {r['b_true']:+.3f}  "
+              f"counts {r['raw']:+.3f}  intervals {r['interval']:+.3f}  applied {r['applied']:+.3f} ({r['chosen']})  "
+              f"counts rule {r['counts_rule']:+.3f}  "
               f"mean log change {r['mean_log_change']:+.3f}", flush=True)
 
     def rms_of(f):

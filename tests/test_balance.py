@@ -230,3 +230,40 @@ def test_off_heavy_scenes_have_C_minus_above_C_plus():
         z, o = get(name), off_heavy(get(name))
         assert o.C_neg > o.C_pos and o.seed != z.seed and effective_C(o) == pytest.approx(effective_C(z))
         assert imbalance(o) == pytest.approx(-abs(imbalance(z)) if imbalance(z) else OFF_HEAVY_B)
+
+
+def _interval_arrays(shape, log_on, log_off, k=20):
+    """Interval sums whose mean log ON and OFF intervals are ``log_on`` and ``log_off`` at every pixel."""
+    k_arr = np.full(shape, float(k))
+    return (k_arr * log_on, k_arr, k_arr * log_off, k_arr)
+
+
+def test_busy_spans_take_the_counts_alone_unless_the_intervals_contradict_them():
+    """The counts' error scale s = NET_CHANGE / (C mean n) shrinks as events accumulate; the intervals'
+    bias does not. At s <= COUNTS_ALONE the counts are used alone (here b = -0.15 while the intervals read
+    -0.01: the minmod would keep -0.01); with few events the minmod decides; and intervals that differ
+    from the counts by more than MAX_IMBALANCE (a change of light) send it back to the minmod."""
+    from evinr_lite.method.balance import COUNTS_ALONE, MAX_IMBALANCE, NET_CHANGE
+
+    shape, C, b = (20, 20), 0.2, -0.15
+    small_r = 2 * np.arctanh(-0.01)                         # the intervals read b = -0.01
+    for n, expect in ((200.0, "counts"), (10.0, "minmod")):
+        n_on, n_off = np.full(shape, n * (1 - b) / 2), np.full(shape, n * (1 + b) / 2)
+        fit = balance_from_counts(n_on, n_off, C, intervals=_interval_arrays(shape, small_r, 0.0))
+        assert fit.counts_error == pytest.approx(NET_CHANGE / (C * n))
+        assert (fit.counts_error <= COUNTS_ALONE) == (expect == "counts") and fit.chosen == expect
+        assert fit.imbalance == pytest.approx(b if expect == "counts" else -0.01, abs=1e-9)
+    n_on, n_off = np.full(shape, 200 * (1 - b) / 2), np.full(shape, 200 * (1 + b) / 2)
+    far = 2 * np.arctanh(b + 1.2 * MAX_IMBALANCE)           # intervals far from the counts, opposite sign
+    fit = balance_from_counts(n_on, n_off, C, intervals=_interval_arrays(shape, far, 0.0))
+    assert fit.chosen == "nominal" and fit.imbalance == 0.0
+
+
+def test_a_long_off_heavy_recording_gets_its_pair():
+    """20 s to and fro with C+ 0.20 and C- 0.25 given as 0.225 (b = -0.111): many events per pixel, so
+    the counts are trusted alone, whatever the intervals read."""
+    ev = simulate_scene(_scene(), C=0.225, C_pos=0.20, C_neg=0.25, seed=0)
+    fit = estimate_balance(ev, 0.225)
+    assert fit.chosen == "counts"
+    assert fit.imbalance == pytest.approx(-0.05 / 0.45, abs=0.01)
+    assert fit.C[0] == pytest.approx(0.20, abs=0.006) and fit.C[1] == pytest.approx(0.25, abs=0.006)
