@@ -182,6 +182,9 @@ def test_minmod_and_bad_arguments():
         balance_from_counts(n, n, 0.2, intervals=(n, n))
     fit = balance_from_counts(n, n, 0.2)                    # counts alone: the consensus cannot be formed
     assert fit.rule == "counts"
+    for bad in (-0.1, 1.0, float("nan"), "0.3"):
+        with pytest.raises(EventDataError, match="max_imbalance must be a number in"):
+            balance_from_counts(n, n, 0.2, max_imbalance=bad)
 
 
 def test_the_configs_balance_counts_is_the_rule_before_the_intervals():

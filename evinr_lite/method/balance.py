@@ -78,6 +78,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..core.checks import is_real_number, require
 from ..core.events import EventDataError, Events
 from .binning import as_thresholds
 from .denoise import hot_threshold
@@ -305,7 +306,8 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, rule: str = "consensu
             counts rule is used (``fit.rule`` says so).
         rule: "consensus" (minmod of the counts' and the intervals' estimates) or "counts" (the counts'
             estimate shrunk by its evidence).
-        min_events: pixels with fewer events are left out. max_imbalance: cap on |b|.
+        min_events: pixels with fewer events are left out. max_imbalance: cap on |b| in [0, 1), and
+            how far the intervals may lie from the counts for the counts to be taken alone.
         prior, net_change: the counts rule's prior spread of b and plausible mean log change (log units).
 
     Returns:
@@ -313,6 +315,9 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, rule: str = "consensu
     """
     if rule not in RULES:
         raise EventDataError(f"rule must be one of {RULES}, got {rule!r}")
+    if not (is_real_number(max_imbalance) and 0 <= max_imbalance < 1):
+        raise EventDataError(f"max_imbalance must be a number in [0, 1) (|b| = |C+ - C-| / (C+ + C-) < 1), "
+                             f"got {max_imbalance!r}")
     n_on = np.asarray(n_on, np.float64)
     n_off = np.asarray(n_off, np.float64)
     if n_on.shape != n_off.shape:
@@ -360,8 +365,6 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, rule: str = "consensu
 
 def estimate_balance(events: Events, C, **kw) -> BalanceFit:
     """:func:`balance_from_counts` on the counts of ``events`` (one span, e.g. one window)."""
-    from ..core.checks import require
-
     events = require(events, Events, "events")
     if len(events) == 0:
         raise EventDataError("no events to estimate the ON/OFF balance from; pass a span with events")
