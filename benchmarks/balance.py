@@ -4,11 +4,12 @@
     python benchmarks/balance.py --heldout    # the held-out scenes instead
     python benchmarks/balance.py --speed      # what the intervals cost beside the counts, 1280 x 720 (about 10 s)
     python benchmarks/balance.py --off-heavy  # every scene of both sets with C- > C+, long ones included (about 8 min)
+    python benchmarks/balance.py --light      # the 20 s pan under a change of light, three C pairs (about 2 min)
 
 For each scene, on the events the kit trains on (hot pixels dropped, background filtered, as
 :mod:`evinr_lite.method.prepare` does): the simulated imbalance b = (C+ - C-) / (C+ + C-), the two
-estimates of :mod:`evinr_lite.method.balance` (the pooled counts, ``raw``, and the intervals between
-events of one polarity, ``interval``), the default's result (``applied``: the counts alone where
+estimates of :mod:`evinr_lite.method.balance` (the pooled counts, ``raw``, the counts fitted with an
+intercept, ``slope``, and the intervals between events of one polarity, ``interval``), the default's result (``applied``: the counts alone where
 their error scale is small, else the minmod; ``chosen`` says which), and the
 counts rule's (``counts_rule``: ``raw`` shrunk by ``shrink``), with the mean event count per usable
 pixel, the counts' error scale ``s = NET_CHANGE / (C mean n)`` (at most COUNTS_ALONE: the counts are
@@ -23,6 +24,12 @@ where they differ and C+ = 0.85 C, C- = 1.15 C (b = -0.15) where they are equal,
 nominal C; it also scores the kit (CLAHE-SSIM / SSIM / MSE, and the level error per quarter on the long
 ones) with the default balance, the counts rule and the true pair.
 Writes benchmarks/balance_results_off_heavy.{json,md}.
+
+``--light`` checks what a long recording's change of light does to the estimate: the zoo's 20 s pan
+with the light falling by e^-0.7 (2x) and e^-2 (7.4x) over the recording, uniform over the sensor, each
+with C+ = C-, C+ > C- and C- > C+ (b = 0, +-0.111), with the kit's scores and level error per quarter
+under the default, b = 0 (``balance="none"``) and the true pair. Writes
+benchmarks/balance_results_light.{json,md}.
 """
 from __future__ import annotations
 
@@ -49,18 +56,20 @@ def scene_row(z) -> dict:
     fit, old = estimate_balance(events, C), estimate_balance(events, C, rule="counts")
     log_mean = np.log(np.clip(np.asarray(gt, np.float64), 1e-3, None)).mean(axis=(1, 2))
     return {"span_s": float(times[-1] - times[0]), "b_true": imbalance(z), "raw": fit.raw_imbalance,
-            "interval": fit.interval_imbalance, "applied": fit.imbalance, "chosen": fit.chosen,
+            "interval": fit.interval_imbalance, "slope": fit.slope_imbalance, "applied": fit.imbalance,
+            "chosen": fit.chosen,
             "counts_error": fit.counts_error, "shrink": old.shrink,
             "counts_rule": old.imbalance, "mean_events": fit.mean_events,
             "mean_log_change": float(log_mean[-1] - log_mean[0])}
 
 
 def markdown(rows: dict, rms: dict) -> str:
-    lines = ["| scene | span (s) | events per pixel | counts' error scale | b simulated | counts (raw) | intervals | "
-             "b applied (taken from) | counts rule (shrink) | truth's mean log change |", "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene | span (s) | events per pixel | counts' error scale | b simulated | counts (raw) | counts (slope) | "
+             "intervals | b applied (taken from) | counts rule (shrink) | truth's mean log change |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
         lines.append(f"| {name} | {r['span_s']:.1f} | {r['mean_events']:.1f} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | "
-                     f"{r['raw']:+.3f} | {r['interval']:+.3f} | {r['applied']:+.3f} ({r['chosen']}) | "
+                     f"{r['raw']:+.3f} | {r['slope']:+.3f} | {r['interval']:+.3f} | {r['applied']:+.3f} ({r['chosen']}) | "
                      f"{r['counts_rule']:+.3f} ({r['shrink']:.2f}) | "
                      f"{r['mean_log_change']:+.3f} |")
     lines += ["", f"Root mean square over these {len(rows)} scenes: simulated b {rms['b']:.3f}, mean log change "
@@ -125,12 +134,67 @@ def off_heavy_row(z) -> dict:
     return row
 
 
+LIGHT_CHANGES = (-0.7, -2.0)   # log units over the recording, --light
+LIGHT_PAIRS = ((0.225, 0.225), (0.25, 0.20), (0.20, 0.25))
+
+
+def light_scenes() -> list:
+    """The 20 s pan (long_pan_20s) under each change of light of LIGHT_CHANGES and each C pair."""
+    from dataclasses import replace
+
+    from evinr_lite.sim.scenes import LightingScene
+
+    base = [z for z in default_scenes(long=True) if z.name == "long_pan_20s"][0]
+
+    def lit(change):
+        return lambda size, duration: LightingScene(base.build(size, duration), global_change=change, vignette=0.0)
+    return [replace(base, name=f"long_pan_20s_light{change:+.1f}_C{c_pos:.3f}_{c_neg:.3f}", build=lit(change),
+                    C_pos=c_pos, C_neg=c_neg) for change in LIGHT_CHANGES for c_pos, c_neg in LIGHT_PAIRS]
+
+
+def light_row(z) -> dict:
+    """:func:`scene_row` with the kit's scores and level error under the default, b = 0 and the true pair."""
+    from benchmarks.quality_zoo import level_error, score
+    from evinr_lite.method import reconstruct
+
+    row = scene_row(z)
+    _, events, times, gt = simulate(z)
+    C = effective_C(z)
+    for name, cfg in (("events", EvINRConfig(C=C, progress=False)),
+                      ("none", EvINRConfig(C=C, balance="none", progress=False)),
+                      ("true_pair", EvINRConfig(C=(z.C_pos, z.C_neg), progress=False))):
+        frames = reconstruct(events, times, cfg).frames
+        sc = score(frames, times, gt, times)
+        row[f"score_{name}"] = [sc["ssim_clahe"], sc["ssim_none"], sc["mse_none"]]
+        row[f"level_{name}"] = level_error(frames, gt, times, z.duration)
+    return row
+
+
+def light_markdown(rows: dict, rms: dict) -> str:
+    fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
+    lv = lambda v: " ".join(f"{x:+.3f}" for x in v)                   # noqa: E731
+    lines = ["| scene | b simulated | counts (pooled) | counts (slope) | intervals | b applied (taken from) | kit | kit, b = 0 | "
+             "kit given the true pair |", "|---|---|---|---|---|---|---|---|---|"]
+    for name, r in rows.items():
+        lines.append(f"| {name} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | {r['interval']:+.3f} | "
+                     f"{r['applied']:+.3f} ({r['chosen']}) | {fmt(r['score_events'])} | {fmt(r['score_none'])} | "
+                     f"{fmt(r['score_true_pair'])} |")
+    lines += ["", "Level error per quarter (mean prediction minus mean truth):", "",
+              "| scene | kit | kit, b = 0 | kit given the true pair |", "|---|---|---|---|"]
+    lines += [f"| {name} | {lv(r['level_events'])} | {lv(r['level_none'])} | {lv(r['level_true_pair'])} |"
+              for name, r in rows.items()]
+    lines += ["", f"Root mean square error of the applied b {rms['applied_error']:.3f}, of the counts rule's "
+              f"{rms['counts_rule_error']:.3f}. Kit cells: CLAHE-SSIM / SSIM / MSE. Written by "
+              "`python benchmarks/balance.py --light`."]
+    return "\n".join(lines) + "\n"
+
+
 def off_heavy_markdown(rows: dict, rms: dict) -> str:
     fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
-    lines = ["| scene (C- > C+) | counts' error scale | b simulated | counts | intervals | b applied (taken from) | counts rule | "
-             "kit | kit, counts rule | kit given the true pair |", "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene (C- > C+) | counts' error scale | b simulated | counts | counts (slope) | intervals | b applied (taken from) | "
+             "counts rule | kit | kit, counts rule | kit given the true pair |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
-        lines.append(f"| {name} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['interval']:+.3f} | "
+        lines.append(f"| {name} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | {r['interval']:+.3f} | "
                      f"{r['applied']:+.3f} ({r['chosen']}) | "
                      f"{r['counts_rule']:+.3f} | {fmt(r['score_events'])} | {fmt(r['score_counts'])} | "
                      f"{fmt(r['score_true_pair'])} |")
@@ -158,6 +222,7 @@ def main(argv=None) -> int:
     p.add_argument("--heldout", action="store_true", help="the held-out scenes instead of the zoo's")
     p.add_argument("--speed", action="store_true", help="only time the intervals against the counts (1280 x 720)")
     p.add_argument("--off-heavy", action="store_true", help="every scene of both sets with C- > C+, and the kit's scores")
+    p.add_argument("--light", action="store_true", help="the 20 s pan under a change of light, three C pairs")
     a = p.parse_args(argv)
     if a.speed:
         r = speed()
@@ -165,13 +230,13 @@ def main(argv=None) -> int:
               f"{r['stride']}): polarity_counts {r['polarity_counts']:.2f} s, interval_sums {r['interval_sums']:.2f} s "
               f"({r['ratio']:.2f}x)")
         return 0
-    suffix = "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
-    scenes = (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \
+    suffix = "_light" if a.light else "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
+    scenes = light_scenes() if a.light else (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \
         [off_heavy(z) for z in default_scenes() + [h for h in HELDOUT if not h.long] +
          [z for z in default_scenes(long=True) + HELDOUT if z.long]]
     rows = {}
     for z in scenes:
-        rows[z.name] = r = off_heavy_row(z) if a.off_heavy else scene_row(z)
+        rows[z.name] = r = light_row(z) if a.light else off_heavy_row(z) if a.off_heavy else scene_row(z)
         print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  s {r['counts_error']:.3f}  b {r['b_true']:+.3f}  "
               f"counts {r['raw']:+.3f}  intervals {r['interval']:+.3f}  applied {r['applied']:+.3f} ({r['chosen']})  "
               f"counts rule {r['counts_rule']:+.3f}  "
@@ -184,10 +249,11 @@ def main(argv=None) -> int:
            "counts_rule_error": rms_of(lambda r: r["counts_rule"] - r["b_true"])}
     print(f"root mean square: b {rms['b']:.3f}, mean log change {rms['log_change']:.2f}; error of the applied b "
           f"{rms['applied_error']:.3f}, of the counts rule's {rms['counts_rule_error']:.3f}")
-    write_json(f"benchmarks/balance_results{suffix}.json", {"heldout": a.heldout, "off_heavy": a.off_heavy,
+    write_json(f"benchmarks/balance_results{suffix}.json", {"heldout": a.heldout, "off_heavy": a.off_heavy, "light": a.light,
                                                              "scenes": rows, "rms": rms, "prior": PRIOR,
                                                              "net_change": NET_CHANGE})
-    Path(f"benchmarks/balance_results{suffix}.md").write_text((off_heavy_markdown if a.off_heavy else markdown)(rows, rms))
+    render = light_markdown if a.light else off_heavy_markdown if a.off_heavy else markdown
+    Path(f"benchmarks/balance_results{suffix}.md").write_text(render(rows, rms))
     print(f"markdown: benchmarks/balance_results{suffix}.md")
     return 0
 

@@ -241,25 +241,50 @@ def _interval_arrays(shape, log_on, log_off, k=20):
     return (k_arr * log_on, k_arr, k_arr * log_off, k_arr)
 
 
+def _counts_with(b, n, light, C):
+    """n_on, n_off [H, W] with n = n_on + n_off and n_off - n_on = b n - light / C at every pixel (the
+    relation C+ n+ - C- n- = light for C+- = C (1 +- b))."""
+    d = b * n - light / C
+    return (n - d) / 2, (n + d) / 2
+
+
 def test_busy_spans_take_the_counts_alone_unless_the_intervals_contradict_them():
     """The counts' error scale s = NET_CHANGE / (C mean n) shrinks as events accumulate; the intervals'
-    bias does not. At s <= COUNTS_ALONE the counts are used alone (here b = -0.15 while the intervals read
-    -0.01: the minmod would keep -0.01); with few events the minmod decides; and intervals that differ
-    from the counts by more than MAX_IMBALANCE (a change of light) send it back to the minmod."""
+    bias does not. At s <= COUNTS_ALONE the counts are used alone, fitted with an intercept, so a change
+    of light common to every pixel (here -0.7 log units, which pulls the pooled counts off b) is not
+    read as an imbalance (b = -0.15 while the intervals read -0.01: the minmod would keep -0.01); with
+    few events the minmod decides; and intervals that differ from the counts by more than MAX_IMBALANCE
+    send it back to the minmod."""
     from evinr_lite.method.balance import COUNTS_ALONE, MAX_IMBALANCE, NET_CHANGE
 
-    shape, C, b = (20, 20), 0.2, -0.15
+    C, b, light = 0.2, -0.15, -0.7
+    rows = np.linspace(0.5, 1.5, 20)[:, None] * np.ones((1, 20))      # event counts vary over the sensor
     small_r = 2 * np.arctanh(-0.01)                         # the intervals read b = -0.01
-    for n, expect in ((200.0, "counts"), (10.0, "minmod")):
-        n_on, n_off = np.full(shape, n * (1 - b) / 2), np.full(shape, n * (1 + b) / 2)
-        fit = balance_from_counts(n_on, n_off, C, intervals=_interval_arrays(shape, small_r, 0.0))
-        assert fit.counts_error == pytest.approx(NET_CHANGE / (C * n))
+    for scale, expect, change in ((200.0, "counts", light), (10.0, "minmod", 0.0)):
+        n = scale * rows
+        n_on, n_off = _counts_with(b, n, change, C)
+        fit = balance_from_counts(n_on, n_off, C, intervals=_interval_arrays(n.shape, small_r, 0.0))
+        assert fit.counts_error == pytest.approx(NET_CHANGE / (C * n.mean()))
         assert (fit.counts_error <= COUNTS_ALONE) == (expect == "counts") and fit.chosen == expect
+        assert fit.slope_imbalance == pytest.approx(b, abs=1e-9)
+        assert (abs(fit.raw_imbalance - b) > 0.01) == (change != 0)   # the pooled counts carry the light's change
         assert fit.imbalance == pytest.approx(b if expect == "counts" else -0.01, abs=1e-9)
-    n_on, n_off = np.full(shape, 200 * (1 - b) / 2), np.full(shape, 200 * (1 + b) / 2)
+    n_on, n_off = _counts_with(b, 200.0 * rows, 0.0, C)
     far = 2 * np.arctanh(b + 1.2 * MAX_IMBALANCE)           # intervals far from the counts, opposite sign
-    fit = balance_from_counts(n_on, n_off, C, intervals=_interval_arrays(shape, far, 0.0))
+    fit = balance_from_counts(n_on, n_off, C, intervals=_interval_arrays(n_on.shape, far, 0.0))
     assert fit.chosen == "nominal" and fit.imbalance == 0.0
+    n_on, n_off = _counts_with(b, np.full((20, 20), 200.0), 0.0, C)    # counts that do not vary: no slope
+    fit = balance_from_counts(n_on, n_off, C, intervals=_interval_arrays(n_on.shape, small_r, 0.0))
+    assert np.isnan(fit.slope_imbalance) and fit.chosen == "minmod"
+
+
+def test_a_long_change_of_light_is_not_read_as_an_imbalance():
+    """20 s to and fro, equal thresholds, while the light falls by e^-2: more OFF than ON events, so the
+    pooled counts read an imbalance; the counts fitted with an intercept do not."""
+    ev = simulate_scene(LightingScene(_scene(), global_change=-2.0, vignette=0.0), C=0.225, seed=0)
+    fit = estimate_balance(ev, 0.225)
+    assert fit.chosen == "counts" and fit.raw_imbalance > 0.04
+    assert abs(fit.imbalance) < 0.015
 
 
 def test_a_long_off_heavy_recording_gets_its_pair():
