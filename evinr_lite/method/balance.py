@@ -326,7 +326,8 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, rule: str = "consensu
         intervals: (log_on, k_on, log_off, k_off) [H, W] from :func:`interval_sums` (or
             :attr:`PolarityCounts.intervals`). Without them the consensus cannot be formed and the
             counts rule is used (``fit.rule`` says so).
-        rule: "consensus" (minmod of the counts' and the intervals' estimates) or "counts" (the counts'
+        rule: "consensus" (minmod of the counts' and the intervals' estimates, or the counts' slope
+            alone where their error scale is at most COUNTS_ALONE) or "counts" (the counts' pooled
             estimate shrunk by its evidence).
         min_events: pixels with fewer events are left out. max_imbalance: cap on |b| in [0, 1), and
             how far the intervals may lie from the counts for the counts to be taken alone.
