@@ -48,9 +48,10 @@ from evinr_lite.method.prepare import prepare_events  # noqa: E402
 from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, imbalance, simulate  # noqa: E402
 
 
-def scene_row(z) -> dict:
-    """The balance of one zoo scene against its simulated thresholds."""
-    _, events, times, gt = simulate(z)
+def scene_row(z, simulated=None) -> dict:
+    """The balance of one zoo scene against its simulated thresholds (``simulated``: ``simulate(z)``'s
+    result when the caller already has it)."""
+    _, events, times, gt = simulated or simulate(z)
     C = effective_C(z)
     events, _ = prepare_events(events, EvINRConfig(C=C, balance="none", progress=False))
     fit, old = estimate_balance(events, C), estimate_balance(events, C, rule="counts")
@@ -115,23 +116,27 @@ def off_heavy(z):
     return replace(z, name=z.name + "_off_heavy", C_pos=c_pos, C_neg=c_neg, seed=z.seed + 1000)
 
 
-def off_heavy_row(z) -> dict:
-    """:func:`scene_row` of the off-heavy scene, with the kit's scores under each balance."""
+def scored_row(z, balances: dict) -> dict:
+    """:func:`scene_row` with the kit's scores (CLAHE-SSIM, SSIM, MSE) and level error per quarter under
+    each balance of ``balances`` (name -> EvINRConfig keyword arguments), the scene simulated once."""
     from benchmarks.quality_zoo import level_error, score
     from evinr_lite.method import reconstruct
 
-    row = scene_row(z)
-    _, events, times, gt = simulate(z)
-    C = effective_C(z)
-    for name, cfg in (("events", EvINRConfig(C=C, progress=False)),
-                      ("counts", EvINRConfig(C=C, balance="counts", progress=False)),
-                      ("true_pair", EvINRConfig(C=(z.C_pos, z.C_neg), progress=False))):
-        frames = reconstruct(events, times, cfg).frames
+    simulated = simulate(z)
+    _, events, times, gt = simulated
+    row = scene_row(z, simulated)
+    for name, kw in balances.items():
+        frames = reconstruct(events, times, EvINRConfig(**{"C": effective_C(z), **kw}, progress=False)).frames
         sc = score(frames, times, gt, times)
         row[f"score_{name}"] = [sc["ssim_clahe"], sc["ssim_none"], sc["mse_none"]]
         row[f"level_{name}"] = level_error(frames, gt, times, z.duration)
     row["long"] = bool(z.long)
     return row
+
+
+def off_heavy_row(z) -> dict:
+    """:func:`scored_row` of the off-heavy scene under the default balance, the counts rule and the true pair."""
+    return scored_row(z, {"events": {}, "counts": {"balance": "counts"}, "true_pair": {"C": (z.C_pos, z.C_neg)}})
 
 
 LIGHT_CHANGES = (-0.7, -2.0)   # log units over the recording, --light
@@ -153,21 +158,8 @@ def light_scenes() -> list:
 
 
 def light_row(z) -> dict:
-    """:func:`scene_row` with the kit's scores and level error under the default, b = 0 and the true pair."""
-    from benchmarks.quality_zoo import level_error, score
-    from evinr_lite.method import reconstruct
-
-    row = scene_row(z)
-    _, events, times, gt = simulate(z)
-    C = effective_C(z)
-    for name, cfg in (("events", EvINRConfig(C=C, progress=False)),
-                      ("none", EvINRConfig(C=C, balance="none", progress=False)),
-                      ("true_pair", EvINRConfig(C=(z.C_pos, z.C_neg), progress=False))):
-        frames = reconstruct(events, times, cfg).frames
-        sc = score(frames, times, gt, times)
-        row[f"score_{name}"] = [sc["ssim_clahe"], sc["ssim_none"], sc["mse_none"]]
-        row[f"level_{name}"] = level_error(frames, gt, times, z.duration)
-    return row
+    """:func:`scored_row` under the default balance, b = 0 and the true pair."""
+    return scored_row(z, {"events": {}, "none": {"balance": "none"}, "true_pair": {"C": (z.C_pos, z.C_neg)}})
 
 
 def light_markdown(rows: dict, rms: dict) -> str:
