@@ -57,7 +57,8 @@ def scene_row(z, simulated=None) -> dict:
     fit, old = estimate_balance(events, C), estimate_balance(events, C, rule="counts")
     log_mean = np.log(np.clip(np.asarray(gt, np.float64), 1e-3, None)).mean(axis=(1, 2))
     return {"span_s": float(times[-1] - times[0]), "b_true": imbalance(z), "raw": fit.raw_imbalance,
-            "interval": fit.interval_imbalance, "slope": fit.slope_imbalance, "applied": fit.imbalance,
+            "interval": fit.interval_imbalance, "slope": fit.slope_imbalance, "gradient": fit.gradient_imbalance,
+            "applied": fit.imbalance,
             "chosen": fit.chosen,
             "counts_error": fit.counts_error, "shrink": old.shrink,
             "counts_rule": old.imbalance, "mean_events": fit.mean_events,
@@ -230,7 +231,7 @@ def main(argv=None) -> int:
     for z in scenes:
         rows[z.name] = r = light_row(z) if a.light else off_heavy_row(z) if a.off_heavy else scene_row(z)
         print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  s {r['counts_error']:.3f}  b {r['b_true']:+.3f}  "
-              f"counts {r['raw']:+.3f}  intervals {r['interval']:+.3f}  applied {r['applied']:+.3f} ({r['chosen']})  "
+              f"counts {r['raw']:+.3f}  slope {r['slope']:+.3f}  edges {r['gradient']:+.3f}  intervals {r['interval']:+.3f}  applied {r['applied']:+.3f} ({r['chosen']})  "
               f"counts rule {r['counts_rule']:+.3f}  "
               f"mean log change {r['mean_log_change']:+.3f}", flush=True)
 

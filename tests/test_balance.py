@@ -5,7 +5,8 @@ import pytest
 from evinr_lite.core.events import EventDataError, Events
 from evinr_lite.method import EvINRConfig, reconstruct
 from evinr_lite.method.balance import (MAX_INTERVAL_PIXELS, PolarityCounts, balance_from_counts, estimate_balance,
-                                       interval_stride, interval_sums, minmod, polarity_counts)
+                                       gradient_imbalance, interval_stride, interval_sums, minmod, polarity_counts,
+                                       slice_counts, span_slices)
 from evinr_lite.method.prepare import prepare_events
 from evinr_lite.sim.scenes import LightingScene, MovingImageScene, OscillatingScene
 from evinr_lite.sim.simulate import add_hot_pixels, simulate_scene
@@ -131,7 +132,7 @@ def test_balance_benchmark_row_reads_a_scene():
     row = scene_row(z)
     assert row["b_true"] == pytest.approx(0.1, abs=1e-9)
     assert abs(row["raw"] - row["b_true"]) < 0.03 and row["interval"] > 0 and 0 < row["shrink"] < 1
-    assert row["applied"] == min(row["raw"], row["interval"])            # they agree: the one nearer 0
+    assert row["applied"] == min(row["gradient"], row["interval"])       # they agree: the one nearer 0
     assert abs(row["counts_rule"]) < abs(row["raw"])
 
 
@@ -295,3 +296,53 @@ def test_a_long_off_heavy_recording_gets_its_pair():
     assert fit.chosen == "counts"
     assert fit.imbalance == pytest.approx(-0.05 / 0.45, abs=0.01)
     assert fit.C[0] == pytest.approx(0.20, abs=0.006) and fit.C[1] == pytest.approx(0.25, abs=0.006)
+
+
+@pytest.fixture(scope="module")
+def darkening_pan():
+    """2 s of the camera image translating at (12, -5) px/s on 60 x 80 pixels, C+ 0.17 and C- 0.23 given
+    as 0.2 (b = -0.15): the pan brings in brighter content, so the pooled counts read the wrong sign."""
+    scene = MovingImageScene("camera", (60, 80), 2.0, velocity=(12.0, -5.0))
+    return simulate_scene(scene, C=0.2, C_pos=0.17, C_neg=0.23, seed=0)
+
+
+def test_the_edges_estimate_takes_the_pooled_counts_place_in_the_minmod(darkening_pan):
+    fit = estimate_balance(darkening_pan, 0.2)
+    assert fit.raw_imbalance > 0.1 and fit.interval_imbalance < -0.1      # the two disagree in sign ...
+    assert fit.gradient_imbalance < -0.05 and fit.chosen == "minmod"       # ... the edges' estimate does not
+    assert fit.imbalance == minmod(fit.gradient_imbalance, fit.interval_imbalance)
+    counts = PolarityCounts((60, 80)).update(darkening_pan)               # no slice counts: the pooled counts
+    old = balance_from_counts(counts.n_on, counts.n_off, 0.2, intervals=counts.intervals)
+    assert np.isnan(old.gradient_imbalance) and old.imbalance == 0.0 and old.chosen == "nominal"
+    assert abs(fit.imbalance + 0.15) < abs(old.imbalance + 0.15) - 0.05
+
+
+def test_a_uniform_change_of_light_does_not_move_the_edges_estimate(darkening_pan):
+    """Every pixel given the same extra OFF events in every slice (a fall of the light, uniform in log
+    intensity): no neighbour difference changes, so neither does the edges' estimate; the pooled counts do."""
+    edges = span_slices(darkening_pan.t[0], darkening_pan.t[-1])
+    on, off = slice_counts(darkening_pan, edges)
+    usable = (on.sum(0) + off.sum(0)) > 0
+    darker = off + np.float32(3.0)
+    assert gradient_imbalance(on, darker, usable) == pytest.approx(gradient_imbalance(on, off, usable), abs=1e-12)
+    before = balance_from_counts(on.sum(0), off.sum(0), 0.2).raw_imbalance
+    assert balance_from_counts(on.sum(0), darker.sum(0), 0.2).raw_imbalance > before + 0.1
+
+
+def test_slice_counts_carried_in_chunks_match_one_span(darkening_pan):
+    edges = span_slices(0.0, 2.0)
+    counts = PolarityCounts((60, 80), slices=edges)
+    for a in np.arange(0.0, 2.0, 0.3):
+        counts.update(darkening_pan.slice_time(a, a + 0.3, allow_empty=True))
+    for chunked, one in zip(counts.sliced, slice_counts(darkening_pan, edges)):
+        np.testing.assert_array_equal(chunked, one)
+    assert sum(a.sum() for a in counts.sliced) == len(darkening_pan)
+    whole = estimate_balance(darkening_pan, 0.2)
+    assert counts.fit(0.2).gradient_imbalance == pytest.approx(whole.gradient_imbalance, abs=0.02)  # slices 0-2 s vs the events' own span
+
+
+def test_bad_slices_are_refused():
+    with pytest.raises(EventDataError, match="increasing"):
+        PolarityCounts(SIZE, slices=[0.0, 1.0, 1.0])
+    with pytest.raises(EventDataError, match="sliced must be"):
+        balance_from_counts(np.ones(SIZE), np.ones(SIZE), 0.2, sliced=(np.ones((4,) + SIZE), np.ones((3,) + SIZE)))

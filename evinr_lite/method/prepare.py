@@ -30,7 +30,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..core.events import EventDataError, Events
-from .balance import PolarityCounts, balance_from_counts
+from .balance import PolarityCounts, balance_from_counts, span_slices
 from .denoise import DEFAULT_DT, denoise_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
@@ -41,10 +41,11 @@ BACKGROUND_MODES = ("keep", "filter")
 REACH = 2 * DEFAULT_DT    # s read beyond a streamed window's edges: more than the filter's DEFAULT_DT, so rounding never matters
 
 
-def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None):
+def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sliced=None):
     """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance`` is not "none" and
     C is one number (``intervals``: the span's :attr:`~evinr_lite.method.balance.PolarityCounts.intervals`,
-    which the "events" rule needs; without them it falls back to the "counts" rule), ``lam="auto"``
+    which the "events" rule needs; without them it falls back to the "counts" rule; ``sliced``: its
+    :attr:`~evinr_lite.method.balance.PolarityCounts.sliced`, for the edges' estimate), ``lam="auto"``
     replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
     for windows covering ``fraction`` of the span), and the hot pixels to drop (bool [H, W], all False
     unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
@@ -58,7 +59,7 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None):
     if cfg.balance != "none" and np.ndim(cfg.C) == 0:
         fit = balance_from_counts(np.where(hot, 0, n_on), np.where(hot, 0, n_off), cfg.C,
                                   intervals=None if intervals is None else [np.where(hot, 0, a) for a in intervals],
-                                  rule="counts" if cfg.balance == "counts" else "consensus")
+                                  sliced=sliced, rule="counts" if cfg.balance == "counts" else "consensus")
         if fit.applied:
             cfg = replace(cfg, C=fit.C)
     if cfg.lam == "auto":
@@ -106,9 +107,9 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
         n_in = len(events)
         events = events.take(denoise_mask(events, hot_pixels=cfg.hot_pixels == "drop")[0])
         _check_left(len(events), n_in)
-    counts = PolarityCounts(tuple(events.sensor_size)).update(events)
+    counts = PolarityCounts(tuple(events.sensor_size), slices=span_slices(t0, t1)).update(events)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap),
-                                counts.intervals)
+                                counts.intervals, counts.sliced)
     return drop_pixels(events, hot), cfg
 
 
@@ -154,7 +155,7 @@ def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str 
     (seconds of the recording read), or None for none."""
     from tqdm.auto import tqdm
 
-    counts = PolarityCounts(tuple(source.sensor_size))
+    counts = PolarityCounts(tuple(source.sensor_size), slices=span_slices(t_start, t_end))
     with tqdm(total=round(t_end - t_start, 3), desc=progress, unit="s", disable=progress is None,
               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s of events [{elapsed}<{remaining}]") as bar:
         for (a, b), events in _read_spans(source, t_start, t_end, chunk_s):
@@ -188,7 +189,7 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
                          "filtering background activity" if progress else None)
         _check_left(int((counts.n_on + counts.n_off).sum()), n_in)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap),
-                                counts.intervals)
+                                counts.intervals, counts.sliced)
     if not filtered and not hot.any():
         return cfg, source
     return cfg, _Prepared(source, span, first, background=filtered, then=hot)
