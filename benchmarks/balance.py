@@ -5,6 +5,7 @@
     python benchmarks/balance.py --speed      # what the intervals cost beside the counts, 1280 x 720 (about 10 s)
     python benchmarks/balance.py --off-heavy  # every scene of both sets with C- > C+, long ones included (about 8 min)
     python benchmarks/balance.py --light      # the 20 s pan under a change of light, three C pairs (about 2 min)
+    python benchmarks/balance.py --fresh      # two fresh random draws of every short scene's sensor (about 5 min)
 
 For each scene, on the events the kit trains on (hot pixels dropped, background filtered, as
 :mod:`evinr_lite.method.prepare` does): the simulated imbalance b = (C+ - C-) / (C+ + C-), the two
@@ -30,6 +31,15 @@ with the light falling by e^-0.7 (2x) and e^-2 (7.4x) over the recording, unifor
 with C+ = C-, C+ > C- and C- > C+ (b = 0, +-0.111), with the kit's scores and level error per quarter
 under the default, b = 0 (``balance="none"``) and the true pair. Writes
 benchmarks/balance_results_light.{json,md}.
+
+``--fresh`` checks scenes built the same ways that no rule was chosen on: each short scene of the zoo
+and the held-out set drawn again, twice (generators seeded 7 and 8, FRESH_SEEDS), with a new seed and a
+new sensor: nominal C uniform in [0.15, 0.35], C+ / C- log-uniform in [0.7, 1.4] (either sign of b),
+background activity the scene's own, 0.3 or 1 Hz, hot pixels its own or 20 (ON-only half the time),
+a threshold mismatch of at least 3 %. It scores the kit under the default balance, under the rule
+before the edges' estimate (``pooled_minmod``: the minmod of the pooled counts and the intervals where
+the counts are not taken alone, applied as a C pair) and given the true pair. Writes
+benchmarks/balance_results_fresh.{json,md}.
 """
 from __future__ import annotations
 
@@ -67,12 +77,12 @@ def scene_row(z, simulated=None) -> dict:
 
 def markdown(rows: dict, rms: dict) -> str:
     lines = ["| scene | span (s) | events per pixel | counts' error scale | b simulated | counts (raw) | counts (slope) | "
-             "intervals | b applied (taken from) | counts rule (shrink) | truth's mean log change |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "edges | intervals | b applied (taken from) | counts rule (shrink) | truth's mean log change |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
         lines.append(f"| {name} | {r['span_s']:.1f} | {r['mean_events']:.1f} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | "
-                     f"{r['raw']:+.3f} | {r['slope']:+.3f} | {r['interval']:+.3f} | {r['applied']:+.3f} ({r['chosen']}) | "
-                     f"{r['counts_rule']:+.3f} ({r['shrink']:.2f}) | "
+                     f"{r['raw']:+.3f} | {r['slope']:+.3f} | {r['gradient']:+.3f} | {r['interval']:+.3f} | "
+                     f"{r['applied']:+.3f} ({r['chosen']}) | {r['counts_rule']:+.3f} ({r['shrink']:.2f}) | "
                      f"{r['mean_log_change']:+.3f} |")
     lines += ["", f"Root mean square over these {len(rows)} scenes: simulated b {rms['b']:.3f}, mean log change "
               f"{rms['log_change']:.2f} (the counts rule's prior spreads in evinr_lite.method.balance: PRIOR {PRIOR}, "
@@ -117,13 +127,14 @@ def off_heavy(z):
     return replace(z, name=z.name + "_off_heavy", C_pos=c_pos, C_neg=c_neg, seed=z.seed + 1000)
 
 
-def scored_row(z, balances: dict) -> dict:
+def scored_row(z, balances: dict, simulated=None) -> dict:
     """:func:`scene_row` with the kit's scores (CLAHE-SSIM, SSIM, MSE) and level error per quarter under
-    each balance of ``balances`` (name -> EvINRConfig keyword arguments), the scene simulated once."""
+    each balance of ``balances`` (name -> EvINRConfig keyword arguments), the scene simulated once
+    (``simulated``: ``simulate(z)``'s result when the caller already has it)."""
     from benchmarks.quality_zoo import level_error, score
     from evinr_lite.method import reconstruct
 
-    simulated = simulate(z)
+    simulated = simulated or simulate(z)
     _, events, times, gt = simulated
     row = scene_row(z, simulated)
     for name, kw in balances.items():
@@ -138,6 +149,70 @@ def scored_row(z, balances: dict) -> dict:
 def off_heavy_row(z) -> dict:
     """:func:`scored_row` of the off-heavy scene under the default balance, the counts rule and the true pair."""
     return scored_row(z, {"events": {}, "counts": {"balance": "counts"}, "true_pair": {"C": (z.C_pos, z.C_neg)}})
+
+
+FRESH_SEEDS = (7, 8)   # generators of the two --fresh draws
+
+
+def fresh_scenes(seed: int) -> list:
+    """Every short scene of the zoo and the held-out set with a new seed and a sensor drawn at random
+    (the module docstring says how), by a generator seeded ``seed``."""
+    from dataclasses import replace
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for z in default_scenes() + [h for h in HELDOUT if not h.long]:
+        C = float(rng.uniform(0.15, 0.35))
+        ratio = float(np.exp(rng.uniform(np.log(0.7), np.log(1.4))))        # C+ / C-
+        out.append(replace(z, name=f"{z.name}_fresh{seed}", seed=z.seed + 777 + int(rng.integers(1000)), C=C,
+                           C_pos=C * 2 * ratio / (1 + ratio), C_neg=C * 2 / (1 + ratio),
+                           noise_hz=float(rng.choice([z.noise_hz, 0.3, 1.0])),
+                           hot_pixels=int(rng.choice([z.hot_pixels, 20])), hot_on_only=bool(rng.random() < 0.5),
+                           threshold_sigma=max(z.threshold_sigma, 0.03)))
+    return out
+
+
+def pooled_minmod(row: dict) -> float:
+    """The b the rule before the edges' estimate applied: the counts' slope where they were taken alone,
+    else the minmod of the pooled counts and the intervals (capped like the default)."""
+    from evinr_lite.method.balance import MAX_IMBALANCE, minmod
+
+    b = row["slope"] if row["chosen"] == "counts" else minmod(row["raw"], row["interval"])
+    return float(np.clip(b, -MAX_IMBALANCE, MAX_IMBALANCE))
+
+
+def fresh_row(z) -> dict:
+    """:func:`scored_row` under the default balance, the rule before (:func:`pooled_minmod`) and the true pair."""
+    simulated = simulate(z)
+    b = pooled_minmod(scene_row(z, simulated))
+    C = effective_C(z)
+    row = scored_row(z, {"events": {}, "pooled_minmod": {"C": (C * (1 + b), C * (1 - b))},
+                         "true_pair": {"C": (z.C_pos, z.C_neg)}}, simulated)
+    row["pooled_minmod"] = b
+    return row
+
+
+def fresh_markdown(rows: dict, rms: dict) -> str:
+    fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
+    lines = ["| scene | b simulated | counts (pooled) | counts (slope) | edges | intervals | b applied (taken from) | "
+             "b, rule before | kit | kit, rule before | kit given the true pair |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for name, r in rows.items():
+        lines.append(f"| {name} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | {r['gradient']:+.3f} | "
+                     f"{r['interval']:+.3f} | {r['applied']:+.3f} ({r['chosen']}) | {r['pooled_minmod']:+.3f} | "
+                     f"{fmt(r['score_events'])} | {fmt(r['score_pooled_minmod'])} | {fmt(r['score_true_pair'])} |")
+    mean = {k: np.mean([r[k] for r in rows.values()], axis=0) for k in ("score_events", "score_pooled_minmod", "score_true_pair")}
+    lines.append(f"| **mean of the {len(rows)} scenes** | | | | | | | | {fmt(mean['score_events'])} | "
+                 f"{fmt(mean['score_pooled_minmod'])} | {fmt(mean['score_true_pair'])} |")
+    neg = [r for r in rows.values() if r["b_true"] < -0.05]
+    if neg:
+        m = {k: np.mean([r[k] for r in neg], axis=0) for k in ("score_events", "score_pooled_minmod", "score_true_pair")}
+        lines.append(f"| **mean of the {len(neg)} with b < -0.05** | | | | | | | | {fmt(m['score_events'])} | "
+                     f"{fmt(m['score_pooled_minmod'])} | {fmt(m['score_true_pair'])} |")
+    err = lambda key: float(np.sqrt(np.mean([(r[key] - r["b_true"]) ** 2 for r in rows.values()])))      # noqa: E731
+    lines += ["", f"Root mean square error of the applied b {err('applied'):.3f}, of the rule before "
+              f"{err('pooled_minmod'):.3f}, of the counts rule's {rms['counts_rule_error']:.3f}. Kit cells: CLAHE-SSIM / "
+              "SSIM / MSE at the zoo's scored times. Written by `python benchmarks/balance.py --fresh`."]
+    return "\n".join(lines) + "\n"
 
 
 LIGHT_CHANGES = (-0.7, -2.0)   # log units over the recording, --light
@@ -184,16 +259,18 @@ def light_markdown(rows: dict, rms: dict) -> str:
 
 def off_heavy_markdown(rows: dict, rms: dict) -> str:
     fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
-    lines = ["| scene (C- > C+) | counts' error scale | b simulated | counts | counts (slope) | intervals | b applied (taken from) | "
-             "counts rule | kit | kit, counts rule | kit given the true pair |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene (C- > C+) | counts' error scale | b simulated | counts | counts (slope) | edges | intervals | "
+             "b applied (taken from) | counts rule | kit | kit, counts rule | kit given the true pair |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
-        lines.append(f"| {name} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | {r['interval']:+.3f} | "
+        lines.append(f"| {name} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | "
+                     f"{r['gradient']:+.3f} | {r['interval']:+.3f} | "
                      f"{r['applied']:+.3f} ({r['chosen']}) | "
                      f"{r['counts_rule']:+.3f} | {fmt(r['score_events'])} | {fmt(r['score_counts'])} | "
                      f"{fmt(r['score_true_pair'])} |")
     short = [r for r in rows.values() if not r.get("long")]
     mean = {k: np.mean([r[k] for r in short], axis=0) for k in ("score_events", "score_counts", "score_true_pair")}
-    lines.append(f"| **mean of the {len(short)} short scenes** | | | | | | {fmt(mean['score_events'])} | "
+    lines.append(f"| **mean of the {len(short)} short scenes** | | | | | | | | | {fmt(mean['score_events'])} | "
                  f"{fmt(mean['score_counts'])} | {fmt(mean['score_true_pair'])} |")
     long = {name: r for name, r in rows.items() if r.get("long")}
     if long:
@@ -216,6 +293,7 @@ def main(argv=None) -> int:
     p.add_argument("--speed", action="store_true", help="only time the intervals against the counts (1280 x 720)")
     p.add_argument("--off-heavy", action="store_true", help="every scene of both sets with C- > C+, and the kit's scores")
     p.add_argument("--light", action="store_true", help="the 20 s pan under a change of light, three C pairs")
+    p.add_argument("--fresh", action="store_true", help="two random draws of every short scene's sensor, and the kit's scores")
     a = p.parse_args(argv)
     if a.speed:
         r = speed()
@@ -223,13 +301,13 @@ def main(argv=None) -> int:
               f"{r['stride']}): polarity_counts {r['polarity_counts']:.2f} s, interval_sums {r['interval_sums']:.2f} s "
               f"({r['ratio']:.2f}x)")
         return 0
-    suffix = "_light" if a.light else "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
-    scenes = light_scenes() if a.light else (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \
+    suffix = "_fresh" if a.fresh else "_light" if a.light else "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
+    scenes = [z for seed in FRESH_SEEDS for z in fresh_scenes(seed)] if a.fresh else light_scenes() if a.light else (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \
         [off_heavy(z) for z in default_scenes() + [h for h in HELDOUT if not h.long] +
          [z for z in default_scenes(long=True) + HELDOUT if z.long]]
     rows = {}
     for z in scenes:
-        rows[z.name] = r = light_row(z) if a.light else off_heavy_row(z) if a.off_heavy else scene_row(z)
+        rows[z.name] = r = fresh_row(z) if a.fresh else light_row(z) if a.light else off_heavy_row(z) if a.off_heavy else scene_row(z)
         print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  s {r['counts_error']:.3f}  b {r['b_true']:+.3f}  "
               f"counts {r['raw']:+.3f}  slope {r['slope']:+.3f}  edges {r['gradient']:+.3f}  intervals {r['interval']:+.3f}  applied {r['applied']:+.3f} ({r['chosen']})  "
               f"counts rule {r['counts_rule']:+.3f}  "
@@ -243,9 +321,10 @@ def main(argv=None) -> int:
     print(f"root mean square: b {rms['b']:.3f}, mean log change {rms['log_change']:.2f}; error of the applied b "
           f"{rms['applied_error']:.3f}, of the counts rule's {rms['counts_rule_error']:.3f}")
     write_json(f"benchmarks/balance_results{suffix}.json", {"heldout": a.heldout, "off_heavy": a.off_heavy, "light": a.light,
+                                                             "fresh": a.fresh,
                                                              "scenes": rows, "rms": rms, "prior": PRIOR,
                                                              "net_change": NET_CHANGE})
-    render = light_markdown if a.light else off_heavy_markdown if a.off_heavy else markdown
+    render = fresh_markdown if a.fresh else light_markdown if a.light else off_heavy_markdown if a.off_heavy else markdown
     Path(f"benchmarks/balance_results{suffix}.md").write_text(render(rows, rms))
     print(f"markdown: benchmarks/balance_results{suffix}.md")
     return 0

@@ -24,9 +24,22 @@ nominal C: the nominal C sets the contrast, the balance only the drift):
    change of light (dark_falling: the falling light adds slow falls on flat regions, so the OFF
    intervals grow: -0.43 for 0). Falling light biases the counts the other way (more OFF events).
 
-The two assumptions fail on different scenes, and a real imbalance moves both estimates alike. So the
-default rule (``rule="consensus"``) takes their **minmod**: the one nearer 0 when they agree in sign,
-0 when they do not. But their errors scale differently: the counts' error is the mean log change over
+3. **Edges** (:func:`gradient_imbalance`): a wrong b adds ``C (b_true - b) n`` to every pixel, an
+   image of its event count, growing in the frames. Across an edge between two pixels the scene's own
+   gradient changes with the texture passing but does not follow their count difference, so b is
+   fitted as the value that leaves each edge's change over the span's 8 time slices least correlated
+   with that difference. A change of light common to all pixels changes no gradient, and a change of
+   the mean brightness does not enter (camera_240x180: pooled counts +0.17 for 0, edges +0.07). It
+   errs where the events' own pattern grows with the light: a change of light on a sensor whose
+   pixels' thresholds differ, or whose noise grows in the dark (dark_falling +0.43 for 0).
+
+Their assumptions fail on different scenes, and a real imbalance moves all of them alike. So the
+default rule (``rule="consensus"``) takes the **minmod** of the edges' estimate (the pooled counts
+where no slice counts are given) and the intervals': the one nearer 0 when they agree in sign, 0 when
+they do not. A change of light pushes the edges and the intervals apart (dark_falling +0.43 and
+-0.43), as it did the pooled counts and the intervals. The edges took the pooled counts' place
+because the pooled counts' error, the mean log change, is a one-signed error of a scene as a whole
+and often larger (``python benchmarks/balance.py --fresh``; figures in docs/defaults.md). But their errors scale differently: the counts' error is the mean log change over
 the events per pixel, ``s = NET_CHANGE / (C mean n)``, which falls as events accumulate, while the
 intervals' bias is a property of the scene (+0.05 to +0.2 on most natural scenes of the simulator with
 C+ = C-; text_shake +0.11, brick_speed_noisy -0.24) that no length of recording removes. So where
@@ -38,6 +51,11 @@ all pixels goes to the intercept): on a long recording a change of light is boun
 keep coming, and the pooled counts would read the light falling 7x over the 20 s pan as b = +0.10,
 the slope as +0.008 (``python benchmarks/balance.py --light``). ``BalanceFit.chosen`` says which was
 taken.
+
+The edges' estimate took the pooled counts' place in the minmod on 2026-12-04: rms error of the applied
+b 0.104 -> 0.092 on the off-heavy short scenes, 0.069 -> 0.063 on 44 fresh random sensors
+(``python benchmarks/balance.py --fresh``), 0.019 -> 0.016 held out, the zoo's unchanged (docs/defaults.md
+has the scores; the figures below are from before it, the pooled counts in the minmod).
 
 Measured on the zoo's 15 scenes and the 10 held-out ones, long ones included (their simulated b is 0
 on 16, 0.10-0.22 on 9), on the events the kit trains on: the estimate is within 0.05 of the truth on
@@ -115,8 +133,9 @@ class BalanceFit:
 
     Attributes:
         C: (c_pos, c_neg) log units per event, mean = the nominal C.
-        imbalance: b applied, (C+ - C-) / (C+ + C-), capped: minmod(raw_imbalance,
-            interval_imbalance) by the consensus rule, shrink x raw_imbalance by the counts rule.
+        imbalance: b applied, (C+ - C-) / (C+ + C-), capped: minmod(gradient_imbalance (or
+            raw_imbalance without slice counts), interval_imbalance) or slope_imbalance by the
+            consensus rule, shrink x raw_imbalance by the counts rule.
         raw_imbalance: the counts' pooled b = sum(n- - n+) / sum(n- + n+) over the usable pixels.
         interval_imbalance: the intervals' b (NaN where not computed: the counts rule, no interval sums).
         shrink: the counts rule's weight for the raw value (0: nominal C kept, 1: raw value used).
@@ -170,16 +189,25 @@ def polarity_counts(events: Events) -> tuple[np.ndarray, np.ndarray]:
 
 def slice_counts(events: Events, edges) -> tuple[np.ndarray, np.ndarray]:
     """(on, off): float32 [K, H, W] ON and OFF counts per pixel in each of the K time slices whose
-    boundaries are ``edges`` (float64 [K + 1], s, increasing); events before the first or after the
-    last boundary count in the first or last slice."""
+    boundaries are ``edges`` (float64 [K + 1], s, increasing; an event at a boundary counts in the slice
+    it opens); events before the first or after the last boundary count in the first or last slice.
+    The events are time-ordered, so each slice is one run of them, counted on its own (the memory
+    beyond the result is one [H, W] count)."""
     H, W = events.sensor_size
     edges = np.asarray(edges, np.float64)
     K = len(edges) - 1
-    k = np.clip(np.searchsorted(edges, np.asarray(events.t, np.float64), side="right") - 1, 0, K - 1)
-    flat = k * (H * W) + events.y.astype(np.int64) * W + events.x
-    on = events.p > 0
-    return tuple(np.bincount(flat[sel], minlength=K * H * W).reshape(K, H, W).astype(np.float32)
-                 for sel in (on, ~on))
+    t = np.asarray(events.t, np.float64)
+    cut = np.concatenate([[0], np.searchsorted(t, edges[1:-1], side="left"), [len(t)]])
+    out = (np.zeros((K, H, W), np.float32), np.zeros((K, H, W), np.float32))
+    for k in range(K):
+        a, b = int(cut[k]), int(cut[k + 1])
+        if b <= a:
+            continue
+        flat = events.y[a:b].astype(np.int64) * W + events.x[a:b]
+        on = events.p[a:b] > 0
+        out[0][k] = np.bincount(flat[on], minlength=H * W).reshape(H, W)
+        out[1][k] = np.bincount(flat[~on], minlength=H * W).reshape(H, W)
+    return out
 
 
 def interval_stride(sensor_size) -> int:

@@ -156,6 +156,11 @@ class EvINRConfig:
       0.0486 -> 0.592 / 0.647 / 0.0468, and the long ones no longer drift (long_ijrr_60s 0.294 ->
       0.696 CLAHE-SSIM); under a change of light over the 20 s pan (``--light``) the kit is within
       0.004 of the true pair. The zoo and held-out scenes: docs/defaults.md.
+      Then the edges' estimate (b that keeps each edge's change from following its pixels' count
+      difference) took the pooled counts' place in the minmod: off-heavy short mean -> 0.598 / 0.654 /
+      0.0452, fresh random sensors (``--fresh``) 0.528 / 0.608 / 0.0478 -> 0.529 / 0.609 / 0.0473,
+      zoo 0.648 / 0.710 / 0.0337 -> 0.648 / 0.710 / 0.0339, real chunk 0.377 / 0.457 / 0.0668 ->
+      0.372 / 0.451 / 0.0656 (docs/defaults.md, "The edges' estimate").
 
     - tonemap="linear", display_mean=0.4 (issue 21; the paper's Eq. 12 with the mean of F at 0.5
       before): frames are clip(exp(F), 0, 1), the intensity whose log changes fired the events, with
@@ -257,8 +262,9 @@ class EvINRConfig:
         balance: "none" (ON and OFF events weigh C as given), "events" or "counts": when C is one number,
             C+ and C- are estimated from the events, their mean kept at C
             (:mod:`evinr_lite.method.balance`). "events": the consensus (minmod) of two estimates with
-            different assumptions, the ON/OFF counts and the intervals between events of one polarity,
-            and the counts alone (fitted with an intercept, so a change of light shared by all pixels
+            different assumptions, the edges' (b that keeps each edge's change over time from
+            following its two pixels' count difference) and the intervals between events of one
+            polarity, and the counts alone (fitted with an intercept, so a change of light shared by all pixels
             does not count) where the span holds enough events that their error scale
             NET_CHANGE / (C events per pixel) is at most COUNTS_ALONE (long or busy recordings);
             "counts": the counts' estimate alone, shrunk towards C as far as the span carries little

@@ -12,8 +12,8 @@ The reference solutions of notebook 02's exercises live here and are registered 
 - :func:`interval_imbalance`: the ON/OFF imbalance from the intervals between consecutive events of
   one polarity at each pixel, pooled over the sensor. :func:`evinr_lite.method.balance.interval_sums`
   and :func:`~evinr_lite.method.balance.interval_imbalance` are the package's (per-pixel sums carried
-  across chunks, hot pixels left out), and the kit takes its minmod with the ON/OFF counts' estimate (the counts alone on spans with
-  many events per pixel).
+  across chunks, hot pixels left out), and the kit takes its minmod with the edges' estimate (b that keeps each edge's change from following
+  its two pixels' count difference; the counts alone on spans with many events per pixel).
 
 Small helpers for the notebook: :func:`pixel_trace` (one pixel's events) and
 :func:`busiest_pixel`.
