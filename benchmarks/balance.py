@@ -2,7 +2,7 @@
 
     python benchmarks/balance.py              # the zoo's scenes, long ones included (about 2 min on 2 cores)
     python benchmarks/balance.py --heldout    # the held-out scenes instead
-    python benchmarks/balance.py --speed      # what the intervals cost beside the counts, 1280 x 720 (about 10 s)
+    python benchmarks/balance.py --speed      # what the intervals and slice counts cost beside the counts, 1280 x 720 (about 10 s)
     python benchmarks/balance.py --off-heavy  # every scene of both sets with C- > C+, long ones included (about 8 min)
     python benchmarks/balance.py --light      # the 20 s pan under a change of light, three C pairs (about 2 min)
     python benchmarks/balance.py --fresh      # two fresh random draws of every short scene's sensor (about 5 min)
@@ -97,7 +97,7 @@ def speed(n_events: int = 20_000_000, sensor_size=(720, 1280), seed: int = 0) ->
     import time
 
     from evinr_lite.core.events import Events
-    from evinr_lite.method.balance import interval_stride, interval_sums, polarity_counts
+    from evinr_lite.method.balance import interval_stride, interval_sums, polarity_counts, slice_counts, span_slices
 
     rng = np.random.default_rng(seed)
     H, W = sensor_size
@@ -105,12 +105,15 @@ def speed(n_events: int = 20_000_000, sensor_size=(720, 1280), seed: int = 0) ->
                     rng.integers(0, H, n_events, dtype=np.int32), rng.choice(np.array([-1, 1], np.int8), n_events),
                     (H, W))
     seconds = {}
-    for name, f in (("polarity_counts", polarity_counts), ("interval_sums", interval_sums)):
+    edges = span_slices(0.0, 2.0)
+    for name, f in (("polarity_counts", polarity_counts), ("interval_sums", interval_sums),
+                    ("slice_counts", lambda ev: slice_counts(ev, edges))):
         t0 = time.perf_counter()
         f(events)
         seconds[name] = time.perf_counter() - t0
     return {"n_events": n_events, "sensor_size": [H, W], "stride": interval_stride((H, W)), **seconds,
-            "ratio": seconds["interval_sums"] / seconds["polarity_counts"]}
+            "ratio": seconds["interval_sums"] / seconds["polarity_counts"],
+            "slice_ratio": seconds["slice_counts"] / seconds["polarity_counts"]}
 
 
 OFF_HEAVY_B = -0.15     # b given to the equal-threshold scenes in --off-heavy
@@ -299,7 +302,7 @@ def main(argv=None) -> int:
         r = speed()
         print(f"{r['n_events']:,} events at {r['sensor_size'][1]} x {r['sensor_size'][0]} (interval stride "
               f"{r['stride']}): polarity_counts {r['polarity_counts']:.2f} s, interval_sums {r['interval_sums']:.2f} s "
-              f"({r['ratio']:.2f}x)")
+              f"({r['ratio']:.2f}x), slice_counts {r['slice_counts']:.2f} s ({r['slice_ratio']:.2f}x)")
         return 0
     suffix = "_fresh" if a.fresh else "_light" if a.light else "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
     scenes = [z for seed in FRESH_SEEDS for z in fresh_scenes(seed)] if a.fresh else light_scenes() if a.light else (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \

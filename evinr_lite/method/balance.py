@@ -124,6 +124,7 @@ COUNTS_ALONE = 0.1        # the counts' error scale NET_CHANGE / (C mean n) at o
 MIN_INTERVAL = 1e-6       # s: intervals between events are floored here (the timestamp resolution)
 LOG_GRID = 2.0 ** 16      # log intervals are rounded to 1 / LOG_GRID (exact sums in any order)
 MAX_INTERVAL_PIXELS = 1 << 16   # pixels whose intervals are timed at most (interval_stride: a grid on larger sensors)
+BAND_ROWS = 64            # rows of the sensor the edges' estimate holds at once (float64 [SLICES + 1, 65, W] arrays)
 SLICES = 8                # time slices of the span whose counts the edges' estimate (gradient_imbalance) compares
 
 
@@ -390,20 +391,28 @@ def gradient_imbalance(on, off, usable) -> float:
     K + 1 times (the start included), ``b = -sum(g' h') / sum(h' h')`` with g', h' less their mean over
     time. C cancels. A change of light common to all pixels changes no gradient; the error left is
     what the texture's changes share with the counts. NaN when no edge's count difference changes."""
-    on = np.asarray(on, np.float64)
-    off = np.asarray(off, np.float64)
-    zero = np.zeros((1,) + on.shape[1:])
-    net = np.concatenate([zero, np.cumsum(on - off, axis=0)])
-    tot = np.concatenate([zero, np.cumsum(on + off, axis=0)])
+    K, H, W = np.shape(on)
     num = den = 0.0
-    for axis in (1, 2):
-        both = (usable[1:, :] & usable[:-1, :]) if axis == 1 else (usable[:, 1:] & usable[:, :-1])
-        g = np.diff(net, axis=axis)[:, both]
-        h = np.diff(tot, axis=axis)[:, both]
-        g -= g.mean(axis=0)
-        h -= h.mean(axis=0)
-        num += float((g * h).sum())
-        den += float((h * h).sum())
+    for r0 in range(0, H, BAND_ROWS):            # bands of rows (and the row below), so memory stays a band's
+        n_rows = min(BAND_ROWS, H - r0)          # rows whose horizontal edges and downward edges this band owns
+        band = slice(r0, min(H, r0 + n_rows + 1))
+        o, f = (np.asarray(a[:, band], np.float64) for a in (on, off))
+        zero = np.zeros((1,) + o.shape[1:])
+        net = np.concatenate([zero, np.cumsum(o - f, axis=0)])
+        tot = np.concatenate([zero, np.cumsum(o + f, axis=0)])
+        u = usable[band]
+        for axis in (1, 2):
+            if axis == 1:
+                both = u[1:, :] & u[:-1, :]
+            else:
+                both = np.zeros_like(u[:, 1:])
+                both[:n_rows] = u[:n_rows, 1:] & u[:n_rows, :-1]
+            g = np.diff(net, axis=axis)[:, both]
+            h = np.diff(tot, axis=axis)[:, both]
+            g -= g.mean(axis=0)
+            h -= h.mean(axis=0)
+            num += float((g * h).sum())
+            den += float((h * h).sum())
     return -num / den if den > 0 else float("nan")
 
 
