@@ -346,3 +346,20 @@ def test_bad_slices_are_refused():
         PolarityCounts(SIZE, slices=[0.0, 1.0, 1.0])
     with pytest.raises(EventDataError, match="sliced must be"):
         balance_from_counts(np.ones(SIZE), np.ones(SIZE), 0.2, sliced=(np.ones((4,) + SIZE), np.ones((3,) + SIZE)))
+
+
+def test_the_fresh_benchmark_draws_both_signs_reproducibly():
+    """benchmarks/balance.py --fresh: the same seed gives the same sensors; the draws cover C- > C+ and
+    C+ > C-; the rule before is the slope where the counts were taken alone, else the pooled minmod."""
+    from benchmarks.balance import fresh_scenes, pooled_minmod
+    from evinr_lite.sim.zoo import imbalance
+
+    a, b = fresh_scenes(7), fresh_scenes(7)
+    assert [(z.name, z.C, z.C_pos, z.C_neg, z.seed) for z in a] == [(z.name, z.C, z.C_pos, z.C_neg, z.seed) for z in b]
+    assert [z.C for z in fresh_scenes(8)] != [z.C for z in a]
+    bs = [imbalance(z) for z in a]
+    assert min(bs) < -0.05 and max(bs) > 0.05 and all(abs(v) < 0.2 for v in bs)
+    assert all(0.5 * (z.C_pos + z.C_neg) == pytest.approx(z.C) for z in a)
+    assert pooled_minmod({"chosen": "counts", "slope": -0.12, "raw": 0.3, "interval": 0.1}) == -0.12
+    assert pooled_minmod({"chosen": "minmod", "slope": -0.12, "raw": 0.3, "interval": 0.1}) == pytest.approx(0.1)
+    assert pooled_minmod({"chosen": "nominal", "slope": -0.12, "raw": 0.3, "interval": -0.1}) == 0.0
