@@ -39,7 +39,9 @@ where no slice counts are given) and the intervals': the one nearer 0 when they 
 they do not. A change of light pushes the edges and the intervals apart (dark_falling +0.43 and
 -0.43), as it did the pooled counts and the intervals. The edges took the pooled counts' place
 because the pooled counts' error, the mean log change, is a one-signed error of a scene as a whole
-and often larger (``python benchmarks/balance.py --fresh``; figures in docs/defaults.md). But their errors scale differently: the counts' error is the mean log change over
+and often larger (``python benchmarks/balance.py --fresh``; figures in docs/defaults.md).
+
+The counts' and the intervals' errors scale differently: the counts' error is the mean log change over
 the events per pixel, ``s = NET_CHANGE / (C mean n)``, which falls as events accumulate, while the
 intervals' bias is a property of the scene (+0.05 to +0.2 on most natural scenes of the simulator with
 C+ = C-; text_shake +0.11, brick_speed_noisy -0.24) that no length of recording removes. So where
