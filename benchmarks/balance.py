@@ -130,16 +130,17 @@ def off_heavy(z):
     return replace(z, name=z.name + "_off_heavy", C_pos=c_pos, C_neg=c_neg, seed=z.seed + 1000)
 
 
-def scored_row(z, balances: dict, simulated=None) -> dict:
+def scored_row(z, balances: dict, simulated=None, row=None) -> dict:
     """:func:`scene_row` with the kit's scores (CLAHE-SSIM, SSIM, MSE) and level error per quarter under
     each balance of ``balances`` (name -> EvINRConfig keyword arguments), the scene simulated once
-    (``simulated``: ``simulate(z)``'s result when the caller already has it)."""
+    (``simulated``: ``simulate(z)``'s result, ``row``: ``scene_row(z, simulated)``, when the caller
+    already has them)."""
     from benchmarks.quality_zoo import level_error, score
     from evinr_lite.method import reconstruct
 
     simulated = simulated or simulate(z)
     _, events, times, gt = simulated
-    row = scene_row(z, simulated)
+    row = dict(row) if row is not None else scene_row(z, simulated)
     for name, kw in balances.items():
         frames = reconstruct(events, times, EvINRConfig(**{"C": effective_C(z), **kw}, progress=False)).frames
         sc = score(frames, times, gt, times)
@@ -187,30 +188,39 @@ def pooled_minmod(row: dict) -> float:
 def fresh_row(z) -> dict:
     """:func:`scored_row` under the default balance, the rule before (:func:`pooled_minmod`) and the true pair."""
     simulated = simulate(z)
-    b = pooled_minmod(scene_row(z, simulated))
+    first = scene_row(z, simulated)
+    b = pooled_minmod(first)
     C = effective_C(z)
     row = scored_row(z, {"events": {}, "pooled_minmod": {"C": (C * (1 + b), C * (1 - b))},
-                         "true_pair": {"C": (z.C_pos, z.C_neg)}}, simulated)
+                         "true_pair": {"C": (z.C_pos, z.C_neg)}}, simulated, first)
     row["pooled_minmod"] = b
     return row
 
 
+def score_cell(v) -> str:
+    """A markdown cell of one score triple (CLAHE-SSIM, SSIM, MSE)."""
+    return f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"
+
+
+def mean_row(label: str, rows, keys, blanks: int) -> str:
+    """A markdown row: ``label``, ``blanks`` empty cells, then the mean over ``rows`` (dicts) of each
+    score triple ``keys``."""
+    return f"| **{label}** |" + " |" * blanks + "".join(
+        f" {score_cell(np.mean([r[k] for r in rows], axis=0))} |" for k in keys)
+
+
 def fresh_markdown(rows: dict, rms: dict) -> str:
-    fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
     lines = ["| scene | b simulated | counts (pooled) | counts (slope) | edges | intervals | b applied (taken from) | "
              "b, rule before | kit | kit, rule before | kit given the true pair |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
         lines.append(f"| {name} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | {r['gradient']:+.3f} | "
                      f"{r['interval']:+.3f} | {r['applied']:+.3f} ({r['chosen']}) | {r['pooled_minmod']:+.3f} | "
-                     f"{fmt(r['score_events'])} | {fmt(r['score_pooled_minmod'])} | {fmt(r['score_true_pair'])} |")
-    mean = {k: np.mean([r[k] for r in rows.values()], axis=0) for k in ("score_events", "score_pooled_minmod", "score_true_pair")}
-    lines.append(f"| **mean of the {len(rows)} scenes** | | | | | | | | {fmt(mean['score_events'])} | "
-                 f"{fmt(mean['score_pooled_minmod'])} | {fmt(mean['score_true_pair'])} |")
+                     f"{score_cell(r['score_events'])} | {score_cell(r['score_pooled_minmod'])} | {score_cell(r['score_true_pair'])} |")
+    keys = ("score_events", "score_pooled_minmod", "score_true_pair")
+    lines.append(mean_row(f"mean of the {len(rows)} scenes", rows.values(), keys, 7))
     neg = [r for r in rows.values() if r["b_true"] < -0.05]
     if neg:
-        m = {k: np.mean([r[k] for r in neg], axis=0) for k in ("score_events", "score_pooled_minmod", "score_true_pair")}
-        lines.append(f"| **mean of the {len(neg)} with b < -0.05** | | | | | | | | {fmt(m['score_events'])} | "
-                     f"{fmt(m['score_pooled_minmod'])} | {fmt(m['score_true_pair'])} |")
+        lines.append(mean_row(f"mean of the {len(neg)} with b < -0.05", neg, keys, 7))
     err = lambda key: float(np.sqrt(np.mean([(r[key] - r["b_true"]) ** 2 for r in rows.values()])))      # noqa: E731
     lines += ["", f"Root mean square error of the applied b {err('applied'):.3f}, of the rule before "
               f"{err('pooled_minmod'):.3f}, of the counts rule's {rms['counts_rule_error']:.3f}. Kit cells: CLAHE-SSIM / "
@@ -242,14 +252,13 @@ def light_row(z) -> dict:
 
 
 def light_markdown(rows: dict, rms: dict) -> str:
-    fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
     lv = lambda v: " ".join(f"{x:+.3f}" for x in v)                   # noqa: E731
     lines = ["| scene | b simulated | counts (pooled) | counts (slope) | intervals | b applied (taken from) | kit | kit, b = 0 | "
              "kit given the true pair |", "|---|---|---|---|---|---|---|---|---|"]
     for name, r in rows.items():
         lines.append(f"| {name} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | {r['interval']:+.3f} | "
-                     f"{r['applied']:+.3f} ({r['chosen']}) | {fmt(r['score_events'])} | {fmt(r['score_none'])} | "
-                     f"{fmt(r['score_true_pair'])} |")
+                     f"{r['applied']:+.3f} ({r['chosen']}) | {score_cell(r['score_events'])} | {score_cell(r['score_none'])} | "
+                     f"{score_cell(r['score_true_pair'])} |")
     lines += ["", "Level error per quarter (mean prediction minus mean truth):", "",
               "| scene | kit | kit, b = 0 | kit given the true pair |", "|---|---|---|---|"]
     lines += [f"| {name} | {lv(r['level_events'])} | {lv(r['level_none'])} | {lv(r['level_true_pair'])} |"
@@ -261,7 +270,6 @@ def light_markdown(rows: dict, rms: dict) -> str:
 
 
 def off_heavy_markdown(rows: dict, rms: dict) -> str:
-    fmt = lambda v: f"{v[0]:.3f} / {v[1]:.3f} / {v[2]:.4f}"          # noqa: E731
     lines = ["| scene (C- > C+) | counts' error scale | b simulated | counts | counts (slope) | edges | intervals | "
              "b applied (taken from) | counts rule | kit | kit, counts rule | kit given the true pair |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -269,12 +277,11 @@ def off_heavy_markdown(rows: dict, rms: dict) -> str:
         lines.append(f"| {name} | {r['counts_error']:.3f} | {r['b_true']:+.3f} | {r['raw']:+.3f} | {r['slope']:+.3f} | "
                      f"{r['gradient']:+.3f} | {r['interval']:+.3f} | "
                      f"{r['applied']:+.3f} ({r['chosen']}) | "
-                     f"{r['counts_rule']:+.3f} | {fmt(r['score_events'])} | {fmt(r['score_counts'])} | "
-                     f"{fmt(r['score_true_pair'])} |")
+                     f"{r['counts_rule']:+.3f} | {score_cell(r['score_events'])} | {score_cell(r['score_counts'])} | "
+                     f"{score_cell(r['score_true_pair'])} |")
     short = [r for r in rows.values() if not r.get("long")]
-    mean = {k: np.mean([r[k] for r in short], axis=0) for k in ("score_events", "score_counts", "score_true_pair")}
-    lines.append(f"| **mean of the {len(short)} short scenes** | | | | | | | | | {fmt(mean['score_events'])} | "
-                 f"{fmt(mean['score_counts'])} | {fmt(mean['score_true_pair'])} |")
+    lines.append(mean_row(f"mean of the {len(short)} short scenes", short,
+                          ("score_events", "score_counts", "score_true_pair"), 8))
     long = {name: r for name, r in rows.items() if r.get("long")}
     if long:
         lv = lambda v: " ".join(f"{x:+.3f}" for x in v)          # noqa: E731
@@ -288,6 +295,19 @@ def off_heavy_markdown(rows: dict, rms: dict) -> str:
               f"{err('counts_rule'):.3f}. Kit cells: CLAHE-SSIM / SSIM / MSE at the zoo's scored times. "
               "Written by `python benchmarks/balance.py --off-heavy`."]
     return "\n".join(lines) + "\n"
+
+
+def mode(a) -> tuple:
+    """(results suffix, scenes, the row function) of the parsed arguments ``a``."""
+    if a.fresh:
+        return "_fresh", [z for seed in FRESH_SEEDS for z in fresh_scenes(seed)], fresh_row
+    if a.light:
+        return "_light", light_scenes(), light_row
+    if a.off_heavy:
+        short = default_scenes() + [h for h in HELDOUT if not h.long]
+        long = [z for z in default_scenes(long=True) + HELDOUT if z.long]
+        return "_off_heavy", [off_heavy(z) for z in short + long], off_heavy_row
+    return ("_heldout", HELDOUT, scene_row) if a.heldout else ("", default_scenes(long=True), scene_row)
 
 
 def main(argv=None) -> int:
@@ -304,13 +324,10 @@ def main(argv=None) -> int:
               f"{r['stride']}): polarity_counts {r['polarity_counts']:.2f} s, interval_sums {r['interval_sums']:.2f} s "
               f"({r['ratio']:.2f}x), slice_counts {r['slice_counts']:.2f} s ({r['slice_ratio']:.2f}x)")
         return 0
-    suffix = "_fresh" if a.fresh else "_light" if a.light else "_off_heavy" if a.off_heavy else "_heldout" if a.heldout else ""
-    scenes = [z for seed in FRESH_SEEDS for z in fresh_scenes(seed)] if a.fresh else light_scenes() if a.light else (HELDOUT if a.heldout else default_scenes(long=True)) if not a.off_heavy else \
-        [off_heavy(z) for z in default_scenes() + [h for h in HELDOUT if not h.long] +
-         [z for z in default_scenes(long=True) + HELDOUT if z.long]]
+    suffix, scenes, row_of = mode(a)
     rows = {}
     for z in scenes:
-        rows[z.name] = r = fresh_row(z) if a.fresh else light_row(z) if a.light else off_heavy_row(z) if a.off_heavy else scene_row(z)
+        rows[z.name] = r = row_of(z)
         print(f"{z.name:20s} span {r['span_s']:5.1f} s  n {r['mean_events']:6.1f}  s {r['counts_error']:.3f}  b {r['b_true']:+.3f}  "
               f"counts {r['raw']:+.3f}  slope {r['slope']:+.3f}  edges {r['gradient']:+.3f}  intervals {r['interval']:+.3f}  applied {r['applied']:+.3f} ({r['chosen']})  "
               f"counts rule {r['counts_rule']:+.3f}  "
@@ -327,7 +344,7 @@ def main(argv=None) -> int:
                                                              "fresh": a.fresh,
                                                              "scenes": rows, "rms": rms, "prior": PRIOR,
                                                              "net_change": NET_CHANGE})
-    render = fresh_markdown if a.fresh else light_markdown if a.light else off_heavy_markdown if a.off_heavy else markdown
+    render = {"_fresh": fresh_markdown, "_light": light_markdown, "_off_heavy": off_heavy_markdown}.get(suffix, markdown)
     Path(f"benchmarks/balance_results{suffix}.md").write_text(render(rows, rms))
     print(f"markdown: benchmarks/balance_results{suffix}.md")
     return 0

@@ -203,13 +203,8 @@ def slice_counts(events: Events, edges) -> tuple[np.ndarray, np.ndarray]:
     cut = np.concatenate([[0], np.searchsorted(t, edges[1:-1], side="left"), [len(t)]])
     out = (np.zeros((K, H, W), np.float32), np.zeros((K, H, W), np.float32))
     for k in range(K):
-        a, b = int(cut[k]), int(cut[k + 1])
-        if b <= a:
-            continue
-        flat = events.y[a:b].astype(np.int64) * W + events.x[a:b]
-        on = events.p[a:b] > 0
-        out[0][k] = np.bincount(flat[on], minlength=H * W).reshape(H, W)
-        out[1][k] = np.bincount(flat[~on], minlength=H * W).reshape(H, W)
+        if cut[k + 1] > cut[k]:
+            out[0][k], out[1][k] = polarity_counts(events.take(slice(int(cut[k]), int(cut[k + 1]))))
     return out
 
 
