@@ -180,6 +180,10 @@ def build_parser() -> argparse.ArgumentParser:
                           "what was removed. The kit recipe filters them anyway, inside the method "
                           "(EvINRConfig.background), without the report")
     rec.add_argument("--keep-background", action="store_true", help=KEEP_BACKGROUND_HELP)
+    rec.add_argument("--static-camera", action="store_true",
+                     help="the camera stood still (a tripod) and things moved in front of it: solve each pixel's "
+                          "offset from the frames where something moved over it, so the background an object "
+                          "passed over appears (EvINRConfig(camera='static'); kit recipe). Not for a moving camera")
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--resume", action="store_true",
@@ -254,7 +258,7 @@ def _run_options(args):
                       t_start=getattr(args, "start", None), t_end=getattr(args, "end", None),
                       time_unit=getattr(args, "time_unit", None), device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
-                      keep_background=args.keep_background,
+                      keep_background=args.keep_background, static_camera=getattr(args, "static_camera", False),
                       colour=getattr(args, "colour", False), tonemap=args.tonemap, video=video,
                       progress=not args.quiet)
 

@@ -138,6 +138,9 @@ class RunOptions:
         keep_background: train on every event, skipping the kit recipe's background-activity filter
             (``EvINRConfig(background="keep")``; paper and v0_1 keep every event anyway): for sparse
             recordings whose isolated events are signal.
+        static_camera: the camera stood still (a tripod): ``EvINRConfig(camera="static")``, the offset
+            solved from the frames where something moved over each pixel, so the background an object
+            passed over is recovered (kit recipe; ``python benchmarks/static_camera.py``).
         tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
             paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
         video: also write MP4 / GIF; progress: show a progress bar.
@@ -157,6 +160,7 @@ class RunOptions:
     anchor: str = "none"
     denoise: bool = False
     keep_background: bool = False
+    static_camera: bool = False
     colour: bool = False
     tonemap: str | None = None
     video: bool = True
@@ -199,8 +203,13 @@ class RunOptions:
                                          for v in size):
                 raise EventDataError(f"sensor_size=(H, W) must be two positive whole numbers, got {self.sensor_size!r}")
             checked["sensor_size"] = (int(size[0]), int(size[1]))
-        for name in ("denoise", "keep_background", "colour", "video", "progress"):
+        for name in ("denoise", "keep_background", "static_camera", "colour", "video", "progress"):
             checked[name] = _flag(name, getattr(self, name))
+        if checked["static_camera"] and (self.recipe != "kit" or self.anchor != "none"):
+            raise EventDataError(f"static_camera (--static-camera) changes the kit recipe's offset solve; the "
+                                 f"{self.recipe!r} recipe with anchor={self.anchor!r} has none to change (the paper's "
+                                 "recipes leave the offset to the regularizer, APS anchors set it): use recipe='kit' "
+                                 "and anchor='none', or leave static_camera out")
         if self.anchor != "none" and checked["colour"]:
             raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
         if self.n_iters is not None:
@@ -238,6 +247,8 @@ class RunOptions:
         With ``denoise`` the events were filtered before (and reported), so the recipe's own background
         filter is not run a second time."""
         extra = {"background": "keep"} if self.denoise or self.keep_background else {}
+        if self.static_camera:
+            extra["camera"] = "static"
         return recipe_config(self.recipe, self.n_iters, self.tonemap, C=C, seed=self.seed, device=self.device,
                              progress=self.progress, anchor=self.anchor, **extra)
 

@@ -71,7 +71,7 @@ def integrated_frames(chunks, times, C, sensor_size) -> np.ndarray | None:
     return np.cumsum(ef.frames, axis=0, out=ef.frames) if ef.counts.sum() else None
 
 
-def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -> np.ndarray:
+def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str, rest: float | None = None) -> np.ndarray:
     """The image [H, W] (float32, mean 0) to add to every frame so that the static image's spatial
     frequencies below ``coarse_px`` come from the integrated events (the module's docstring).
 
@@ -83,6 +83,7 @@ def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -
         frames: [G, H, W] the INR's log intensities with their offset added (the offset grid).
         coarse_px: the Gaussian's sigma (pixels) below which the integrated events set the static image.
         method: the integrated events' offset solve ("median_gradient" or "l1_gradient").
+        rest: None, or log units: a static camera's solve (:func:`~evinr_lite.method.offset.l1_gradient_offset`).
     """
     F = np.asarray(frames)
     H, W = F.shape[1:]
@@ -90,7 +91,7 @@ def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str) -
     I = integrated_frames(chunks, coarse_times(t), C, (H, W))
     if I is None:
         return np.zeros((H, W), np.float32)
-    static = I.mean(axis=0, dtype=np.float64) + offset_image(I, method)
+    static = I.mean(axis=0, dtype=np.float64) + offset_image(I, method, rest)
     del I
     d = gaussian_lowpass(static - F.mean(axis=0, dtype=np.float64), coarse_px)
     return (d - d.mean()).astype(np.float32)

@@ -18,11 +18,13 @@ from ..core.events import EventDataError
 from .anchor import ANCHOR_MODES
 from .balance import BALANCE_MODES, HOT_PIXEL_MODES
 from .binning import as_thresholds
-from .offset import OFFSET_SOLVES
+from .offset import OFFSET_SOLVES, STATIC_REST
 from .prepare import BACKGROUND_MODES
 from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEMAPS
 
-__all__ = ["EvINRConfig"]
+__all__ = ["EvINRConfig", "CAMERAS"]
+
+CAMERAS = ("moving", "static")   # what the user knows of the camera (EvINRConfig.camera)
 
 
 FIRST_OMEGA_0 = 10.0   # first_omega_0's default; used only where first_omega_per_s is None
@@ -259,6 +261,13 @@ class EvINRConfig:
             frequencies below this scale (a Gaussian's sigma, pixels) come from the integrated
             events' own offset solve, the finer ones and every change in time from the INR
             (:mod:`evinr_lite.method.coarse`); None: the static image from the INR's frames alone.
+        camera: "moving" (the default) or "static" (the camera stood still, e.g. on a tripod, and
+            things moved in front of it). Events never see a background at rest, so with "static"
+            each edge's offset is solved from the frames in which something moved over it (a pixel
+            more than STATIC_REST x C from its temporal median; :func:`~evinr_lite.method.offset.l1_gradient_offset`
+            with ``rest``): where an object passed, the background it covered is recovered instead of
+            being flattened. Needs offset_solve "l1_gradient". Not for a moving camera: there every
+            frame is informative and leaving the resting ones out loses (``python benchmarks/static_camera.py``).
         balance: "none" (ON and OFF events weigh C as given), "events" or "counts": when C is one number,
             C+ and C- are estimated from the events, their mean kept at C
             (:mod:`evinr_lite.method.balance`). "events": the consensus (minmod) of two estimates with
@@ -328,6 +337,7 @@ class EvINRConfig:
     offset_solve: str = "l1_gradient"
     offset_window: float | None = 5.0
     offset_coarse_px: float | None = 8.0
+    camera: str = "moving"
     balance: str = "events"
     hot_pixels: str = "drop"
     background: str = "filter"
@@ -343,13 +353,17 @@ class EvINRConfig:
         choices = {"binning": ("fixed", "equal_count"), "temporal_loss": ("derivative", "difference"),
                    "regularizer": ("tikhonov", "tv", "none"), "offset_solve": OFFSET_SOLVES,
                    "balance": BALANCE_MODES, "hot_pixels": HOT_PIXEL_MODES,
-                   "background": BACKGROUND_MODES, "tonemap": TONEMAPS}
+                   "background": BACKGROUND_MODES, "tonemap": TONEMAPS, "camera": CAMERAS}
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
         if self.head_solve and self.regularizer == "tv":
             raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
                                  "pass head_solve=False to train the head with Adam")
+        if self.camera == "static" and self.offset_solve != "l1_gradient":
+            raise EventDataError(f"camera='static' solves the offset from the frames where something moved, which "
+                                 f"needs offset_solve='l1_gradient', got {self.offset_solve!r}; pass "
+                                 "offset_solve='l1_gradient' or camera='moving'")
         if self.anchor not in ANCHOR_MODES:
             raise EventDataError(f"anchor must be one of {ANCHOR_MODES}, got {self.anchor!r}")
         if isinstance(self.anchor_every, bool) or not isinstance(self.anchor_every, (int, np.integer)) or \
@@ -483,6 +497,13 @@ class EvINRConfig:
             return self.first_omega_0
         w = np.asarray(windows, np.float64).reshape(-1, 2)
         return float(self.first_omega_per_s * float(np.max(w[:, 1] - w[:, 0])) / 2.0)
+
+    def offset_rest(self) -> float | None:
+        """The offset solve's ``rest`` (log units): None for a moving camera; for a static one STATIC_REST x
+        the smaller threshold (a pixel that moved less since its median has seen no event)."""
+        if self.camera != "static":
+            return None
+        return float(STATIC_REST * np.min(as_thresholds(self.C)))
 
     @property
     def n_bisections(self) -> int:

@@ -165,7 +165,8 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
     grid = offset_grid(t_start, t_end, len(windows), cfg.offset_solve)
     trend = None
     if cfg.offset_solve != "none":                                              # 4. offset solve
-        trend = offset_trend(grid, blend_networks(model, windows, grid, offsets), cfg.offset_window, cfg.offset_solve)
+        trend = offset_trend(grid, blend_networks(model, windows, grid, offsets), cfg.offset_window, cfg.offset_solve,
+                             rest=cfg.offset_rest())
         if len(trend.knots) == 1:   # one offset image for all networks: the alignment stays
             offsets += trend.images[0]
             trend = None
@@ -174,7 +175,8 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
         trend.add_to(L_grid, grid)
         history["offset_knots_s"] = trend.knots.tolist()
     if coarse_applies(cfg, t_start, t_end):      # 4b. the static image's coarse part from the integrated events
-        coarse = coarse_correction([events], cfg.C, grid, L_grid, cfg.offset_coarse_px, cfg.offset_solve)
+        coarse = coarse_correction([events], cfg.C, grid, L_grid, cfg.offset_coarse_px, cfg.offset_solve,
+                                   cfg.offset_rest())
         offsets += coarse
         L_grid += coarse
     offsets += _level_shift(L_grid, cfg)                                        # 5. level anchor

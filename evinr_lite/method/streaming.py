@@ -209,12 +209,13 @@ def first_window_offset(model: FrameINR, window, config: EvINRConfig, events=Non
     H, W = model.sensor_size
     offset = np.zeros((H, W), np.float32)
     if config.offset_solve != "none":
-        offset += offset_image(F, config.offset_solve).astype(np.float32)
+        offset += offset_image(F, config.offset_solve, config.offset_rest()).astype(np.float32)
     F += offset
     if coarse_applies(config, lo, hi):
         if events is None:
             raise ValueError("first_window_offset needs the window's events for the static image's coarse part")
-        coarse = coarse_correction([events], config.C, grid, F, config.offset_coarse_px, config.offset_solve)
+        coarse = coarse_correction([events], config.C, grid, F, config.offset_coarse_px, config.offset_solve,
+                                   config.offset_rest())
         offset += coarse
         F += coarse
     offset += np.float32(display_shift(F, config.tonemap, config.gamma, config.display_mean))
@@ -342,7 +343,7 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times, chunks
     with tqdm(total=n_solves, desc="EvINR offset", unit="solve", disable=not (progress and n_solves)) as bar:
         if config.offset_solve != "none":
             trend = offset_trend(grid_times, grid_frames, config.offset_window, config.offset_solve,
-                                 on_image=lambda: bar.update(1))
+                                 on_image=lambda: bar.update(1), rest=config.offset_rest())
             if len(trend.knots) == 1:
                 offset += trend.images[0]
                 trend = None
@@ -353,7 +354,7 @@ def span_offset(grid_frames: np.ndarray, config: EvINRConfig, grid_times, chunks
             if chunks is None:
                 raise ValueError("span_offset needs the span's events for the static image's coarse part")
             coarse = coarse_correction(chunks, config.C, grid_times, shifted, config.offset_coarse_px,
-                                       config.offset_solve)
+                                       config.offset_solve, config.offset_rest())
             offset += coarse
             shifted += coarse
             bar.update(1)
