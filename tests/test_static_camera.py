@@ -9,7 +9,7 @@ from evinr_lite import EvINRConfig
 from evinr_lite.apps.options import RunOptions
 from evinr_lite.core.events import EventDataError
 from evinr_lite.evaluation.scoring import score_sequence
-from evinr_lite.method.offset import l1_gradient_offset, offset_image
+from evinr_lite.method.offset import STATIC_COARSE_PX, gaussian_lowpass, l1_gradient_offset, offset_image
 from evinr_lite.method.solver import reconstruct
 from evinr_lite.method.streaming import stream_reconstruct
 from evinr_lite.sim.scenes import ObjectOverBackgroundScene
@@ -53,6 +53,11 @@ def test_the_static_solve_recovers_the_background_an_object_passed_over():
     assert _corr(moving[inner], bg[inner]) < 0.5                       # the default flattens it
     outside = ~swath                                                   # where nothing moved: nearly flat
     assert np.std(static[outside]) < 0.5 * np.std(static[inner])
+    # what the solver uses: the structure finer than STATIC_COARSE_PX from that solve, the coarser from the plain one
+    used = offset_image(frames, "l1_gradient", rest=0.5 * C)
+    fine = lambda img: img - gaussian_lowpass(img, STATIC_COARSE_PX)          # noqa: E731
+    assert _corr(fine(used)[inner], fine(bg)[inner]) > 0.85
+    assert _corr(fine(offset_image(frames, "l1_gradient"))[inner], fine(bg)[inner]) < 0.5
 
 
 def test_frames_at_rest_leave_each_edge_term_exactly():

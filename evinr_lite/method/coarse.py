@@ -21,11 +21,9 @@ than ``MAX_SPAN_S`` the INR's static image was the better one on every recording
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft
 
-from ..core.runtime import cpu_threads
 from .binning import events_to_frames_chunked
-from .offset import offset_image
+from .offset import gaussian_lowpass, offset_image
 
 __all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "coarse_times", "integrated_frames", "MAX_SPAN_S"]
 
@@ -46,19 +44,6 @@ def coarse_times(times) -> np.ndarray:
     ``FRAMES`` of them, evenly spread (every other one of a 64-frame grid)."""
     t = np.asarray(times, np.float64)
     return t[::max(1, len(t) // FRAMES)]
-
-
-def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
-    """``image`` [H, W] blurred by a Gaussian of ``sigma_px`` pixels, its borders mirrored: float64. In the
-    DCT-II basis (the mirrored image's Fourier basis) each coefficient is multiplied by the Gaussian's
-    transfer function exp(-sigma^2 (wx^2 + wy^2) / 2), w = pi k / N the frequency along each axis. From
-    2 px on it is scipy.ndimage.gaussian_filter(mode="reflect") to 1e-9 (below, sampling its kernel aliases)."""
-    img = np.asarray(image, np.float64)
-    H, W = img.shape
-    wy, wx = np.pi * np.arange(H) / H, np.pi * np.arange(W) / W
-    gain = np.exp(-0.5 * sigma_px ** 2 * (wy[:, None] ** 2 + wx[None, :] ** 2))
-    c = scipy.fft.dctn(img, type=2, norm="ortho", workers=cpu_threads())
-    return scipy.fft.idctn(c * gain, type=2, norm="ortho", workers=cpu_threads())
 
 
 def integrated_frames(chunks, times, C, sensor_size) -> np.ndarray | None:
