@@ -185,6 +185,24 @@ def test_keep_background_turns_off_the_kit_filter_from_the_command_line(monkeypa
         RunOptions(keep_background="yes")
 
 
+def test_static_camera_reaches_the_config_from_reconstruct_and_batch(monkeypatch, tmp_path):
+    """--static-camera (reconstruct and batch) gives EvINRConfig(camera="static"); a batch's settings carry it,
+    and a batch.json written before the option reads as a moving camera."""
+    import evinr_lite.apps.recon_job as job
+    from evinr_lite.apps.batch import result_settings
+
+    seen = {}
+    monkeypatch.setattr(job, "run_reconstruct", lambda path, out, options, **kw: seen.update(options=options))
+    assert main(["reconstruct", "rec", "--out", str(tmp_path / "o"), "--static-camera", "--quiet"]) == 0
+    o = seen["options"]
+    assert o.static_camera and o.config(0.2).camera == "static" and RunOptions().config(0.2).camera == "moving"
+    assert build_parser().parse_args(["batch", "a", "--out", "o", "--static-camera"]).static_camera
+    settings = json.loads(json.dumps(o.to_dict(BATCH_FIELDS)))
+    assert RunOptions.from_settings(settings).static_camera is True
+    assert result_settings({})["static_camera"] is False
+    assert main(["reconstruct", "rec", "--out", str(tmp_path / "p"), "--static-camera", "--recipe", "paper", "--quiet"]) != 0
+
+
 # ---- method: the default C and the memory estimate -------------------------------------------------
 
 def test_default_C_is_the_configs():

@@ -113,6 +113,9 @@ TONEMAP_HELP = ("how frames are shown: linear (the intensity itself, clip(exp(F)
                 "the kit's) or reinhard (the paper's Eq. 12, (I / (I + 1))^0.6 with the mean log intensity at 0.5: "
                 "compresses contrast and keeps the highlights of a high-dynamic-range scene on screen); "
                 "default: the recipe's own")
+STATIC_CAMERA_HELP = ("the camera stood still (a tripod) and things moved in front of it: solve each pixel's offset "
+                      "from the frames where something moved over it, so the background an object passed over "
+                      "appears (EvINRConfig(camera='static'); kit recipe, events only). Not for a moving camera")
 KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-activity filter (an event is kept "
                         "when a neighbouring pixel fired one of the same polarity within 50 ms; EvINRConfig.background); "
                         "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
@@ -180,10 +183,7 @@ def build_parser() -> argparse.ArgumentParser:
                           "what was removed. The kit recipe filters them anyway, inside the method "
                           "(EvINRConfig.background), without the report")
     rec.add_argument("--keep-background", action="store_true", help=KEEP_BACKGROUND_HELP)
-    rec.add_argument("--static-camera", action="store_true",
-                     help="the camera stood still (a tripod) and things moved in front of it: solve each pixel's "
-                          "offset from the frames where something moved over it, so the background an object "
-                          "passed over appears (EvINRConfig(camera='static'); kit recipe). Not for a moving camera")
+    rec.add_argument("--static-camera", action="store_true", help=STATIC_CAMERA_HELP)
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--resume", action="store_true",
@@ -226,6 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--denoise", action="store_true", help="remove hot pixels and background activity first "
                                                               "(as reconstruct --denoise)")
     batch.add_argument("--keep-background", action="store_true", help=KEEP_BACKGROUND_HELP)
+    batch.add_argument("--static-camera", action="store_true", help=STATIC_CAMERA_HELP)
     batch.add_argument("--anchor", choices=("none", "first", "all"), default="none",
                        help="use each recording's APS frames as anchors (as reconstruct --anchor; anchor frames "
                             "are not scored)")
@@ -258,7 +259,7 @@ def _run_options(args):
                       t_start=getattr(args, "start", None), t_end=getattr(args, "end", None),
                       time_unit=getattr(args, "time_unit", None), device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
-                      keep_background=args.keep_background, static_camera=getattr(args, "static_camera", False),
+                      keep_background=args.keep_background, static_camera=args.static_camera,
                       colour=getattr(args, "colour", False), tonemap=args.tonemap, video=video,
                       progress=not args.quiet)
 

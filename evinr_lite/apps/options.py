@@ -32,7 +32,7 @@ DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth 
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
 BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap",
-                "keep_background")
+                "keep_background", "static_camera")
 MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
 _INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
 
