@@ -224,11 +224,18 @@ def _edge_values(F: np.ndarray, axis: int) -> np.ndarray:
 
 
 def _moved(F: np.ndarray, rest: float) -> np.ndarray:
-    """bool [K, H, W]: where a pixel of F [K, H, W] lies more than ``rest`` from its own temporal median."""
-    if not (isinstance(rest, (int, float, np.floating)) and rest > 0 and np.isfinite(rest)):
+    """bool [K, H, W]: where a pixel of F [K, H, W] lies more than ``rest`` from its own temporal median (a
+    block of image rows at a time: float32 work arrays of about 2 M cells, whatever the sensor)."""
+    if isinstance(rest, (bool, np.bool_)) or not (isinstance(rest, (int, float, np.floating)) and rest > 0
+                                                   and np.isfinite(rest)):
         raise ValueError(f"rest must be a positive number of log units or None, got {rest!r}")
-    centre = np.median(F, axis=0).astype(np.float32)
-    return np.abs(np.asarray(F, np.float32) - centre) > rest
+    K, H, W = F.shape
+    out = np.empty((K, H, W), bool)
+    rows = max(1, (1 << 21) // max(K * W, 1))
+    for r0 in range(0, H, rows):
+        block = np.asarray(F[:, r0:r0 + rows], np.float32)
+        out[:, r0:r0 + rows] = np.abs(block - np.median(block, axis=0)) > rest
+    return out
 
 
 def _leave_out_rest(values: np.ndarray, moved: np.ndarray, axis: int, scale: float) -> None:
@@ -236,25 +243,32 @@ def _leave_out_rest(values: np.ndarray, moved: np.ndarray, axis: int, scale: flo
     (:func:`_edge_values`' [E, K + 2]) become -M and +M in pairs, which add a constant to the edge's term
     on [-M, M] and move neither its median nor its proximal step. An odd one out takes the median of the
     edge's other frames, which leaves that median where it was and makes it unique. An edge that nothing
-    moved over keeps all its frames: they all show the offset alone, and a flat one is the best guess there."""
-    K = moved.shape[0]
-    m = moved[:, :, :-1] & moved[:, :, 1:] if axis == 2 else moved[:, :-1, :] & moved[:, 1:, :]
-    rest = ~m.reshape(K, -1).T                                        # [E, K]
-    rest &= ~rest.all(axis=1, keepdims=True)                          # an edge nothing moved over keeps every frame
-    block = values[:, 1:K + 1]
-    n_rest = rest.sum(axis=1)
-    odd = np.flatnonzero(n_rest % 2 == 1)
-    if odd.size:                                                      # the median of the frames that moved
-        kept = np.where(rest[odd], np.nan, block[odd])
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)          # an edge where nothing moved: all NaN
-            centre = np.nan_to_num(np.nanmedian(kept, axis=1))
-    order = np.cumsum(rest, axis=1)                                   # 1, 2, ... along each edge's resting frames
+    moved over keeps all its frames: they all show the offset alone, and a flat one is the best guess there.
+    A block of edge rows at a time (work arrays of about 2 M cells)."""
+    K, H, W = moved.shape
+    width, n_rows = (W - 1, H) if axis == 2 else (W, H - 1)
     M = np.float32(LEFT_OUT * max(scale, 1e-12))
-    block[rest] = np.where(order[rest] % 2 == 0, M, -M)
-    if odd.size:
-        last = np.argmax(np.where(rest[odd], order[odd], 0), axis=1)  # each odd edge's last resting frame
-        block[odd, last] = centre
+    rows = max(1, (1 << 21) // max(K * width, 1))
+    for r0 in range(0, n_rows, rows):
+        r1 = min(n_rows, r0 + rows)
+        if axis == 2:
+            m = moved[:, r0:r1, :-1] & moved[:, r0:r1, 1:]
+        else:
+            m = moved[:, r0:r1, :] & moved[:, r0 + 1:r1 + 1, :]
+        rest = ~m.reshape(K, -1).T                                    # [edges of these rows, K]
+        rest &= ~rest.all(axis=1, keepdims=True)                      # an edge nothing moved over keeps every frame
+        block = values[r0 * width:r1 * width, 1:K + 1]
+        odd = np.flatnonzero(rest.sum(axis=1) % 2 == 1)
+        if odd.size:                                                  # the median of the frames that moved
+            kept = np.where(rest[odd], np.float32(np.nan), block[odd])
+            with np.errstate(all="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)      # an edge where nothing moved: all NaN
+                centre = np.nan_to_num(np.nanmedian(kept, axis=1))
+        order = np.cumsum(rest, axis=1, dtype=np.int32)               # 1, 2, ... along each edge's resting frames
+        block[rest] = np.where(order[rest] % 2 == 0, M, -M)
+        if odd.size:
+            last = np.argmax(np.where(rest[odd], order[odd], 0), axis=1)   # each odd edge's last resting frame
+            block[odd, last] = centre
 
 
 def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TOL, rest: float | None = None) -> np.ndarray:
