@@ -266,7 +266,9 @@ class EvINRConfig:
             each edge's offset is solved from the frames in which something moved over it (a pixel
             more than STATIC_REST x C from its temporal median; :func:`~evinr_lite.method.offset.l1_gradient_offset`
             with ``rest``): where an object passed, the background it covered is recovered instead of
-            being flattened. Needs offset_solve "l1_gradient". Not for a moving camera: there every
+            being flattened; that solve sets the offset's structure finer than STATIC_COARSE_PX (8 px),
+            the plain one the coarser (:func:`~evinr_lite.method.offset.offset_image`). Needs
+            offset_solve "l1_gradient". Not for a moving camera: there every
             frame is informative and leaving the resting ones out loses (``python benchmarks/static_camera.py``).
         balance: "none" (ON and OFF events weigh C as given), "events" or "counts": when C is one number,
             C+ and C- are estimated from the events, their mean kept at C
