@@ -201,6 +201,12 @@ def test_static_camera_reaches_the_config_from_reconstruct_and_batch(monkeypatch
     assert RunOptions.from_settings(settings).static_camera is True
     assert result_settings({})["static_camera"] is False
     assert main(["reconstruct", "rec", "--out", str(tmp_path / "p"), "--static-camera", "--recipe", "paper", "--quiet"]) != 0
+    from evinr_lite.apps.cli import _message
+
+    with pytest.raises(EventDataError) as err:
+        RunOptions(static_camera=True, recipe="v0_1")
+    text = _message(err.value)                   # the command line names its flags, not the Python fields
+    assert "--static-camera" in text and "--recipe kit" in text and "static_camera" not in text.replace("--static-camera", "")
 
 
 # ---- method: the default C and the memory estimate -------------------------------------------------

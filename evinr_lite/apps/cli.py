@@ -310,6 +310,9 @@ FLAG_FOR = [
     (re.compile(r"\btime_unit='(\w+)'"), r"--time-unit \1"),
     (re.compile(r"\banchor='(\w+)'"), r"--anchor \1"),
     (re.compile(r"\bEvINRConfig\(background='keep'\)"), "--keep-background"),
+    (re.compile(r"\bstatic_camera \(--static-camera\)"), "--static-camera"),
+    (re.compile(r"\bleave static_camera out"), "leave --static-camera out"),
+    (re.compile(r"\brecipe='(\w+)'"), r"--recipe \1"),
     # solver settings with no flag: the command line keeps the advice it can follow
     (re.compile(r",? or pass offset_coarse_px=None or offset_solve=\"median_gradient\""), ""),
     (re.compile(r"use a longer bin_duration, a shorter tau or fewer hidden_features, or "), ""),
