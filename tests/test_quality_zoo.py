@@ -55,6 +55,7 @@ def test_windows_answer_every_time_and_summary_has_the_targets(small):
     # what each MSE is made of: the truth shown at half its level is exact once the level is the truth's
     half = qz.score(0.5 * np.asarray(gt), times, gt, times)
     assert half["level_gain"] == pytest.approx(2.0, rel=1e-6) and half["mse_at_level"] < 1e-12 < half["mse_none"]
+    assert half["ssim_none_at_level"] == pytest.approx(1.0) and half["ssim_clahe_at_level"] == pytest.approx(1.0)
     best_l = min(rows[m]["mse_at_level"] for m in qz.BEST_OF)
     assert s["kit_mse_at_level_over_best_baseline"] == pytest.approx(rows["kit"]["mse_at_level"] / best_l)
     results = {"t": {"rows": rows, "summary": s, "noise_free": False, "long": True}}
