@@ -13,6 +13,7 @@ from PIL import Image
 
 from evinr_lite import read_recording
 from evinr_lite.apps.cli import main
+from evinr_lite.evaluation import error_parts
 from evinr_lite.sim.recordings import write_example_recording
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -104,6 +105,12 @@ def test_reconstruct_with_ground_truth(capsys, ijrr_folder, tmp_path):
     pred = np.stack([np.asarray(Image.open(p), np.float64) / 255 for p in pngs])
     gt = np.stack([np.asarray(Image.open(p), np.float64) / 255 for p in sorted((out_dir / "gt").glob("frame_*.png"))])
     assert np.mean((pred - gt) ** 2) == pytest.approx(metrics["protocols"]["none"]["mse"], abs=2e-3)
+    # and what that MSE is made of: the same images with the level set from the truth (evaluation.error_parts)
+    none = metrics["protocols"]["none"]
+    parts = error_parts(pred, gt)
+    assert none["mse_at_level"] == pytest.approx(parts["mse_at_level"], abs=2e-3)
+    assert none["level_gain"] == pytest.approx(parts["gain"], rel=0.02) and 0 <= none["static_coarse"] <= none["mse_at_level"]
+    assert "at the truth's level, gain" in out
     rows = (out_dir / "metrics.csv").read_text().splitlines()
     assert rows[0].startswith("gt_index,t_s,mse_none,ssim_none,mse_clahe,ssim_clahe") and len(rows) == len(gt_t) + 1
     run_json = json.loads((out_dir / "run.json").read_text())

@@ -231,7 +231,8 @@ def _finish(run: dict, times, scores, out_dir, t0: float, options, log) -> dict:
             f"(training {run.get('train_time_s') or 0.0:.1f} s)")
     if scores:
         parts = [f"{eq}: MSE {s['mse']:.4f} SSIM {s['ssim']:.3f}" + (f" LPIPS {s['lpips']:.3f}" if s.get("lpips") else "")
-                 for eq, s in scores.items()]
+                 + (f" (MSE {s['mse_at_level']:.4f} at the truth's level, gain {s['level_gain']:.2f})"
+                    if "mse_at_level" in s else "") for eq, s in scores.items()]
         line += f"; scored against {scores['none']['n_frames']} ground-truth frames ({'; '.join(parts)})"
     else:
         line += "; no ground-truth frames, not scored"

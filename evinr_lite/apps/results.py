@@ -14,8 +14,9 @@ import numpy as np
 from ..core.events import EventDataError
 from ..core.frames import Frames
 from ..core.recording import Recording
+from ..evaluation.level import error_parts
 from ..evaluation.metrics import SCORE_PROTOCOLS
-from ..evaluation.scoring import score_sequence
+from ..evaluation.scoring import match_frames, score_sequence
 from ..method.anchor import held_out
 from ..method.solver import Reconstruction
 
@@ -36,11 +37,22 @@ def _score_one(pred, pred_times, gt: Frames, equalization: str) -> dict:
 def score_predictions(pred_frames, pred_times, gt: Frames) -> dict:
     """Score frames [Q, H, W] in [0, 1] at ``pred_times`` against ground truth, without equalisation
     and with CLAHE: {"none": {...}, "clahe": {...}}, each with mse, ssim, lpips (None unless its
-    weights are present), n_frames, protocol (text) and per-frame lists (per_frame_t_s the GT times)."""
+    weights are present), n_frames, protocol (text) and per-frame lists (per_frame_t_s the GT times).
+
+    "none" also says what its MSE is made of (:func:`evinr_lite.evaluation.error_parts`, a diagnostic):
+    mse_at_level (the frames times the one gain over the scored frames that gives them the truth's
+    mean: the level events never give), level_gain (that gain; above 1: shown too dark) and
+    static_coarse (of mse_at_level, the part the same in every frame and coarser than 8 px)."""
     pred_times = np.asarray(pred_times, np.float64)
-    scores = {eq: _score_one(np.asarray(pred_frames), pred_times, gt, eq) for eq in SCORE_PROTOCOLS}
+    pred_frames = np.asarray(pred_frames)
+    scores = {eq: _score_one(pred_frames, pred_times, gt, eq) for eq in SCORE_PROTOCOLS}
     for s in scores.values():
         s["per_frame_t_s"] = gt.t[s["per_frame_index"]].tolist()
+    p_idx, g_idx = match_frames(pred_times, gt.t)          # the pairs score_sequence scored
+    if p_idx.size and pred_frames[p_idx].max() > 0:        # a black reconstruction has no level to set
+        parts = error_parts(pred_frames[p_idx], gt.images[g_idx])
+        scores["none"].update(mse_at_level=parts["mse_at_level"], level_gain=parts["gain"],
+                              static_coarse=parts["static_coarse"])
     return scores
 
 
