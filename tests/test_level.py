@@ -62,6 +62,8 @@ def test_uint8_truth_is_read_as_a_fraction_of_255():
     (np.full((2, 8, 8), np.nan), np.ones((2, 8, 8)), "NaN"),
     (np.zeros((2, 8, 8)), np.ones((2, 8, 8)), "black"),
     (np.array([[["a"]]]), np.ones((1, 1, 1)), "uint8"),
+    (np.ones((1, 8, 8)), np.full((1, 8, 8), 128.0), "divide by 255"),
+    (np.ones((1, 8, 8)), np.full((1, 8, 8), 128, np.int32), "pass uint8"),
 ])
 def test_bad_frames_say_what_is_wrong(pred, gt, words):
     with pytest.raises(EventDataError, match=words):

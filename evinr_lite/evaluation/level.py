@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import real_number
+from ..core.checks import check_image_values, real_number
 from ..core.events import EventDataError
 from ..method.offset import gaussian_lowpass
 
@@ -37,13 +37,9 @@ def _frames(a, name: str) -> np.ndarray:
     if a.ndim != 3 or a.shape[0] < 1:
         raise EventDataError(f"{name} must be a stack [K, H, W] of frames, got shape {a.shape}"
                              + ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else ""))
-    if a.dtype.kind not in "uif" or a.dtype == bool:
-        raise EventDataError(f"{name} must be uint8 (0..255) or float in [0, 1], got dtype {a.dtype}")
+    check_image_values(a, name, clipped=(name == "pred"))   # uint8, or finite floats in [0, 1] (not 0..255)
     f = a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else a.astype(np.float64)
-    if not np.isfinite(f).all():
-        raise EventDataError(f"{name} holds {int((~np.isfinite(f)).sum()):,} NaN or infinite value(s); "
-                             "frames must be finite intensities in [0, 1]")
-    return np.clip(f, 0.0, 1.0)
+    return np.clip(f, 0.0, 1.0)     # predictions as displayed (the protocol clips them too)
 
 
 def _pair(pred, gt) -> tuple[np.ndarray, np.ndarray]:
