@@ -61,7 +61,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from evinr_lite.core.events import Events  # noqa: E402
-from evinr_lite.evaluation.level import error_parts, match_level  # noqa: E402
+from evinr_lite.evaluation.level import error_parts  # noqa: E402
 from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
 from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
@@ -152,20 +152,26 @@ run_method.last_sweep = None
 
 
 def score(frames, times, gt, gt_t) -> dict:
-    """CLAHE-SSIM, SSIM and MSE under both protocols, and what the MSE is made of
-    (:func:`evinr_lite.evaluation.error_parts`: the MSE at the truth's level, its static large-scale part
-    and the level's gain) with both SSIMs at the truth's level too, for frames [Q, H, W] at ``times``
-    scored against ``gt`` at ``gt_t``."""
     out = {}
     for eq in SCORE_PROTOCOLS:
         s = score_sequence(frames, times, gt, gt_t, eq, lpips_model=False)
         out[f"mse_{eq}"], out[f"ssim_{eq}"] = s["mse"], s["ssim"]
-    if np.array_equal(np.asarray(times), np.asarray(gt_t)):     # one prediction per ground-truth frame (the zoo's)
-        parts = error_parts(frames, gt)
-        out.update(mse_at_level=parts["mse_at_level"], static_coarse=parts["static_coarse"], level_gain=parts["gain"])
-        matched = match_level(frames, gt)[0].astype(np.float32)
-        for eq in SCORE_PROTOCOLS:       # a level shown too bright also clips highlights: SSIM pays it too
-            out[f"ssim_{eq}_at_level"] = score_sequence(matched, times, gt, gt_t, eq, lpips_model=False)["ssim"]
+    return out
+
+
+def level_scores(frames, times, gt, duration: float | None = None) -> dict:
+    """What each MSE is made of (:func:`evinr_lite.evaluation.error_parts`: the MSE at the truth's level, its
+    static part coarser than 8 px, the level's gain), both SSIMs at the truth's level (a level shown too
+    bright also clips highlights, which CLAHE does not undo) and, given the recording's ``duration``,
+    the level error per quarter at the truth's level: drift alone. ``frames`` [Q, H, W] are predictions at
+    the ground-truth frames ``gt`` [Q, H, W], both at ``times``."""
+    parts = error_parts(frames, gt)
+    out = {"mse_at_level": parts["mse_at_level"], "static_coarse": parts["static_coarse"], "level_gain": parts["gain"]}
+    for eq in SCORE_PROTOCOLS:
+        out[f"ssim_{eq}_at_level"] = score_sequence(parts["matched"].astype(np.float32), times, gt, times, eq,
+                                                    lpips_model=False)["ssim"]
+    if duration is not None:
+        out["level_error_at_level"] = level_error(parts["matched"], gt, times, duration)
     return out
 
 
@@ -236,10 +242,8 @@ def run_zoo(scenes, methods, variants, log=print) -> dict:
             if (z.long and m in SLOW) or (m in WINDOWED and not z.long):
                 continue
             f, seconds = run_method(m, events, times, C, variants, L_first, gt)
-            rows[m] = {**score(f, times, gt, times), "time_s": seconds,
-                       "level_error": level_error(f, gt, times, z.duration),
-                       # the same with the recording's one gain set from the truth: the drift the method controls
-                       "level_error_at_level": level_error(match_level(f, gt)[0], gt, times, z.duration)}
+            rows[m] = {**score(f, times, gt, times), **level_scores(f, times, gt, z.duration), "time_s": seconds,
+                       "level_error": level_error(f, gt, times, z.duration)}
             if run_method.last_sweep is not None:
                 rows[m]["sweep"] = run_method.last_sweep
             frames[m] = f[len(f) // 2]
@@ -278,7 +282,7 @@ def run_real(methods, variants, log=print) -> dict | None:
     rows, frames = {}, {}
     for m in [m for m in methods if m not in ORACLES and m not in WINDOWED]:
         f, seconds = run_method(m, rec.events, gt_t, 1.0, variants, gt=gt)
-        rows[m] = {**score(f, gt_t, gt, gt_t), "time_s": seconds}
+        rows[m] = {**score(f, gt_t, gt, gt_t), **level_scores(f, gt_t, gt), "time_s": seconds}
         if run_method.last_sweep is not None:
             rows[m]["sweep"] = run_method.last_sweep
         frames[m] = f[len(f) // 2]
@@ -319,24 +323,12 @@ def markdown(results: dict, methods) -> str:
               "cutoff / leak picked per scene by CLAHE-SSIM against the ground truth (sweep below); the best baseline "
               "is the best of hf_best, leaky_best and integration_offset. The mean is over the short scenes (the "
               "long ones skip paper and v0_1).", "",
-              "Level error (mean prediction minus mean truth, display units) per quarter of each recording:", "",
-              "| scene | " + " | ".join(methods) + " |", "|---" * (len(methods) + 1) + "|"]
-    for name, r in synth.items():
-        cells = []
-        for m in methods:
-            lv = r["rows"].get(m, {}).get("level_error")
-            cells.append("-" if not lv else " ".join("-" if v is None else f"{v:+.3f}" for v in lv))
-        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+              "Level error (mean prediction minus mean truth, display units) per quarter of each recording:", ""]
+    lines += quarter_table(synth, methods, "level_error")
     if any("level_error_at_level" in row for r in synth.values() for row in r["rows"].values()):
         lines += ["", "The same at the truth's level (each method's one gain over the recording set from the truth, "
-                  "as in the MSE parts below): what is left is drift within the recording:", "",
-                  "| scene | " + " | ".join(methods) + " |", "|---" * (len(methods) + 1) + "|"]
-        for name, r in synth.items():
-            cells = []
-            for m in methods:
-                lv = r["rows"].get(m, {}).get("level_error_at_level")
-                cells.append("-" if not lv else " ".join("-" if v is None else f"{v:+.3f}" for v in lv))
-            lines.append(f"| {name} | " + " | ".join(cells) + " |")
+                  "as in the MSE parts below): what is left is drift within the recording:", ""]
+        lines += quarter_table(synth, methods, "level_error_at_level")
     if any("mse_at_level" in row for r in results.values() for row in r["rows"].values()):
         lines += ["", "What each MSE is made of (evinr_lite.evaluation.error_parts), and the SSIMs at the truth's "
                   "level: CLAHE-SSIM / SSIM / MSE of the prediction times the one gain over the recording that gives it "
@@ -369,6 +361,18 @@ def markdown(results: dict, methods) -> str:
         lines.append("Columns are the five settings in order: " + "; ".join(
             f"{m} {SWEEP[m][1]} = {', '.join(f'{v:g}' for v in SWEEP[m][2])} Hz" for m in SWEPT) + ".")
     return "\n".join(lines)
+
+
+def quarter_table(results: dict, methods, key: str) -> list[str]:
+    """Markdown lines: a scene per row, a method per column, each cell the four quarters of ``key``."""
+    lines = ["| scene | " + " | ".join(methods) + " |", "|---" * (len(methods) + 1) + "|"]
+    for name, r in results.items():
+        cells = []
+        for m in methods:
+            lv = r["rows"].get(m, {}).get(key)
+            cells.append("-" if not lv else " ".join("-" if v is None else f"{v:+.3f}" for v in lv))
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def figure(results: dict, names, methods, path: Path) -> None:

@@ -45,15 +45,15 @@ def test_windows_answer_every_time_and_summary_has_the_targets(small):
     rows = {}
     for m in ("kit", "integration_offset", "hf_best", "leaky_best", "oracle_linear", "kit_windows"):
         fr, s = qz.run_method(m, events, times, 0.2, {}, scene.log_intensity(times[0]), gt)
-        rows[m] = {**qz.score(fr, times, gt, times), "time_s": s, "level_error": qz.level_error(fr, gt, times, 2.0),
-                   "level_error_at_level": qz.level_error(qz.match_level(fr, gt)[0], gt, times, 2.0)}
+        rows[m] = {**qz.score(fr, times, gt, times), **qz.level_scores(fr, times, gt, 2.0), "time_s": s,
+                   "level_error": qz.level_error(fr, gt, times, 2.0)}
     s = qz.summarise(rows)
     assert s["best_baseline"] in qz.BEST_OF
     best_mse = min(rows[m]["mse_none"] for m in qz.BEST_OF)
     assert s["kit_mse_over_best_baseline_mse"] == pytest.approx(rows["kit"]["mse_none"] / best_mse)
     assert "whole_minus_windows_clahe" in s and "kit_level_error_max_abs" in s
     # what each MSE is made of: the truth shown at half its level is exact once the level is the truth's
-    half = qz.score(0.5 * np.asarray(gt), times, gt, times)
+    half = {**qz.score(0.5 * np.asarray(gt), times, gt, times), **qz.level_scores(0.5 * np.asarray(gt), times, gt)}
     assert half["level_gain"] == pytest.approx(2.0, rel=1e-6) and half["mse_at_level"] < 1e-12 < half["mse_none"]
     assert half["ssim_none_at_level"] == pytest.approx(1.0) and half["ssim_clahe_at_level"] == pytest.approx(1.0)
     best_l = min(rows[m]["mse_at_level"] for m in qz.BEST_OF)

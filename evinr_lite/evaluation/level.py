@@ -93,7 +93,8 @@ def error_parts(pred, gt, coarse_px: float = COARSE_PX) -> dict:
     Returns:
         {"mse": the protocol's MSE (no equalisation), "mse_at_level": the MSE after :func:`match_level`,
         "static_coarse": of the latter, the mean square of the error's temporal mean blurred by a
-        Gaussian of ``coarse_px`` pixels, "gain": the level's gain (1 = the truth's level)}.
+        Gaussian of ``coarse_px`` pixels, "gain": the level's gain (1 = the truth's level), "matched":
+        the frames at the truth's level, float64 [K, H, W] (to score them further without a second match)}.
     """
     coarse_px = real_number(coarse_px, "coarse_px", lo=0.0, lo_open=True, hint="a Gaussian's sigma in pixels (8)")
     p, g = _pair(pred, gt)
@@ -101,4 +102,4 @@ def error_parts(pred, gt, coarse_px: float = COARSE_PX) -> dict:
     err = matched - g
     static = gaussian_lowpass(err.mean(axis=0), coarse_px)
     return {"mse": float(np.mean((p - g) ** 2)), "mse_at_level": float(np.mean(err ** 2)),
-            "static_coarse": float(np.mean(static ** 2)), "gain": gain}
+            "static_coarse": float(np.mean(static ** 2)), "gain": gain, "matched": matched}
