@@ -58,6 +58,12 @@ def _fixtures(root: Path) -> dict:
     (d / "ev.txt").write_text(f"{W} {H}\n" + "".join(f"{a:.9f} {b} {c} {e}\n" for a, b, c, e in zip(t, x, y, p)))
     out["txt"] = (d, "ev.txt", ["ev.txt"], {})
 
+    d = root / "csv"   # Metavision's layout: a geometry line, then x,y,p,t in microseconds
+    d.mkdir()
+    (d / "ev.csv").write_text(f"%geometry:{W},{H}\n" + "".join(f"{b},{c},{e},{int(round(a * 1e6))}\n"
+                                                              for a, b, c, e in zip(t, x, y, p)))
+    out["csv"] = (d, "ev.csv", ["ev.csv"], {})
+
     d = root / "ijrr" / "seq"
     (d / "images").mkdir(parents=True)
     t_abs = t + 1_468_939_993.0
@@ -179,7 +185,7 @@ def read_and_classify(kind, path, kwargs):
     OUTCOMES[kind]["events"] += 1
 
 
-FORMATS = ["npy", "txt", "ijrr", "evreal", "h5", "canonical", "aedat4", "prophesee_raw", "prophesee_dat"]
+FORMATS = ["npy", "txt", "csv", "ijrr", "evreal", "h5", "canonical", "aedat4", "prophesee_raw", "prophesee_dat"]
 
 
 @pytest.mark.parametrize("kind", FORMATS)

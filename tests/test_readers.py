@@ -381,9 +381,9 @@ def test_read_recording_detects_formats(tmp_path, small_txt):
 
 
 def test_read_recording_unknown_format(tmp_path):
-    path = tmp_path / "events.csv"
+    path = tmp_path / "events.xyz"
     path.write_text("0.1,1,1,1\n")
-    with pytest.raises(EventDataError, match=r"unknown format '.csv'.*supported formats: an IJRR folder"):
+    with pytest.raises(EventDataError, match=r"unknown format '.xyz'.*supported formats: an IJRR folder"):
         read_recording(path)
     with pytest.raises(EventDataError, match=r"folder of unknown format.*supported formats"):
         read_recording(tmp_path)

@@ -24,8 +24,8 @@ import numpy as np
 
 from ..core.events import LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit
 
-__all__ = ["EventBlock", "parse_event_block", "parse_event_text", "parse_frame_list", "line_blocks",
-           "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
+__all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "parse_frame_list",
+           "line_blocks", "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
 
 NS = 10**9              # nanoseconds per second
 NS_PER_UNIT = {"s": NS, "ms": 10**6, "us": 10**3, "ns": 1}   # nanoseconds per unit of a timestamp token
@@ -34,6 +34,25 @@ EVENT_COLUMNS = "`t x y p` (time in seconds, x = column, y = row, polarity)"
 MAX_PIXEL = 1 << 31     # a coordinate at or beyond this is no pixel of any sensor (nor fits the int64 cast exactly)
 MAX_CLOCK_S = 2.0**53   # seconds (285 million years): a timestamp beyond it is no clock, whatever its unit
 FRAME_COLUMNS = "`t images/frame_%08d.png`"
+
+
+@dataclass(frozen=True)
+class TextLayout:
+    """Where t, x, y and p sit on a line of event text, and how error messages name them.
+
+    ``order``: the token index of t, x, y and p on each 4-token line ((0, 1, 2, 3): `t x y p`;
+    Metavision's CSV `x,y,p,t` is (3, 0, 1, 2)). ``columns``: the columns as messages write them.
+    ``sort_hint``: how to sort such a file, for the message about unsorted timestamps.
+    ``separators``: bytes that separate values besides white space (a CSV's b",;").
+    """
+
+    order: tuple = (0, 1, 2, 3)
+    columns: str = EVENT_COLUMNS
+    sort_hint: str = "sort the file (e.g. `sort -g -k1,1 events.txt`)"
+    separators: bytes = b""
+
+
+TXT_LAYOUT = TextLayout()   # `t x y p` (IJRR events.txt, rpg_e2vid)
 
 
 def origin_to_ns(t_origin) -> int:
@@ -61,17 +80,22 @@ class _BadToken(Exception):
         self.row = row
 
 
-def _tokenize(buf: np.ndarray):
+def _tokenize(buf: np.ndarray, separators: bytes = b""):
     """Whitespace-separated tokens of whole lines of text.
 
     Args:
         buf: uint8 [B], the bytes of one or more whole lines.
+        separators: bytes that also separate tokens (e.g. b",;" for CSV).
     Returns:
         starts, ends: int64 [K], byte span [start, end) of each token.
         counts: int64 [n_lines], tokens on each line.
         newlines: int64, byte positions of the newlines in buf.
     """
-    word = np.concatenate(([False], _IS_WORD[buf], [False]))
+    is_word = _IS_WORD
+    if separators:
+        is_word = _IS_WORD.copy()
+        is_word[list(separators)] = False
+    word = np.concatenate(([False], is_word[buf], [False]))
     starts = np.flatnonzero(word[1:] & ~word[:-1])
     ends = np.flatnonzero(word[:-1] & ~word[1:])
     newlines = np.flatnonzero(buf == 10)
@@ -254,7 +278,8 @@ class EventBlock:
 
 
 def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0, first: bool = False,
-                      t_last: float | None = None, time_unit: str = "s") -> EventBlock:
+                      t_last: float | None = None, time_unit: str = "s",
+                      layout: TextLayout = TXT_LAYOUT) -> EventBlock:
     """Parse one block of whole `t x y p` lines, all vectorised.
 
     Args:
@@ -268,11 +293,12 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         time_unit: unit of the timestamp tokens, 's', 'ms', 'us' or 'ns'; 'auto': plain integer
             tokens are microseconds (with a TimeUnitWarning), decimals seconds. The unit used is
             returned in ``EventBlock.time_unit`` (pass it to the next block).
+        layout: where t, x, y, p sit on a line (:class:`TextLayout`; default `t x y p`).
     Raises:
         EventDataError naming ``source``, the line number and the line's text.
     """
     buf = np.frombuffer(buf, dtype=np.uint8) if isinstance(buf, (bytes, bytearray, memoryview)) else buf
-    starts, ends, counts, newlines = _tokenize(buf)
+    starts, ends, counts, newlines = _tokenize(buf, layout.separators)
     n_lines = len(newlines) + (0 if len(buf) == 0 or buf[-1] == 10 else 1)
 
     def fail(line, problem):  # line: 0-based within this block
@@ -293,14 +319,15 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     if bad.size:
         i = int(bad[0])
         hint = " (a `W H` header is allowed only as the first line)" if counts[i] == 2 else ""
-        fail(i, f"found {counts[i]} columns, expected 4: {EVENT_COLUMNS}{hint}")
+        fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}")
     empty = np.zeros(0, dtype=np.int64)
     if time_unit not in TIME_UNITS and time_unit != "auto":
         raise EventDataError(f"unknown time_unit={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
     if len(starts) == 0:
         return EventBlock(np.zeros(0), empty, empty, empty.astype(np.int8), header, origin_ns, n_lines,
                           time_unit)
-    starts, ends = starts.reshape(-1, 4), ends.reshape(-1, 4)
+    order = list(layout.order)
+    starts, ends = starts.reshape(-1, 4)[:, order], ends.reshape(-1, 4)[:, order]   # columns t, x, y, p
     if time_unit == "auto":
         time_unit = resolve_time_unit("i" if _plain_integers(buf, starts[:, 0], ends[:, 0]) else "f", None, source)
 
@@ -309,13 +336,13 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     try:
         t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns, time_unit)
     except _BadToken as err:
-        fail(row_line(err.row), f"the timestamp is not a number; expected {EVENT_COLUMNS}")
+        fail(row_line(err.row), f"the timestamp is not a number; expected {layout.columns}")
     xyp = []
     for c, name in ((1, "x"), (2, "y"), (3, "p")):
         try:
             xyp.append(_parse_number(buf, starts[:, c], ends[:, c]))
         except _BadToken as err:
-            fail(row_line(err.row), f"{name} is not a number; expected {EVENT_COLUMNS}")
+            fail(row_line(err.row), f"{name} is not a number; expected {layout.columns}")
     x, y, p = xyp
 
     nonfinite = np.flatnonzero(~np.isfinite(t))
@@ -329,7 +356,7 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         back = np.flatnonzero(np.diff(t, prepend=t_last) < 0)
         if back.size:
             fail(row_line(back[0]), "the timestamp is earlier than the one before: the events are not "
-                 "sorted by time; sort the file (e.g. `sort -g -k1,1 events.txt`) or load the columns "
+                 f"sorted by time; {layout.sort_hint} or load the columns "
                  "with numpy and use Events.from_arrays(..., sort=True)")
     for name, v in (("x", x), ("y", y)):
         if v.dtype.kind == "f":
@@ -377,20 +404,23 @@ def read_text_bytes(path, what: str = "file") -> bytes:
     return data
 
 
-def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto") -> EventBlock:
+def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto", data: bytes | None = None,
+                     layout: TextLayout = TXT_LAYOUT, header_line: bool = True) -> EventBlock:
     """A whole `t x y p` text file (optionally after a `W H` header), block by block.
 
     Timestamps must be finite and non-decreasing. ``origin_ns`` None picks the origin from the
     first timestamp. ``time_unit``: see :func:`parse_event_block` ('auto': integers are
-    microseconds, decimals seconds). Raises EventDataError naming the file and line.
+    microseconds, decimals seconds). ``data``: the file's bytes when the caller has read (and
+    prepared) them already; ``layout``: the columns' order (:class:`TextLayout`); ``header_line``:
+    an rpg_e2vid `W H` first line is allowed. Raises EventDataError naming the file and line.
     """
     path = Path(path)
-    data = read_text_bytes(path, "event file")
+    data = read_text_bytes(path, "event file") if data is None else data
     everything = np.frombuffer(data, dtype=np.uint8)
     parts, header, line_base, t_last = [], None, 0, -np.inf
     for lo, hi in line_blocks(data, CHUNK_BYTES):
         block = parse_event_block(everything[lo:hi], origin_ns, source=path, line_base=line_base,
-                                  first=lo == 0, t_last=t_last, time_unit=time_unit)
+                                  first=header_line and lo == 0, t_last=t_last, time_unit=time_unit, layout=layout)
         header = block.header if lo == 0 else header
         origin_ns = block.origin_ns
         line_base += block.n_lines
@@ -399,7 +429,7 @@ def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "au
             parts.append((block.t, block.x, block.y, block.p))
             t_last = block.t[-1]
     if not parts:
-        raise EventDataError(f"{path}: no events found; expected lines {EVENT_COLUMNS}")
+        raise EventDataError(f"{path}: no events found; expected lines {layout.columns}")
     t, x, y, p = (np.concatenate(c) for c in zip(*parts))
     return EventBlock(t, x, y, p, header, origin_ns, line_base, time_unit)
 
