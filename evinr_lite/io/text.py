@@ -404,7 +404,7 @@ def read_text_bytes(path, what: str = "file") -> bytes:
     return data
 
 
-def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto", data: bytes | None = None,
+def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto", data: bytes | bytearray | None = None,
                      layout: TextLayout = TXT_LAYOUT, header_line: bool = True) -> EventBlock:
     """A whole `t x y p` text file (optionally after a `W H` header), block by block.
 

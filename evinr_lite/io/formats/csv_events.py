@@ -133,7 +133,7 @@ def _guess_order(path: Path, data: bytes, start: int) -> tuple:
                          f"(or the rows are not sorted by time, or a row is damaged); add {NAMED}")
 
 
-def csv_layout(path, data: bytes, time_unit: str = "auto") -> tuple[bytes, TextLayout, tuple | None, str]:
+def csv_layout(path, data: bytes, time_unit: str = "auto") -> tuple[bytes | bytearray, TextLayout, tuple | None, str]:
     """(the file's bytes ready for the event-text parser: header and comment lines blanked, line numbers
     kept; the columns' layout (commas and semicolons separate values); (H, W) from `%geometry:W,H` or None; the time unit
     to read with), from the raw bytes ``data`` of the .csv file ``path``."""
@@ -151,10 +151,11 @@ def csv_layout(path, data: bytes, time_unit: str = "auto") -> tuple[bytes, TextL
         how = "Metavision: t in integer microseconds" if metavision else "t in seconds, or integers in microseconds"
         if metavision and time_unit == "auto":
             time_unit = "us"
-    buf = bytearray(data)
-    for lo, hi in spans:
-        buf[lo:hi] = b" " * (hi - lo)
-    return bytes(buf), _layout(tuple(roles), how), geometry, time_unit
+    if spans:                     # one copy, only when there is a header to blank
+        data = bytearray(data)
+        for lo, hi in spans:
+            data[lo:hi] = b" " * (hi - lo)
+    return data, _layout(tuple(roles), how), geometry, time_unit
 
 
 def read_events_csv(path, sensor_size=None, *, polarity="auto", t_origin=None, time_unit="auto",
