@@ -133,8 +133,8 @@ def build_parser() -> argparse.ArgumentParser:
     common.add_argument("--debug", action="store_true", default=argparse.SUPPRESS,
                         help="show the traceback of an internal error")
     sub = parser.add_subparsers(dest="command", required=True)
-    unit_help = ("unit of the timestamps for .npy, text, IJRR, EVREAL and HQF h5 recordings (default: integers "
-                 "are microseconds, with a note; decimals seconds)")
+    unit_help = ("unit of the timestamps for .npy, text, .csv, IJRR, EVREAL and HQF h5 recordings (default: the "
+                 "unit a .csv header names; else integers are microseconds, with a note; decimals seconds)")
 
     info = sub.add_parser("info", help="what a recording holds: format, sensor size, events, frames",
                           description=f"Supported formats: {SUPPORTED_FORMATS}.", parents=[common])

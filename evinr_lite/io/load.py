@@ -98,7 +98,7 @@ def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: flo
             `W H` header, an IJRR folder without images.txt, some Prophesee .raw); for the others
             it must match the file's.
         t_start, t_end: passed to readers that read only a window from disk (the others read all).
-        time_unit: unit of the timestamps for formats that do not fix it (.npy, text, IJRR, EVREAL,
+        time_unit: unit of the timestamps for formats that do not fix it (.npy, text, .csv, IJRR, EVREAL,
             HQF h5): 's', 'ms', 'us', 'ns'; None: the reader's detection (integers are taken as
             microseconds, with a warning). For AEDAT4 / Prophesee (microseconds) and canonical files
             (seconds) a different unit is refused.
