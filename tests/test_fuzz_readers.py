@@ -111,6 +111,14 @@ def _fixtures(root: Path) -> dict:
         f["t_offset"] = np.int64(47_000_000)
     out["dsec"] = (d, "events.h5", ["events.h5"], dict(sensor_size=(H, W)))
 
+    d = root / "mvsec"
+    d.mkdir()
+    with h5py.File(d / "seq_data.hdf5", "w") as f:
+        f.create_dataset("davis/left/events", data=np.stack([x, y, t + 1_504_643_000.0, p * 2.0 - 1], axis=1))
+        f.create_dataset("davis/left/image_raw", data=np.full((2, H, W), 80, np.uint8))
+        f.create_dataset("davis/left/image_raw_ts", data=np.array([t[0], t[-1]]) + 1_504_643_000.0)
+    out["mvsec"] = (d, "seq_data.hdf5", ["seq_data.hdf5"], {})
+
     from evinr_lite.io.canonical import CanonicalWriter
 
     d = root / "canonical"
@@ -196,7 +204,7 @@ def read_and_classify(kind, path, kwargs):
     OUTCOMES[kind]["events"] += 1
 
 
-FORMATS = ["npy", "txt", "csv", "ijrr", "evreal", "h5", "dsec", "canonical", "aedat4", "prophesee_raw", "prophesee_dat"]
+FORMATS = ["npy", "txt", "csv", "ijrr", "evreal", "h5", "dsec", "mvsec", "canonical", "aedat4", "prophesee_raw", "prophesee_dat"]
 
 
 @pytest.mark.parametrize("kind", FORMATS)
@@ -226,7 +234,7 @@ def test_mutated_files_give_events_or_an_input_error(fixtures, kind):
 H5_EDITS = ["drop_dataset", "retype_dataset", "drop_attr", "attr_to_text", "attr_to_nan", "shorten_dataset"]
 
 
-@pytest.mark.parametrize("kind", ["h5", "dsec", "canonical"])
+@pytest.mark.parametrize("kind", ["h5", "dsec", "mvsec", "canonical"])
 def test_hdf5_structure_edits_give_events_or_an_input_error(fixtures, kind):
     import h5py
 

@@ -25,7 +25,7 @@ def _declared():
 def test_every_format_module_declares_a_complete_format():
     declared = _declared()
     assert set(declared) == {"ijrr", "evreal", "canonical", "h5", "aedat4", "prophesee_raw", "prophesee_dat",
-                             "npy", "txt", "csv", "dsec"}
+                             "npy", "txt", "csv", "dsec", "mvsec"}
     for name, (module, fmt) in declared.items():
         assert isinstance(fmt, FileFormat) and callable(fmt.reader) and callable(fmt.sniff), name
         assert fmt.folder or fmt.suffixes, f"{module}: a file format names its suffixes"

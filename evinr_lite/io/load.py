@@ -59,7 +59,7 @@ def open_recording(path, *, sensor_size=None, time_unit: str | None = None, **op
         time_unit: unit of the timestamps for formats that do not fix it ('s', 'ms', 'us', 'ns'; None:
             the reader's detection); refused for formats that fix theirs.
         options: the format's other reader options (e.g. ``columns=`` for .npy).
-    Formats that can read a window without the rest (memory-mapped .npy, canonical and HQF h5, AEDAT4
+    Formats that can read a window without the rest (memory-mapped .npy, canonical, HQF, DSEC and MVSEC h5, AEDAT4
     and Prophesee packets) do so; the others (text, IJRR and EVREAL folders) are read once and sliced.
     """
     fmt = get_format(detect_format(path))
@@ -95,8 +95,8 @@ def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: flo
     Args:
         path: file or folder; the format is detected (:func:`evinr_lite.io.detect_format`).
         sensor_size: (H, W). Needed for formats that do not record it (.npy, text without a
-            `W H` header, an IJRR folder without images.txt, some Prophesee .raw); for the others
-            it must match the file's.
+            `W H` header, a .csv without `%geometry`, a DSEC .h5, an MVSEC .hdf5 without frames, an
+            IJRR folder without images.txt, some Prophesee .raw); for the others it must match the file's.
         t_start, t_end: passed to readers that read only a window from disk (the others read all).
         time_unit: unit of the timestamps for formats that do not fix it (.npy, text, .csv, IJRR, EVREAL,
             HQF h5): 's', 'ms', 'us', 'ns'; None: the reader's detection (integers are taken as
