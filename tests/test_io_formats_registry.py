@@ -31,6 +31,7 @@ def test_every_format_module_declares_a_complete_format():
         assert fmt.folder or fmt.suffixes, f"{module}: a file format names its suffixes"
         assert not fmt.windowed or fmt.open_source is not None, name
         assert fmt.description in registry.SUPPORTED_FORMATS
+        assert ";" not in fmt.description, f"{name}: the list of formats is joined with '; '"
 
 
 def test_tables_are_derived_from_the_declarations():

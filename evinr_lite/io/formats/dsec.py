@@ -208,6 +208,6 @@ def _sniff(path, head) -> bool:
 
 
 FORMAT = FileFormat(
-    name="dsec", description="a DSEC-style .h5 (events/x, y, t in microseconds, p; t_offset)", reader=read_dsec,
+    name="dsec", description="a DSEC-style .h5 (events/x, y, t in microseconds since t_offset, p)", reader=read_dsec,
     suffixes=(".h5", ".hdf5"), sniff=_sniff, needs_sensor_size=True, takes_sensor_size=True, time_unit="us",
     windowed=True, open_source=DsecSource, options=("polarity",), priority=15)

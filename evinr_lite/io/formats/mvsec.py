@@ -242,6 +242,6 @@ def _sniff(path, head) -> bool:
 
 
 FORMAT = FileFormat(
-    name="mvsec", description="an MVSEC .hdf5 (davis/left/events rows x, y, t, p; image_raw frames)",
+    name="mvsec", description="an MVSEC .hdf5 (davis/left/events rows x, y, t, p, and the image_raw frames)",
     reader=read_mvsec, suffixes=(".h5", ".hdf5"), sniff=_sniff, needs_sensor_size=True, takes_sensor_size=True,
     time_unit="s", windowed=True, open_source=MvsecSource, options=("camera",), priority=16)
