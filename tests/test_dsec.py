@@ -89,7 +89,7 @@ def _bad(tmp_path, edit):
     (lambda f: f.__delitem__("events/p") or f.create_dataset("events/p", data=np.zeros(5, np.uint8)),
      r"must be 1-D with the same length"),
     (lambda f: f.__delitem__("events/t") or f.create_dataset("events/t", data=np.linspace(0, 1, 300)),
-     r"events/t must hold integers \(t in microseconds\)"),
+     r"events/t must be integers \(t in microseconds\)"),
     (lambda f: f.__delitem__("t_offset") or f.create_dataset("t_offset", data=[1, 2]),
      r"t_offset must be one integer"),
 ])

@@ -13,34 +13,14 @@ import numpy as np
 
 from ...core.events import EventDataError, Events, check_time_span
 from ...core.recording import Recording
-from ..source import RecordingSource
-from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, check_time_spread,
-                   existing, plain_attr, probe_sorted, size_value)
+from .base import Clock, FileFormat, build_events, check_time_spread, plain_attr, size_value
+from .h5window import H5Source, TimeIndexed, column_count, read_window, sniff_h5
 
 __all__ = ["read_dsec", "DsecSource", "FORMAT"]
 
 EVENT_NAMES = ("events/x", "events/y", "events/t", "events/p")
-H5_ERRORS = (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError)
 FILTERS = {32001: "Blosc", 32004: "LZ4", 32008: "bitshuffle", 32015: "Zstandard", 32026: "Blosc2"}
 SIZE_FIX = "pass sensor_size=(H, W) (rows, columns; DSEC's event cameras: (480, 640))"
-
-
-def _open_file(path):
-    import h5py
-
-    try:
-        import hdf5plugin  # noqa: F401  (registers the Blosc / zstd / LZ4 filters DSEC's files are written with)
-    except ImportError:   # a missing filter is then named, with the fix, by _check_filters
-        pass
-    try:
-        return h5py.File(path, "r")
-    except OSError as err:
-        raise _damaged(path, err) from None
-
-
-def _damaged(path, err) -> EventDataError:
-    return EventDataError(f"{path}: the HDF5 file is damaged or incomplete ({type(err).__name__}: {err}); copy or "
-                          "download it again")
 
 
 def _check_filters(f, path) -> None:
@@ -65,21 +45,16 @@ def is_dsec_file(f) -> bool:
     return all(name in f and isinstance(f[name], h5py.Dataset) for name in EVENT_NAMES)
 
 
-class _Layout:
+class _Layout(TimeIndexed):
     """The checked layout of an open DSEC file: event count, clock, sensor size."""
 
-    def __init__(self, f, path, sensor_size):
-        self.f, self.path = f, path
+    def __init__(self, f, path, sensor_size, polarity="auto"):
+        self.f, self.path, self.polarity = f, path, polarity
         if not is_dsec_file(f):
             raise EventDataError(f"{path}: expected DSEC's datasets {list(EVENT_NAMES)}")
         t = self.t = f["events/t"]
-        n = self.n = t.shape[0] if t.ndim == 1 else -1
-        if any(f[name].shape != (n,) for name in EVENT_NAMES):
-            raise EventDataError(f"{path}: {list(EVENT_NAMES)} must be 1-D with the same length, got "
-                                 f"{[f[name].shape for name in EVENT_NAMES]}")
-        for name in EVENT_NAMES:
-            if f[name].dtype.kind not in "iub":
-                raise EventDataError(f"{path}: {name} must hold integers (t in microseconds), got dtype {f[name].dtype}")
+        n = self.n = column_count(f, path, ("events/t", "events/x", "events/y", "events/p"), "iub",
+                                  "integers (t in microseconds)")
         _check_filters(f, path)
         self.offset = 0
         if "t_offset" in f:
@@ -102,21 +77,14 @@ class _Layout:
         if n >= 2:
             check_time_spread(*self.span(), n, f"{path}: events/t")
 
-    def span(self) -> tuple[float, float]:
-        if not self.n:
-            return 0.0, 0.0
-        return float(self.clock.seconds(self.t[0])), float(self.clock.seconds(self.t[self.n - 1]))
-
-    def window(self, t_start, t_end) -> tuple[int, int]:
-        lo = 0 if t_start is None else bisect_seconds(self.t, self.clock, t_start, 0, self.n, self.path)
-        hi = self.n if t_end is None else bisect_seconds(self.t, self.clock, t_end, lo, self.n, self.path)
-        return lo, hi
-
-    def events(self, lo: int, hi: int, polarity: str = "auto") -> Events:
+    def events(self, lo: int, hi: int) -> Events:
         t = self.clock.seconds(self.t[lo:hi])
         check_time_span(t, f"{self.path}: events/t", "us")
         x, y, p = (self.f[name][lo:hi] for name in ("events/x", "events/y", "events/p"))
-        return build_events(self.path, t, x, y, p, self.sensor_size, polarity=polarity, t_origin=self.origin)
+        return build_events(self.path, t, x, y, p, self.sensor_size, polarity=self.polarity, t_origin=self.origin)
+
+    def frames(self, t_start=None, t_end=None, meta=None) -> None:
+        return None   # DSEC keeps its frame camera's images in other files
 
     def meta(self) -> dict:
         return {"format": "dsec", "path": str(self.path), "t_offset_us": self.offset,
@@ -135,76 +103,19 @@ def read_dsec(path, sensor_size=None, *, t_start=None, t_end=None, polarity="aut
         EventDataError for a missing, damaged or compressed-but-undecodable file, missing datasets,
         a missing sensor size, an empty window.
     """
-    path = existing(path)
-    check_reader_window(t_start, t_end)
-    f = _open_file(path)
-    try:
-        with f:
-            layout = _Layout(f, path, sensor_size)
-            if t_start is not None or t_end is not None:
-                probe_sorted(layout.t, path)
-            lo, hi = layout.window(t_start, t_end)
-            if hi <= lo:
-                first, last = layout.span()
-                span = f"[{first:.6f}, {last:.6f}] s" if layout.n else "nothing"
-                raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
-                                     f"{span} (relative to t_origin = {layout.origin}); choose a window inside that range")
-            events = layout.events(lo, hi, polarity)
-            meta = {**layout.meta(), "event_slice": (lo, hi)}
-    except EventDataError:
-        raise
-    except H5_ERRORS as err:
-        raise _damaged(path, err) from None
-    return Recording(events, None, meta)
+    return read_window(path, lambda f, p: _Layout(f, p, sensor_size, polarity), t_start, t_end)
 
 
-class DsecSource(RecordingSource):
+class DsecSource(H5Source):
     """Windows of a DSEC file: each found by bisection on events/t, only its slice read. Holds the file open."""
 
     def __init__(self, path, *, sensor_size=None, polarity="auto"):
-        path = existing(path)
-        self._f = _open_file(path)
-        try:
-            self._layout = layout = _Layout(self._f, path, sensor_size)
-            probe_sorted(layout.t, path)
-            self.meta = layout.meta()
-            self.t_span = layout.span()
-        except EventDataError:
-            self.close()
-            raise
-        except H5_ERRORS as err:
-            self.close()
-            raise _damaged(path, err) from None
-        self.path, self.format, self.frames, self._polarity = path, "dsec", None, polarity
-        self.sensor_size, self.t_origin, self.n_events = layout.sensor_size, layout.origin, layout.n
-
-    def _read_window(self, t0: float, t1: float) -> Events:
-        try:
-            lo, hi = self._layout.window(t0, t1)
-            return (self._layout.events(lo, hi, self._polarity) if hi > lo
-                    else Events.empty(self.sensor_size, self.t_origin))
-        except EventDataError:
-            raise
-        except H5_ERRORS as err:
-            raise _damaged(self.path, err) from None
-
-    def close(self) -> None:
-        f, self._f = getattr(self, "_f", None), None
-        if f is not None:
-            f.close()
+        super().__init__(path, lambda f, p: _Layout(f, p, sensor_size, polarity), "dsec")
 
 
 def _sniff(path, head) -> bool:
     """An HDF5 file with DSEC's events/x, events/y, events/t and events/p datasets."""
-    if head is None or not head.startswith(b"\x89HDF\r\n\x1a\n"):
-        return False
-    import h5py
-
-    try:
-        with h5py.File(path, "r") as f:
-            return is_dsec_file(f)
-    except H5_ERRORS:
-        return False
+    return sniff_h5(path, head, is_dsec_file)
 
 
 FORMAT = FileFormat(

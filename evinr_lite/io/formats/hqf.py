@@ -13,33 +13,17 @@ import numpy as np
 from ...core.events import TIME_UNITS, EventDataError, Events, check_time_span, resolve_time_unit
 from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
-from ..source import RecordingSource
 from ..notes import note
-from .base import (Clock, FileFormat, bisect_seconds, build_events, check_finite_images, check_reader_window,
-                   check_time_spread, existing, frames_on_event_clock, note_decimal_seconds, plain_attr, probe_sorted,
-                   size_value)
+from .base import (Clock, FileFormat, build_events, check_finite_images, check_time_spread, frames_on_event_clock,
+                   note_decimal_seconds, plain_attr, size_value)
+from .h5window import HDF5_MAGIC, H5Source, TimeIndexed, column_count, read_window
 
 __all__ = ["read_h5", "HqfSource", "FORMAT"]
 
 EVENT_NAMES = ("events/xs", "events/ys", "events/ts", "events/ps")
-H5_ERRORS = (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError)
 
 
-def _damaged(path, err) -> EventDataError:
-    return EventDataError(f"{path}: the HDF5 file is damaged or incomplete ({type(err).__name__}: {err}); copy or "
-                          "convert it again")
-
-
-def _open_file(path):
-    import h5py
-
-    try:
-        return h5py.File(path, "r")
-    except OSError as err:
-        raise _damaged(path, err) from None
-
-
-class _Layout:
+class _Layout(TimeIndexed):
     """The checked layout of an open HQF file: sensor size, event count, clock, time unit."""
 
     def __init__(self, f, path, time_unit):
@@ -54,14 +38,9 @@ class _Layout:
             raise EventDataError(f"{path}: no root attribute 'sensor_resolution' (H, W); add it, e.g. "
                                  "h5py.File(path, 'r+').attrs['sensor_resolution'] = (H, W)")
         self.sensor_size = size_value(path, f.attrs["sensor_resolution"], "the attribute sensor_resolution")
-        ts = self.ts = f["events/ts"]
-        n = self.n = ts.shape[0] if ts.ndim == 1 else -1
-        if any(f[name].shape != (n,) for name in EVENT_NAMES):
-            raise EventDataError(f"{path}: {EVENT_NAMES} must be 1-D with the same length, got "
-                                 f"{[f[name].shape for name in EVENT_NAMES]}")
-        for name in EVENT_NAMES:
-            if f[name].dtype.kind not in "iufb":
-                raise EventDataError(f"{path}: {name} must be numeric, got dtype {f[name].dtype}")
+        ts = self.t = f["events/ts"]
+        self.time_unit = time_unit
+        n = self.n = column_count(f, path, ("events/ts", "events/xs", "events/ys", "events/ps"), "iufb", "numeric")
         self.unit = resolve_time_unit(ts.dtype.kind if n else "f", time_unit, f"{path}: events/ts")
         per_s = 1.0 / TIME_UNITS[self.unit]
         if n and not (math.isfinite(float(ts[0])) and math.isfinite(float(ts[n - 1]))):
@@ -77,23 +56,17 @@ class _Layout:
         if n >= 2:   # every event at one instant: a damaged events/ts, refused before any window is read
             check_time_spread(*self.span(), n, f"{path}: events/ts")
 
-    def note_units(self, time_unit, meta) -> None:
-        """A note when decimal timestamps detected as seconds come too slowly for seconds."""
+    def meta(self) -> dict:
+        """The reading's meta, with a note when decimal timestamps detected as seconds come too slowly
+        for seconds."""
+        meta = {"format": "h5", "path": str(self.path), "attrs": {k: plain_attr(v) for k, v in self.f.attrs.items()},
+                "time_unit": self.unit}
         if self.n > 1:
-            note_decimal_seconds(*self.span(), self.n, time_unit, self.unit, f"{self.path}: events/ts", meta)
-
-    def span(self) -> tuple[float, float]:
-        if not self.n:
-            return 0.0, 0.0
-        return float(self.clock.seconds(self.ts[0])), float(self.clock.seconds(self.ts[self.n - 1]))
-
-    def window(self, t_start, t_end) -> tuple[int, int]:
-        lo = 0 if t_start is None else bisect_seconds(self.ts, self.clock, t_start, 0, self.n, self.path)
-        hi = self.n if t_end is None else bisect_seconds(self.ts, self.clock, t_end, lo, self.n, self.path)
-        return lo, hi
+            note_decimal_seconds(*self.span(), self.n, self.time_unit, self.unit, f"{self.path}: events/ts", meta)
+        return meta
 
     def events(self, lo: int, hi: int) -> Events:
-        t = self.clock.seconds(self.ts[lo:hi])
+        t = self.clock.seconds(self.t[lo:hi])
         check_time_span(t, f"{self.path}: events/ts", self.unit)
         x, y, p = (self.f[name][lo:hi] for name in ("events/xs", "events/ys", "events/ps"))
         return build_events(self.path, t, x, y, p, self.sensor_size, polarity="auto", t_origin=self.origin)
@@ -173,72 +146,18 @@ def read_h5(path, *, t_start=None, t_end=None, time_unit="auto") -> Recording:
     Raises:
         EventDataError for a missing, damaged or incomplete file, missing datasets or attributes.
     """
-    path = existing(path)
-    check_reader_window(t_start, t_end)
-    f = _open_file(path)
-    try:
-        with f:
-            layout = _Layout(f, path, time_unit)
-            if t_start is not None or t_end is not None:
-                probe_sorted(layout.ts, path)
-            lo, hi = layout.window(t_start, t_end)
-            if hi <= lo:
-                first, last = layout.span()
-                span = f"[{first:.6f}, {last:.6f}] s" if layout.n else "nothing"
-                raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
-                                     f"{span} (relative to t_origin = {layout.origin}); choose a window inside that range")
-            events = layout.events(lo, hi)
-            meta = {"format": "h5", "path": str(path), "attrs": {k: plain_attr(v) for k, v in f.attrs.items()},
-                    "event_slice": (lo, hi), "time_unit": layout.unit}
-            layout.note_units(time_unit, meta)
-            frames = layout.frames(t_start, t_end, meta)
-    except EventDataError:
-        raise
-    except H5_ERRORS as err:
-        raise _damaged(path, err) from None
-    return Recording(events, frames, meta)
+    return read_window(path, lambda f, p: _Layout(f, p, time_unit), t_start, t_end)
 
 
-class HqfSource(RecordingSource):
+class HqfSource(H5Source):
     """Windows of an HQF h5 file: each found by bisection on events/ts, only its slice read. Holds the file open."""
 
     def __init__(self, path, *, time_unit="auto"):
-        path = existing(path)
-        self._f = _open_file(path)
-        try:
-            self._layout = layout = _Layout(self._f, path, time_unit)
-            probe_sorted(layout.ts, path)
-            self.meta = {"format": "h5", "path": str(path),
-                         "attrs": {k: plain_attr(v) for k, v in self._f.attrs.items()}, "time_unit": layout.unit}
-            layout.note_units(time_unit, self.meta)
-            self.frames = layout.frames(meta=self.meta)
-            self.t_span = layout.span()
-        except EventDataError:
-            self.close()
-            raise
-        except H5_ERRORS as err:
-            self.close()
-            raise _damaged(path, err) from None
-        self.path, self.format = path, "h5"
-        self.sensor_size, self.t_origin, self.n_events = layout.sensor_size, layout.origin, layout.n
-
-    def _read_window(self, t0: float, t1: float) -> Events:
-        try:
-            lo, hi = self._layout.window(t0, t1)
-            return self._layout.events(lo, hi) if hi > lo else Events.empty(self.sensor_size, self.t_origin)
-        except EventDataError:
-            raise
-        except H5_ERRORS as err:
-            raise _damaged(self.path, err) from None
-
-    def close(self) -> None:
-        f, self._f = getattr(self, "_f", None), None
-        if f is not None:
-            f.close()
+        super().__init__(path, lambda f, p: _Layout(f, p, time_unit), "h5")
 
 
 def _sniff(path, head) -> bool:
-    return head is not None and head.startswith(b"\x89HDF\r\n\x1a\n")
+    return head is not None and head.startswith(HDF5_MAGIC)
 
 
 FORMAT = FileFormat(

@@ -13,33 +13,14 @@ import numpy as np
 from ...core.events import EventDataError, Events, check_time_span
 from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
-from ..source import RecordingSource
-from .base import (Clock, FileFormat, bisect_seconds, build_events, check_declared_size, check_finite_images,
-                   check_reader_window, check_time_spread, existing, frames_on_event_clock, probe_sorted, size_value)
+from .base import (Clock, FileFormat, build_events, check_declared_size, check_finite_images, check_time_spread,
+                   frames_on_event_clock, size_value)
+from .h5window import H5Source, TimeIndexed, read_window, sniff_h5
 
 __all__ = ["read_mvsec", "MvsecSource", "FORMAT", "CAMERAS"]
 
 CAMERAS = ("left", "right")
-H5_ERRORS = (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError)
 SIZE_FIX = "pass sensor_size=(H, W) (rows, columns; MVSEC's DAVIS 346: (260, 346))"
-
-
-def _damaged(path, err) -> EventDataError:
-    return EventDataError(f"{path}: the HDF5 file is damaged or incomplete ({type(err).__name__}: {err}); copy or "
-                          "download it again")
-
-
-def _open_file(path):
-    import h5py
-
-    try:
-        import hdf5plugin  # noqa: F401  (registers compression filters beyond h5py's own)
-    except ImportError:
-        pass
-    try:
-        return h5py.File(path, "r")
-    except OSError as err:
-        raise _damaged(path, err) from None
 
 
 def mvsec_camera(f) -> str | None:
@@ -63,7 +44,7 @@ class _TimeColumn:
         return self.ds[i, 2]
 
 
-class _Layout:
+class _Layout(TimeIndexed):
     """The checked layout of an open MVSEC file for one camera."""
 
     def __init__(self, f, path, camera, sensor_size):
@@ -102,16 +83,6 @@ class _Layout:
         self.origin = self.clock.origin
         if self.n >= 2:
             check_time_spread(*self.span(), self.n, f"{path}: {name}")
-
-    def span(self) -> tuple[float, float]:
-        if not self.n:
-            return 0.0, 0.0
-        return float(self.clock.seconds(self.t[0])), float(self.clock.seconds(self.t[self.n - 1]))
-
-    def window(self, t_start, t_end) -> tuple[int, int]:
-        lo = 0 if t_start is None else bisect_seconds(self.t, self.clock, t_start, 0, self.n, self.path)
-        hi = self.n if t_end is None else bisect_seconds(self.t, self.clock, t_end, lo, self.n, self.path)
-        return lo, hi
 
     def events(self, lo: int, hi: int) -> Events:
         rows = self.ds[lo:hi]
@@ -168,77 +139,19 @@ def read_mvsec(path, sensor_size=None, *, t_start=None, t_end=None, camera=None)
     Raises:
         EventDataError for a missing, damaged or incomplete file, a missing events dataset, an empty window.
     """
-    path = existing(path)
-    check_reader_window(t_start, t_end)
-    f = _open_file(path)
-    try:
-        with f:
-            layout = _Layout(f, path, camera, sensor_size)
-            if t_start is not None or t_end is not None:
-                probe_sorted(layout.t, path)
-            lo, hi = layout.window(t_start, t_end)
-            if hi <= lo:
-                first, last = layout.span()
-                span = f"[{first:.6f}, {last:.6f}] s" if layout.n else "nothing"
-                raise EventDataError(f"{path}: no events in the window [{t_start}, {t_end}) s; the events cover "
-                                     f"{span} (relative to t_origin = {layout.origin}); choose a window inside that range")
-            events = layout.events(lo, hi)
-            meta = {**layout.meta(), "event_slice": (lo, hi)}
-            frames = layout.frames(t_start, t_end, meta)
-    except EventDataError:
-        raise
-    except H5_ERRORS as err:
-        raise _damaged(path, err) from None
-    return Recording(events, frames, meta)
+    return read_window(path, lambda f, p: _Layout(f, p, camera, sensor_size), t_start, t_end)
 
 
-class MvsecSource(RecordingSource):
+class MvsecSource(H5Source):
     """Windows of an MVSEC file: each found by bisection on the time column, only its rows read. Holds the file open."""
 
     def __init__(self, path, *, sensor_size=None, camera=None):
-        path = existing(path)
-        self._f = _open_file(path)
-        try:
-            self._layout = layout = _Layout(self._f, path, camera, sensor_size)
-            probe_sorted(layout.t, path)
-            self.meta = layout.meta()
-            self.frames = layout.frames(meta=self.meta)
-            self.t_span = layout.span()
-        except EventDataError:
-            self.close()
-            raise
-        except H5_ERRORS as err:
-            self.close()
-            raise _damaged(path, err) from None
-        self.path, self.format = path, "mvsec"
-        self.sensor_size, self.t_origin, self.n_events = layout.sensor_size, layout.origin, layout.n
-
-    def _read_window(self, t0: float, t1: float) -> Events:
-        try:
-            lo, hi = self._layout.window(t0, t1)
-            return self._layout.events(lo, hi) if hi > lo else Events.empty(self.sensor_size, self.t_origin)
-        except EventDataError:
-            raise
-        except H5_ERRORS as err:
-            raise _damaged(self.path, err) from None
-
-    def close(self) -> None:
-        f, self._f = getattr(self, "_f", None), None
-        if f is not None:
-            f.close()
+        super().__init__(path, lambda f, p: _Layout(f, p, camera, sensor_size), "mvsec")
 
 
 def _sniff(path, head) -> bool:
     """An HDF5 file with davis/left/events or davis/right/events rows (x, y, t, p)."""
-    if head is None or not head.startswith(b"\x89HDF\r\n\x1a\n"):
-        return False
-    import h5py
-
-    try:
-        with h5py.File(path, "r") as f:
-            return mvsec_camera(f) is not None
-    except H5_ERRORS:
-        return False
+    return sniff_h5(path, head, mvsec_camera)
 
 
 FORMAT = FileFormat(
