@@ -140,7 +140,8 @@ def build_parser() -> argparse.ArgumentParser:
                           description=f"Supported formats: {SUPPORTED_FORMATS}.", parents=[common])
     info.add_argument("recording", help="file or folder (format detected from content and name)")
     info.add_argument("--sensor", type=_size, help="sensor size HxW, for files that do not record it (.npy, "
-                                                   "text without a header, some Prophesee .raw)")
+                                                   "text without a header, .csv without %%geometry, DSEC .h5, "
+                                                   "some Prophesee .raw)")
     info.add_argument("--json", action="store_true", help="print the description as JSON")
     info.add_argument("--time-unit", choices=TIME_UNIT_CHOICES, help=unit_help)
 
