@@ -394,3 +394,16 @@ def test_read_recording_missing_path(tmp_path):
         read_recording(tmp_path / "nothing.h5")
     with pytest.raises(EventDataError, match=r"no such file: .*nothing\.txt"):
         read_events_txt(tmp_path / "nothing.txt", (3, 5))
+
+
+def test_a_metavision_hdf5_file_names_the_conversion(tmp_path):
+    """Metavision SDK 4+ writes CD/events (a compound dataset, ECF-compressed), which the kit does not
+    decode: the error names the format and the conversion, not the HQF datasets it lacks."""
+    import h5py
+
+    path = tmp_path / "recording.hdf5"
+    dtype = np.dtype([("x", "<u2"), ("y", "<u2"), ("p", "<i2"), ("t", "<i8")])
+    with h5py.File(path, "w") as f:
+        f.create_dataset("CD/events", data=np.zeros(4, dtype))
+    with pytest.raises(EventDataError, match=r"Prophesee Metavision HDF5 file.*metavision_file_to_dat"):
+        read_recording(path)

@@ -31,6 +31,11 @@ class _Layout(TimeIndexed):
 
         self.f, self.path = f, path
         missing = [n for n in EVENT_NAMES if n not in f or not isinstance(f[n], h5py.Dataset)]
+        if missing and isinstance(f.get("CD/events"), h5py.Dataset):   # Metavision SDK 4+ writes this layout
+            raise EventDataError(f"{path}: a Prophesee Metavision HDF5 file (CD/events, compressed with Prophesee's "
+                                 "ECF codec, which no h5py plugin here decodes); convert it with Metavision's "
+                                 "metavision_file_to_dat (a .dat file) or metavision_file_to_csv (a .csv file) and "
+                                 "read that")
         if missing:
             raise EventDataError(f"{path}: missing datasets {missing} (or groups where datasets belong); expected "
                                  f"the HQF layout {list(EVENT_NAMES)}, each a 1-D dataset")
