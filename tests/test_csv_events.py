@@ -61,6 +61,8 @@ def test_metavision_layout_with_geometry_reads_microseconds(tmp_path, reference)
     ("x,y,p,t", "{x},{y},{p},{t:.6f}", 1e-6),
     ("X; Y; Time [ms]; Pol", "{x}; {y}; {t:.3f}; {p}", 1e-3),
     ('"y","x","p","ts"', "{y},{x},{p},{t:.6f}", 1e-6),
+    ("t,x,y,p,", "{t:.6f},{x},{y},{p},", 1e-6),          # a trailing separator on every line
+    ("t x y p", "{t:.6f} {x} {y} {p}", 1e-6),            # white space only
 ])
 def test_named_columns_in_any_order(tmp_path, reference, names, fmt, scale):
     t_us, x, y, p = _events()

@@ -89,7 +89,10 @@ def _numbers(line: bytes) -> bool:
 def _names(path: Path, line: bytes) -> tuple[list, str | None]:
     """The role (t, x, y, p) of each named column and the unit the time's name gives (or None)."""
     text = line.decode("utf-8", errors="replace")
-    names = [n.strip().strip("'\"").lower() for n in re.split(r"[,;\t]", text)]
+    separator = r"[,;\t]" if re.search(r"[,;\t]", text) else r"\s+"   # `t x y p` in a .csv: white space
+    names = [n.strip().strip("'\"").lower() for n in re.split(separator, text.strip())]
+    while names and not names[-1]:   # a trailing separator (as on every row of some exports)
+        names.pop()
     roles, unit = [], None
     for n in names:
         m = _NAME.match(n)
