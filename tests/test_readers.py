@@ -407,3 +407,13 @@ def test_a_metavision_hdf5_file_names_the_conversion(tmp_path):
         f.create_dataset("CD/events", data=np.zeros(4, dtype))
     with pytest.raises(EventDataError, match=r"Prophesee Metavision HDF5 file.*metavision_file_to_dat"):
         read_recording(path)
+
+
+def test_a_ros_bag_names_the_conversion(tmp_path):
+    from evinr_lite.io.formats import sniff_format
+
+    path = tmp_path / "recording.bag"
+    path.write_bytes(b"#ROSBAG V2.0\n" + bytes(64))
+    assert sniff_format(path) == "rosbag"
+    with pytest.raises(EventDataError, match=r"a ROS1 bag.*python -m data_fetch convert"):
+        read_recording(path)

@@ -30,6 +30,8 @@ UNSUPPORTED = {   # first bytes of files that are recognised but not read -> the
     b"#!AER-DAT1": "an AEDAT2 file; only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) "
                    "or export the events to a `t x y p` text file",
     b"PK\x03\x04": "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside",
+    b"#ROSBAG V2.0": "a ROS1 bag, which is not read directly; convert it with `python -m data_fetch convert FILE.bag` "
+                     "(dvs_msgs event arrays and the APS images, to the canonical .h5 that evinr-lite reads)",
 }
 
 
@@ -125,7 +127,7 @@ def is_recording_folder(path) -> bool:
 
 def sniff_format(path) -> str | None:
     """The format of a file from its first bytes alone: a format's name, 'hdf5' for any HDF5 file,
-    'aedat2' / 'aedat3' / 'zip' for files recognised but not read, or None (not recognised: maybe text)."""
+    'aedat2' / 'aedat3' / 'zip' / 'rosbag' for files recognised but not read, or None (not recognised: maybe text)."""
     path = Path(path)
     with open(path, "rb") as f:
         head = f.read(HEAD_BYTES)
@@ -134,7 +136,8 @@ def sniff_format(path) -> str | None:
     for fmt in FORMATS:
         if not fmt.folder and not fmt.by_suffix and fmt.sniff(path, head):
             return fmt.name
-    names = {b"#!AER-DAT3": "aedat3", b"#!AER-DAT2": "aedat2", b"#!AER-DAT1": "aedat2", b"PK\x03\x04": "zip"}
+    names = {b"#!AER-DAT3": "aedat3", b"#!AER-DAT2": "aedat2", b"#!AER-DAT1": "aedat2", b"PK\x03\x04": "zip",
+             b"#ROSBAG V2.0": "rosbag"}
     return next((name for magic, name in names.items() if head.startswith(magic)), None)
 
 
