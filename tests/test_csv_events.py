@@ -99,6 +99,8 @@ def test_absolute_microsecond_clock_is_exact(tmp_path):
      r"`%geometry:W,H` line says the sensor is \(H, W\) = \(30, 40\)"),
     (["t_us,x,y,p"], ["100,1,2,1", "200,1,2,0"], {"time_unit": "s"}, r"names the time in 'us'.*time_unit='s'"),
     (["t,x,y,p"], ["0.1,1,2,1", "0.2,1,2,0"], {}, r"no `%geometry:W,H` line\); pass sensor_size=\(H, W\)"),
+    ([f"%geometry:{W},{H}"], [], {}, r"no events found after the header"),
+    (["t,x,y,p"], [], {}, r"no events found; expected lines `t,x,y,p`"),
     (["t,x,y,p"], ["0.1,1,2,1", "0.2,1.5,2,0"], {"sensor_size": (H, W)}, r"line 3: x must be a whole pixel index"),
 ])
 def test_bad_files_are_refused_with_the_fix(tmp_path, header, rows, kwargs, message):

@@ -122,6 +122,9 @@ def _guess_order(path: Path, data: bytes, start: int) -> tuple:
             break
         if len(values) != 4:
             break
+    if not rows and not data[start:].strip():
+        raise EventDataError(f"{path}: no events found after the header; expected lines such as `t,x,y,p` or "
+                             "Metavision's `x,y,p,t`")
     ok = len(rows) > 0 and all(len(r) == 4 for r in rows)
     if ok:
         a = np.asarray(rows)
