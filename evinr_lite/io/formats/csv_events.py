@@ -33,6 +33,7 @@ ROLE_NAMES = {"t": ("t", "ts", "time", "timestamp", "timestamps"), "x": ("x",), 
               "p": ("p", "pol", "polarity")}
 UNITS = {"s": "s", "ms": "ms", "us": "us", "\u00b5s": "us", "ns": "ns"}
 SNIFF_ROWS = 1000          # rows read to tell the order when no line names the columns
+SNIFF_BYTES = 1 << 16      # at most this many bytes of them
 _NAME = re.compile(r"^(?P<name>[a-z]+)(?:[\s_]*[\[(]?(?P<unit>s|ms|us|\u00b5s|ns)[\])]?)?$")
 _GEOMETRY = re.compile(rb"^%\s*geometry\s*:\s*(\d+)\s*[,x ]\s*(\d+)\s*$", re.IGNORECASE)
 _SEPARATORS = bytes.maketrans(b",;", b"  ")
@@ -111,8 +112,8 @@ def _names(path: Path, line: bytes) -> tuple[list, str | None]:
 
 def _guess_order(path: Path, data: bytes, start: int) -> tuple:
     """The roles of the columns from the first :data:`SNIFF_ROWS` rows when no line names them."""
-    rows = []
-    for line in data[start:].split(b"\n", SNIFF_ROWS)[:SNIFF_ROWS]:
+    rows, head = [], bytes(data[start:start + SNIFF_BYTES])   # a bounded slice: the file may be GBs
+    for line in head.split(b"\n", SNIFF_ROWS)[:SNIFF_ROWS]:
         values = line.translate(_SEPARATORS).split()
         if not values:
             continue
@@ -122,7 +123,7 @@ def _guess_order(path: Path, data: bytes, start: int) -> tuple:
             break
         if len(values) != 4:
             break
-    if not rows and not data[start:].strip():
+    if not rows and not head.strip():
         raise EventDataError(f"{path}: no events found after the header; expected lines such as `t,x,y,p` or "
                              "Metavision's `x,y,p,t`")
     ok = len(rows) > 0 and all(len(r) == 4 for r in rows)
