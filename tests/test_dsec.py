@@ -124,3 +124,16 @@ def test_unsorted_times_are_refused_for_a_window(tmp_path):
     path = _write(tmp_path / "events.h5", t[::-1].copy(), x, y, p)
     with pytest.raises(EventDataError, match=r"not sorted"):
         read_dsec(path, (H, W), t_start=49600.0, t_end=49601.0)
+
+
+def test_reconstruct_reads_a_window_of_a_dsec_file(tmp_path):
+    """The command end to end on a window: frames written for the window only, from the file's events."""
+    t, x, y, p = _events()
+    path = _write(tmp_path / "events.h5", t, x, y, p)
+    start = (OFFSET + int(t[0])) / 1e6 + 0.5
+    out = tmp_path / "rec"
+    run = subprocess.run([sys.executable, "-m", "evinr_lite", "reconstruct", str(path), "--sensor", f"{H}x{W}",
+                          "--start", f"{start:.6f}", "--end", f"{start + 1.0:.6f}", "--fps", "4", "--out", str(out),
+                          "--quiet", "--no-video"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert len(sorted(out.glob("**/*.png"))) == 4
