@@ -88,3 +88,20 @@ def test_unsorted_times_are_refused_for_a_window(tmp_path):
     path, _ = _write(tmp_path / "unsorted.hdf5", sorted_t=False)
     with pytest.raises(EventDataError, match=r"not sorted"):
         read_mvsec(path, t_start=0.5, t_end=1.0)
+
+
+def test_reconstruct_scores_against_the_aps_frames(tmp_path):
+    """The command end to end: a window of an MVSEC file, scored against its APS frames (metrics.json)."""
+    import json
+    import subprocess
+    import sys
+
+    path, _ = _write(tmp_path / "seq_data.hdf5")
+    out = tmp_path / "rec"
+    run = subprocess.run([sys.executable, "-m", "evinr_lite", "reconstruct", str(path), "--start", "0.5", "--end",
+                          "2.5", "--out", str(out), "--quiet", "--no-video"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    metrics = json.loads(next(out.glob("**/metrics.json")).read_text())
+    stamps = T0 + np.linspace(0.1, 2.9, 12) - np.floor(T0)          # the APS frames on the returned clock
+    inside = stamps[(stamps >= 0.5) & (stamps <= 2.5)]
+    np.testing.assert_allclose(metrics["per_frame"]["none"]["per_frame_t_s"], inside, atol=1e-6)
