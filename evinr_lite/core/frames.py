@@ -8,7 +8,7 @@ import numpy as np
 from .checks import check_image_values
 from .events import EventDataError, InputError, check_t_origin
 
-__all__ = ["Frames", "to_grey_uint8", "to_uint8", "GREY_WEIGHTS"]
+__all__ = ["Frames", "in_window", "to_grey_uint8", "to_uint8", "GREY_WEIGHTS"]
 
 GREY_WEIGHTS = np.array([0.2125, 0.7154, 0.0721])   # ITU-R 709 luminance of (R, G, B): every RGB -> grey here
 
@@ -69,17 +69,24 @@ class Frames:
 
     def slice_time(self, t_start: float | None = None, t_end: float | None = None) -> "Frames":
         """Frames with ``t_start <= t < t_end`` (seconds)."""
-        keep = np.ones(len(self), bool)
-        if t_start is not None:
-            keep &= self.t >= t_start
-        if t_end is not None:
-            keep &= self.t < t_end
+        keep = in_window(self.t, t_start, t_end)
         return Frames(self.images[keep], self.t[keep], self.t_origin)
 
     def sorted(self) -> "Frames":
         """Frames in time order (some recordings store one frame out of order)."""
         order = np.argsort(self.t, kind="stable")
         return Frames(self.images[order], self.t[order], self.t_origin)
+
+
+def in_window(t, t_start: float | None = None, t_end: float | None = None) -> np.ndarray:
+    """bool [N]: which of the times ``t`` [N] (seconds) lie in [t_start, t_end) (None: open on that side)."""
+    t = np.asarray(t)
+    keep = np.ones(t.shape, bool)
+    if t_start is not None:
+        keep &= t >= t_start
+    if t_end is not None:
+        keep &= t < t_end
+    return keep
 
 
 def to_uint8(img) -> np.ndarray:

@@ -15,6 +15,7 @@ Public functions: :func:`parse_event_block` (one block of whole lines), :func:`p
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from fractions import Fraction
@@ -44,12 +45,14 @@ class TextLayout:
     Metavision's CSV `x,y,p,t` is (3, 0, 1, 2)). ``columns``: the columns as messages write them.
     ``sort_hint``: how to sort such a file, for the message about unsorted timestamps.
     ``separators``: bytes that separate values besides white space (a CSV's b",;").
+    ``size_line``: an rpg_e2vid `W H` first line may open the file.
     """
 
     order: tuple = (0, 1, 2, 3)
     columns: str = EVENT_COLUMNS
     sort_hint: str = "sort the file (e.g. `sort -g -k1,1 events.txt`)"
     separators: bytes = b""
+    size_line: bool = True
 
 
 TXT_LAYOUT = TextLayout()   # `t x y p` (IJRR events.txt, rpg_e2vid)
@@ -80,6 +83,16 @@ class _BadToken(Exception):
         self.row = row
 
 
+@functools.lru_cache(maxsize=None)
+def _word_table(separators: bytes) -> np.ndarray:
+    """bool [256]: the bytes that belong to a token (not white space, not one of ``separators``)."""
+    if not separators:
+        return _IS_WORD
+    table = _IS_WORD.copy()
+    table[list(separators)] = False
+    return table
+
+
 def _tokenize(buf: np.ndarray, separators: bytes = b""):
     """Whitespace-separated tokens of whole lines of text.
 
@@ -91,11 +104,7 @@ def _tokenize(buf: np.ndarray, separators: bytes = b""):
         counts: int64 [n_lines], tokens on each line.
         newlines: int64, byte positions of the newlines in buf.
     """
-    is_word = _IS_WORD
-    if separators:
-        is_word = _IS_WORD.copy()
-        is_word[list(separators)] = False
-    word = np.concatenate(([False], is_word[buf], [False]))
+    word = np.concatenate(([False], _word_table(separators)[buf], [False]))
     starts = np.flatnonzero(word[1:] & ~word[:-1])
     ends = np.flatnonzero(word[:-1] & ~word[1:])
     newlines = np.flatnonzero(buf == 10)
@@ -405,14 +414,14 @@ def read_text_bytes(path, what: str = "file") -> bytes:
 
 
 def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto", data: bytes | bytearray | None = None,
-                     layout: TextLayout = TXT_LAYOUT, header_line: bool = True) -> EventBlock:
+                     layout: TextLayout = TXT_LAYOUT) -> EventBlock:
     """A whole `t x y p` text file (optionally after a `W H` header), block by block.
 
     Timestamps must be finite and non-decreasing. ``origin_ns`` None picks the origin from the
     first timestamp. ``time_unit``: see :func:`parse_event_block` ('auto': integers are
     microseconds, decimals seconds). ``data``: the file's bytes when the caller has read (and
-    prepared) them already; ``layout``: the columns' order (:class:`TextLayout`); ``header_line``:
-    an rpg_e2vid `W H` first line is allowed. Raises EventDataError naming the file and line.
+    prepared) them already; ``layout``: the columns' order and separators, and whether a `W H` line
+    may open the file (:class:`TextLayout`). Raises EventDataError naming the file and line.
     """
     path = Path(path)
     data = read_text_bytes(path, "event file") if data is None else data
@@ -420,7 +429,7 @@ def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "au
     parts, header, line_base, t_last = [], None, 0, -np.inf
     for lo, hi in line_blocks(data, CHUNK_BYTES):
         block = parse_event_block(everything[lo:hi], origin_ns, source=path, line_base=line_base,
-                                  first=header_line and lo == 0, t_last=t_last, time_unit=time_unit, layout=layout)
+                                  first=layout.size_line and lo == 0, t_last=t_last, time_unit=time_unit, layout=layout)
         header = block.header if lo == 0 else header
         origin_ns = block.origin_ns
         line_base += block.n_lines

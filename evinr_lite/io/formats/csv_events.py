@@ -36,7 +36,8 @@ SNIFF_ROWS = 1000          # rows read to tell the order when no line names the 
 SNIFF_BYTES = 1 << 16      # at most this many bytes of them
 _NAME = re.compile(r"^(?P<name>[a-z]+)(?:[\s_]*[\[(]?(?P<unit>s|ms|us|\u00b5s|ns)[\])]?)?$")
 _GEOMETRY = re.compile(rb"^%\s*geometry\s*:\s*(\d+)\s*[,x ]\s*(\d+)\s*$", re.IGNORECASE)
-_SEPARATORS = bytes.maketrans(b",;", b"  ")
+SEPARATORS = b",;"          # besides white space
+_SEPARATORS = bytes.maketrans(SEPARATORS, b" " * len(SEPARATORS))
 NAMED = "a first line naming the columns, e.g. `t,x,y,p` or `x,y,p,t` (t in seconds unless named `t_us`, `t_ms`...)"
 SORT_HINT = "sort the rows by the time column"
 
@@ -46,7 +47,7 @@ def _layout(order_names: tuple, how: str) -> TextLayout:
     written = ",".join(order_names)
     return TextLayout(order=tuple(order_names.index(r) for r in "txyp"),
                       columns=f"`{written}` ({how}; x = column, y = row, polarity)", sort_hint=SORT_HINT,
-                      separators=b",;")
+                      separators=SEPARATORS, size_line=False)
 
 
 def _header(path: Path, data: bytes) -> tuple[list, tuple | None, list | None, str | None]:
@@ -183,7 +184,7 @@ def read_events_csv(path, sensor_size=None, *, polarity="auto", t_origin=None, t
     path = Path(path)
     data, layout, geometry, unit = csv_layout(path, read_text_bytes(path, "event file"), time_unit)
     raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=unit, data=data,
-                           layout=layout, header_line=False)
+                           layout=layout)
     check_time_spread(float(raw.t[0]), float(raw.t[-1]), len(raw.t), path)
     check_time_span(raw.t, path, raw.time_unit)
     note_decimal_seconds(raw.t[0], raw.t[-1], len(raw.t), unit, raw.time_unit, path, meta)

@@ -14,28 +14,13 @@ import numpy as np
 from ...core.events import EventDataError, Events, check_time_span
 from ...core.recording import Recording
 from .base import Clock, FileFormat, build_events, check_time_spread, plain_attr, size_value
-from .h5window import H5Source, TimeIndexed, column_count, read_window, sniff_h5
+from .h5window import FILTERS, H5Source, TimeIndexed, check_filters, column_count, read_window, sniff_h5  # noqa: F401
+# (FILTERS names DSEC's compressions, Blosc and zstd, beside the reader that meets them)
 
 __all__ = ["read_dsec", "DsecSource", "FORMAT"]
 
 EVENT_NAMES = ("events/x", "events/y", "events/t", "events/p")
-FILTERS = {32001: "Blosc", 32004: "LZ4", 32008: "bitshuffle", 32015: "Zstandard", 32026: "Blosc2"}
 SIZE_FIX = "pass sensor_size=(H, W) (rows, columns; DSEC's event cameras: (480, 640))"
-
-
-def _check_filters(f, path) -> None:
-    """Refuse, with the fix, a dataset compressed by a filter this h5py cannot decode."""
-    import h5py
-
-    for name in EVENT_NAMES:
-        plist = f[name].id.get_create_plist()
-        for i in range(plist.get_nfilters()):
-            fid = plist.get_filter(i)[0]
-            if not h5py.h5z.filter_avail(fid):
-                raise EventDataError(f"{path}: {name} is compressed with HDF5 filter {fid} "
-                                     f"({FILTERS.get(fid, 'a plugin filter')}), which this Python cannot decode; "
-                                     "install hdf5plugin (`pip install hdf5plugin`, in environment.txt), which "
-                                     "registers it, and run again")
 
 
 def is_dsec_file(f) -> bool:
@@ -55,7 +40,7 @@ class _Layout(TimeIndexed):
         t = self.t = f["events/t"]
         n = self.n = column_count(f, path, ("events/t", "events/x", "events/y", "events/p"), "iub",
                                   "integers (t in microseconds)")
-        _check_filters(f, path)
+        check_filters(f, path, EVENT_NAMES)
         self.offset = 0
         if "t_offset" in f:
             value = np.asarray(f["t_offset"][()])

@@ -19,11 +19,28 @@ from ...core.recording import Recording
 from ..source import RecordingSource
 from .base import bisect_seconds, check_reader_window, existing, probe_sorted
 
-__all__ = ["H5_ERRORS", "HDF5_MAGIC", "open_h5", "damaged", "sniff_h5", "column_count", "TimeIndexed", "read_window",
-           "H5Source"]
+__all__ = ["H5_ERRORS", "HDF5_MAGIC", "FILTERS", "open_h5", "damaged", "check_filters", "sniff_h5", "column_count",
+           "TimeIndexed", "read_window", "H5Source"]
 
 H5_ERRORS = (OSError, KeyError, RuntimeError, TypeError, ValueError, IndexError)
 HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
+FILTERS = {32001: "Blosc", 32004: "LZ4", 32008: "bitshuffle", 32015: "Zstandard", 32026: "Blosc2"}   # plugin filters
+
+
+def check_filters(f, path, names) -> None:
+    """Refuse, with the fix, a dataset of ``names`` compressed by a filter this h5py cannot decode (h5py
+    would only say it cannot read the data)."""
+    import h5py
+
+    for name in names:
+        plist = f[name].id.get_create_plist()
+        for i in range(plist.get_nfilters()):
+            fid = plist.get_filter(i)[0]
+            if not h5py.h5z.filter_avail(fid):
+                raise EventDataError(f"{path}: {name} is compressed with HDF5 filter {fid} "
+                                     f"({FILTERS.get(fid, 'a plugin filter')}), which this Python cannot decode; "
+                                     "install hdf5plugin (`pip install hdf5plugin`, in environment.txt), which "
+                                     "registers it, and run again")
 
 
 def sniff_h5(path, head, has_layout) -> bool:

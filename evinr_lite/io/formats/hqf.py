@@ -11,12 +11,12 @@ import math
 import numpy as np
 
 from ...core.events import TIME_UNITS, EventDataError, Events, check_time_span, resolve_time_unit
-from ...core.frames import Frames, to_grey_uint8
+from ...core.frames import Frames, in_window, to_grey_uint8
 from ...core.recording import Recording
 from ..notes import note
 from .base import (Clock, FileFormat, build_events, check_finite_images, check_time_spread, frames_on_event_clock,
                    note_decimal_seconds, plain_attr, size_value)
-from .h5window import HDF5_MAGIC, H5Source, TimeIndexed, column_count, read_window
+from .h5window import HDF5_MAGIC, H5Source, TimeIndexed, check_filters, column_count, read_window
 
 __all__ = ["read_h5", "HqfSource", "FORMAT"]
 
@@ -46,6 +46,7 @@ class _Layout(TimeIndexed):
         ts = self.t = f["events/ts"]
         self.time_unit = time_unit
         n = self.n = column_count(f, path, ("events/ts", "events/xs", "events/ys", "events/ps"), "iufb", "numeric")
+        check_filters(f, path, EVENT_NAMES)
         self.unit = resolve_time_unit(ts.dtype.kind if n else "f", time_unit, f"{path}: events/ts")
         per_s = 1.0 / TIME_UNITS[self.unit]
         if n and not (math.isfinite(float(ts[0])) and math.isfinite(float(ts[n - 1]))):
@@ -113,11 +114,7 @@ class _Layout(TimeIndexed):
         if np.any(np.diff(stamps) < 0):   # one HQF sequence has a frame out of order
             note(meta, f"{path}: the frames' timestamps are not in the order of their names; they are read sorted "
                        "by time")
-        keep = np.ones(len(keys), dtype=bool)
-        if t_start is not None:
-            keep &= stamps >= t_start
-        if t_end is not None:
-            keep &= stamps < t_end
+        keep = in_window(stamps, t_start, t_end)
         order = np.argsort(stamps[keep], kind="stable")
         keys, stamps = keys[keep][order], stamps[keep][order]
         if not len(keys):

@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.events import EventDataError, Events, check_time_span
-from ...core.frames import Frames, to_grey_uint8
+from ...core.frames import Frames, in_window, to_grey_uint8
 from ...core.recording import Recording
 from .base import (Clock, FileFormat, build_events, check_declared_size, check_finite_images, check_time_spread,
                    frames_on_event_clock, size_value)
-from .h5window import H5Source, TimeIndexed, read_window, sniff_h5
+from .h5window import H5Source, TimeIndexed, check_filters, read_window, sniff_h5
 
 __all__ = ["read_mvsec", "MvsecSource", "FORMAT", "CAMERAS"]
 
@@ -57,12 +57,13 @@ class _Layout(TimeIndexed):
         name = f"davis/{camera}/events"
         ds = f.get(name)
         if not isinstance(ds, h5py.Dataset) or ds.ndim != 2 or ds.shape[1] != 4:
-            other = [c for c in CAMERAS if c != camera and mvsec_camera(f) == c]
+            found = mvsec_camera(f)
             raise EventDataError(f"{path}: no {name} dataset of rows (x, y, t, p)"
-                                 + (f"; the file has the {other[0]} camera's: pass camera={other[0]!r}" if other else ""))
+                                 + (f"; the file has the {found} camera's: pass camera={found!r}" if found else ""))
         if ds.dtype.kind not in "iuf":
             raise EventDataError(f"{path}: {name} must be numeric, got dtype {ds.dtype}")
         self.ds, self.name, self.n = ds, name, ds.shape[0]
+        check_filters(f, path, [name])
         self.t = _TimeColumn(ds)
         self.images, self.image_ts = f.get(f"davis/{camera}/image_raw"), f.get(f"davis/{camera}/image_raw_ts")
         has_frames = (isinstance(self.images, h5py.Dataset) and self.images.ndim == 3 and self.images.shape[0] > 0
@@ -109,16 +110,11 @@ class _Layout(TimeIndexed):
 
         stamps, _ = frames_on_event_clock(seconds, "s", self.span() if self.n else None,
                                           f"{self.path}: davis/{self.camera}/image_raw_ts", meta)
-        keep = np.ones(len(stamps), dtype=bool)
-        if t_start is not None:
-            keep &= stamps >= t_start
-        if t_end is not None:
-            keep &= stamps < t_end
-        index = np.flatnonzero(keep)
+        index = np.flatnonzero(in_window(stamps, t_start, t_end))
         if not len(index):
             return None
-        index = index[np.argsort(stamps[index], kind="stable")]
-        images = self.images[np.sort(index)] if np.all(np.diff(index) > 0) else np.stack([self.images[i] for i in index])
+        index = index[np.argsort(stamps[index], kind="stable")]   # in time order
+        images = self.images[index] if np.all(np.diff(index) > 0) else np.stack([self.images[i] for i in index])
         source = f"{self.path}:davis/{self.camera}/image_raw"
         check_finite_images(images, source)
         images = images if images.dtype == np.uint8 else np.stack([to_grey_uint8(im, source) for im in images])
