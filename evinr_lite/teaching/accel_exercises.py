@@ -95,14 +95,19 @@ def _inputs_bisect(rng):
     t = np.sort(np.concatenate([rng.uniform(0.0, 0.5, 9), [0.8]]))
     cases.append(dict(t_events=t, boundaries=np.array([0.0, 0.25, 0.5, 0.75, 1.0])))
     t = np.sort(rng.uniform(0.0, 2.0, 101))
-    b = np.concatenate([[0.0], np.sort(rng.uniform(0.1, 1.9, 6)), [2.0]])
+    # bins that start at b_0 = 0.0625, not at 0, with an event exactly there: bin 0 holds it (`t == b_0`, not
+    # `t == 0`), and the events before it belong to no bin. 0.0625 is exact in float32 too
+    b = np.concatenate([[0.0625], np.sort(rng.uniform(0.1, 1.9, 6)), [2.0]])
+    t[np.searchsorted(t, b[0]) - 1] = b[0]
     cases.append(dict(t_events=t, boundaries=b))
-    # the boundary rule: events exactly on the edges. Those at b_1 = 1 and b_2 = 2 belong to the bin that
-    # ends there, those at b_0 = 0 to bin 0; a half-open [b_i, b_{i+1}) or a strict t < b_{i+1} moves them.
-    # Bin (1, 2] holds 1.5 and three events at 2.0: its cut between events 1 and 2 would land on the edge 2.0,
-    # so the bin is cut at its time mid-point instead
-    cases.append(dict(t_events=np.array([0.0, 0.2, 0.6, 1.0, 1.0, 1.5, 2.0, 2.0, 2.0, 2.5, 2.9, 3.0]),
-                      boundaries=np.array([0.0, 1.0, 2.0, 3.0])))
+    # the boundary rule: events exactly on the edges. Those at b_1 = 1.25 and b_2 = 2.25 belong to the bin that
+    # ends there, the one at b_0 = 0.25 to bin 0; a half-open [b_i, b_{i+1}) or a strict t < b_{i+1} moves them.
+    # Bin (1.25, 2.25] holds 1.75 and three events at 2.25: its cut between events 1 and 2 would land on the
+    # edge 2.25, so the bin is cut at its time mid-point instead. The times start at 0.25, not 0 (exact in
+    # binary, so the equalities hold): bin 0's closed left edge is t == b_0, and its 5 events (an odd count)
+    # put the cut elsewhere when the event at b_0 is left out (`t == 0` in place of `t == b_0`)
+    cases.append(dict(t_events=np.array([0.0, 0.2, 0.6, 1.0, 1.0, 1.5, 2.0, 2.0, 2.0, 2.5, 2.9, 3.0]) + 0.25,
+                      boundaries=np.array([0.0, 1.0, 2.0, 3.0]) + 0.25))
     return cases
 
 

@@ -52,6 +52,17 @@ def _global_last_time(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return state * np.exp(-alpha * (t_end - t_prev))
 
 
+def _last_time_not_updated(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """The mistake of never updating t_last: every event decays the state from t_start, not from the pixel's
+    previous event."""
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_last = np.full((H, W), float(t_start))
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * state[yi, xi] + C * pi
+    return state * np.exp(-alpha * (t_end - t_last))
+
+
 def _decay_after_adding(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     H, W = sensor_size
     state = np.zeros((H, W))
@@ -76,6 +87,8 @@ exercises.register(
         "each pixel decays since its own last event: keep one t_last per pixel, not one for the stream":
             _global_last_time,
         "decay the old state first, then add C * p (the new event has not decayed yet)": _decay_after_adding,
+        "after each event, set that pixel's t_last to the event's time: the next decay runs from the pixel's "
+        "previous event, not from t_start": _last_time_not_updated,
     })
 
 
@@ -90,6 +103,13 @@ def _inputs_render(rng):
     steps = np.array([[0.25, -0.25], [0.5, 0.0], [-0.75, 0.25], [0.25, 1.0]])
     cases.append(dict(L_boundaries=np.concatenate([np.zeros((1, 2)), steps]).cumsum(axis=0)[:, None, :], C=0.25))
     return cases
+
+
+def _reference_fixed(L_boundaries, C):
+    """The mistake of never moving the reference: every bin counts from L(b_0), so a change is counted
+    again in every later bin."""
+    L = np.asarray(L_boundaries, dtype=np.float64)
+    return np.trunc((L[1:] - L[0]) / C).astype(np.int64)
 
 
 def _no_carry(L_boundaries, C):
@@ -134,4 +154,6 @@ exercises.register(
         "a camera fires only once the change reaches C: round toward zero (np.trunc), not to the nearest": _round_nearest,
         "move the reference by n * C, not to the current level (the part below C must carry over)":
             _reference_to_level,
+        "move the reference after each bin (ref += n * C): a reference that stays at L(b_0) counts the same "
+        "change again in every later bin": _reference_fixed,
     })

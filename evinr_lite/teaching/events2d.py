@@ -158,7 +158,12 @@ def _inputs_frames(rng):
                 np.array([1, -1, 1, 1, -1, 1, 1, -1]), (2, 3))
     cases.append(dict(events=ev, boundaries=np.array([0.0, 0.25, 0.5]), C=0.5))
     ev = _random_events(rng, 300, (5, 7))
-    cases.append(dict(events=ev, boundaries=np.array([0.1, 0.2, 0.45, 0.5, 0.8, 0.95]), C=0.15))
+    # bins that start at b_0 = 0.125, not at 0, with one event exactly there: bin 0 takes it (`t == b_0`, not
+    # `t == 0`). 0.125 is exact in float32 too, so times and edges held in float32 still meet on it
+    t = ev.t.copy()
+    t[np.searchsorted(t, 0.125) - 1] = 0.125
+    ev = Events(t, ev.x, ev.y, ev.p, ev.sensor_size)
+    cases.append(dict(events=ev, boundaries=np.array([0.125, 0.2, 0.45, 0.5, 0.8, 0.95]), C=0.15))
     return cases
 
 
@@ -194,6 +199,28 @@ def _frames_xy_swapped(events, boundaries, C):
     return events_to_frames_fixed(events, boundaries, C).transpose(0, 2, 1)
 
 
+def _frames_first_edge_at_zero(events, boundaries, C):
+    """A wrong version (for the hint): bin 0's closed left edge written as `t == 0`, right only when b_0 = 0."""
+    b = np.asarray(boundaries, dtype=np.float64)
+    H, W = events.sensor_size
+    i = np.searchsorted(b, events.t, side="left") - 1
+    i[events.t == 0] = 0
+    keep = (i >= 0) & (i < b.size - 1)
+    frames = np.zeros((b.size - 1, H, W))
+    np.add.at(frames, (i[keep], events.y[keep], events.x[keep]), events.p[keep])
+    return (C * frames).astype(np.float32)
+
+
+def _frames_clipped(events, boundaries, C):
+    """A wrong version (for the hint): events outside [b_0, b_B] clipped into the first or last bin."""
+    b = np.asarray(boundaries, dtype=np.float64)
+    H, W = events.sensor_size
+    i = np.clip(np.searchsorted(b, events.t, side="left") - 1, 0, b.size - 2)
+    frames = np.zeros((b.size - 1, H, W))
+    np.add.at(frames, (i, events.y, events.x), events.p)
+    return (C * frames).astype(np.float32)
+
+
 def _frames_no_first_edge(events, boundaries, C):
     b = np.asarray(boundaries, dtype=np.float64)
     return events_to_frames_fixed(events.take(events.t != b[0]), b, C)
@@ -216,6 +243,12 @@ exercises.register(
             _frames_no_first_edge,
         "images are indexed [y, x] (row, column)":
             _frames_xy_swapped,
+        "bin 0 takes the events at exactly b_0 = boundaries[0], which need not be 0: test `t == boundaries[0]`, "
+        "not `t == 0`":
+            _frames_first_edge_at_zero,
+        "events before b_0 or after b_B belong to no bin: drop them (keep 0 <= bin < B), do not clip them "
+        "into the first or last bin":
+            _frames_clipped,
     })
 
 
@@ -324,6 +357,32 @@ def _intervals_of_means(events):
     return float(np.tanh(np.log(dt[pair & on].mean() / dt[pair & ~on].mean()) / 2))
 
 
+def _intervals_pixel_index_h(events):
+    """A wrong version (for the hint): the pixel number y * H + x, which gives two pixels one number
+    when H != W (y = 1, x = 0 and y = 0, x = H)."""
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * H + events.x
+    return _imbalance_of_pixel_numbers(events, pix, "stable")
+
+
+def _intervals_unstable_sort(events):
+    """A wrong version (for the hint): np.argsort's default sort, which need not keep each pixel's events in
+    time order (some intervals become negative and are floored, others are paired out of order)."""
+    H, W = events.sensor_size
+    return _imbalance_of_pixel_numbers(events, events.y.astype(np.int64) * W + events.x, "quicksort")
+
+
+def _imbalance_of_pixel_numbers(events, pix, kind):
+    order = np.argsort(pix, kind=kind)
+    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
 def _intervals_log_ratio(events):
     """A wrong version (for the hint): r itself, log(C+ / C-), instead of b."""
     return float(2 * np.arctanh(interval_imbalance(events)))
@@ -348,6 +407,12 @@ exercises.register(
         "floor each interval at MIN_INTERVAL (1 us) before its log: two events with the same timestamp "
         "give log(0) = -inf":
             _intervals_no_floor,
+        "number the pixels y * W + x, W = sensor_size[1] (the row length): y * H + x gives two pixels one "
+        "number when the sensor is not square":
+            _intervals_pixel_index_h,
+        "sort with np.argsort(pix, kind=\"stable\"): the default sort need not keep each pixel's events in "
+        "time order, so consecutive events of a pixel are paired out of order":
+            _intervals_unstable_sort,
     })
 
 

@@ -112,6 +112,9 @@ exercises.register(
             lambda F_boundaries, event_frames: torch.mean((event_frames - (F_boundaries[:-1] - F_boundaries[1:])) ** 2),
         "square the difference (an absolute value gives another loss)":
             lambda F_boundaries, event_frames: torch.mean(torch.abs(event_frames - (F_boundaries[1:] - F_boundaries[:-1]))),
+        "bin i's change is F(b_{i+1}) - F(b_i), from its own start (F_boundaries[1:] - F_boundaries[:-1]), "
+        "not from the first boundary F(b_0)":
+            lambda F_boundaries, event_frames: torch.mean((event_frames - (F_boundaries[1:] - F_boundaries[:1])) ** 2),
     })
 
 

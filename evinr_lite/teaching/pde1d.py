@@ -136,6 +136,11 @@ def _inputs_rate(rng):
         t, p = _sorted_events(rng, n)
         inner = np.sort(rng.uniform(lo + 0.05, min(hi, 1.0) - 0.05, B - 1 - empty_end))
         b = np.concatenate([[lo], inner, [1.1] if empty_end else [], [hi]])
+        # the events before b_0 (and after b_B) must not sum to 0, or a version that counts them in the first
+        # (last) window passes by luck: flip the first (last) one's polarity when they do
+        for outside, k in ((t < lo, 0), (t > hi, -1)):
+            if outside.any() and p[outside].sum() == 0:
+                p[np.flatnonzero(outside)[k]] *= -1
         cases.append(dict(t_events=t, p_events=p, C=C, boundaries=b))
     # the boundary rule (b_k, b_{k+1}]: events exactly on an inner edge and on the last edge belong to
     # the window that ends there, so `<` in place of `<=` (or side="left" / "right" swapped) fails here
@@ -166,6 +171,30 @@ def _rate_left_closed(t_events, p_events, C, boundaries):
     p = np.asarray(p_events, float)
     sums = [p[(t >= b1) & (t < b2)].sum() for b1, b2 in zip(b[:-1], b[1:])]
     return C * np.array(sums) / np.diff(b)
+
+
+def _rate_clipped(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): events before b_0 / after b_B counted in the first / last window
+    (the window index clipped into 0 .. B - 1 instead of the events dropped)."""
+    b = np.asarray(boundaries, float)
+    i = np.clip(np.searchsorted(b, np.asarray(t_events, float), side="left") - 1, 0, b.size - 2)
+    return C * np.bincount(i, weights=np.asarray(p_events, float), minlength=b.size - 1) / np.diff(b)
+
+
+def _rate_early_in_first(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): events before b_0 counted in the first window (only the end b_B
+    checked, then the window index raised to 0 with np.maximum)."""
+    t, b = np.asarray(t_events, float), np.asarray(boundaries, float)
+    keep = t <= b[-1]
+    i = np.maximum(np.searchsorted(b, t[keep], side="left") - 1, 0)
+    return C * np.bincount(i, weights=np.asarray(p_events, float)[keep], minlength=b.size - 1) / np.diff(b)
+
+
+def _rate_histogram(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): np.histogram's bins, [b_k, b_{k+1}) with the last one closed."""
+    sums, _ = np.histogram(np.asarray(t_events, float), bins=np.asarray(boundaries, float),
+                           weights=np.asarray(p_events, float))
+    return C * sums / np.diff(np.asarray(boundaries, float))
 
 
 def _inputs_loss(rng):
@@ -209,6 +238,16 @@ exercises.register(
         "an event exactly on a window's end edge b_{k+1} belongs to that window: (b_k, b_{k+1}] needs "
         "`t <= b_{k+1}`, not a strict `<`":
             _rate_open,
+        "np.histogram's bins are [b_k, b_{k+1}) (only the last one closed): an event exactly on an inner edge "
+        "belongs to the window that ends there, (b_k, b_{k+1}], so count with `(t > b_k) & (t <= b_{k+1})` "
+        "or np.searchsorted(boundaries, t, side='left') - 1":
+            _rate_histogram,
+        "events before b_0 or after b_B belong to no window: drop them (a window index below 0 or above "
+        "B - 1), do not clip them into the first or last window":
+            _rate_clipped,
+        "events before b_0 belong to no window: drop them (t >= b_0) before np.maximum(index, 0), which "
+        "would put them in the first window":
+            _rate_early_in_first,
     })
 
 exercises.register(

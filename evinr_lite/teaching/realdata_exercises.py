@@ -176,6 +176,11 @@ def _offset_mean_only(first_frame, L_t0, eps=FRAME_EPS):
     return np.full_like(g, g.mean())
 
 
+def _offset_float_divided(first_frame, L_t0, eps: float = FRAME_EPS):
+    """The mistake of dividing every frame by 255, a float frame (already in [0, 1]) too."""
+    return np.log(np.asarray(first_frame, np.float64) / 255.0 + eps) - np.asarray(L_t0, np.float64)
+
+
 exercises.register(
     "anchor_first_offset", anchor_first_offset, _inputs_anchor, rtol=1e-6, atol=1e-9,
     hints={
@@ -186,4 +191,6 @@ exercises.register(
         "eps goes inside the log, log(I0 + eps): log(I0) is -inf on a black pixel": _offset_eps_outside,
         "one offset per pixel, not one for the whole image: events never fix any pixel's level":
             _offset_mean_only,
+        "divide by 255 only a uint8 frame (first_frame.dtype == np.uint8): a float frame is already in [0, 1]":
+            _offset_float_divided,
     })

@@ -1,0 +1,309 @@
+"""Exercise checks, round 3: wrong solutions found by mutating the reference solutions.
+
+Every registered exercise's reference was mutated the way learners err (a sign, x and y, a searchsorted side,
+< or <=, units, a dropped factor, mean or sum, polarity, float32, integer division, a forgotten sort or line,
+an index off by one, exp or log, a transposed result). The wrong solutions below passed a check, or failed it
+with only a generic mismatch, before this round: bins whose closed first edge was written ``t == 0`` (right
+only while every case started at 0), events before the first window counted in it, np.histogram's
+[b_k, b_{k+1}) bins, a pixel number ``y * H + x``, an unstable sort, a float frame divided by 255, a t_last never
+updated, a reference never moved, a bin change measured from the first boundary. Each now fails and its report
+names the mistake; the references, the notebooks' own solutions and correct alternatives still pass, and the
+counts of inputs that the notebooks quote ("matches the reference on N inputs") are unchanged.
+"""
+import contextlib
+import io
+import json
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from evinr_lite.core.events import Events
+from evinr_lite.teaching import events2d, exercises, pde1d
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _report(name, fn):
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ok = exercises.check(name, fn)
+    return ok, buf.getvalue()
+
+
+# ---- wrong solutions -------------------------------------------------------------------------------------
+
+def _frames(events, boundaries, C, *, first_edge="b0", clip=False):
+    b = np.asarray(boundaries, dtype=np.float64)
+    H, W = events.sensor_size
+    B = b.size - 1
+    i = np.searchsorted(b, events.t, side="left") - 1
+    i[events.t == (0.0 if first_edge == "zero" else b[0])] = 0
+    if clip:
+        i = np.clip(i, 0, B - 1)
+    keep = (i >= 0) & (i < B)
+    frames = np.zeros((B, H, W))
+    np.add.at(frames, (i[keep], events.y[keep], events.x[keep]), events.p[keep])
+    return C * frames
+
+
+def _frames_first_edge_zero(events, boundaries, C):
+    return _frames(events, boundaries, C, first_edge="zero")
+
+
+def _frames_clipped(events, boundaries, C):
+    return _frames(events, boundaries, C, clip=True)
+
+
+def _bisect(t_events, boundaries, *, zero=False):
+    t, b = np.asarray(t_events, dtype=float), np.asarray(boundaries, dtype=float)
+    out = [b[0]]
+    for i in range(len(b) - 1):
+        lo, hi = b[i], b[i + 1]
+        in_bin = t[((t > lo) | ((i == 0) & (t == (0.0 if zero else lo)))) & (t <= hi)]
+        n = len(in_bin)
+        cut = 0.5 * (lo + hi)
+        if n >= 2 and lo < 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2]) < hi:
+            cut = 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2])
+        out += [cut, hi]
+    return np.array(out)
+
+
+def _bisect_first_edge_zero(t_events, boundaries):
+    return _bisect(t_events, boundaries, zero=True)
+
+
+def _rate_early_events_in_first_window(t_events, p_events, C, boundaries):
+    b = np.asarray(boundaries, dtype=np.float64)
+    t = np.asarray(t_events, dtype=np.float64)
+    inside = t <= b[-1]                               # the lower end forgotten
+    idx = np.maximum(np.searchsorted(b, t[inside], side="left") - 1, 0)
+    sums = C * np.bincount(idx, weights=np.asarray(p_events, dtype=np.float64)[inside], minlength=b.size - 1)
+    return sums / np.diff(b)
+
+
+def _rate_clipped(t_events, p_events, C, boundaries):
+    b = np.asarray(boundaries, dtype=np.float64)
+    i = np.clip(np.searchsorted(b, t_events, side="left") - 1, 0, b.size - 2)
+    return C * np.bincount(i, weights=np.asarray(p_events, float), minlength=b.size - 1) / np.diff(b)
+
+
+def _rate_histogram(t_events, p_events, C, boundaries):
+    sums, _ = np.histogram(t_events, bins=boundaries, weights=np.asarray(p_events, float))
+    return C * sums / np.diff(boundaries)
+
+
+def _imbalance(events, *, row_length=None, kind="stable"):
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * (W if row_length is None else row_length(H, W)) + events.x
+    order = np.argsort(pix, kind=kind)
+    pix, t, p = pix[order], events.t[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    log_dt = np.log(np.maximum(np.diff(t), events2d.MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
+def _imbalance_y_times_h(events):
+    return _imbalance(events, row_length=lambda H, W: H)
+
+
+def _imbalance_default_sort(events):
+    return _imbalance(events, kind="quicksort")     # np.argsort's default
+
+
+def _offset_float_divided(first_frame, L_t0, eps=1 / 255):
+    return np.log(np.asarray(first_frame, np.float64) / 255.0 + eps) - L_t0
+
+
+def _highpass(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0, *, update=True):
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_last = np.full((H, W), float(t_start))
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * state[yi, xi] + C * pi
+        if update:
+            t_last[yi, xi] = ti
+    return state * np.exp(-alpha * (t_end - t_last))
+
+
+def _highpass_t_last_not_updated(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    return _highpass(t, x, y, p, sensor_size, C, alpha, t_end, t_start, update=False)
+
+
+def _render_fixed_reference(L_boundaries, C):
+    L = np.asarray(L_boundaries, dtype=np.float64)
+    return np.trunc((L[1:] - L[0]) / C).astype(np.int64)
+
+
+def _boundary_loss_from_first(F_boundaries, event_frames):
+    return torch.mean((event_frames - (F_boundaries[1:] - F_boundaries[:1])) ** 2)
+
+
+WRONG = [
+    # times that do not start at 0: the closed first edge is t == b_0
+    ("events_to_frames_fixed", _frames_first_edge_zero, "`t == boundaries[0]`, not `t == 0`"),
+    # events outside every window or bin
+    ("event_rate_derivative", _rate_early_events_in_first_window, "events before b_0 belong to no window"),
+    ("event_rate_derivative", _rate_clipped, "do not clip them into the first or last window"),
+    ("events_to_frames_fixed", _frames_clipped, "do not clip them into the first or last bin"),
+    # the bin-edge rule through np.histogram
+    ("event_rate_derivative", _rate_histogram, "np.histogram's bins are [b_k, b_{k+1})"),
+    # H and W in the pixel number; a sort that loses the time order
+    ("interval_imbalance", _imbalance_y_times_h, "y * H + x gives two pixels one number"),
+    ("interval_imbalance", _imbalance_default_sort, 'kind="stable"'),
+    # a dropped (here: an extra) normalisation
+    ("anchor_first_offset", _offset_float_divided, "divide by 255 only a uint8 frame"),
+    # a forgotten line
+    ("highpass_per_event", _highpass_t_last_not_updated, "set that pixel's t_last to the event's time"),
+    ("render_event_counts", _render_fixed_reference, "move the reference after each bin"),
+    # an index off: every change measured from the first boundary
+    ("temporal_loss_boundary", _boundary_loss_from_first, "from its own start"),
+]
+
+
+@pytest.mark.parametrize("name, wrong, words", WRONG, ids=[f"{n}-{w.__name__}" for n, w, _ in WRONG])
+def test_wrong_solution_fails_and_names_the_problem(name, wrong, words):
+    ok, report = _report(name, wrong)
+    assert not ok, report
+    assert words in report, report
+    assert "Traceback" not in report
+
+
+def test_bisect_with_the_first_edge_at_zero_fails_on_bin_0():
+    """bisect_equal_count keeps its four hints (test_accel_exercises pins them), so this mistake gets no hint
+    of its own: the report points at bin 0's cut (output index 1) of the case whose times start at 0.25."""
+    ok, report = _report("bisect_equal_count", _bisect_first_edge_zero)
+    assert not ok, report
+    assert "input #4 of 4" in report and "at index 1: got 1.05, expected 0.65" in report, report
+
+
+def test_a_hint_needs_the_same_mistake_on_every_input():
+    """The new hints are confirmed on the other inputs: the b_0 = 0 version of bins matches the reference on the
+    cases that start at 0, so its hint is not the 'drops the event at b_0' one."""
+    ok, report = _report("events_to_frames_fixed", _frames_first_edge_zero)
+    assert not ok and "an event at exactly t = b_0 belongs to bin 0 (the first bin" not in report
+
+
+# ---- the cases hold what the wrong solutions trip on -------------------------------------------------------
+
+def test_cases_start_away_from_zero_with_an_event_on_the_first_edge():
+    for name in ("events_to_frames_fixed", "bisect_equal_count"):
+        hits = 0
+        for _, kw in exercises.get(name).cases():
+            t = kw["events"].t if "events" in kw else kw["t_events"]
+            b0 = kw["boundaries"][0]
+            hits += b0 != 0 and np.any(t == b0) and float(np.float32(b0)) == b0   # exact in float32 too
+        assert hits >= 1, name
+
+
+def test_events_outside_the_windows_do_not_cancel():
+    ok = False
+    for _, kw in exercises.get("event_rate_derivative").cases():
+        t, p, b = kw["t_events"], kw["p_events"], kw["boundaries"]
+        if np.any(t < b[0]) and np.any(t > b[-1]):
+            ok = p[t < b[0]].sum() != 0 and p[t > b[-1]].sum() != 0
+    assert ok
+
+
+def test_the_counts_the_notebooks_quote_are_unchanged():
+    """Each notebook says "✓ NAME: matches the reference on N inputs"; cases were changed, never added."""
+    quoted = {}
+    for path in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")):
+        text = "".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"])
+        for name, n in re.findall(r"✓ (\w+): matches the reference on (\d+) input", text):
+            quoted[name] = int(n)
+    for name in ("events_to_frames_fixed", "bisect_equal_count", "event_rate_derivative", "interval_imbalance",
+                 "anchor_first_offset", "highpass_per_event", "render_event_counts", "temporal_loss_boundary"):
+        assert name in quoted, name
+        assert len(exercises.get(name).cases()) == quoted[name], name
+
+
+# ---- correct solutions still pass --------------------------------------------------------------------------
+
+def _frames_bincount(events, boundaries, C):
+    """A flat-index bincount, float32 throughout."""
+    b = np.asarray(boundaries, dtype=np.float32)
+    H, W = events.sensor_size
+    B = b.size - 1
+    t = events.t.astype(np.float32)
+    i = np.searchsorted(b, t, side="left") - 1
+    i[t == b[0]] = 0
+    keep = (i >= 0) & (i < B)
+    flat = (i[keep] * H + events.y[keep]) * W + events.x[keep]
+    counts = np.bincount(flat, weights=events.p[keep].astype(np.float32), minlength=B * H * W)
+    return (np.float32(C) * counts.astype(np.float32)).reshape(B, H, W)
+
+
+def _rate_loop(t_events, p_events, C, boundaries):
+    """The notebook's loop over windows (b_k, b_{k+1}]."""
+    sums = [p_events[(t_events > b1) & (t_events <= b2)].sum() for b1, b2 in zip(boundaries[:-1], boundaries[1:])]
+    return C * np.array(sums, dtype=float) / np.diff(boundaries)
+
+
+def _imbalance_lexsort(events):
+    """Sorted by (pixel x * H + y, then time) with np.lexsort: another correct numbering and sort."""
+    H, W = events.sensor_size
+    pix = events.x.astype(np.int64) * H + events.y
+    order = np.lexsort((events.t, pix))
+    pix, t, p = pix[order], events.t[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    log_dt = np.log(np.maximum(np.diff(t), events2d.MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
+def _render_loop(L_boundaries, C):
+    L = np.asarray(L_boundaries, dtype=np.float64)
+    ref, out = L[0].copy(), []
+    for k in range(1, len(L)):
+        n = np.trunc((L[k] - ref) / C)
+        ref = ref + n * C
+        out.append(n.astype(np.int64))
+    return np.stack(out)
+
+
+CORRECT = [(name, exercises.reference(name)) for name in dict.fromkeys(n for n, _, _ in WRONG)] + [
+    ("bisect_equal_count", exercises.reference("bisect_equal_count")),
+    ("events_to_frames_fixed", _frames_bincount),
+    ("events_to_frames_fixed", lambda events, boundaries, C: _frames(events, boundaries, C)),
+    ("bisect_equal_count", _bisect),
+    ("bisect_equal_count", lambda t_events, boundaries: _bisect(np.asarray(t_events, np.float32),
+                                                                np.asarray(boundaries, np.float32))),
+    ("event_rate_derivative", _rate_loop),
+    ("interval_imbalance", _imbalance_lexsort),
+    ("interval_imbalance", lambda events: _imbalance(events, kind="mergesort")),
+    ("highpass_per_event", _highpass),
+    ("render_event_counts", _render_loop),
+    ("anchor_first_offset", lambda first_frame, L_t0, eps=1 / 255: np.log(
+        (first_frame / 255.0 if first_frame.dtype == np.uint8 else first_frame.astype(float)) + eps) - L_t0),
+    ("temporal_loss_boundary", lambda F_boundaries, event_frames: torch.mean(
+        (event_frames - torch.diff(F_boundaries, dim=0)) ** 2)),
+]
+
+
+@pytest.mark.parametrize("name, fn", CORRECT, ids=[f"{n}-{k}" for k, (n, _) in enumerate(CORRECT)])
+def test_references_and_correct_alternatives_pass(name, fn):
+    ok, report = _report(name, fn)
+    assert ok, report
+
+
+def test_the_wrong_versions_differ_from_the_reference():
+    """Every wrong solution above really is wrong somewhere in its exercise's cases (a test that cannot
+    pass by the check being lenient)."""
+    for name, wrong, _ in WRONG + [("bisect_equal_count", _bisect_first_edge_zero, "")]:
+        ex = exercises.get(name)
+        differs = False
+        for args, kwargs in ex.cases():
+            got = exercises._run(wrong, args, kwargs)
+            expected = exercises._run(ex.reference, args, kwargs)
+            differs |= exercises._compare(got, expected, ex.rtol, ex.atol) is not None
+        assert differs, name
