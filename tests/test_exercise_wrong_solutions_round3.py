@@ -146,6 +146,12 @@ def _boundary_loss_from_first(F_boundaries, event_frames):
     return torch.mean((event_frames - (F_boundaries[1:] - F_boundaries[:1])) ** 2)
 
 
+def _rate_strict_first_edge(t_events, p_events, C, boundaries):
+    """Every window open on the left, the first one too: an event at exactly b_0 is lost."""
+    sums = [p_events[(t_events > b1) & (t_events <= b2)].sum() for b1, b2 in zip(boundaries[:-1], boundaries[1:])]
+    return C * np.array(sums, dtype=float) / np.diff(boundaries)
+
+
 WRONG = [
     # times that do not start at 0: the closed first edge is t == b_0
     ("events_to_frames_fixed", _frames_first_edge_zero, "`t == boundaries[0]`, not `t == 0`"),
@@ -153,6 +159,8 @@ WRONG = [
     ("event_rate_derivative", _rate_early_events_in_first_window, "events before b_0 belong to no window"),
     ("event_rate_derivative", _rate_clipped, "do not clip them into the first or last window"),
     ("events_to_frames_fixed", _frames_clipped, "do not clip them into the first or last bin"),
+    # an event exactly at b_0 left out of the first window (the notebook's text and the reference agree on it)
+    ("event_rate_derivative", _rate_strict_first_edge, "an event exactly on the first edge b_0 opens window 0"),
     # the bin-edge rule through np.histogram
     ("event_rate_derivative", _rate_histogram, "np.histogram's bins are [b_k, b_{k+1})"),
     # H and W in the pixel number; a sort that loses the time order
@@ -242,8 +250,9 @@ def _frames_bincount(events, boundaries, C):
 
 
 def _rate_loop(t_events, p_events, C, boundaries):
-    """The notebook's loop over windows (b_k, b_{k+1}]."""
+    """The notebook's loop over windows (b_k, b_{k+1}], an event at exactly b_0 in the first."""
     sums = [p_events[(t_events > b1) & (t_events <= b2)].sum() for b1, b2 in zip(boundaries[:-1], boundaries[1:])]
+    sums[0] += p_events[t_events == boundaries[0]].sum()
     return C * np.array(sums, dtype=float) / np.diff(boundaries)
 
 
@@ -307,3 +316,18 @@ def test_the_wrong_versions_differ_from_the_reference():
             expected = exercises._run(ex.reference, args, kwargs)
             differs |= exercises._compare(got, expected, ex.rtol, ex.atol) is not None
         assert differs, name
+
+
+def test_notebook_01_solution_and_text_agree_with_the_reference_on_the_first_edge():
+    """Notebook 01's exercise 2 says an event exactly at b_0 opens the first window, as the reference (and the
+    kit's binning) counts it; its solution passes a check that has such an event."""
+    nb = json.loads((ROOT / "notebooks" / "01_event_generation_1d.ipynb").read_text())
+    cells = ["".join(c["source"]) for c in nb["cells"]]
+    assert any("exactly on the first edge $b_0$ opens the first window" in c for c in cells)
+    assert any(np.any(kw["t_events"] == kw["boundaries"][0]) for _, kw in exercises.get("event_rate_derivative").cases())
+    src = next(c for c in cells if c.startswith("def event_rate_derivative"))
+    body = "\n".join(line for line in src.splitlines() if "### " not in line)
+    scope = {"np": np}
+    exec(body, scope)
+    ok, report = _report("event_rate_derivative", scope["event_rate_derivative"])
+    assert ok, report

@@ -71,7 +71,8 @@ def window_sums(t_events, p_events, C, boundaries) -> np.ndarray:
 
 
 def event_rate_derivative(t_events, p_events, C, boundaries):
-    """Eq. 4's right-hand side: (1 / (t2 - t1)) * C * (sum of polarities in (t1, t2]) per window.
+    """Eq. 4's right-hand side: (1 / (t2 - t1)) * C * (sum of polarities in (t1, t2]) per window (an
+    event exactly at the first edge b_0 counts in the first window).
 
     It estimates dL/dt at the window mid-points ``(b[i] + b[i+1]) / 2``.
 
@@ -143,10 +144,11 @@ def _inputs_rate(rng):
                 p[np.flatnonzero(outside)[k]] *= -1
         cases.append(dict(t_events=t, p_events=p, C=C, boundaries=b))
     # the boundary rule (b_k, b_{k+1}]: events exactly on an inner edge and on the last edge belong to
-    # the window that ends there, so `<` in place of `<=` (or side="left" / "right" swapped) fails here
+    # the window that ends there, so `<` in place of `<=` (or side="left" / "right" swapped) fails here;
+    # the one exactly on the first edge b_0 opens window 0 (as the kit's binning), so a strict b_0 < t loses it
     b = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
-    t = np.array([0.1, 0.25, 0.25, 0.4, 0.5, 0.6, 0.75, 1.0])
-    p = np.array([1, 1, -1, 1, 1, -1, 1, 1], dtype=np.int8)
+    t = np.array([0.0, 0.1, 0.25, 0.25, 0.4, 0.5, 0.6, 0.75, 1.0])
+    p = np.array([1, 1, 1, -1, 1, 1, -1, 1, 1], dtype=np.int8)
     cases.append(dict(t_events=t, p_events=p, C=0.5, boundaries=b))
     return cases
 
@@ -155,6 +157,13 @@ def _integrate_strict(t_events, p_events, C, t_query):
     """A wrong version (for the hint): events exactly at t_q left out (t_i < t_q)."""
     csum = np.concatenate([[0.0], np.cumsum(np.asarray(p_events, dtype=np.float64))])
     return C * csum[np.searchsorted(np.asarray(t_events, float), np.asarray(t_query, float), side="left")]
+
+
+def _rate_no_first_edge(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): an event exactly at b_0 left out (b_0 < t for window 0 too)."""
+    t = np.asarray(t_events, dtype=np.float64)
+    keep = t != np.asarray(boundaries, dtype=np.float64)[0]
+    return event_rate_derivative(t[keep], np.asarray(p_events)[keep], C, boundaries)
 
 
 def _rate_open(t_events, p_events, C, boundaries):
@@ -238,6 +247,9 @@ exercises.register(
         "an event exactly on a window's end edge b_{k+1} belongs to that window: (b_k, b_{k+1}] needs "
         "`t <= b_{k+1}`, not a strict `<`":
             _rate_open,
+        "an event exactly on the first edge b_0 opens window 0 (nothing at the start is lost): add it to "
+        "the first window's sum":
+            _rate_no_first_edge,
         "np.histogram's bins are [b_k, b_{k+1}) (only the last one closed): an event exactly on an inner edge "
         "belongs to the window that ends there, (b_k, b_{k+1}], so count with `(t > b_k) & (t <= b_{k+1})` "
         "or np.searchsorted(boundaries, t, side='left') - 1":
