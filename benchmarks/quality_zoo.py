@@ -4,6 +4,7 @@
     python benchmarks/quality_zoo.py --long                # also the 20 s and 60 s recordings (about 15 min more)
     python benchmarks/quality_zoo.py --quick               # smaller sensors, shorter scenes (a few minutes)
     python benchmarks/quality_zoo.py --heldout             # the held-out scenes no default was chosen on
+    python benchmarks/quality_zoo.py --stress              # scenes with settings outside both sets' ranges
     python benchmarks/quality_zoo.py --scenes camera_translate,noisy_gravel --methods kit,integration
     python benchmarks/quality_zoo.py --variant "lam 0.1=lam=0.1"        # add an EvINR variant (NAME=field=value,...)
     python -m benchmarks --only zoo                        # the same, from the benchmark runner
@@ -18,7 +19,10 @@ C+ != C- given as one nominal C, threshold mismatch and drift, a refractory peri
 IJRR slider_depth chunk beside the project is scored too when present. ``--heldout`` scores instead
 ``evinr_lite.sim.zoo.HELDOUT``: ten scenes (one of 20 s) built the same ways with other images, motions and seeds,
 on which no default was chosen (they check that the defaults carry over; the real chunk is skipped,
-and the results go to ``zoo_results_heldout.*``).
+and the results go to ``zoo_results_heldout.*``). ``--stress`` scores ``evinr_lite.sim.zoo.STRESS`` the
+same way: eleven scenes built the same ways with settings outside both sets' ranges (a threshold of 0.1
+or 0.45, 64x64 and 90x320 sensors, a speed that nearly stops, 2 Hz of background activity, an OFF-heavy
+pair, 15 % mismatch, a bar sweeping over a flat background); results in ``zoo_results_stress.*``.
 
 Methods: ``kit`` (``EvINRConfig()``, the kit's default), ``paper`` (``EvINRConfig.paper()``, the
 paper's recipe exactly), ``v0_1`` (the kit's default before the zoo; paper and v0_1 are skipped on the
@@ -66,7 +70,7 @@ from evinr_lite.evaluation.metrics import SCORE_PROTOCOLS  # noqa: E402
 from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noqa: E402
 from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
 from evinr_lite.method.tonemap import anchor_mean, to_display  # noqa: E402
-from evinr_lite.sim.zoo import HELDOUT, ZOO, default_scenes, effective_C, quick, simulate  # noqa: E402
+from evinr_lite.sim.zoo import HELDOUT, STRESS, ZOO, default_scenes, effective_C, quick, simulate  # noqa: E402
 
 BASELINES = ("integration", "hf")                   # the baselines at their default settings
 SWEPT = ("hf_best", "leaky_best")                   # HF's cutoff / leaky integration's leak picked per scene
@@ -550,12 +554,16 @@ def zoo_main(argv=None) -> dict:
     p.add_argument("--variant", action="append", default=[], help="an EvINR variant NAME=field=value,... (repeat)")
     p.add_argument("--heldout", action="store_true",
                    help="the held-out scenes (zoo.HELDOUT) instead of the zoo; no real chunk; *_heldout.* outputs")
+    p.add_argument("--stress", action="store_true",
+                   help="the stress scenes (zoo.STRESS) instead of the zoo; no real chunk; *_stress.* outputs")
     p.add_argument("--no-real", action="store_true", help="skip the real slider_depth chunk")
-    p.add_argument("--json", default=None, help="default benchmarks/zoo_results[_heldout].json")
-    p.add_argument("--md", default=None, help="default benchmarks/zoo_results[_heldout].md")
-    p.add_argument("--figure", default=None, help="default benchmarks/zoo_figure[_heldout].png")
+    p.add_argument("--json", default=None, help="default benchmarks/zoo_results[_heldout|_stress].json")
+    p.add_argument("--md", default=None, help="default benchmarks/zoo_results[_heldout|_stress].md")
+    p.add_argument("--figure", default=None, help="default benchmarks/zoo_figure[_heldout|_stress].png")
     a = p.parse_args(argv)
-    suffix = "_heldout" if a.heldout else ""
+    if a.heldout and a.stress:
+        p.error("--heldout and --stress are two other sets of scenes: give one of them")
+    suffix = "_heldout" if a.heldout else "_stress" if a.stress else ""
     a.json = f"benchmarks/zoo_results{suffix}.json" if a.json is None else a.json
     a.md = f"benchmarks/zoo_results{suffix}.md" if a.md is None else a.md
     a.figure = f"benchmarks/zoo_figure{suffix}.png" if a.figure is None else a.figure
@@ -564,18 +572,18 @@ def zoo_main(argv=None) -> dict:
     unknown = [m for m in methods if m not in METHODS + OPTIONAL and m not in variants]
     if unknown:
         p.error(f"unknown methods {unknown}; use {METHODS + OPTIONAL} or add --variant NAME=...")
-    pool = HELDOUT if a.heldout else ZOO
+    pool = HELDOUT if a.heldout else STRESS if a.stress else ZOO
     if a.scenes is None:
-        scenes = list(HELDOUT) if a.heldout else default_scenes(a.long)
+        scenes = list(pool) if a.heldout or a.stress else default_scenes(a.long)
     else:
         scenes = [z for z in pool if z.name in a.scenes.split(",")]
     if a.scenes and len(scenes) != len(a.scenes.split(",")):
-        p.error(f"unknown scenes in {a.scenes}; {'the held-out set' if a.heldout else 'the zoo'} holds "
+        p.error(f"unknown scenes in {a.scenes}; {'the held-out set' if a.heldout else 'the stress set' if a.stress else 'the zoo'} holds "
                 f"{[z.name for z in pool]}")
     scenes = [quick(z) for z in scenes] if a.quick else scenes
     t0 = time.perf_counter()
     results = run_zoo(scenes, methods, variants)
-    if not (a.no_real or a.heldout):
+    if not (a.no_real or a.heldout or a.stress):
         real = run_real(methods, variants)
         if real is not None:
             results["real_slider_chunk"] = real
@@ -594,7 +602,7 @@ def zoo_main(argv=None) -> dict:
         Path(a.md).write_text(md + "\n")
     if a.json:
         clean = {n: {k: v for k, v in r.items() if k != "figure"} for n, r in results.items()}
-        Path(a.json).write_text(json.dumps({"quick": a.quick, "long": a.long, "heldout": a.heldout, "methods": methods, "variants": variants,
+        Path(a.json).write_text(json.dumps({"quick": a.quick, "long": a.long, "heldout": a.heldout, "stress": a.stress, "methods": methods, "variants": variants,
                                             "scenes": clean, "targets": target_rows(results)}, indent=2,
                                            default=float) + "\n")
         print(f"json: {a.json}")

@@ -87,6 +87,29 @@ def test_heldout_scenes_are_new_and_simulate():
     scene, events, times, gt = zoo.simulate(z)
     assert gt.shape == (z.n_scored, *z.size) and len(events) > 1000 and 0 < gt.min() and gt.max() <= 1
 
+def test_stress_scenes_are_new_outside_the_ranges_and_simulate():
+    """The stress set: its own names and seeds, documented, with settings outside the zoo's and the
+    held-out set's ranges (threshold, sensor size, noise, an OFF-heavy pair, mismatch), and its scenes
+    simulate (quick sizes) with events and frames in range."""
+    names = [z.name for z in zoo.STRESS]
+    others = zoo.ZOO + zoo.HELDOUT
+    assert len(names) == len(set(names)) >= 8 and not set(names) & {z.name for z in others}
+    assert all(len(z.doc) > 20 for z in zoo.STRESS)
+    assert not {z.seed for z in zoo.STRESS} & {z.seed for z in others}
+    assert zoo.get(names[-1]) is zoo.STRESS[-1]
+    C = [zoo.effective_C(z) for z in others]
+    assert min(zoo.effective_C(z) for z in zoo.STRESS) < min(C) and max(zoo.effective_C(z) for z in zoo.STRESS) > max(C)
+    pixels = [z.size[0] * z.size[1] for z in others]
+    assert min(z.size[0] * z.size[1] for z in zoo.STRESS) < min(pixels)
+    assert max(z.size[1] / z.size[0] for z in zoo.STRESS) > max(z.size[1] / z.size[0] for z in others)
+    assert max(z.noise_hz for z in zoo.STRESS) > max(z.noise_hz for z in others)
+    assert min(zoo.imbalance(z) for z in zoo.STRESS) < 0 <= min(zoo.imbalance(z) for z in others)
+    assert max(z.threshold_sigma for z in zoo.STRESS) > max(z.threshold_sigma for z in others)
+    for name in ("chelsea_off_heavy", "bar_sweep"):
+        z = zoo.quick(zoo.get(name))
+        scene, events, times, gt = zoo.simulate(z)
+        assert gt.shape == (z.n_scored, *z.size) and len(events) > 1000 and 0 < gt.min() and gt.max() <= 1
+
 
 # ---- issue 21: the zoo grows (long scenes, ON-only hot pixels, drifting thresholds, light-dependent noise)
 

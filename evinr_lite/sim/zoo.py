@@ -16,7 +16,8 @@ background activity growing as light falls. Motion also includes bounded to-and-
 and hand-held shake (:class:`~evinr_lite.sim.scenes.OscillatingScene`). ``benchmarks/quality_zoo.py`` scores every method on
 them; the kit's defaults were chosen on their mean, never on one scene. ``HELDOUT`` holds ten more
 scenes built the same ways (other images, motions, sizes and seeds; one of 20 s) on which no default
-was chosen: ``quality_zoo.py --heldout`` checks that the defaults carry over to them.
+was chosen: ``quality_zoo.py --heldout`` checks that the defaults carry over to them. ``STRESS`` holds
+eleven built the same ways with settings outside both sets' ranges (``quality_zoo.py --stress``).
 """
 from __future__ import annotations
 
@@ -27,7 +28,7 @@ import numpy as np
 from . import scenes as sc
 from .simulate import add_background_noise, add_hot_pixels, add_light_noise, simulate_scene
 
-__all__ = ["ZooScene", "ZOO", "HELDOUT", "N_SCORED", "quick", "simulate", "effective_C", "imbalance", "get", "default_scenes",
+__all__ = ["ZooScene", "ZOO", "HELDOUT", "STRESS", "N_SCORED", "quick", "simulate", "effective_C", "imbalance", "get", "default_scenes",
            "SIGNAL", "BACKGROUND", "HOT"]
 
 N_SCORED = 10   # ground-truth times scored per scene, evenly spread over [0.1, 0.95] of the duration
@@ -179,6 +180,50 @@ HELDOUT = [
 ]
 
 
+# Stress: built the same ways again, with settings outside the ranges of ZOO and HELDOUT (a threshold of
+# 0.1 or 0.45, a 64x64 or a 90x320 sensor, a speed that nearly stops, 2 Hz of background activity, an
+# OFF-heavy pair, 15 % mismatch, a flat background under a sweeping bar). No default was chosen on them
+# either; ``quality_zoo.py --stress`` says where the defaults stop carrying over (docs/defaults.md).
+STRESS = [
+    ZooScene("camera_coarse_C", "camera panned with C 0.45: a few events per pixel; clean sensor",
+             lambda s, d: sc.MovingImageScene("camera", s, d, velocity=(18.0, 7.0), rotation=0.06, zoom=0.04),
+             C=0.45, seed=31),
+    ZooScene("coffee_fine_C_noisy", "coffee at C 0.1 (dense events): 0.5 Hz background, 10 hot pixels, 5 % mismatch",
+             lambda s, d: sc.MovingImageScene("coffee", s, d, velocity=(-10.0, 6.0), rotation=0.05, zoom=0.03),
+             C=0.1, threshold_sigma=0.05, noise_hz=0.5, hot_pixels=10, seed=32),
+    ZooScene("astronaut_near_stop", "astronaut whose speed swings 0.05x-1.95x (it nearly stops), 3 s; clean",
+             lambda s, d: sc.VaryingSpeedScene(sc.MovingImageScene("astronaut", s, d, velocity=(15.0, -8.0),
+                                                                   rotation=0.05, zoom=0.0), depth=0.95, period=d),
+             duration=3.0, seed=33),
+    ZooScene("cat_64x64", "cat on a 64x64 sensor, pan + rotation + zoom; clean",
+             lambda s, d: sc.MovingImageScene("cat", s, d, velocity=(8.0, 5.0), rotation=0.1, zoom=0.05),
+             size=(64, 64), seed=34),
+    ZooScene("brick_90x320", "brick wall panned along a 90x320 strip; clean",
+             lambda s, d: sc.MovingImageScene("brick", s, d, velocity=(25.0, 3.0), rotation=0.02, zoom=0.0),
+             size=(90, 320), seed=35),
+    ZooScene("rocket_very_noisy", "rocket under 2 Hz background activity and 60 hot pixels, C+ 0.22 != C- 0.18",
+             lambda s, d: sc.MovingImageScene("rocket", s, d, velocity=(12.0, 9.0), rotation=0.05, zoom=0.05),
+             C_pos=0.22, C_neg=0.18, noise_hz=2.0, hot_pixels=60, seed=36),
+    ZooScene("chelsea_off_heavy", "chelsea at 150x200, 3 s: C+ 0.17, C- 0.27 given as 0.22 (OFF-heavy), "
+             "20 ON-only hot pixels, 0.2 Hz background",
+             lambda s, d: sc.MovingImageScene("chelsea", s, d, velocity=(-14.0, -7.0), rotation=0.07, zoom=-0.05),
+             size=(150, 200), duration=3.0, C=0.22, C_pos=0.17, C_neg=0.27, noise_hz=0.2, hot_pixels=20,
+             hot_on_only=True, seed=37),
+    ZooScene("gravel_mismatch", "gravel with 15 % threshold mismatch between pixels",
+             lambda s, d: sc.MovingImageScene("gravel", s, d, velocity=(16.0, 10.0), rotation=0.03, zoom=0.03),
+             threshold_sigma=0.15, seed=38),
+    ZooScene("bar_sweep", "a bright bar sweeping across a flat dark background (no texture); clean",
+             lambda s, d: sc.MovingBarScene(s, d), seed=39),
+    ZooScene("ihc_rotate_5s", "immunohistochemistry turning in place at 0.25 rad/s for 5 s; clean",
+             lambda s, d: sc.MovingImageScene("immunohistochemistry", s, d, velocity=(0.0, 0.0), rotation=0.25,
+                                              zoom=0.0),
+             duration=5.0, seed=40),
+    ZooScene("page_shake_noisy", "a printed page under fast hand-held shake: 0.3 Hz background, 10 hot pixels",
+             lambda s, d: sc.OscillatingScene("page", s, d, path=((5.0, 3.0, 0.5, 0.0), (2.0, 4.0, 0.3, 1.0)),
+                                              rotation=(0.02, 0.6)),
+             noise_hz=0.3, hot_pixels=10, seed=41),
+]
+
 def quick(z: ZooScene) -> ZooScene:
     """A smaller, shorter version (--quick): 3/5 of the size, 3/4 of the length."""
     H, W = z.size
@@ -248,10 +293,10 @@ def default_scenes(long: bool = False) -> list:
 
 
 def get(name: str) -> ZooScene:
-    """The zoo scene (or held-out scene) called ``name``."""
-    for z in ZOO + HELDOUT:
+    """The zoo scene (or held-out or stress scene) called ``name``."""
+    for z in ZOO + HELDOUT + STRESS:
         if z.name == name:
             return z
     from ..core.events import EventDataError
 
-    raise EventDataError(f"no zoo scene {name!r}; the zoo holds {[z.name for z in ZOO + HELDOUT]}")
+    raise EventDataError(f"no zoo scene {name!r}; the zoo holds {[z.name for z in ZOO + HELDOUT + STRESS]}")
