@@ -4,6 +4,7 @@
     python benchmarks/lam_rule.py --long      # also the 20 s and 60 s recordings (several minutes more)
     python benchmarks/lam_rule.py --quick     # the quick zoo's smaller scenes
     python benchmarks/lam_rule.py --heldout   # the held-out scenes the rule was not chosen on (zoo.HELDOUT)
+    python benchmarks/lam_rule.py --stress    # the stress scenes, settings outside both sets' ranges (zoo.STRESS)
 
 For each scene: the activity m (events per pixel per network window that came and went,
 ``evinr_lite.method.smoothing.activity``), the lam that ``EvINRConfig(lam="auto")`` gives, and
@@ -29,7 +30,7 @@ from evinr_lite.method.prepare import prepare_events  # noqa: E402
 from evinr_lite.method.config import EvINRConfig  # noqa: E402
 from evinr_lite.method.smoothing import activity, window_fraction  # noqa: E402
 from evinr_lite.method.solver import reconstruct  # noqa: E402
-from evinr_lite.sim.zoo import HELDOUT, default_scenes, effective_C, quick, simulate  # noqa: E402
+from evinr_lite.sim.zoo import HELDOUT, STRESS, default_scenes, effective_C, quick, simulate  # noqa: E402
 
 SWEEP = (0.001, 0.002, 0.005, 0.01, 0.03, 0.1)
 
@@ -55,7 +56,7 @@ def scene_row(name, events, times, gt, C, log=print) -> dict:
     return row
 
 
-def markdown(rows: dict, heldout: bool = False) -> str:
+def markdown(rows: dict, heldout: bool = False, label: str | None = None) -> str:
     head = "| scene | activity m | lam auto | auto | " + " | ".join(f"lam {v:g}" for v in SWEEP) + " | best fixed |"
     lines = [head, "|" + "---|" * (5 + len(SWEEP))]
     for name, r in rows.items():
@@ -64,7 +65,7 @@ def markdown(rows: dict, heldout: bool = False) -> str:
         lines.append(f"| {name} | {r['activity']:.1f} | {r['lam_auto']:.4f} | " + " | ".join(cells) + f" | {r['best_fixed']} |")
     short = [r for n, r in rows.items() if not r.get("long") and n != "real_slider_chunk"]
     if short:
-        label = "held-out" if heldout else "zoo"
+        label = label or ("held-out" if heldout else "zoo")
         means = [np.mean([r["scores"][k]["ssim_clahe"] for r in short]) for k in ("auto",) + tuple(str(v) for v in SWEEP)]
         lines.append(f"| **mean, {len(short)} short {label} scenes (CLAHE-SSIM)** | | | " + " | ".join(f"{v:.3f}" for v in means)
                      + " | |")
@@ -79,23 +80,26 @@ def main(argv=None) -> int:
     p.add_argument("--quick", action="store_true")
     p.add_argument("--long", action="store_true")
     p.add_argument("--heldout", action="store_true", help="the held-out scenes instead (no real chunk)")
-    p.add_argument("--json", default=None, help="default benchmarks/lam_rule_results[_heldout].json")
-    p.add_argument("--md", default=None, help="default benchmarks/lam_rule_results[_heldout].md")
+    p.add_argument("--stress", action="store_true", help="the stress scenes instead (no real chunk)")
+    p.add_argument("--json", default=None, help="default benchmarks/lam_rule_results[_heldout|_stress].json")
+    p.add_argument("--md", default=None, help="default benchmarks/lam_rule_results[_heldout|_stress].md")
     a = p.parse_args(argv)
-    suffix = "_heldout" if a.heldout else ""
+    if a.heldout and a.stress:
+        p.error("--heldout and --stress are two other sets of scenes: give one of them")
+    suffix = "_heldout" if a.heldout else "_stress" if a.stress else ""
     a.json = a.json or f"benchmarks/lam_rule_results{suffix}.json"
     a.md = a.md or f"benchmarks/lam_rule_results{suffix}.md"
     rows = {}
-    for z in (HELDOUT if a.heldout else default_scenes(long=a.long)):
+    for z in (HELDOUT if a.heldout else STRESS if a.stress else default_scenes(long=a.long)):
         z = quick(z) if a.quick else z
         scene, events, times, gt = simulate(z)
         rows[z.name] = {**scene_row(z.name, events, times, gt, effective_C(z)), "long": z.long}
-    found = None if a.heldout else real_chunk()
+    found = None if a.heldout or a.stress else real_chunk()
     if found is not None:
         rec, gt, gt_t = found
         rows["real_slider_chunk"] = scene_row("real_slider_chunk", rec.events, gt_t, gt, 1.0)
-    write_json(a.json, {"quick": a.quick, "heldout": a.heldout, "sweep": list(SWEEP), "scenes": rows})
-    Path(a.md).write_text(markdown(rows, a.heldout))
+    write_json(a.json, {"quick": a.quick, "heldout": a.heldout, "stress": a.stress, "sweep": list(SWEEP), "scenes": rows})
+    Path(a.md).write_text(markdown(rows, a.heldout, "stress" if a.stress else None))
     print(f"json: {a.json}\nmarkdown: {a.md}")
     return 0
 
