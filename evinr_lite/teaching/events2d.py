@@ -167,14 +167,19 @@ def _inputs_frames(rng):
     return cases
 
 
-def _frames_right(events, boundaries, C):
-    b = np.asarray(boundaries, dtype=np.float64)
+def _frames_of_bins(events, n_bins: int, i, C):
+    """The wrong versions' last step: C x the polarities summed into bins ``i`` [N] (those outside 0..n_bins-1
+    dropped), float32 [n_bins, H, W]."""
     H, W = events.sensor_size
-    i = np.searchsorted(b, events.t, side="right") - 1
-    keep = (i >= 0) & (i < b.size - 1)
-    frames = np.zeros((b.size - 1, H, W))
+    keep = (i >= 0) & (i < n_bins)
+    frames = np.zeros((n_bins, H, W))
     np.add.at(frames, (i[keep], events.y[keep], events.x[keep]), events.p[keep])
     return (C * frames).astype(np.float32)
+
+
+def _frames_right(events, boundaries, C):
+    b = np.asarray(boundaries, dtype=np.float64)
+    return _frames_of_bins(events, b.size - 1, np.searchsorted(b, events.t, side="right") - 1, C)
 
 
 def _frames_fancy_index(events, boundaries, C):
@@ -202,23 +207,15 @@ def _frames_xy_swapped(events, boundaries, C):
 def _frames_first_edge_at_zero(events, boundaries, C):
     """A wrong version (for the hint): bin 0's closed left edge written as `t == 0`, right only when b_0 = 0."""
     b = np.asarray(boundaries, dtype=np.float64)
-    H, W = events.sensor_size
     i = np.searchsorted(b, events.t, side="left") - 1
     i[events.t == 0] = 0
-    keep = (i >= 0) & (i < b.size - 1)
-    frames = np.zeros((b.size - 1, H, W))
-    np.add.at(frames, (i[keep], events.y[keep], events.x[keep]), events.p[keep])
-    return (C * frames).astype(np.float32)
+    return _frames_of_bins(events, b.size - 1, i, C)
 
 
 def _frames_clipped(events, boundaries, C):
     """A wrong version (for the hint): events outside [b_0, b_B] clipped into the first or last bin."""
     b = np.asarray(boundaries, dtype=np.float64)
-    H, W = events.sensor_size
-    i = np.clip(np.searchsorted(b, events.t, side="left") - 1, 0, b.size - 2)
-    frames = np.zeros((b.size - 1, H, W))
-    np.add.at(frames, (i, events.y, events.x), events.p)
-    return (C * frames).astype(np.float32)
+    return _frames_of_bins(events, b.size - 1, np.clip(np.searchsorted(b, events.t, side="left") - 1, 0, b.size - 2), C)
 
 
 def _frames_no_first_edge(events, boundaries, C):
