@@ -235,3 +235,17 @@ def test_denoise_anchor_and_C_auto_reach_every_task_and_change_the_settings(reco
         run_batch([subset], out, sequential=True, n_iters=ITERS, C="auto", denoise=True, progress=False, log=_quiet)
     with pytest.raises(EventDataError, match="anchor="):
         run_batch([subset], tmp_path / "o2", sequential=True, anchor="last", progress=False, log=_quiet)
+
+
+def test_lam_reaches_every_task_and_a_rerun_with_another_is_refused(recordings, tmp_path):
+    """batch --lam 0.05: every recording trains with that lam (its run.json's config), and a rerun into the same
+    folder with another lam is refused (it changes the scores) instead of mixing the two."""
+    subset = tmp_path / "one"
+    subset.mkdir()
+    os.symlink(recordings / "rec_camera", subset / "rec_camera")
+    out = tmp_path / "out"
+    summary = run_batch([subset], out, sequential=True, lam=0.05, progress=False, log=_quiet)
+    assert [r["status"] for r in summary["recordings"]] == ["done"]
+    assert json.loads((out / "rec_camera" / "run.json").read_text())["evinr_config"]["lam"] == 0.05
+    with pytest.raises(EventDataError, match="other settings.*lam"):
+        run_batch([subset], out, sequential=True, lam=0.01, progress=False, log=_quiet)

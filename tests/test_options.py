@@ -257,3 +257,44 @@ def test_the_command_lines_choices_are_the_librarys():
     assert set(actions["anchor"].choices) == set(ANCHOR_MODES)
     from evinr_lite.method.tonemap import TONEMAPS
     assert set(TONEMAP_CHOICES) == set(TONEMAPS) and set(actions["tonemap"].choices) == set(TONEMAPS)
+
+
+# ---- --lam: the regularizer's weight, set or chosen from the events -----------------------------------------
+
+@pytest.mark.parametrize("bad", [-0.1, float("nan"), float("inf"), "x", True, [0.1]])
+def test_a_bad_lam_is_refused_with_the_fix(bad):
+    with pytest.raises(EventDataError, match="lam= must be 'auto'.*or a number >= 0"):
+        RunOptions(lam=bad)
+
+
+def test_lam_reaches_the_recipes_config():
+    assert RunOptions().config(0.2).lam == "auto"                         # the kit's own
+    assert RunOptions(recipe="paper").config(0.2).lam == EvINRConfig.paper().lam
+    assert RunOptions(lam=0.1).config(0.2).lam == 0.1
+    assert RunOptions(recipe="paper", lam="AUTO").config(0.2).lam == "auto"
+    assert RunOptions(lam=0).config(0.2).lam == 0.0
+    assert "lam" in BATCH_FIELDS
+
+
+@pytest.mark.parametrize("text, message", [("-1", "must be auto or a number >= 0"), ("x", "expected auto or a number")])
+def test_the_lam_flag_refuses_bad_text(text, message, capsys):
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["reconstruct", "rec", "--out", "o", "--lam", text])
+    assert message in capsys.readouterr().err
+
+
+def test_reconstruct_says_which_lam_it_chose_and_uses_a_given_one(tmp_path, capsys):
+    """Without --lam the kit's recipe logs the lam it chose from the events and keeps it in run.json (lam_used,
+    within the rule's range); with --lam the run trains with that value and logs no choice."""
+    from evinr_lite.method.smoothing import LAM_MAX, LAM_MIN
+    from evinr_lite.sim.recordings import write_example_recording
+
+    rec = write_example_recording(tmp_path / "rec", scene="camera", sensor_size=(30, 40), duration=0.4, frame_rate=10.0)
+    main(["reconstruct", str(rec), "--out", str(tmp_path / "a"), "--no-video", "--quiet"])
+    log = capsys.readouterr().out
+    run = json.loads((tmp_path / "a" / "run.json").read_text())
+    assert LAM_MIN <= run["lam_used"] <= LAM_MAX and f"lam = {run['lam_used']:.4g}" in log
+    main(["reconstruct", str(rec), "--out", str(tmp_path / "b"), "--no-video", "--quiet", "--lam", "0.2"])
+    log = capsys.readouterr().out
+    run = json.loads((tmp_path / "b" / "run.json").read_text())
+    assert run["evinr_config"]["lam"] == 0.2 and "lam_used" not in run and "chosen from the events' activity" not in log

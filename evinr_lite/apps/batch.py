@@ -517,8 +517,9 @@ def check_scheduler_address(address: str) -> str:
 
 
 RESULT_SETTINGS = ("C", "fps", "n_iters", "recipe", "seed", "sensor_size", "denoise", "anchor",
-                   "keep_background", "static_camera")   # change the scores
-SETTING_DEFAULTS = {"denoise": False, "anchor": "none", "keep_background": False, "static_camera": False}   # what a batch.json written before these options meant
+                   "keep_background", "static_camera", "lam")   # change the scores
+SETTING_DEFAULTS = {"denoise": False, "anchor": "none", "keep_background": False, "static_camera": False,
+                    "lam": None}   # what a batch.json written before these options meant
 
 
 def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: str | None = None,
@@ -539,7 +540,7 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
         torch_threads: torch threads per task (default 1: one per worker process).
         options: a :class:`~evinr_lite.apps.options.RunOptions`, or its fields as keywords (the
             keywords replace fields of ``options``): C, fps, n_iters, recipe, seed, device, video,
-            sensor_size, denoise, keep_background, static_camera, anchor as for ``evinr-lite reconstruct`` (``video`` off by default:
+            sensor_size, denoise, keep_background, static_camera, lam, anchor as for ``evinr-lite reconstruct`` (``video`` off by default:
             PNG frames and scores only; ``C`` may be a number, a pair (c_pos, c_neg) or "auto":
             fitted per recording from its APS frames), progress (the batch's progress bar).
     Returns:

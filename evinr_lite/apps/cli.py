@@ -63,6 +63,19 @@ def _contrast(text: str):
                                          f"0.22,0.18) or auto, got {text!r}") from None
 
 
+def _lam(text: str):
+    """--lam: "auto" or a number >= 0."""
+    if text.strip().lower() == "auto":
+        return "auto"
+    try:
+        value = _finite(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected auto or a number >= 0, got {text!r}") from None
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"must be auto or a number >= 0, got {text!r}")
+    return value
+
+
 def _count(text: str) -> int:
     try:
         value = int(text)
@@ -119,6 +132,9 @@ STATIC_CAMERA_HELP = ("the camera stood still (a tripod) and things moved in fro
 KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-activity filter (an event is kept "
                         "when a neighbouring pixel fired one of the same polarity within 50 ms; EvINRConfig.background); "
                         "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
+LAM_HELP = ("the spatial regularizer's weight lambda: auto (the kit's: chosen from the events' activity) or a "
+            "number >= 0; more smooths more (e.g. 0.03-0.1 for a recording with heavy background activity); "
+            "default: the recipe's own (auto for kit, 0.05 for paper and v0_1)")
 ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose output layer is solved in closed "
               "form; 300 for paper and v0_1, with coarse-to-fine at a third and two thirds)")
 
@@ -168,6 +184,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     rec.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
     rec.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
+    rec.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
     rec.add_argument("--seed", type=_seed, default=0)
     rec.add_argument("--colour", action="store_true",
                      help="reconstruct in colour from a colour event camera (a recording with a 2x2 colour filter, "
@@ -237,6 +254,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     batch.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
     batch.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
+    batch.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
     batch.add_argument("--seed", type=_seed, default=0)
     batch.add_argument("--video", action="store_true", help="also write MP4 / GIF per recording")
     batch.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -261,7 +279,7 @@ def _run_options(args):
                       time_unit=getattr(args, "time_unit", None), device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
                       keep_background=args.keep_background, static_camera=args.static_camera,
-                      colour=getattr(args, "colour", False), tonemap=args.tonemap, video=video,
+                      colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap, video=video,
                       progress=not args.quiet)
 
 

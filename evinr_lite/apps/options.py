@@ -26,13 +26,13 @@ from ..method.memory import check_times_memory
 from ..method.recipes import RECIPES, contrast_option, recipe_config
 from ..method.tonemap import TONEMAPS
 
-__all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "BATCH_FIELDS", "DEFAULT_FPS"]
+__all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "lam_option", "BATCH_FIELDS", "DEFAULT_FPS"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
 BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap",
-                "keep_background", "static_camera")
+                "keep_background", "static_camera", "lam")
 MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
 _INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
 
@@ -104,6 +104,17 @@ def parse_times(at) -> np.ndarray:
     return np.sort(times)
 
 
+def lam_option(value) -> float | str:
+    """``lam=`` checked: "auto" or a finite number >= 0 (as a float); EventDataError naming the fix."""
+    if isinstance(value, str) and value.strip().lower() == "auto":
+        return "auto"
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(value) or value < 0:
+        raise EventDataError(f"lam= must be 'auto' (chosen from the events) or a number >= 0 (e.g. 0.01; more "
+                             f"smooths more), got {value!r}")
+    return float(value)
+
+
 def _finite(name: str, value) -> float | None:
     if value is None:
         return None
@@ -141,6 +152,10 @@ class RunOptions:
         static_camera: the camera stood still (a tripod): ``EvINRConfig(camera="static")``, the offset
             solved from the frames where something moved over each pixel, so the background an object
             passed over is recovered (kit recipe; ``python benchmarks/static_camera.py``).
+        lam: the spatial regularizer's weight (``EvINRConfig.lam``): None (the recipe's own: "auto" for kit,
+            chosen from the events' activity; 0.05 for paper and v0_1), "auto", or a number >= 0. More
+            smoothing for a recording with heavy background activity (docs/defaults.md, "Stress scenes": 2 Hz of
+            background activity wants about 0.1), less for a busy, clean one.
         tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
             paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
         video: also write MP4 / GIF; progress: show a progress bar.
@@ -162,6 +177,7 @@ class RunOptions:
     keep_background: bool = False
     static_camera: bool = False
     colour: bool = False
+    lam: float | str | None = None
     tonemap: str | None = None
     video: bool = True
     progress: bool = True
@@ -212,6 +228,8 @@ class RunOptions:
                                  "and anchor='none', or leave static_camera out")
         if self.anchor != "none" and checked["colour"]:
             raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
+        if self.lam is not None:
+            checked["lam"] = lam_option(self.lam)
         if self.n_iters is not None:
             checked["n_iters"] = int(self.n_iters)
         checked["seed"] = int(self.seed)
@@ -249,6 +267,8 @@ class RunOptions:
         extra = {"background": "keep"} if self.denoise or self.keep_background else {}
         if self.static_camera:
             extra["camera"] = "static"
+        if self.lam is not None:
+            extra["lam"] = self.lam
         return recipe_config(self.recipe, self.n_iters, self.tonemap, C=C, seed=self.seed, device=self.device,
                              progress=self.progress, anchor=self.anchor, **extra)
 

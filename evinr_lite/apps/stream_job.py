@@ -74,6 +74,16 @@ def report_balance(C, used, settings: dict, log) -> None:
         f"C = {format_contrast(C)} (pass --C {format_contrast(C)},{format_contrast(C)} to use it for both)")
 
 
+def report_lam(lam, used, settings: dict, log) -> None:
+    """When the regularizer's weight was chosen from the events (``lam="auto"``): log the value and record it in
+    ``settings["lam_used"]`` (the in-memory and the streamed job both)."""
+    if lam != "auto" or used is None:
+        return
+    settings["lam_used"] = float(used)
+    log(f"spatial smoothing chosen from the events' activity: lam = {float(used):.4g} (pass --lam to set it; more "
+        "smooths more, e.g. 0.03-0.1 under heavy background activity)")
+
+
 def _key(path, config, times, window) -> dict:
     """What a saved state must match to be resumed: the input, the settings, the times and the span."""
     digest = hashlib.sha256(np.ascontiguousarray(times, np.float64).tobytes()).hexdigest()
@@ -223,6 +233,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     settings = {"C": C, "C_source": C_source, "times_source": times_source, "device": device_name,
                 "seed": options.seed, "memory_estimate_bytes": est["total"]}
     report_balance(C, used, settings, log)
+    report_lam(config.lam, history.get("lam_used"), settings, log)
     if writer.video_fps is not None:
         settings["video_fps"] = writer.video_fps
     run = write_results(target.staging, rec, times, history, scores, settings=settings, written=written,

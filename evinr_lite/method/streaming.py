@@ -70,7 +70,8 @@ class StreamPart:
     times, log_intensity and frames float32 [Q_k, H, W] (anchored log intensity; tone-mapped in
     [0, 1]), ``window`` (index, t_lo, t_hi) of the window that finished them (None for the final
     pass of ``offset_from="span"``) and ``history`` (training so far: train_time_s, n_windows, per window;
-    C_used: [C] or [C+, C-], the thresholds the events were integrated with, after the ON/OFF balance)."""
+    C_used: [C] or [C+, C-], the thresholds the events were integrated with, after the ON/OFF balance;
+    lam_used: the regularizer's weight trained with, ``lam="auto"`` resolved)."""
 
     times: np.ndarray
     indices: np.ndarray
@@ -296,7 +297,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
     used = [float(c) for c in np.atleast_1d(cfg.C)]           # the thresholds the events are integrated with
     if offset_from == "first_window":
         for part, _ in _windows(source, q, grid, cfg, state, None, on_state, show):
-            part.history["C_used"] = used
+            part.history.update(C_used=used, lam_used=float(cfg.lam))
             yield part
         return
     with tempfile.TemporaryDirectory(prefix="evinr-stream-") if workdir is None else _nothing(workdir) as folder:
@@ -305,7 +306,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
             pass
         offset = span_offset(state.grid, cfg, grid, read_chunks(source, t_start, t_end, cfg.tau or t_end - t_start),
                              progress=show)
-        yield from _final_pass(spill, q, offset, cfg, source.sensor_size, {**_history(state), "C_used": used},
+        yield from _final_pass(spill, q, offset, cfg, source.sensor_size, {**_history(state), "C_used": used, "lam_used": float(cfg.lam)},
                                progress=show)
 
 
