@@ -331,3 +331,25 @@ def test_notebook_01_solution_and_text_agree_with_the_reference_on_the_first_edg
     exec(body, scope)
     ok, report = _report("event_rate_derivative", scope["event_rate_derivative"])
     assert ok, report
+
+
+def _event_rate_from_zero(t, bin_s):
+    t = np.asarray(t, dtype=np.float64)
+    n_bins = max(int(np.ceil(t[-1] / bin_s)), 1)
+    k = np.clip(np.ceil(t / bin_s).astype(np.int64) - 1, 0, n_bins - 1)
+    return (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
+
+
+def _temporal_loss_halved(dF_dt, delta_L, durations):
+    return 0.5 * torch.mean((delta_L - dF_dt * durations) ** 2)
+
+
+@pytest.mark.parametrize("name, wrong, words", [
+    ("event_rate", _event_rate_from_zero, "count the bins from the first event t0 = t[0]"),
+    ("temporal_loss", _temporal_loss_halved, "no factor 1/2 in front"),
+])
+def test_mistakes_that_got_only_a_generic_report_now_get_their_hint(name, wrong, words):
+    """Two mistakes the mutation audit saw fail with only a generic mismatch: bins counted from time 0, and a
+    loss halved (one number, so the generic 'constant factor' note cannot tell)."""
+    ok, report = _report(name, wrong)
+    assert not ok and words in report, report

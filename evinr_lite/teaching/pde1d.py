@@ -267,6 +267,8 @@ exercises.register(
     hints={
         "use the mean over windows, not the sum":
             lambda dF_dt, delta_L, durations: torch.sum((delta_L - dF_dt * durations) ** 2),
+        "Eq. 6 is the plain mean of the squared differences: no factor 1/2 in front":
+            lambda dF_dt, delta_L, durations: 0.5 * torch.mean((delta_L - dF_dt * durations) ** 2),
         "multiply dF/dt by the window length t2 - t1 before comparing with delta_L (Eq. 5)":
             lambda dF_dt, delta_L, durations: torch.mean((delta_L - dF_dt) ** 2),
         "Eq. 6 squares the difference; an absolute value gives a different loss":

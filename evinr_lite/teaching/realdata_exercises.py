@@ -76,6 +76,14 @@ def _rate_edges_to_later_bin(t, bin_s):
     return t[0] + (np.arange(n_bins) + 0.5) * bin_s, counts / bin_s
 
 
+def _rate_bins_from_zero(t, bin_s):
+    """The mistake: bins counted from time 0 (edges k bin_s) instead of from the first event t0 = t[0]."""
+    t = np.asarray(t, dtype=np.float64)
+    n_bins = max(int(np.ceil(t[-1] / bin_s)), 1)
+    k = np.clip(np.ceil(t / bin_s).astype(np.int64) - 1, 0, n_bins - 1)
+    return (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
+
+
 exercises.register(
     "event_rate", event_rate, _inputs_rate,
     hints={"divide the counts by the bin width to get events per second":
@@ -85,7 +93,10 @@ exercises.register(
            "an event exactly on a bin edge t0 + k bin_s belongs to bin k - 1 (bins are (b_k, b_{k+1}], the "
            "library's rule; bin 0 also holds t0): use ceil((t - t0) / bin_s) - 1 clipped at 0, or "
            "searchsorted(edges, t, side='left') - 1, not floor or side='right'":
-           _rate_edges_to_later_bin})
+           _rate_edges_to_later_bin,
+           "count the bins from the first event t0 = t[0] (edges t0 + k bin_s), not from time 0: a recording's "
+           "clock rarely starts at 0":
+           _rate_bins_from_zero})
 
 
 def _inputs_threshold(rng):
