@@ -120,9 +120,10 @@ def temporal_loss_variants(**common) -> dict[str, EvINRConfig]:
 
 
 def recipe_variants(n_events: int, span_s: float, **common) -> dict[str, EvINRConfig]:
-    """From the paper's recipe to the public reference code's, one change at a time (each row adds one).
+    """From ``EvINRConfig.v0_1()`` (the paper's recipe with two changes) to the public reference code's, one
+    change at a time (each row adds one).
 
-    1. "Full (paper)": Tikhonov, fixed 1/32 s bins, derivative loss, first layer omega 10.
+    1. "Full (v0_1)": EvINRConfig.v0_1(): Tikhonov, fixed 1/32 s bins, derivative loss, first layer omega 10.
     2. "+ TV": anisotropic TV instead of Tikhonov (the code's main regularizer term).
     3. "+ equal-count bins": bins of equal event counts, as many as the fixed bins (the binning rule alone).
     4. "+ boundary difference": F(b_{i+1}) - F(b_i) against each bin's events.
@@ -145,7 +146,7 @@ def recipe_variants(n_events: int, span_s: float, **common) -> dict[str, EvINRCo
         raise ValueError(f"recipe_variants counts bins over one window: use tau=None or tau >= span_s ({span_s} s)")
     n_fixed = max(1, int(round(span_s / base.bin_duration)))
     code_bins = {"events_per_bin": max(1, int(round(n_events / 100))), "c2f_iters": (base.n_iters // 2,)}
-    steps = [("Full (paper)", {}),
+    steps = [("Full (v0_1)", {}),
              ("+ TV instead of Tikhonov", {"regularizer": "tv"}),
              ("+ equal-count bins", {"binning": "equal_count", "events_per_bin": max(1, int(round(n_events / n_fixed)))}),
              ("+ boundary difference", {"temporal_loss": "difference"}),
