@@ -20,7 +20,8 @@ for IJRR). Methods, every one scored only on frames it did not use as anchors:
   frame's predecessors, i.e. far more frames than ``first``); scored on frames 1, 2, ...
 
 Two output protocols: ``linear`` (the frames' intensity, clip(exp(L) - 1/255, 0, 1): what anchored runs
-and the filter produce) and ``tone-mapped`` (the kit's display map: Reinhard after the mean anchor);
+and the filter produce) and ``tone-mapped`` (the paper's Eq. 12 display, Reinhard after the mean anchor: the kit's display
+until issue 21 made it linear; a fixed protocol here, so the committed results stay comparable);
 each scored without equalisation (plain SSIM) and with CLAHE. Writes benchmarks/anchors_results.json|md.
 """
 from __future__ import annotations
