@@ -185,11 +185,12 @@ def test_wrong_solution_fails_and_names_the_problem(name, wrong, words):
 
 
 def test_bisect_with_the_first_edge_at_zero_fails_on_bin_0():
-    """bisect_equal_count keeps its four hints (test_accel_exercises pins them), so this mistake gets no hint
-    of its own: the report points at bin 0's cut (output index 1) of the case whose times start at 0.25."""
+    """The report points at bin 0's cut (output index 1) of the case whose times start at 0.25, and names the
+    mistake (a hint of its own since this session: test_accel_exercises counts five)."""
     ok, report = _report("bisect_equal_count", _bisect_first_edge_zero)
     assert not ok, report
     assert "input #4 of 4" in report and "at index 1: got 1.05, expected 0.65" in report, report
+    assert "test `t == b_0`, not `t == 0`" in report, report
 
 
 def test_a_hint_needs_the_same_mistake_on_every_input():

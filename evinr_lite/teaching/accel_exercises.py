@@ -151,6 +151,18 @@ def _left_closed_bins(t_events, boundaries):
     return out
 
 
+def _first_edge_at_zero(t_events, boundaries):
+    """The mistake of bin 0's closed left edge written as `t == 0`: right only when b_0 = 0."""
+    t = np.asarray(t_events, dtype=np.float64)
+    out = _midpoints(t, boundaries)
+    for i, (lo, hi) in enumerate(zip(out[0:-1:2], out[2::2])):
+        in_bin = t[((t > lo) | ((i == 0) & (t == 0))) & (t <= hi)]
+        n = len(in_bin)
+        if n >= 2 and lo < 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2]) < hi:
+            out[2 * i + 1] = 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2])
+    return out
+
+
 exercises.register(
     "bisect_equal_count", bisect_equal_count, _inputs_bisect,
     hints={
@@ -162,6 +174,8 @@ exercises.register(
         "n//2 - 1 and n//2)": _cut_at_mean,
         "you cut exactly at event n//2; cut half-way between events n//2 - 1 and n//2, so that no event "
         "sits on an edge": _cut_at_event,
+        "bin 0 takes the events at exactly b_0 = boundaries[0], which need not be 0: test `t == b_0`, "
+        "not `t == 0`": _first_edge_at_zero,
     })
 
 
