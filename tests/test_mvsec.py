@@ -105,3 +105,67 @@ def test_reconstruct_scores_against_the_aps_frames(tmp_path):
     stamps = T0 + np.linspace(0.1, 2.9, 12) - np.floor(T0)          # the APS frames on the returned clock
     inside = stamps[(stamps >= 0.5) & (stamps <= 2.5)]
     np.testing.assert_allclose(metrics["per_frame"]["none"]["per_frame_t_s"], inside, atol=1e-6)
+
+
+def _write_stereo(path):
+    """Both cameras of a stereo file, each at its own sensor size and frame count, so that a reader of the
+    wrong one is seen at once."""
+    rng = np.random.default_rng(3)
+    with h5py.File(path, "w") as f:
+        for camera, (h, w), n_frames in (("left", (H, W), 12), ("right", (H + 4, W - 6), 7)):
+            n = 4000
+            t = T0 + np.sort(rng.uniform(0, 3, n))
+            rows = np.stack([rng.integers(0, w, n), rng.integers(0, h, n), t, rng.choice([-1.0, 1.0], n)], 1)
+            f.create_dataset(f"davis/{camera}/events", data=rows)
+            f.create_dataset(f"davis/{camera}/image_raw", data=rng.integers(0, 255, (n_frames, h, w)).astype(np.uint8))
+            f.create_dataset(f"davis/{camera}/image_raw_ts", data=T0 + np.linspace(0.1, 2.9, n_frames))
+    return path
+
+
+def _cli(*args):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "evinr_lite", *map(str, args)], capture_output=True, text=True)
+
+
+def test_the_camera_flag_picks_a_stereo_files_camera(tmp_path):
+    """--camera right reads davis/right (its own sensor size and APS frames) in info and reconstruct; the default
+    stays the left camera; load_recording and open_recording take the same camera=."""
+    import json
+
+    path = _write_stereo(tmp_path / "stereo_data.hdf5")
+    assert load_recording(path).events.sensor_size == (H, W)
+    assert load_recording(path, camera="right").events.sensor_size == (H + 4, W - 6)
+    with open_recording(path, camera="right") as source:
+        assert source.sensor_size == (H + 4, W - 6)
+    info = _cli("info", path, "--camera", "right", "--json")
+    assert info.returncode == 0, info.stderr
+    assert json.loads(info.stdout)["sensor_size"] == [H + 4, W - 6]
+    out = tmp_path / "right"
+    run = _cli("reconstruct", path, "--camera", "right", "--out", out, "--quiet", "--no-video")
+    assert run.returncode == 0, run.stderr
+    metrics = json.loads(next(out.glob("**/metrics.json")).read_text())
+    assert len(metrics["per_frame"]["none"]["per_frame_t_s"]) == 7            # the right camera's frames
+    assert json.loads((out / "run.json").read_text())["sensor_size"] == [H + 4, W - 6]
+
+
+def test_the_camera_flag_is_refused_where_it_cannot_apply(tmp_path):
+    """A one-camera format refuses --camera with the fix, a stereo-less MVSEC file names the camera it has, a
+    camera that MVSEC does not have is refused by the parser and by RunOptions, and a batch refuses it."""
+    from evinr_lite.apps.options import RunOptions
+
+    npy = tmp_path / "ev.npy"
+    np.save(npy, np.stack([np.linspace(0, 1, 50), np.arange(50) % 8, np.arange(50) % 6, np.ones(50)], 1))
+    run = _cli("info", npy, "--sensor", "6x8", "--camera", "right")
+    assert run.returncode == 2 and "--camera right cannot apply" in run.stderr and "leave --camera out" in run.stderr, run.stderr
+    path, _ = _write(tmp_path / "left_only.hdf5")
+    run = _cli("reconstruct", path, "--camera", "right", "--out", tmp_path / "o", "--quiet")
+    assert run.returncode == 2 and "--camera left" in run.stderr, run.stderr
+    assert not (tmp_path / "o").exists()
+    run = _cli("info", path, "--camera", "middle")
+    assert run.returncode == 2 and "invalid choice" in run.stderr
+    with pytest.raises(EventDataError, match="camera= must be one of"):
+        RunOptions(camera="middle")
+    with pytest.raises(EventDataError, match="camera="):
+        RunOptions(camera="right").check_batch()

@@ -132,6 +132,9 @@ STATIC_CAMERA_HELP = ("the camera stood still (a tripod) and things moved in fro
 KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-activity filter (an event is kept "
                         "when a neighbouring pixel fired one of the same polarity within 50 ms; EvINRConfig.background); "
                         "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
+CAMERA_CHOICES = ("left", "right")
+CAMERA_HELP = ("which camera of an MVSEC stereo file (davis/left or davis/right; default: the left one, or the "
+               "one the file has); other formats hold one camera")
 LAM_HELP = ("the spatial regularizer's weight lambda: auto (the kit's: chosen from the events' activity) or a "
             "number >= 0; more smooths more (e.g. 0.03-0.1 for a recording with heavy background activity); "
             "default: the recipe's own (auto for kit, 0.05 for paper and v0_1)")
@@ -160,6 +163,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                    "some Prophesee .raw)")
     info.add_argument("--json", action="store_true", help="print the description as JSON")
     info.add_argument("--time-unit", choices=TIME_UNIT_CHOICES, help=unit_help)
+    info.add_argument("--camera", choices=CAMERA_CHOICES, help=CAMERA_HELP)
 
     rec = sub.add_parser("reconstruct", help="reconstruct frames from a recording with EvINR",
                          description="Reconstruct frames with EvINR and write PNGs, an MP4 and a GIF; when the "
@@ -174,6 +178,7 @@ def build_parser() -> argparse.ArgumentParser:
                                                  "frames in the window; printed with its uncertainty, kept in "
                                                  "run.json); default: the file's, else 1 as in the paper")
     rec.add_argument("--time-unit", choices=TIME_UNIT_CHOICES, help=unit_help)
+    rec.add_argument("--camera", choices=CAMERA_CHOICES, help=CAMERA_HELP)
     when = rec.add_mutually_exclusive_group()
     when.add_argument("--fps", type=_positive, help="reconstruct this many frames per second over the window")
     when.add_argument("--at", help="reconstruct at these times (seconds, comma-separated, or a file with "
@@ -264,7 +269,7 @@ def build_parser() -> argparse.ArgumentParser:
 def _info(args) -> None:
     from .describe import describe_recording, format_info, open_recording   # no torch: info needs none
 
-    with open_recording(args.recording, sensor_size=args.sensor, time_unit=args.time_unit) as source:
+    with open_recording(args.recording, sensor_size=args.sensor, time_unit=args.time_unit, camera=args.camera) as source:
         info = describe_recording(source)   # reads only what the format can tell cheaply (seconds on GB files)
     print(json.dumps(info, indent=2) if args.json else format_info(info))
 
@@ -276,7 +281,8 @@ def _run_options(args):
     video = not args.no_video if hasattr(args, "no_video") else args.video   # reconstruct writes video by default
     return RunOptions(sensor_size=args.sensor, C=args.C, fps=args.fps, at=getattr(args, "at", None),
                       t_start=getattr(args, "start", None), t_end=getattr(args, "end", None),
-                      time_unit=getattr(args, "time_unit", None), device=args.device, recipe=args.recipe,
+                      time_unit=getattr(args, "time_unit", None), camera=getattr(args, "camera", None),
+                      device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
                       keep_background=args.keep_background, static_camera=args.static_camera,
                       colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap, video=video,
@@ -327,6 +333,8 @@ FLAG_FOR = [
     (re.compile(r"\boverwrite=True"), "--overwrite"),
     (re.compile(r"\bdevice='(\w+)'"), r"--device \1"),
     (re.compile(r"\btime_unit='(\w+)'"), r"--time-unit \1"),
+    (re.compile(r"\bcamera='(left|right)'"), r"--camera \1"),
+    (re.compile(r"\bleave camera= out"), "leave --camera out"),
     (re.compile(r"\banchor='(\w+)'"), r"--anchor \1"),
     (re.compile(r"\bEvINRConfig\(background='keep'\)"), "--keep-background"),
     (re.compile(r"\bstatic_camera \(--static-camera\)"), "--static-camera"),

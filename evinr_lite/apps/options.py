@@ -21,6 +21,7 @@ import numpy as np
 from ..core.events import TIME_UNITS, EventDataError
 from ..method.anchor import ANCHOR_MODES
 from ..core.recording import Recording
+from ..io.formats.mvsec import CAMERAS
 from ..method.config import EvINRConfig
 from ..method.memory import check_times_memory
 from ..method.recipes import RECIPES, contrast_option, recipe_config
@@ -141,6 +142,8 @@ class RunOptions:
             as the parsed float64 [Q] seconds). Neither: the ground-truth frame times, else 30 per second.
         t_start, t_end: the window, seconds on the recording's clock (None: the events' first / last).
         time_unit: the unit of integer or text timestamps ('s', 'ms', 'us', 'ns'; None: detected).
+        camera: 'left' or 'right': which camera of an MVSEC stereo file (None: its left one, or the one it
+            has); refused for formats with one camera, and by a batch.
         device: "cpu", "cuda" or None (a GPU when present; checked when the run starts).
         recipe: "kit", "paper" or "v0_1" (:mod:`evinr_lite.method.recipes`); n_iters: its Adam
             iterations (None: the recipe's own); seed: seeds the networks.
@@ -168,6 +171,7 @@ class RunOptions:
     t_start: float | None = None
     t_end: float | None = None
     time_unit: str | None = None
+    camera: str | None = None
     device: str | None = None
     recipe: str = "kit"
     n_iters: int | None = None
@@ -209,6 +213,8 @@ class RunOptions:
             raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {self.recipe!r}")
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2**63:
             raise EventDataError(f"seed must be a whole number in [0, 2**63), got {self.seed!r}")
+        if self.camera is not None and self.camera not in CAMERAS:
+            raise EventDataError(f"camera= must be one of {CAMERAS} (an MVSEC stereo file's cameras), got {self.camera!r}")
         if self.time_unit is not None and self.time_unit not in TIME_UNITS:
             raise EventDataError(f"time_unit= must be one of {', '.join(TIME_UNITS)}, got {self.time_unit!r}")
         if self.device is not None and not isinstance(self.device, str):
@@ -253,7 +259,7 @@ class RunOptions:
 
     def check_batch(self) -> "RunOptions":
         """These options, refused (EventDataError) if they set one that a batch does not take."""
-        own = [name for name in ("at", "t_start", "t_end", "time_unit") if getattr(self, name) is not None]
+        own = [name for name in ("at", "t_start", "t_end", "time_unit", "camera") if getattr(self, name) is not None]
         own += ["colour"] if self.colour else []
         if own:
             raise EventDataError(f"a batch reconstructs each recording's own evaluation window at its frame times: "

@@ -167,7 +167,7 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
         except RuntimeError as err:
             raise EventDataError(str(err)) from None
         rec = load_recording(path, sensor_size=options.sensor_size, t_start=options.t_start, t_end=options.t_end,
-                             time_unit=options.time_unit)
+                             time_unit=options.time_unit, camera=options.camera)
         denoise_report = None
         if options.denoise:   # before anything reads the events: times, memory, training, the scores
             rec, denoise_report = denoise_recording(rec, path, log)

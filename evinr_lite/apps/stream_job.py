@@ -135,7 +135,7 @@ def _header(path, options, log):
     metadata and the span, with no events) after every check that needs no training."""
     from ..io.load import open_recording
 
-    source = open_recording(path, sensor_size=options.sensor_size, time_unit=options.time_unit)
+    source = open_recording(path, sensor_size=options.sensor_size, time_unit=options.time_unit, camera=options.camera)
     first, last = source.t_span
     lo = first if options.t_start is None else float(options.t_start)
     hi = last if options.t_end is None else float(options.t_end)

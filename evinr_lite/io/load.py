@@ -27,10 +27,17 @@ __all__ = ["open_recording", "read_any", "load_recording", "describe_recording",
 INFO_SAMPLE_EVENTS = 2_000_000   # info reads at most about this many events (evenly spread) for the polarity balance
 
 
-def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | None = None) -> dict:
+def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | None = None,
+                   camera: str | None = None) -> dict:
     """The keyword options for ``fmt``'s reader: ``sensor_size`` where the reader takes it, ``time_unit``
-    where the format does not fix it (a different unit for a format that fixes its own is refused)."""
+    where the format does not fix it (a different unit for a format that fixes its own is refused), and
+    ``camera`` for a format with more than one camera in a file (MVSEC's stereo pair; refused for the others)."""
     options = {}
+    if camera is not None:
+        if "camera" not in fmt.options:
+            raise EventDataError(f"{path}: a {fmt.name} recording holds one camera, so camera={camera!r} cannot "
+                                 "apply (it picks the left or right camera of an MVSEC stereo file); leave camera= out")
+        options["camera"] = camera
     if fmt.takes_sensor_size and sensor_size is not None:
         options["sensor_size"] = sensor_size
     if time_unit is not None:
@@ -50,7 +57,8 @@ def check_sensor_size_matches(path, found, sensor_size) -> None:
                              f"sensor size {tuple(int(v) for v in sensor_size)} was given; leave it out or pass {H}x{W}")
 
 
-def open_recording(path, *, sensor_size=None, time_unit: str | None = None, **options) -> RecordingSource:
+def open_recording(path, *, sensor_size=None, time_unit: str | None = None, camera: str | None = None,
+                   **options) -> RecordingSource:
     """Open a recording (any format :func:`~evinr_lite.io.detect_format` knows) for reading window by window.
 
     Args:
@@ -58,12 +66,14 @@ def open_recording(path, *, sensor_size=None, time_unit: str | None = None, **op
         sensor_size: (H, W); supplied to formats that may not record it, checked against the others.
         time_unit: unit of the timestamps for formats that do not fix it ('s', 'ms', 'us', 'ns'; None:
             the reader's detection); refused for formats that fix theirs.
+        camera: 'left' or 'right' for an MVSEC stereo file (None: its left camera, or the one it has);
+            refused for formats with one camera.
         options: the format's other reader options (e.g. ``columns=`` for .npy).
     Formats that can read a window without the rest (memory-mapped .npy, canonical, HQF, DSEC and MVSEC h5, AEDAT4
     and Prophesee packets) do so; the others (text, IJRR and EVREAL folders) are read once and sliced.
     """
     fmt = get_format(detect_format(path))
-    options = {**reader_options(fmt, path, sensor_size, time_unit), **options}
+    options = {**reader_options(fmt, path, sensor_size, time_unit, camera), **options}
     if fmt.open_source is not None:
         source = fmt.open_source(Path(path), **options)
     else:
@@ -89,7 +99,7 @@ def open_recording(path, *, sensor_size=None, time_unit: str | None = None, **op
 
 
 def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None,
-             time_unit: str | None = None) -> Recording:
+             time_unit: str | None = None, camera: str | None = None) -> Recording:
     """Read a recording of any supported format, the sensor size checked or supplied.
 
     Args:
@@ -102,12 +112,14 @@ def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: flo
             HQF h5): 's', 'ms', 'us', 'ns'; None: the reader's detection (integers are taken as
             microseconds, with a warning). For AEDAT4 / Prophesee (microseconds) and canonical files
             (seconds) a different unit is refused.
+        camera: 'left' or 'right' for an MVSEC stereo file (None: its left camera, or the one it has);
+            refused for formats with one camera.
     Raises:
         EventDataError: missing file, unknown format, wrong or missing sensor size, a time unit the
             format does not allow.
     """
     fmt = get_format(detect_format(path))
-    kwargs = reader_options(fmt, path, sensor_size, time_unit)
+    kwargs = reader_options(fmt, path, sensor_size, time_unit, camera)
     if fmt.windowed:
         kwargs.update(t_start=t_start, t_end=t_end)
     rec = fmt.reader(Path(path), **kwargs)
@@ -116,11 +128,11 @@ def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: flo
 
 
 def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None,
-                   time_unit: str | None = None) -> Recording:
+                   time_unit: str | None = None, camera: str | None = None) -> Recording:
     """Read a recording (any supported format) restricted to the window [t_start, t_end).
 
     Args:
-        path, sensor_size, time_unit: see :func:`read_any`.
+        path, sensor_size, time_unit, camera: see :func:`read_any`.
         t_start, t_end: seconds on the recording's clock; None: from the first / to the last event.
     Returns:
         Recording whose events lie in the window and whose frames lie in [start, end], the span
@@ -136,7 +148,8 @@ def load_recording(path, *, sensor_size=None, t_start: float | None = None, t_en
     # [start, end]. Readers that read only a window from disk are asked for a little more (a frame
     # exactly at t_end included) and everything is cut here.
     reader_end = None if t_end is None else math.nextafter(float(t_end), math.inf)
-    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=reader_end, time_unit=time_unit)
+    rec = read_any(path, sensor_size=sensor_size, t_start=t_start, t_end=reader_end, time_unit=time_unit,
+                   camera=camera)
     events, frames = rec.events, rec.frames
     events = events.slice_time(t_start, t_end)
     if len(events) < 2:
