@@ -160,7 +160,8 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--delete-raw", action="store_true", help="delete the raw download after converting")
     q.add_argument("--quiet", action="store_true", help="no progress bars")
     q.set_defaults(func=_cmd_get)
-    q = sub.add_parser("convert", help="convert a raw file you already have")
+    q = sub.add_parser("convert", help="convert a raw file you already have (an IJRR zip or folder, a ROS1 .bag, "
+                                       "a ROS2 bag's folder, a CED zip, an MVSEC / HQF .h5)")
     q.add_argument("raw")
     q.add_argument("--out", help="output .h5 file or folder (default: the cache)")
     q.add_argument("--dataset")

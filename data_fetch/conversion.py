@@ -47,14 +47,22 @@ def extract_member(archive: Path, member_name: str, dest: Path) -> Path:
 
 
 def _kind(path: Path) -> str:
+    from evinr_lite.io.formats.registry import is_ros2_bag
+
     if path.is_dir():
         if (path / "events.txt").exists() or any(path.glob("*/events.txt")):
             return "ijrr"
-        raise ConversionError(f"{path}: a folder without events.txt; data_fetch converts IJRR folders, .zip, "
-                              ".bag and .h5/.hdf5 files (an AED sequence folder: add --dataset aed)")
+        if is_ros2_bag(path):
+            return "bag2"
+        raise ConversionError(f"{path}: a folder without events.txt or a ROS2 bag's metadata.yaml; data_fetch converts "
+                              "IJRR folders, ROS2 bag folders, .zip, .bag and .h5/.hdf5 files (an AED sequence folder: "
+                              "add --dataset aed)")
     suffix = path.suffix.lower()
     if suffix == ".bag":
         return "bag"
+    if suffix in (".db3", ".mcap") and is_ros2_bag(path.parent):
+        raise ConversionError(f"{path}: one storage file of a ROS2 bag; pass the bag's folder {path.parent} (with "
+                              "its metadata.yaml)")
     if suffix in (".h5", ".hdf5"):
         return "h5"
     if suffix == ".zip":
@@ -73,7 +81,7 @@ def _kind(path: Path) -> str:
         raise ConversionError(f"{path}: pass the IJRR folder or zip (events.txt with images.txt), not events.txt "
                               "alone; or read a bare events.txt with evinr_lite.io.readers.read_events_txt")
     raise ConversionError(f"{path}: unknown raw format {suffix or '(none)'!r}; data_fetch converts IJRR zips/folders, "
-                          "ROS1 .bag files, CED zips of bags, MVSEC .hdf5 and HQF-style .h5")
+                          "ROS1 .bag files, ROS2 bag folders, CED zips of bags, MVSEC .hdf5 and HQF-style .h5")
 
 
 def check_writable_folder(folder: Path, what: str) -> None:
@@ -116,7 +124,8 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
     """Convert a raw recording to the canonical HDF5 file and return its path.
 
     Args:
-        raw: an IJRR ``.zip`` or folder, a ROS1 ``.bag`` (HQF, CED, MVSEC, IJRR), a CED zip of bags
+        raw: an IJRR ``.zip`` or folder, a ROS1 ``.bag`` (HQF, CED, MVSEC, IJRR), a ROS2 bag's folder
+            (dvs_msgs/EventArray and sensor_msgs/Image, rewritten as a ROS1 bag first), a CED zip of bags
             (pass ``sequence``), an MVSEC ``_data.hdf5``, an HQF-style ``.h5``, or an AED sequence
             folder with ``dataset="aed"`` (layout: :mod:`data_fetch.convert_aed`; ``sensor_size`` is
             then the raw Quad Bayer event sensor).
@@ -194,7 +203,7 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
 
     if time_unit not in (None, "auto") and kind not in ("ijrr", "h5"):
         raise DataFetchError(f"{raw}: a {kind} recording stores its time unit itself; leave --time-unit out")
-    if cfa not in (_UNSET, None) and kind not in ("bag", "bag-zip"):
+    if cfa not in (_UNSET, None) and kind not in ("bag", "bag2", "bag-zip"):
         raise DataFetchError(f"{raw}: cfa= applies to ROS bags (CED) only, not a {kind} recording; leave it out")
     if kind == "ijrr":
         from .convert_ijrr import convert_ijrr
@@ -211,6 +220,15 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
                   cfa=(ds.cfa if ds else None) if cfa is _UNSET else cfa, grey=grey)
     if kind == "bag":
         return convert_bag(raw, out, **common, **topics)
+    if kind == "bag2":   # a ROS2 bag: rewritten as a ROS1 bag beside the output, converted, the copy deleted
+        from .convert_bag import ros2_to_ros1
+
+        out.parent.mkdir(parents=True, exist_ok=True)
+        bag = ros2_to_ros1(raw, out.parent / f".{raw.name}.ros1.bag")
+        try:
+            return convert_bag(bag, out, **common, **topics)
+        finally:
+            bag.unlink(missing_ok=True)
     # a CED-style zip of bags: take out the one bag, convert it, delete the copy
     member = (seq.archive_member if seq and seq.archive_member else f"{name}.bag")
     bag = extract_member(raw, member, out.parent / f".{member}")

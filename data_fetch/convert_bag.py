@@ -30,7 +30,8 @@ from evinr_lite.core.cfa import CFA_NAMES, check_cfa
 from .canonical import CanonicalWriter
 from .errors import ConversionError
 
-__all__ = ["convert_bag", "decode_event_array", "decode_image", "debayer", "EVENT_DTYPE", "EVENT_ARRAY_MD5"]
+__all__ = ["convert_bag", "ros2_to_ros1", "decode_event_array", "decode_image", "debayer", "EVENT_DTYPE",
+           "EVENT_ARRAY_MD5", "ROS2_DVS_MSGS"]
 
 log = logging.getLogger("data_fetch")
 
@@ -38,8 +39,39 @@ EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("sec", "<u4"), ("nsec", "<u
 EVENT_ARRAY_MD5 = "5e8beee5a6c107e504c2e78903c224b8"   # dvs_msgs/EventArray (as generated from its definition)
 EVENT_ARRAY_TYPE = "dvs_msgs/msg/EventArray"
 IMAGE_TYPE = "sensor_msgs/msg/Image"
+# dvs_msgs as ROS2 drivers declare them, for ROS2 bags too old to carry their own message definitions
+ROS2_DVS_MSGS = {"dvs_msgs/msg/Event": "uint16 x\nuint16 y\nbuiltin_interfaces/Time ts\nbool polarity\n",
+                 "dvs_msgs/msg/EventArray": "std_msgs/Header header\nuint32 height\nuint32 width\n"
+                                            "dvs_msgs/Event[] events\n"}
 PREFERRED_EVENT_TOPICS = ("/dvs/events", "/davis/left/events")
 PREFERRED_IMAGE_TOPICS = ("/dvs/image_raw", "/davis/left/image_raw", "/dvs/image_color")
+
+
+def ros2_to_ros1(src, dst) -> Path:
+    """A ROS2 bag (its folder: metadata.yaml with .db3 or .mcap storage) rewritten as the ROS1 bag ``dst``,
+    message by message, by rosbags' converter (CDR to ROS1 serialization), so that :func:`convert_bag`
+    reads it. The bag's own message definitions are used; dvs_msgs are known here for bags that carry none
+    (:data:`ROS2_DVS_MSGS`). ``dst`` is replaced. ConversionError names what failed."""
+    from rosbags.convert import ConverterError, convert
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    src, dst = Path(src), Path(dst)
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types = {}
+    for name, text in ROS2_DVS_MSGS.items():
+        types.update(get_types_from_msg(text, name))
+    store.register(types)
+    dst.unlink(missing_ok=True)
+    log.info("data_fetch: %s: a ROS2 bag; rewriting it as a ROS1 bag first (rosbags)", src)
+    try:
+        convert(srcs=[src], dst=dst, dst_storage="sqlite3", dst_version=None, compress=None, compress_mode="file",
+                default_typestore=store, typestore=None, exclude_topics=(), include_topics=(), exclude_msgtypes=(),
+                include_msgtypes=())
+    except (ConverterError, OSError, ValueError, KeyError) as err:
+        dst.unlink(missing_ok=True)
+        raise ConversionError(f"{src}: the ROS2 bag could not be read ({type(err).__name__}: {err}); check that the "
+                              "folder holds the whole bag (metadata.yaml and its .db3 or .mcap files)") from None
+    return dst
 
 
 def _u32(raw, offset: int) -> int:

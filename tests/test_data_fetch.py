@@ -22,6 +22,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+
+from evinr_lite.core.events import EventDataError
 from PIL import Image
 
 import data_fetch
@@ -677,3 +679,83 @@ def test_import_is_light():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=Path(__file__).resolve().parents[1], env={**os.environ, "PYTHONPATH": "."})
     assert out.stdout.strip() == "[]"
+
+
+# ---- ROS2 bags: rewritten as ROS1 by rosbags, then converted as any bag ---------------------------------------
+
+def make_ros2_bag(folder, ev, frames, per_msg=97, storage="sqlite3"):
+    """A ROS2 bag folder (rosbag2 version 9, its message definitions stored) with dvs_msgs/EventArray on
+    /dvs/events and sensor_msgs/Image on /dvs/image_raw, as a ROS2 driver records them."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    from data_fetch.convert_bag import ROS2_DVS_MSGS
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types = {}
+    for name, text in ROS2_DVS_MSGS.items():
+        types.update(get_types_from_msg(text, name))
+    store.register(types)
+    T = store.types
+    Time, Header = T["builtin_interfaces/msg/Time"], T["std_msgs/msg/Header"]
+    Event, EventArray, Img = T["dvs_msgs/msg/Event"], T["dvs_msgs/msg/EventArray"], T["sensor_msgs/msg/Image"]
+    images, fns = frames
+    msgs = []
+    n = len(ev["ns"])
+    for a in range(0, n, per_msg):
+        idx = range(a, min(n, a + per_msg))
+        events = [Event(x=int(ev["x"][i]), y=int(ev["y"][i]), ts=Time(sec=int(ev["ns"][i] // NS),
+                        nanosec=int(ev["ns"][i] % NS)), polarity=bool(ev["p"][i])) for i in idx]
+        stamp = int(ev["ns"][idx[-1]])
+        msgs.append((stamp, "/dvs/events", EventArray(header=Header(stamp=Time(sec=stamp // NS, nanosec=stamp % NS),
+                                                                    frame_id=""), height=ev["H"], width=ev["W"],
+                                                      events=events), "dvs_msgs/msg/EventArray"))
+    for im, t in zip(images, fns):
+        head = Header(stamp=Time(sec=int(t // NS), nanosec=int(t % NS)), frame_id="")
+        msgs.append((int(t), "/dvs/image_raw", Img(header=head, height=im.shape[0], width=im.shape[1], encoding="mono8",
+                                                   is_bigendian=0, step=im.shape[1], data=im.reshape(-1)),
+                     "sensor_msgs/msg/Image"))
+    msgs.sort(key=lambda m: m[0])
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    with Writer(Path(folder), version=9, storage_plugin=plugin) as writer:
+        conns = {}
+        for t, topic, msg, msgtype in msgs:
+            if topic not in conns:
+                conns[topic] = writer.add_connection(topic, msgtype, typestore=store)
+            writer.write(conns[topic], t, store.serialize_cdr(msg, msgtype))
+    return Path(folder)
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_a_ros2_bag_converts_exactly(tmp_path, storage):
+    """python -m data_fetch convert FOLDER on a ROS2 bag: the events and APS frames come out exactly as
+    written (integer nanoseconds), through rosbags' rewrite as a ROS1 bag, whose copy does not stay."""
+    from data_fetch import convert
+    from evinr_lite.io import load_recording
+
+    ev, frames = make_events(), make_frames()
+    bag = make_ros2_bag(tmp_path / "drive_ros2", ev, frames, storage=storage)
+    out = convert(bag, tmp_path / "out", progress=False)
+    rec = load_recording(out)
+    check_events(rec, ev)
+    keep = (frames[1] >= ev["ns"][0]) & (frames[1] <= ev["ns"][-1])     # the frames within the events' span
+    np.testing.assert_array_equal(rec.frames.images, frames[0][keep])
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [out.name]
+
+
+def test_a_ros2_bag_is_refused_by_the_kit_with_the_conversion(tmp_path):
+    """evinr-lite on a ROS2 bag's folder, or on one of its storage files, names `python -m data_fetch convert`;
+    data_fetch given a storage file asks for the folder."""
+    from data_fetch import convert
+    from data_fetch.errors import DataFetchError
+    from evinr_lite.io.formats.registry import detect_format, sniff_format
+
+    bag = make_ros2_bag(tmp_path / "rec", make_events(200), make_frames(2))
+    with pytest.raises(EventDataError, match=r"a ROS2 bag.*python -m data_fetch convert"):
+        detect_format(bag)
+    db3 = next(bag.glob("*.db3"))
+    assert sniff_format(db3) == "sqlite"
+    with pytest.raises(EventDataError, match=r"ROS2 bag's \.db3 storage.*data_fetch convert FOLDER"):
+        detect_format(db3)
+    with pytest.raises(DataFetchError, match="pass the bag's folder"):
+        convert(db3, tmp_path / "o.h5", progress=False)

@@ -19,7 +19,7 @@ from .base import FileFormat
 
 __all__ = ["FORMATS", "get_format", "detect_format", "read_recording", "read_events", "sniff_format",
            "SUPPORTED_FORMATS", "RECORDING_SUFFIXES", "SIZE_FREE_FORMATS", "READER_WINDOW_FORMATS",
-           "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder"]
+           "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder", "is_ros2_bag"]
 
 HEAD_BYTES = 64
 UNSUPPORTED = {   # first bytes of files that are recognised but not read -> the fix
@@ -32,7 +32,23 @@ UNSUPPORTED = {   # first bytes of files that are recognised but not read -> the
     b"PK\x03\x04": "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside",
     b"#ROSBAG V2.0": "a ROS1 bag, which is not read directly; convert it with `python -m data_fetch convert FILE.bag` "
                      "(dvs_msgs event arrays and the APS images, to the canonical .h5 that evinr-lite reads)",
+    b"\x89MCAP": "an MCAP file, the storage of a ROS2 bag, which is not read directly; pass the bag's folder (the one "
+                 "with metadata.yaml) to `python -m data_fetch convert FOLDER`, which writes the canonical .h5 "
+                 "that evinr-lite reads",
+    b"SQLite format 3\x00": "an SQLite database, such as a ROS2 bag's .db3 storage, which is not read directly; for a "
+                            "bag, pass its folder (the one with metadata.yaml) to `python -m data_fetch convert FOLDER`, "
+                            "which writes the canonical .h5 that evinr-lite reads",
 }
+ROS2_METADATA = "rosbag2_bagfile_information"   # the key a ROS2 bag's metadata.yaml opens with
+
+
+def is_ros2_bag(folder) -> bool:
+    """True for a ROS2 bag's folder: a metadata.yaml that names itself rosbag2_bagfile_information."""
+    meta = Path(folder) / "metadata.yaml"
+    try:
+        return meta.is_file() and ROS2_METADATA in meta.read_text(errors="replace")[:4096]
+    except OSError:
+        return False
 
 
 def _collect() -> tuple[FileFormat, ...]:
@@ -96,6 +112,10 @@ def detect_format(path) -> str:
         for fmt in FORMATS:
             if fmt.folder and fmt.sniff(path, None):
                 return fmt.name
+        if is_ros2_bag(path):
+            raise EventDataError(f"{path}: a ROS2 bag, which is not read directly; convert it with `python -m data_fetch "
+                                 f"convert {path}` (dvs_msgs event arrays and the APS images, to the canonical .h5 "
+                                 "that evinr-lite reads)")
         raise EventDataError(f"{path}: folder of unknown format (no events.txt or events_ts.npy); "
                              f"supported formats: {SUPPORTED_FORMATS}")
     if path.stat().st_size == 0:
@@ -127,7 +147,8 @@ def is_recording_folder(path) -> bool:
 
 def sniff_format(path) -> str | None:
     """The format of a file from its first bytes alone: a format's name, 'hdf5' for any HDF5 file,
-    'aedat2' / 'aedat3' / 'zip' / 'rosbag' for files recognised but not read, or None (not recognised: maybe text)."""
+    'aedat2' / 'aedat3' / 'zip' / 'rosbag' / 'mcap' / 'sqlite' for files recognised but not read, or None (not
+    recognised: maybe text)."""
     path = Path(path)
     with open(path, "rb") as f:
         head = f.read(HEAD_BYTES)
@@ -137,7 +158,7 @@ def sniff_format(path) -> str | None:
         if not fmt.folder and not fmt.by_suffix and fmt.sniff(path, head):
             return fmt.name
     names = {b"#!AER-DAT3": "aedat3", b"#!AER-DAT2": "aedat2", b"#!AER-DAT1": "aedat2", b"PK\x03\x04": "zip",
-             b"#ROSBAG V2.0": "rosbag"}
+             b"#ROSBAG V2.0": "rosbag", b"\x89MCAP": "mcap", b"SQLite format 3\x00": "sqlite"}
     return next((name for magic, name in names.items() if head.startswith(magic)), None)
 
 
