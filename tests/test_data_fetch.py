@@ -759,3 +759,22 @@ def test_a_ros2_bag_is_refused_by_the_kit_with_the_conversion(tmp_path):
         detect_format(db3)
     with pytest.raises(DataFetchError, match="pass the bag's folder"):
         convert(db3, tmp_path / "o.h5", progress=False)
+
+
+def test_a_ros2_bag_without_message_definitions_converts_with_the_known_dvs_msgs(tmp_path, monkeypatch):
+    """Bags recorded before rosbag2 stored message definitions carry none: the ROS2 dvs_msgs definitions
+    supplied to the converter stand in (without them rosbags does not know dvs_msgs/msg/EventArray)."""
+    import sqlite3
+
+    import data_fetch.convert_bag as cb
+    from data_fetch import convert
+    from evinr_lite.io import load_recording
+
+    ev = make_events(300)
+    bag = make_ros2_bag(tmp_path / "old", ev, make_frames(2))
+    with sqlite3.connect(next(bag.glob("*.db3"))) as con:
+        con.execute("delete from message_definitions")
+    check_events(load_recording(convert(bag, tmp_path / "a.h5", progress=False)), ev)
+    monkeypatch.setattr(cb, "ROS2_DVS_MSGS", {})
+    with pytest.raises(DataFetchError, match=r"ROS2 bag could not be read.*dvs_msgs/msg/EventArray"):
+        convert(bag, tmp_path / "b.h5", progress=False)
