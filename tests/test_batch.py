@@ -249,3 +249,20 @@ def test_lam_reaches_every_task_and_a_rerun_with_another_is_refused(recordings, 
     assert json.loads((out / "rec_camera" / "run.json").read_text())["evinr_config"]["lam"] == 0.05
     with pytest.raises(EventDataError, match="other settings.*lam"):
         run_batch([subset], out, sequential=True, lam=0.01, progress=False, log=_quiet)
+
+
+def test_ros_bags_among_the_inputs_are_named_with_their_conversion(tmp_path):
+    """A ROS2 bag's folder given to batch is refused with the data_fetch command; ROS bags inside a folder of
+    recordings are skipped with it (the other recordings still run), not as 'not a recording'."""
+    bag2 = tmp_path / "in" / "drive"
+    bag2.mkdir(parents=True)
+    (bag2 / "metadata.yaml").write_text("rosbag2_bagfile_information:\n  version: 9\n")
+    (bag2 / "drive_0.db3").write_bytes(b"SQLite format 3\x00")
+    (tmp_path / "in" / "old.bag").write_bytes(b"#ROSBAG V2.0\n")
+    write_example_recording(tmp_path / "in" / "rec", sensor_size=(20, 30), duration=0.3, frame_rate=10.0)
+    with pytest.raises(EventDataError, match=r"a ROS2 bag.*python -m data_fetch convert"):
+        resolve_inputs([bag2], log=_quiet)
+    said = []
+    items = resolve_inputs([tmp_path / "in"], log=said.append)
+    assert [i["name"] for i in items] == ["rec"]
+    assert sum("a ROS bag" in line and "python -m data_fetch convert" in line for line in said) == 2, said

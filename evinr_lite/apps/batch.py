@@ -41,7 +41,7 @@ import numpy as np
 from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
-from ..io.formats import RECORDING_SUFFIXES, detect_format, is_recording_folder  # formats: io.formats
+from ..io.formats import RECORDING_SUFFIXES, detect_format, is_recording_folder, is_ros2_bag  # formats: io.formats
 from .options import BATCH_FIELDS, RunOptions
 from .recon_job import EQUALIZATIONS, run_reconstruct
 
@@ -151,6 +151,9 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
         path = Path(spec)
         if path.exists():
             path = _real_path(path)
+            if path.is_dir() and is_ros2_bag(path):
+                raise EventDataError(f"{spec}: a ROS2 bag, which is not read directly; convert it with `python -m "
+                                     f"data_fetch convert {spec}` and pass the .h5 it writes")
             if path.is_dir() and not _is_recording_dir(path):
                 found = []
                 for child in sorted(path.iterdir()):
@@ -159,6 +162,9 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
                     if child.is_file() and child.suffix.lower() in RECORDING_SUFFIXES or \
                             child.is_dir() and _is_recording_dir(child):
                         found.append({"path": str(child), "dataset": path.name, "name": child.stem})
+                    elif child.is_dir() and is_ros2_bag(child) or child.suffix.lower() == ".bag":
+                        log(f"batch: skipped {child} (a ROS bag, which is not read directly: convert it with "
+                            f"`python -m data_fetch convert {child}` and pass the .h5 it writes)")
                     else:
                         log(f"batch: skipped {child} (not a recording)")
                 if not found:
