@@ -139,28 +139,27 @@ def _cut_at_event(t_events, boundaries):
     return out
 
 
-def _left_closed_bins(t_events, boundaries):
-    """The mistake of bins [b_i, b_{i+1}) (searchsorted side='left' at both ends, or t < b_{i+1})."""
+def _median_cuts(t_events, boundaries, in_bin):
+    """The reference's cut with another membership rule (the wrong versions below): ``in_bin(t, i, lo, hi)``
+    -> bool mask of bin i's events."""
     t = np.asarray(t_events, dtype=np.float64)
     out = _midpoints(t, boundaries)
     for i, (lo, hi) in enumerate(zip(out[0:-1:2], out[2::2])):
-        in_bin = t[(t >= lo) & (t < hi)]
-        n = len(in_bin)
-        if n >= 2 and lo < 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2]) < hi:
-            out[2 * i + 1] = 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2])
+        inside = t[in_bin(t, i, lo, hi)]
+        n = len(inside)
+        if n >= 2 and lo < 0.5 * (inside[n // 2 - 1] + inside[n // 2]) < hi:
+            out[2 * i + 1] = 0.5 * (inside[n // 2 - 1] + inside[n // 2])
     return out
+
+
+def _left_closed_bins(t_events, boundaries):
+    """The mistake of bins [b_i, b_{i+1}) (searchsorted side='left' at both ends, or t < b_{i+1})."""
+    return _median_cuts(t_events, boundaries, lambda t, i, lo, hi: (t >= lo) & (t < hi))
 
 
 def _first_edge_at_zero(t_events, boundaries):
     """The mistake of bin 0's closed left edge written as `t == 0`: right only when b_0 = 0."""
-    t = np.asarray(t_events, dtype=np.float64)
-    out = _midpoints(t, boundaries)
-    for i, (lo, hi) in enumerate(zip(out[0:-1:2], out[2::2])):
-        in_bin = t[((t > lo) | ((i == 0) & (t == 0))) & (t <= hi)]
-        n = len(in_bin)
-        if n >= 2 and lo < 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2]) < hi:
-            out[2 * i + 1] = 0.5 * (in_bin[n // 2 - 1] + in_bin[n // 2])
-    return out
+    return _median_cuts(t_events, boundaries, lambda t, i, lo, hi: ((t > lo) | ((i == 0) & (t == 0))) & (t <= hi))
 
 
 exercises.register(

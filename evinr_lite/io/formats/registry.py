@@ -22,22 +22,21 @@ __all__ = ["FORMATS", "get_format", "detect_format", "read_recording", "read_eve
            "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder", "is_ros2_bag"]
 
 HEAD_BYTES = 64
-UNSUPPORTED = {   # first bytes of files that are recognised but not read -> the fix
-    b"#!AER-DAT3": "an AEDAT3 file; only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) "
-                   "or export the events to a `t x y p` text file",
-    b"#!AER-DAT2": "an AEDAT2 file; only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) "
-                   "or export the events to a `t x y p` text file",
-    b"#!AER-DAT1": "an AEDAT2 file; only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) "
-                   "or export the events to a `t x y p` text file",
-    b"PK\x03\x04": "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside",
-    b"#ROSBAG V2.0": "a ROS1 bag, which is not read directly; convert it with `python -m data_fetch convert FILE.bag` "
-                     "(dvs_msgs event arrays and the APS images, to the canonical .h5 that evinr-lite reads)",
-    b"\x89MCAP": "an MCAP file, the storage of a ROS2 bag, which is not read directly; pass the bag's folder (the one "
-                 "with metadata.yaml) to `python -m data_fetch convert FOLDER`, which writes the canonical .h5 "
-                 "that evinr-lite reads",
-    b"SQLite format 3\x00": "an SQLite database, such as a ROS2 bag's .db3 storage, which is not read directly; for a "
-                            "bag, pass its folder (the one with metadata.yaml) to `python -m data_fetch convert FOLDER`, "
-                            "which writes the canonical .h5 that evinr-lite reads",
+_AEDAT_FIX = "only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) or export the events " \
+             "to a `t x y p` text file"
+_ROS2_FIX = "pass the bag's folder (the one with metadata.yaml) to `python -m data_fetch convert FOLDER`, which " \
+            "writes the canonical .h5 that evinr-lite reads"
+UNSUPPORTED = {   # first bytes of files that are recognised but not read -> (sniff_format's name, the fix)
+    b"#!AER-DAT3": ("aedat3", f"an AEDAT3 file; {_AEDAT_FIX}"),
+    b"#!AER-DAT2": ("aedat2", f"an AEDAT2 file; {_AEDAT_FIX}"),
+    b"#!AER-DAT1": ("aedat2", f"an AEDAT2 file; {_AEDAT_FIX}"),
+    b"PK\x03\x04": ("zip", "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside"),
+    b"#ROSBAG V2.0": ("rosbag", "a ROS1 bag, which is not read directly; convert it with `python -m data_fetch convert "
+                                "FILE.bag` (dvs_msgs event arrays and the APS images, to the canonical .h5 that "
+                                "evinr-lite reads)"),
+    b"\x89MCAP": ("mcap", f"an MCAP file, the storage of a ROS2 bag, which is not read directly; {_ROS2_FIX}"),
+    b"SQLite format 3\x00": ("sqlite", "an SQLite database, such as a ROS2 bag's .db3 storage, which is not read "
+                                       f"directly; for a bag, {_ROS2_FIX}"),
 }
 ROS2_METADATA = "rosbag2_bagfile_information"   # the key a ROS2 bag's metadata.yaml opens with
 
@@ -128,7 +127,7 @@ def detect_format(path) -> str:
                 return fmt.name
     except OSError as err:
         raise EventDataError(f"{path}: cannot be read ({err.strerror}); check its permissions") from None
-    for magic, problem in UNSUPPORTED.items():
+    for magic, (_, problem) in UNSUPPORTED.items():
         if head.startswith(magic):
             raise EventDataError(f"{path}: {problem}")
     suffix = path.suffix.lower()
@@ -157,9 +156,7 @@ def sniff_format(path) -> str | None:
     for fmt in FORMATS:
         if not fmt.folder and not fmt.by_suffix and fmt.sniff(path, head):
             return fmt.name
-    names = {b"#!AER-DAT3": "aedat3", b"#!AER-DAT2": "aedat2", b"#!AER-DAT1": "aedat2", b"PK\x03\x04": "zip",
-             b"#ROSBAG V2.0": "rosbag", b"\x89MCAP": "mcap", b"SQLite format 3\x00": "sqlite"}
-    return next((name for magic, name in names.items() if head.startswith(magic)), None)
+    return next((name for magic, (name, _) in UNSUPPORTED.items() if head.startswith(magic)), None)
 
 
 def read_recording(path, **options) -> Recording:
