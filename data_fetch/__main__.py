@@ -191,8 +191,11 @@ def main(argv=None) -> int:
     The guard is evinr-lite's (:func:`evinr_lite.core.guard.run_guarded`): signals handled from the
     first line, a closed stdout pipe harmless, a deleted current folder refused."""
     from evinr_lite.core.guard import run_guarded   # standard library only
+    from evinr_lite.core.runtime import command_page_policy   # standard library only
 
     owns_process = argv is None
+    if owns_process:                       # numpy not imported yet: its page policy (core/runtime.py)
+        command_page_policy()
     argv = list(sys.argv[1:] if argv is None else argv)
     seen = {}
 

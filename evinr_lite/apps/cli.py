@@ -388,8 +388,11 @@ def main(argv=None) -> int:
     says what happened to the output folder; a closed stdout pipe does not change the result.
     """
     from ..core.guard import run_guarded   # standard library only
+    from ..core.runtime import command_page_policy   # standard library only
 
     owns_process = argv is None            # the command itself, not a call from Python
+    if owns_process:                       # numpy not imported yet: its page policy (core/runtime.py)
+        command_page_policy()
     argv = list(sys.argv[1:] if argv is None else argv)
     seen = {}
 

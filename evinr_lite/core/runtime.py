@@ -8,15 +8,19 @@
   under pytest/nbval (``tests/conftest.py`` sets it) and in CI (``CI`` set).
 - ``cache_dir`` / ``weights_dir``: where downloads, converted sequences and model weights live
   (``$EVINR_DATA`` or ``~/.cache/evinr-lite``); ``data_fetch`` writes there, the kit reads there.
+- ``command_page_policy``: the commands' numpy arrays on ordinary memory pages, not transparent
+  huge pages (``NUMPY_MADVISE_HUGEPAGE``; why below).
 """
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 from .guard import InputError   # standard library only: the command's start-up stays light
 
-__all__ = ["default_device", "DeviceUnavailable", "cpu_threads", "fast_mode", "pick", "cache_dir", "weights_dir", "FAST_ENV_VAR", "CACHE_ENV_VAR"]
+__all__ = ["default_device", "DeviceUnavailable", "cpu_threads", "fast_mode", "pick", "cache_dir", "weights_dir", "FAST_ENV_VAR", "CACHE_ENV_VAR",
+           "command_page_policy", "HUGEPAGE_ENV_VAR"]
 
 CACHE_ENV_VAR = "EVINR_DATA"
 
@@ -89,3 +93,25 @@ def cache_dir() -> Path:
 def weights_dir(name: str) -> Path:
     """Folder of a weight set (e.g. "lpips"): ``<cache>/weights/<name>``."""
     return cache_dir() / "weights" / name.lower()
+
+
+HUGEPAGE_ENV_VAR = "NUMPY_MADVISE_HUGEPAGE"
+
+
+def command_page_policy() -> bool:
+    """Ask numpy for ordinary (4 KiB) memory pages for the rest of this process, unless the user chose
+    (``NUMPY_MADVISE_HUGEPAGE`` set) or numpy is already imported (numpy reads the variable once, when
+    it is imported); returns whether the setting was made. ``evinr-lite`` and ``python -m data_fetch``
+    call it on their first line, when they are the process; a library call leaves numpy as it is.
+
+    Why: numpy asks the kernel for transparent huge pages (2 MiB) for every array of 4 MiB and more.
+    On virtual machines that back their memory lazily, as the machines this kit is developed and tested
+    on do, a huge page touched for the first time is far dearer than ordinary pages: 1.5 GB of fresh
+    float32 arrays took 9.1-9.6 s there against 0.6-0.7 s without huge pages (a new process each, 6 s
+    apart), and a 1280x720 2 s ``reconstruct``, whose arrays reach 1.5 GB, spent 10 of its 22 s in
+    the kernel (docs/scale.md). Arrays below 4 MiB (a 240x180 scene's) are not affected, and on a
+    machine where huge pages pay, ``NUMPY_MADVISE_HUGEPAGE=1`` keeps them."""
+    if HUGEPAGE_ENV_VAR in os.environ or "numpy" in sys.modules:
+        return False
+    os.environ[HUGEPAGE_ENV_VAR] = "0"
+    return True
