@@ -160,7 +160,7 @@ class SumAbsProx:
         self.s[:, 0], self.s[:, K + 1] = -np.inf, np.inf
         self.flat = self.s.reshape(-1)
         self.row = np.arange(E, dtype=np.int64) * K2
-        self.j = None
+        self.j = self.c_lo = self.c_hi = None          # each edge's j, c_(j-1) and c_j, from the first call on
 
     def _bisect(self, w: np.ndarray, row: np.ndarray) -> np.ndarray:
         # the smallest j in [0, K] with w <= c_j (c_j sits in column j + 1)
@@ -177,17 +177,30 @@ class SumAbsProx:
         if self.j is None:
             self.j = self._bisect(w, self.row)
             idx = self.row + self.j
-            c_before = self.flat[idx]
+            self.c_lo, self.c_hi = self.flat[idx], self.flat[idx + 1]
         else:                                       # last iteration's j where it still holds: c_(j-1) < w <= c_j
-            idx = self.row + self.j
-            c_before = self.flat[idx]
-            moved = np.flatnonzero((w <= c_before) | (w > self.flat[idx + 1]))
+            moved = np.flatnonzero((w <= self.c_lo) | (w > self.c_hi))
             if moved.size:
-                self.j[moved] = self._bisect(w[moved], self.row[moved])
-                idx[moved] = self.row[moved] + self.j[moved]
-                c_before[moved] = self.flat[idx[moved]]
+                self._search(w, moved)
         # z = w - (2 j - K) / rho, pushed up to b_(j) = c_(j-1) - (2 (j - 1) - K) / rho (-inf for j = 0)
-        return np.maximum(w - self.steps[self.j], c_before - self.steps_before[self.j])
+        z = w - self.steps[self.j]
+        return np.maximum(z, self.c_lo - self.steps_before[self.j], out=z)
+
+    def _search(self, w: np.ndarray, moved: np.ndarray) -> None:
+        """j, c_(j-1) and c_j again for the ``moved`` edges. Most moved by one since the last iteration, so
+        j - 1 and j + 1 are tried first (one look-up each), and only the rest are bisected."""
+        wm, base = w[moved], self.row[moved] + self.j[moved]
+        down = wm <= self.c_lo[moved]                                  # w <= c_(j-1): j is smaller
+        # one step down holds when c_(j-2) < w (column j - 1; -inf for j = 1), one up when w <= c_(j+1)
+        # (column j + 2; +inf for j = K - 1): either way the same unique j as a bisection
+        near = np.where(down, wm > self.flat[base - down], wm <= self.flat[base + 2 - 2 * down])
+        j = self.j[moved] + np.where(down, -1, 1)
+        far = ~near
+        if far.any():
+            j[far] = self._bisect(wm[far], self.row[moved[far]])
+        self.j[moved] = j
+        idx = self.row[moved] + j
+        self.c_lo[moved], self.c_hi[moved] = self.flat[idx], self.flat[idx + 1]
 
 
 class _EdgeSplit:
@@ -201,26 +214,33 @@ class _EdgeSplit:
         """One iteration from D g (this direction's differences of the current offset): returns z - u
         (float64 [E]), what the Poisson step integrates."""
         # over-relaxed ADMM (h = a D g + (1 - a) z, a = L1_RELAX): the same fixed point, fewer iterations
-        h = L1_RELAX * dg.astype(np.float32).ravel() + (1 - L1_RELAX) * self.z
+        h = dg.astype(np.float32).ravel()
+        h *= L1_RELAX
+        h += (1 - L1_RELAX) * self.z
         self.z = self.prox(h + self.u)
-        self.u += h - self.z
+        h -= self.z
+        self.u += h
         return (self.z - self.u).astype(np.float64)
 
 
-def _edge_values(F: np.ndarray, axis: int) -> np.ndarray:
+def _edge_values(F: np.ndarray, axis: int) -> tuple[np.ndarray, float]:
     """float32 [E, K + 2]: the K frames' -(forward differences along ``axis`` of F [K, H, W]) per edge
-    (E edges, row-major) in columns 1..K, the two end columns left for :class:`SumAbsProx`; a block of
-    image rows at a time (no float64 copy of F, and each block's transpose stays in cache)."""
+    (E edges, row-major) in columns 1..K, the two end columns left for :class:`SumAbsProx`; and the mean
+    |difference| (float). A block of image rows at a time (no float64 copy of F, no second E x K array,
+    and each block's transpose stays in cache)."""
     K, H, W = F.shape
     width = W - 1 if axis == 2 else W
     n_rows = H if axis == 2 else H - 1
     out = np.empty((n_rows * width, K + 2), np.float32)
+    total = 0.0
     rows = max(1, (1 << 18) // max(K * width, 1))
     for r0 in range(0, n_rows, rows):
         r1 = min(n_rows, r0 + rows)
         block = np.asarray(F[:, r0:r1 + (axis == 1)], np.float32)
-        out[r0 * width:r1 * width, 1:K + 1] = -np.diff(block, axis=axis).reshape(K, -1).T
-    return out
+        d = np.diff(block, axis=axis)
+        total += float(np.abs(d).sum(dtype=np.float64))
+        out[r0 * width:r1 * width, 1:K + 1] = -d.reshape(K, -1).T
+    return out, total / max(out.shape[0] * K, 1)
 
 
 def _moved(F: np.ndarray, rest: float) -> np.ndarray:
@@ -296,9 +316,9 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
     # same numbers on any count
     with ThreadPoolExecutor(2 if cpu_threads() >= 2 else 1) as pool:
         both = lambda fx, fy: [f.result() for f in (pool.submit(fx), pool.submit(fy))]   # noqa: E731
-        bx, by = both(lambda: _edge_values(F, 2), lambda: _edge_values(F, 1))
+        (bx, mx), (by, my) = both(lambda: _edge_values(F, 2), lambda: _edge_values(F, 1))
         # the mean, not the median: integrated events are flat at most pixels, so their median |gradient| is 0
-        scale = float(np.abs(bx[:, 1:K + 1]).mean(dtype=np.float64) + np.abs(by[:, 1:K + 1]).mean(dtype=np.float64)) / 2
+        scale = (mx + my) / 2
         if rest is not None:                        # a static camera: the frames at rest leave each edge's term
             moved = _moved(F, rest)
             both(lambda: _leave_out_rest(bx, moved, 2, scale), lambda: _leave_out_rest(by, moved, 1, scale))
