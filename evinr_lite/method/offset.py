@@ -143,8 +143,9 @@ class SumAbsProx:
     is that z for the smallest j with z <= b_(j+1) (the sorted values, 1-based), pushed up to b_(j) when it
     falls below it. Put c_j = b_(j+1) + (2 j - K) / rho, increasing in j: then j is the number of c_j below
     w (c_(j-1) < w <= c_j), found by bisection. Between ADMM iterations w moves little, so last iteration's
-    j is checked first and only the edges whose j moved are searched again. Memory: float32 [E, K + 2],
-    each row -inf, c_0 .. c_(K-1), +inf (the two ends spare every test for j = 0 and j = K)."""
+    j is checked first (against c_(j-1) and c_j, kept beside j) and only the edges whose j moved are searched
+    again. Memory: float32 [E, K + 2], each row -inf, c_0 .. c_(K-1), +inf (the two ends spare every test for
+    j = 0 and j = K), and 16 bytes per edge for j, c_(j-1) and c_j."""
 
     def __init__(self, values: np.ndarray, rho: float):
         # values: float32 [E, K + 2], each edge's K values b_ek in columns 1..K (sorted here, in place)
@@ -299,8 +300,8 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
     integral of z - u (:func:`poisson_integrate`). It starts from the median answer and stops after
     ``max_iters`` iterations or once no pixel moves by more than ``tol`` x the mean |gradient|. rho and a
     set how fast it gets there, not where (the problem is convex). Cost: one sort of each edge's K values,
-    then per iteration a few passes over the edges (x and y on two threads) and one DCT solve; 1.5-2.5x
-    the median's time (0.12 s against 0.08 s at 64 x 180 x 240, 3.3 s against 1.3 s at 64 x 720 x 1280).
+    then per iteration a few passes over the edges (x and y on two threads) and one DCT solve; about the
+    median's time (0.06 s against 0.10 s at 64 x 180 x 240, 1.5 s against 1.4 s at 64 x 720 x 1280, 2 cores).
     Memory: float32 [K + 2] per edge in x and y, 12 bytes per frame and pixel at its peak (tracemalloc).
 
     ``rest``: None (every frame counts), or log units: each edge's term counts only the frames where one
