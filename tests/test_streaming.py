@@ -243,3 +243,18 @@ def test_a_killed_command_resumes_without_recomputing_finished_windows(tmp_path,
         a = np.asarray(Image.open(tmp_path / "whole" / "frames" / name))
         b = np.asarray(Image.open(tmp_path / "out" / "frames" / name))
         np.testing.assert_array_equal(a, b)
+
+
+def test_the_command_saves_the_state_after_every_window_but_the_last(tmp_path, monkeypatch):
+    # the last window's state would spare a resume only that window's training, and writing it (the offset
+    # grid) cost a third of that at 1280x720: the command skips it
+    from evinr_lite.apps.recon_job import run_reconstruct
+
+    path = _recording_file(tmp_path / "rec.h5")
+    saved = []
+    save = StreamState.save
+    monkeypatch.setattr(StreamState, "save", lambda self, file: (saved.append((self.next_window, len(self.windows))),
+                                                                 save(self, file))[1])
+    run_reconstruct(path, tmp_path / "out", fps=5, video=False, progress=False, log=lambda *a: None)
+    n = saved[0][1]
+    assert n >= 3 and [k for k, _ in saved] == list(range(1, n))

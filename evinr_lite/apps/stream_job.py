@@ -209,8 +209,11 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
                 state = _prepare_resume(folder, _key(path, config, times, (lo, hi)), resume, log)
                 made = True
             writer = _FrameWriter(target.staging, times, query, gt_t, options.video, log)
+            # the state after the last window is not saved: writing it (the offset grid: 240 MB at 1280x720)
+            # took as long as a third of that window's training, which is all a resume from it would spare
             parts = stream_reconstruct(source, query, config, t_start=lo, t_end=hi, workdir=folder, state=state,
-                                       on_state=lambda s: s.save(folder / "state.npz"), progress=options.progress)
+                                       on_state=lambda s: s.save(folder / "state.npz") if s.next_window < len(s.windows)
+                                       else None, progress=options.progress)
             for part in parts:
                 writer.add(part)
                 history = part.history
