@@ -1,9 +1,10 @@
-"""Prophesee recordings: EVT 2 / 3 ``.raw`` and DAT ``.dat`` (CD events), decoded by faery.
+"""Prophesee recordings: EVT 2 / 3 ``.raw`` and DAT ``.dat`` (CD events), decoded by faery, and EVT 2.1
+``.raw``, which faery 0.7.1 does not decode, by :mod:`.evt21` (numpy).
 
 The sensor size comes from the header (``% geometry`` / ``% format ...;width=;height=`` /
 ``% Width`` ``% Height``); some files carry none, and then ``sensor_size`` must be given. No frames.
-EVT 2.1 is not decoded by faery 0.7.1 yet. Timestamps are integer microseconds (see :mod:`.decoding`);
-a window is read by decoding packets in order and stopping after it.
+Timestamps are integer microseconds (see :mod:`.decoding`); a window is read by decoding packets in
+order and stopping after it.
 """
 from __future__ import annotations
 
@@ -16,11 +17,12 @@ from ...core.events import EventDataError
 from ...core.recording import Recording
 from .base import FileFormat, check_declared_size, check_reader_window, existing
 from .decoding import PacketCollector, decoder_failed, decoder_stderr
+from .evt21 import data_offset, evt21_packets, header_sensor_size, is_evt21, word_order
 from .packets import PacketSource
 
 __all__ = ["read_prophesee", "prophesee_header", "prophesee_kind", "RAW_VERSIONS", "FORMATS"]
 
-RAW_VERSIONS = ("evt2", "evt3")   # faery 0.7.1 does not decode EVT 2.1 yet
+RAW_VERSIONS = ("evt2", "evt21", "evt3")   # evt21 by .evt21 (faery 0.7.1 does not decode it)
 SUFFIX_KIND = {".raw": "prophesee_raw", ".dat": "prophesee_dat"}
 
 
@@ -67,6 +69,14 @@ def _decoded(path: Path, sensor_size=None, version: str | None = None):
         raise EventDataError(f"{path}: not a Prophesee .raw or .dat file (no `%` header and no .raw/.dat extension)")
     if version is not None and version not in RAW_VERSIONS:
         raise EventDataError(f"version must be one of {RAW_VERSIONS}, got {version!r}")
+    if kind == "prophesee_raw":
+        header = prophesee_header(path)
+        if is_evt21(header) or (version == "evt21" and not any(h.lower().startswith(("evt ", "format evt"))
+                                                                 for h in header)):
+            yield _evt21(path, header, sensor_size)
+            return
+    elif version == "evt21":
+        raise EventDataError(f"{path}: version='evt21' applies to .raw files, not to a DAT file")
     module, fallback_version = (evt, version or "evt3") if kind == "prophesee_raw" else (dat, "dat2")
     fallback_size = None if sensor_size is None else (int(sensor_size[1]), int(sensor_size[0]))  # (W, H)
     try:
@@ -117,16 +127,31 @@ def _decoded(path: Path, sensor_size=None, version: str | None = None):
         yield size, meta, packets()
 
 
+def _evt21(path: Path, header: list[str], sensor_size):
+    """(size, meta, packets) of an EVT 2.1 file, as :func:`_decoded` yields them."""
+    declared = header_sensor_size(header)
+    if declared is None and sensor_size is None:
+        raise EventDataError(f"{path}: the header does not give the sensor size; pass sensor_size=(H, W), e.g. "
+                             "(320, 320) for a GenX320 sensor, (720, 1280) for an IMX636")
+    size = (check_declared_size(path, declared, sensor_size, "header") if declared is not None
+            else (int(sensor_size[0]), int(sensor_size[1])))
+    offset = data_offset(path)
+    order = word_order(path, offset, size)
+    meta = {"format": "prophesee_raw", "path": str(path), "encoding": "evt21", "word_order": order,
+            "sensor_size_from": "header" if declared is not None else "sensor_size argument"}
+    return size, meta, (("events", packet) for packet in evt21_packets(path, offset, order))
+
+
 def read_prophesee(path, *, sensor_size=None, version: str | None = None,
                    t_start: float | None = None, t_end: float | None = None):
-    """A Prophesee recording: EVT 2 / 3 ``.raw`` or DAT ``.dat`` (CD events) as a Recording.
+    """A Prophesee recording: EVT 2 / 2.1 / 3 ``.raw`` or DAT ``.dat`` (CD events) as a Recording.
 
     Args:
         path: the file.
         sensor_size: (H, W); needed only when the header does not give the size (then it is an
             error to leave it out); checked against the header otherwise.
-        version: for a .raw whose header does not name its encoding: "evt2" or "evt3" (default
-            "evt3"); ignored when the header names it.
+        version: for a .raw whose header does not name its encoding: "evt2", "evt21" or "evt3"
+            (default "evt3"); ignored when the header names it.
         t_start, t_end: seconds relative to ``t_origin`` (the whole seconds of the first event on an
             absolute clock); only events with t_start <= t < t_end are kept, memory holds only them.
     Returns:
@@ -174,7 +199,7 @@ def _sniff_dat(path, head) -> bool:
 _COMMON = dict(reader=read_prophesee, takes_sensor_size=True, time_unit="us", windowed=True,
                open_source=open_prophesee, options=("version",))
 FORMATS = (
-    FileFormat(name="prophesee_raw", description="a Prophesee EVT2/EVT3 .raw file", suffixes=(".raw",),
+    FileFormat(name="prophesee_raw", description="a Prophesee EVT2/EVT2.1/EVT3 .raw file", suffixes=(".raw",),
                sniff=_sniff_raw, **_COMMON),
     FileFormat(name="prophesee_dat", description="a Prophesee DAT .dat file", suffixes=(".dat",), sniff=_sniff_dat,
                **_COMMON),
