@@ -290,7 +290,8 @@ class PolarityCounts:
     (:func:`interval_sums`) follow the last event of each pixel across updates, so chunks give the
     sums of the whole span. ``slices``: the boundaries (float64 [K + 1], s) of the span's time slices
     for the edges' estimate (:func:`slice_counts`; None: not counted, and the pooled counts stand in
-    for it); they take 8 K bytes per pixel (59 MB at 1280 x 720 with K = 8).
+    for it); they take 8 K bytes per pixel (59 MB at 1280 x 720 with K = 8). ``counts_only``: the ON /
+    OFF counts alone (the intervals and slices stay zero), for a pass that only finds hot pixels.
     """
 
     sensor_size: tuple
@@ -301,6 +302,7 @@ class PolarityCounts:
     last: tuple = field(default=None, repr=False)          # (last_t, last_p), [H, W] each
     slices: object = None                                   # float64 [K + 1] slice boundaries (s), or None
     sliced: tuple = field(default=None, repr=False)        # (on, off), float32 [K, H, W] each
+    counts_only: bool = False                               # n_on / n_off alone (a hot-pixel pass)
 
     def __post_init__(self):
         if not (0 < float(self.decay) <= 1):
@@ -325,6 +327,8 @@ class PolarityCounts:
         on, off = polarity_counts(events)
         self.n_on = self.n_on * self.decay + on
         self.n_off = self.n_off * self.decay + off
+        if self.counts_only:
+            return self
         *new, last_t, last_p = interval_sums(events, self.last)
         self.intervals = tuple(old * self.decay + add for old, add in zip(self.intervals, new))
         self.last = (last_t, last_p)

@@ -150,12 +150,15 @@ def _read_spans(source, t_start: float, t_end: float, chunk_s: float):
         yield (a, b), source.events(a, np.nextafter(b, np.inf) if i == len(edges) - 2 else b)
 
 
-def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str | None = None) -> PolarityCounts:
-    """The per-pixel ON / OFF counts over the span, read a chunk at a time; ``progress``: a bar's title
-    (seconds of the recording read), or None for none."""
+def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str | None = None,
+            counts_only: bool = False) -> PolarityCounts:
+    """The per-pixel ON / OFF counts over the span, read a chunk at a time (``counts_only``: those alone,
+    without the balance's intervals and slices); ``progress``: a bar's title (seconds of the recording
+    read), or None for none."""
     from tqdm.auto import tqdm
 
-    counts = PolarityCounts(tuple(source.sensor_size), slices=span_slices(t_start, t_end))
+    counts = PolarityCounts(tuple(source.sensor_size), slices=None if counts_only else span_slices(t_start, t_end),
+                            counts_only=counts_only)
     with tqdm(total=round(t_end - t_start, 3), desc=progress, unit="s", disable=progress is None,
               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s of events [{elapsed}<{remaining}]") as bar:
         for (a, b), events in _read_spans(source, t_start, t_end, chunk_s):
@@ -180,7 +183,8 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         # whole-span solve does, and hand the windows slices of it instead of reading and filtering again
         held, cfg = prepare_events(source.events(t_start, np.nextafter(t_end, np.inf)), cfg, span)
         return cfg, _Prepared(source, span, held=held)
-    counts = _counts(source, t_start, t_end, chunk_s, "counting events" if progress else None)
+    # with the filter, this first pass only finds the hot pixels (the balance reads the second one's counts)
+    counts = _counts(source, t_start, t_end, chunk_s, "counting events" if progress else None, counts_only=filtered)
     if filtered:
         if cfg.hot_pixels == "drop":
             first = _hot_mask(counts.n_on + counts.n_off)
