@@ -139,6 +139,19 @@ def _fixtures(root: Path) -> dict:
         d.mkdir()
         faery.events_stream_from_array(packet, dimensions=(W, H)).to_file(d / fname, version=version)
         out[name] = (d, fname, [fname], {})
+    d = root / "prophesee_evt21"        # decoded by the kit (io/formats/evt21.py), the IMX636's word order
+    d.mkdir()
+    t_us = np.round(t * 1e6).astype(np.uint64) + np.uint64(7_000_000)
+    words = []
+    for i in range(len(t)):
+        if i == 0 or t_us[i] >> 6 != t_us[i - 1] >> 6:
+            words.append((0x8 << 60) | (int(t_us[i] >> 6) << 32))
+        words.append((int(p[i] > 0) << 60) | ((int(t_us[i]) & 0x3F) << 54) | (int(y[i]) << 32) | (1 << int(x[i])))
+    words = np.array(words, np.uint64)
+    words = (words << np.uint64(32)) | (words >> np.uint64(32))
+    (d / "rec.raw").write_bytes(f"% evt 2.1\n% format EVT21;height={H};width={W}\n% end\n".encode()
+                                + words.astype("<u8").tobytes())
+    out["prophesee_evt21"] = (d, "rec.raw", ["rec.raw"], {})
     return out
 
 
@@ -204,7 +217,8 @@ def read_and_classify(kind, path, kwargs):
     OUTCOMES[kind]["events"] += 1
 
 
-FORMATS = ["npy", "txt", "csv", "ijrr", "evreal", "h5", "dsec", "mvsec", "canonical", "aedat4", "prophesee_raw", "prophesee_dat"]
+FORMATS = ["npy", "txt", "csv", "ijrr", "evreal", "h5", "dsec", "mvsec", "canonical", "aedat4", "prophesee_raw", "prophesee_dat",
+           "prophesee_evt21"]
 
 
 @pytest.mark.parametrize("kind", FORMATS)

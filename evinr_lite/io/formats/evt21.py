@@ -49,14 +49,15 @@ def header_sensor_size(header: list[str]):
     width = height = None
     for line in header:
         low = line.strip().lower()
-        m = re.match(r"geometry\s+(\d+)\s*x\s*(\d+)", low)
+        m = re.match(r"geometry\s+([0-9]+)\s*x\s*([0-9]+)", low)
         if m:
             return int(m.group(2)), int(m.group(1))
         if low.startswith("format"):
             fields = dict(f.split("=", 1) for f in low.split(";")[1:] if "=" in f)
-            if fields.get("width", "").strip().isdigit() and fields.get("height", "").strip().isdigit():
-                return int(fields["height"]), int(fields["width"])
-        m = re.match(r"(width|height)\s+(\d+)$", low)
+            w, h = (re.fullmatch(r"\s*([0-9]+)\s*", fields.get(k, "")) for k in ("width", "height"))
+            if w and h:
+                return int(h.group(1)), int(w.group(1))
+        m = re.match(r"(width|height)\s+([0-9]+)$", low)
         if m:
             width, height = (int(m.group(2)), height) if m.group(1) == "width" else (width, int(m.group(2)))
     return (height, width) if width and height else None
