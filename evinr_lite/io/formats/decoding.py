@@ -15,9 +15,27 @@ import numpy as np
 
 from ...core.events import LARGE_T, EventDataError, Events
 
-__all__ = ["US", "decoder_failed", "decoder_stderr", "PacketCollector", "origin_us_of"]
+__all__ = ["US", "decoder_failed", "decoder_stderr", "PacketCollector", "origin_us_of", "percent_header"]
 
 US = 10**6  # microseconds per second
+
+
+def percent_header(path, limit: int = 1 << 16) -> tuple[list[str], int]:
+    """A Prophesee file's ``% ...`` header: its lines (without the '% ') and the byte after it, where the
+    binary data starts. The header ends at a ``% end`` line or at the first line not opened by '%'."""
+    lines = []
+    with open(path, "rb") as f:
+        head = f.read(limit)
+    pos = 0
+    while pos < len(head) and head[pos:pos + 1] == b"%":
+        end = head.find(b"\n", pos)
+        if end < 0:
+            break
+        lines.append(head[pos + 1:end].decode("latin-1").strip())
+        pos = end + 1
+        if lines[-1].lower() == "end":
+            break
+    return lines, pos
 
 
 def origin_us_of(first_us: int) -> int:

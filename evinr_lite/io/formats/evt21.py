@@ -25,7 +25,7 @@ import numpy as np
 
 from ...core.events import EventDataError
 
-__all__ = ["is_evt21", "header_sensor_size", "data_offset", "word_order", "decode_words", "evt21_packets",
+__all__ = ["is_evt21", "header_sensor_size", "word_order", "decode_words", "evt21_packets",
            "EVENT_DTYPE", "ORDERS"]
 
 EVENT_DTYPE = np.dtype([("t", "<u8"), ("x", "<u2"), ("y", "<u2"), ("on", "?")])
@@ -61,21 +61,6 @@ def header_sensor_size(header: list[str]):
         if m:
             width, height = (int(m.group(2)), height) if m.group(1) == "width" else (width, int(m.group(2)))
     return (height, width) if width and height else None
-
-
-def data_offset(path: Path, limit: int = 1 << 16) -> int:
-    """The byte where the event words start: after the last line of the ``%`` header."""
-    with open(path, "rb") as f:
-        head = f.read(limit)
-    pos = 0
-    while pos < len(head) and head[pos:pos + 1] == b"%":
-        end = head.find(b"\n", pos)
-        if end < 0:
-            raise EventDataError(f"{path}: the '%' header does not end within its first {limit} bytes")
-        pos = end + 1
-        if head[:pos].rstrip().lower().endswith(b"% end"):
-            break
-    return pos
 
 
 def _as_words(raw: np.ndarray, order: str) -> np.ndarray:

@@ -16,8 +16,8 @@ import numpy as np
 from ...core.events import EventDataError
 from ...core.recording import Recording
 from .base import FileFormat, check_declared_size, check_reader_window, existing
-from .decoding import PacketCollector, decoder_failed, decoder_stderr
-from .evt21 import data_offset, evt21_packets, header_sensor_size, is_evt21, word_order
+from .decoding import PacketCollector, decoder_failed, decoder_stderr, percent_header
+from .evt21 import evt21_packets, header_sensor_size, is_evt21, word_order
 from .packets import PacketSource
 
 __all__ = ["read_prophesee", "prophesee_header", "prophesee_kind", "RAW_VERSIONS", "FORMATS"]
@@ -28,19 +28,7 @@ SUFFIX_KIND = {".raw": "prophesee_raw", ".dat": "prophesee_dat"}
 
 def prophesee_header(path: Path, limit: int = 1 << 16) -> list[str]:
     """The `% ...` header lines at the start of a Prophesee file (without the '% ')."""
-    lines = []
-    with open(path, "rb") as f:
-        head = f.read(limit)
-    pos = 0
-    while pos < len(head) and head[pos:pos + 1] == b"%":
-        end = head.find(b"\n", pos)
-        if end < 0:
-            break
-        lines.append(head[pos + 1:end].decode("latin-1").strip())
-        pos = end + 1
-        if lines[-1].lower() == "end":
-            break
-    return lines
+    return percent_header(path, limit)[0]
 
 
 def prophesee_kind(path, head: bytes | None) -> str | None:
@@ -135,7 +123,7 @@ def _evt21(path: Path, header: list[str], sensor_size):
                              "(320, 320) for a GenX320 sensor, (720, 1280) for an IMX636")
     size = (check_declared_size(path, declared, sensor_size, "header") if declared is not None
             else (int(sensor_size[0]), int(sensor_size[1])))
-    offset = data_offset(path)
+    offset = percent_header(path)[1]
     order = word_order(path, offset, size)
     meta = {"format": "prophesee_raw", "path": str(path), "encoding": "evt21", "word_order": order,
             "sensor_size_from": "header" if declared is not None else "sensor_size argument"}
