@@ -30,7 +30,7 @@ answers into one image. :func:`l1_gradient_offset` (``offset_solve="l1_gradient"
 objective behind the median jointly instead: the image g whose addition makes all frames' gradients
 sparsest in total, min_g sum_k |D (F_k + g)|_1, with D the forward differences. It is convex; ADMM
 splits it into an exact proximal step per edge (over that edge's K values) and the same DCT Poisson
-solve per iteration, at 1.5-2.5x the median's time.
+solve per iteration, at about the median's time (1.5-2.5x before 2026-12-06; docs/scale.md).
 
 A static camera (``EvINRConfig(camera="static")``, ``rest=`` here) breaks the sparse-gradient rule's
 premise. A pixel the moving object never covers fires no event, and one it covers rests before and
