@@ -227,6 +227,8 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
         bag = ros2_to_ros1(raw, out.parent / f".{raw.name}.ros1.bag")
         try:
             return convert_bag(bag, out, **common, **topics)
+        except ConversionError as err:   # name the user's bag, not its temporary ROS1 copy
+            raise ConversionError(str(err).replace(str(bag), str(raw))) from None
         finally:
             bag.unlink(missing_ok=True)
     # a CED-style zip of bags: take out the one bag, convert it, delete the copy

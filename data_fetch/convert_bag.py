@@ -8,6 +8,13 @@ after the header come height, width, the event count and then packed 13-byte eve
 Python object per event. The numpy path is used only when the connection's message definition has
 the dvs_msgs/EventArray md5; any other definition goes through rosbags' deserializer.
 
+Prophesee cameras under ROS (``metavision_driver``) publish event_camera_msgs/EventPacket instead: each
+message carries a slice of the camera's own byte stream (``encoding`` "evt3", "evt2" or "evt21"), and the
+slices in order are that stream. A bag without a dvs_msgs topic is converted from such packets: their bytes
+are written one after the other into a temporary Prophesee ``.raw`` file beside ``out`` (header from the
+packets' encoding, width and height), which the kit's Prophesee reader decodes a window at a time, on the
+sensor's clock (microseconds since the camera started). Other encodings (libcaer's) are refused by name.
+
 Colour cameras (CED's Color DAVIS346: a 2 x 2 RGGB Bayer filter over both the events and the APS):
 ``cfa="RGGB"`` records the filter with the events (the canonical ``cfa`` attribute), and colour frames
 are kept in colour (/frames/rgb, with their grey version in /frames/images): rgb8 / bgr8 / rgba8 /
@@ -31,7 +38,7 @@ from .canonical import CanonicalWriter
 from .errors import ConversionError
 
 __all__ = ["convert_bag", "ros2_to_ros1", "decode_event_array", "decode_image", "debayer", "EVENT_DTYPE",
-           "EVENT_ARRAY_MD5", "ROS2_DVS_MSGS"]
+           "EVENT_ARRAY_MD5", "ROS2_DVS_MSGS", "EVENT_PACKET_MSGS", "EVENT_PACKET_TYPE", "packets_to_raw"]
 
 log = logging.getLogger("data_fetch")
 
@@ -43,22 +50,28 @@ IMAGE_TYPE = "sensor_msgs/msg/Image"
 ROS2_DVS_MSGS = {"dvs_msgs/msg/Event": "uint16 x\nuint16 y\nbuiltin_interfaces/Time ts\nbool polarity\n",
                  "dvs_msgs/msg/EventArray": "std_msgs/Header header\nuint32 height\nuint32 width\n"
                                             "dvs_msgs/Event[] events\n"}
+EVENT_PACKET_TYPE = "event_camera_msgs/msg/EventPacket"
+# event_camera_msgs/EventPacket (ROS1 and ROS2 alike), for bags that carry no message definitions
+EVENT_PACKET_MSGS = {EVENT_PACKET_TYPE: "std_msgs/Header header\nuint32 height\nuint32 width\nuint64 seq\n"
+                                        "uint64 time_base\nstring encoding\nbool is_bigendian\nuint8[] events\n"}
+PACKET_HEADERS = {"evt3": "evt 3.0\n% format EVT3", "evt2": "evt 2.0\n% format EVT2", "evt21": "evt 2.1\n% format EVT21"}
 PREFERRED_EVENT_TOPICS = ("/dvs/events", "/davis/left/events")
+PREFERRED_PACKET_TOPICS = ("/event_camera/events",)
 PREFERRED_IMAGE_TOPICS = ("/dvs/image_raw", "/davis/left/image_raw", "/dvs/image_color")
 
 
 def ros2_to_ros1(src, dst) -> Path:
     """A ROS2 bag (its folder: metadata.yaml with .db3 or .mcap storage) rewritten as the ROS1 bag ``dst``,
     message by message, by rosbags' converter (CDR to ROS1 serialization), so that :func:`convert_bag`
-    reads it. The bag's own message definitions are used; dvs_msgs are known here for bags that carry none
-    (:data:`ROS2_DVS_MSGS`). ``dst`` is replaced. ConversionError names what failed."""
+    reads it. The bag's own message definitions are used; dvs_msgs and event_camera_msgs/EventPacket are
+    known here for bags that carry none (:data:`ROS2_DVS_MSGS`, :data:`EVENT_PACKET_MSGS`). ``dst`` is replaced. ConversionError names what failed."""
     from rosbags.convert import ConverterError, convert
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     src, dst = Path(src), Path(dst)
     store = get_typestore(Stores.ROS2_HUMBLE)
     types = {}
-    for name, text in ROS2_DVS_MSGS.items():
+    for name, text in {**ROS2_DVS_MSGS, **EVENT_PACKET_MSGS}.items():
         types.update(get_types_from_msg(text, name))
     store.register(types)
     dst.unlink(missing_ok=True)
@@ -240,8 +253,14 @@ def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None
     try:
         ev_conn = _pick(reader.connections, EVENT_ARRAY_TYPE, event_topic, PREFERRED_EVENT_TOPICS, "event", path)
         if ev_conn is None:
+            packets = _pick(reader.connections, EVENT_PACKET_TYPE, event_topic, PREFERRED_PACKET_TOPICS, "event", path)
+            if packets is not None:
+                return _convert_packets(reader, packets, path, out, sensor_size=sensor_size, C=C,
+                                        eval_window=eval_window, dataset=dataset, sequence=sequence, source=source,
+                                        source_url=source_url, progress=progress)
             topics = sorted(f"{c.topic} ({c.msgtype})" for c in reader.connections)
-            raise ConversionError(f"{path}: no dvs_msgs/EventArray topic; the bag holds {topics}")
+            raise ConversionError(f"{path}: no dvs_msgs/EventArray or event_camera_msgs/EventPacket topic; the bag "
+                                  f"holds {topics}")
         img_conn = _pick(reader.connections, IMAGE_TYPE, image_topic, PREFERRED_IMAGE_TOPICS, "image", path)
         if img_conn is None:
             log.warning("data_fetch: %s: no sensor_msgs/Image topic, so no ground-truth frames", path)
@@ -324,3 +343,94 @@ def convert_bag(path, out, *, sensor_size=None, C: float = 1.0, eval_window=None
         if "w" in writer_box:
             writer_box["w"].abort()
         reader.close()
+
+
+def _packet_store(conn):
+    """A ROS1 typestore that knows ``conn``'s EventPacket definition (the bag's own, else the known one)."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    text = conn.msgdef.data if conn.msgdef and conn.msgdef.data else EVENT_PACKET_MSGS[EVENT_PACKET_TYPE]
+    store.register({k: v for k, v in get_types_from_msg(text, conn.msgtype).items() if k not in store.types})
+    return store
+
+
+def packets_to_raw(messages, raw: Path, path) -> tuple[int, int, str]:
+    """Write the event bytes of EventPacket messages (deserialized, in order) after a Prophesee header into
+    ``raw``: the camera's own stream, which the Prophesee reader decodes. Returns (height, width, encoding);
+    ConversionError for an encoding the reader cannot decode, a big-endian stream or packets that disagree."""
+    first = None
+    with open(raw, "wb") as f:
+        for msg in messages:
+            key = (int(msg.height), int(msg.width), str(msg.encoding))
+            if first is None:
+                first = key
+                H, W, encoding = key
+                if encoding not in PACKET_HEADERS:
+                    raise ConversionError(f"{path}: event packets in the {encoding!r} encoding; data_fetch decodes "
+                                          f"{sorted(PACKET_HEADERS)} (Prophesee cameras); convert others with the "
+                                          "camera's own tools to a format evinr-lite reads (docs/commands.md)")
+                if not (H and W):
+                    raise ConversionError(f"{path}: the event packets give no sensor size (height {H}, width {W})")
+                f.write(f"% {PACKET_HEADERS[encoding]};height={H};width={W}\n% geometry {W}x{H}\n% end\n".encode())
+            elif key != first:
+                raise ConversionError(f"{path}: the event packets change from {first} to {key} (height, width, "
+                                      "encoding) within the topic; a topic must hold one camera's stream")
+            if msg.is_bigendian:
+                raise ConversionError(f"{path}: big-endian event packets are not decoded (Prophesee cameras send "
+                                      "little-endian ones)")
+            f.write(np.asarray(msg.events, np.uint8).tobytes())
+    if first is None:
+        raise ConversionError(f"{path}: the event packet topic holds no messages")
+    return first
+
+
+def _convert_packets(reader, conn, path: Path, out, *, sensor_size, C, eval_window, dataset, sequence, source,
+                     source_url, progress) -> Path:
+    """:func:`convert_bag` for a topic of event_camera_msgs/EventPacket: the packets' bytes into a temporary
+    ``.raw`` beside ``out``, decoded by the Prophesee reader a second at a time into the canonical file."""
+    from tqdm.auto import tqdm
+
+    from evinr_lite.io.formats.prophesee import open_prophesee
+
+    store = _packet_store(conn)
+    others = sorted(c.topic for c in reader.connections if c.msgtype == IMAGE_TYPE)
+    if others:
+        log.warning("data_fetch: %s: image topics %s are not stored: the event packets carry the camera's own "
+                    "clock, not the bag's", path, others)
+    raw = Path(out).parent / f".{Path(out).name}.packets.raw"
+    try:
+        with tqdm(total=conn.msgcount, unit="msg", desc=f"{sequence}: packets", disable=not progress) as bar:
+            def messages():
+                for _, _, data in reader.messages(connections=[conn]):
+                    bar.update(1)
+                    yield store.deserialize_ros1(data, conn.msgtype)
+            H, W, encoding = packets_to_raw(messages(), raw, path)
+        if sensor_size is not None and tuple(int(v) for v in sensor_size) != (H, W):
+            log.warning("data_fetch: %s: the packets report a %dx%d sensor, not the expected %dx%d; using the "
+                        "packets' size", path, W, H, int(sensor_size[1]), int(sensor_size[0]))
+        try:
+            source_ = open_prophesee(raw)
+            t0, t1 = source_.t_span
+        except EventDataError as err:
+            why = str(err).replace(f"{raw}: ", "")          # the temporary file is not the user's to look for
+            raise ConversionError(f"{path}: the {encoding} stream in the event packets could not be decoded ({why}); "
+                                  "the bag is damaged or the packets are not in order") from None
+        writer = CanonicalWriter(out, sensor_size=(H, W), t_origin=float(source_.t_origin), dataset=dataset,
+                                 sequence=sequence, source=source, source_url=source_url, raw_file=path.name, C=C,
+                                 eval_window=eval_window, converter="data_fetch.convert_bag",
+                                 meta={"event_topic": conn.topic, "image_topic": None, "packet_encoding": encoding,
+                                       "clock": "the camera's (microseconds), not the bag's"})
+        try:
+            edges = np.append(np.arange(t0, t1, 1.0), np.nextafter(t1, np.inf))
+            for a, b in zip(edges[:-1], edges[1:]):
+                ev = source_.events(float(a), float(b))
+                if len(ev):
+                    writer.add_events(ev.t, ev.x, ev.y, ev.p, where="packet events")
+            writer.meta["n_event_messages"] = conn.msgcount
+            return writer.close()
+        finally:
+            writer.abort()
+            source_.close()
+    finally:
+        raw.unlink(missing_ok=True)

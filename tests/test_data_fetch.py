@@ -778,3 +778,132 @@ def test_a_ros2_bag_without_message_definitions_converts_with_the_known_dvs_msgs
     monkeypatch.setattr(cb, "ROS2_DVS_MSGS", {})
     with pytest.raises(DataFetchError, match=r"ROS2 bag could not be read.*dvs_msgs/msg/EventArray"):
         convert(bag, tmp_path / "b.h5", progress=False)
+
+
+# ---- event_camera_msgs/EventPacket (Prophesee cameras under ROS: metavision_driver) --------------------------------
+
+def _packet_stream(n=3000, H=30, W=40, seed=3, encoding="evt3"):
+    """Events on a camera clock (integer microseconds), and the camera's own byte stream for them (faery's
+    EVT 2 / 3 writer, its header taken off)."""
+    faery = pytest.importorskip("faery")
+    rng = np.random.default_rng(seed)
+    ev = np.zeros(n, dtype=faery.EVENTS_DTYPE)
+    ev["t"] = np.sort(1_200_000 + rng.integers(0, 2_500_000, n)).astype(np.uint64)
+    ev["x"], ev["y"], ev["on"] = rng.integers(0, W, n), rng.integers(0, H, n), rng.random(n) < 0.5
+    path = Path(__import__("tempfile").mkdtemp()) / "s.raw"
+    faery.events_stream_from_array(ev, dimensions=(W, H)).to_file(path, version=encoding)
+    data = path.read_bytes()
+    pos, t0 = 0, 0
+    while data[pos:pos + 1] == b"%":
+        end = data.index(b"\n", pos)
+        if data[pos:end].startswith(b"% t0 "):       # faery's stream counts from this time: so does the camera's
+            t0 = int(data[pos + 5:end])
+        pos = end + 1
+    ev["t"] -= np.uint64(t0)
+    return ev, data[pos:]
+
+
+def make_packet_bag(folder, stream, H, W, encoding="evt3", per_msg=501, ros2=True, image=False):
+    """A bag of event_camera_msgs/EventPacket on /event_camera/events: the stream cut into messages of
+    per_msg bytes (anywhere, even inside a word: the messages in order are the stream), as metavision_driver
+    records them; image: also a sensor_msgs/Image topic."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    from data_fetch.convert_bag import EVENT_PACKET_MSGS, EVENT_PACKET_TYPE
+
+    store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
+    store.register(get_types_from_msg(EVENT_PACKET_MSGS[EVENT_PACKET_TYPE], EVENT_PACKET_TYPE))
+    T = store.types
+    Time, Header, Packet = T["builtin_interfaces/msg/Time"], T["std_msgs/msg/Header"], T[EVENT_PACKET_TYPE]
+    msgs = []
+    for k, a in enumerate(range(0, len(stream), per_msg)):
+        stamp = ORIGIN * NS + k * 1_000_000
+        head = Header(stamp=Time(sec=stamp // NS, nanosec=stamp % NS), frame_id="cam") if ros2 else \
+            Header(seq=k, stamp=Time(sec=stamp // NS, nanosec=stamp % NS), frame_id="cam")
+        msgs.append((stamp, "/event_camera/events", Packet(header=head, height=H, width=W, seq=k, time_base=0,
+                     encoding=encoding, is_bigendian=False, events=np.frombuffer(stream[a:a + per_msg], np.uint8)),
+                     EVENT_PACKET_TYPE))
+    if image:
+        Img = T["sensor_msgs/msg/Image"]
+        im = np.zeros((H, W), np.uint8)
+        head = Header(stamp=Time(sec=ORIGIN, nanosec=5), frame_id="") if ros2 else \
+            Header(seq=0, stamp=Time(sec=ORIGIN, nanosec=5), frame_id="")
+        msgs.append((ORIGIN * NS + 5, "/image", Img(header=head, height=H, width=W, encoding="mono8", is_bigendian=0,
+                                                     step=W, data=im.reshape(-1)), "sensor_msgs/msg/Image"))
+    msgs.sort(key=lambda m: m[0])
+    if ros2:
+        from rosbags.rosbag2 import Writer
+        ctx, serialize = Writer(Path(folder), version=9), store.serialize_cdr
+    else:
+        from rosbags.rosbag1 import Writer
+        ctx, serialize = Writer(Path(folder)), store.serialize_ros1
+    with ctx as writer:
+        conns = {}
+        for t, topic, msg, msgtype in msgs:
+            if topic not in conns:
+                conns[topic] = writer.add_connection(topic, msgtype, typestore=store)
+            writer.write(conns[topic], t, serialize(msg, msgtype))
+    return Path(folder)
+
+
+@pytest.mark.parametrize("encoding, ros2", [("evt3", True), ("evt3", False), ("evt2", True)])
+def test_event_packets_of_a_prophesee_camera_convert_exactly(tmp_path, encoding, ros2):
+    """A ROS2 (or ROS1) bag of event_camera_msgs/EventPacket: the packets' bytes in order are the camera's
+    stream; the canonical file holds its events exactly, on the camera's clock (microseconds)."""
+    from data_fetch import convert
+    from evinr_lite.io import load_recording
+
+    ev, stream = _packet_stream(encoding=encoding)
+    bag = make_packet_bag(tmp_path / ("rec" if ros2 else "rec.bag"), stream, 30, 40, encoding, ros2=ros2)
+    out = convert(bag, tmp_path / "out.h5", progress=False)
+    rec = load_recording(out)
+    e = rec.events
+    assert e.sensor_size == (30, 40) and rec.frames is None
+    us = np.round((e.t + e.t_origin) * 1e6).astype(np.int64)
+    np.testing.assert_array_equal(us, ev["t"].astype(np.int64))
+    np.testing.assert_array_equal(e.x, ev["x"])
+    np.testing.assert_array_equal(e.y, ev["y"])
+    np.testing.assert_array_equal(e.p, np.where(ev["on"], 1, -1))
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["out.h5", bag.name])    # no temporary left
+
+
+def test_event_packets_refused_with_the_reason(tmp_path):
+    from data_fetch import convert
+
+    ev, stream = _packet_stream(500)
+    bag = make_packet_bag(tmp_path / "cmp", stream, 30, 40, encoding="libcaer_cmp")
+    with pytest.raises(ConversionError, match=r"'libcaer_cmp' encoding; data_fetch decodes \['evt2', 'evt21', 'evt3'\]"):
+        convert(bag, tmp_path / "a.h5", progress=False)
+    garbage = np.random.default_rng(0).integers(0, 256, 4000, dtype=np.uint8).tobytes()
+    bag = make_packet_bag(tmp_path / "junk", garbage, 30, 40)
+    with pytest.raises(ConversionError, match=r"junk: the evt3 stream in the event packets could not be decoded "
+                                              r"\((?!.*packets\.raw).*the bag is damaged"):
+        convert(bag, tmp_path / "b.h5", progress=False)
+    assert not list(tmp_path.glob(".*packets.raw")) and not (tmp_path / "b.h5").exists()
+    import logging
+
+    seen = []
+    handler = logging.Handler(logging.WARNING)
+    handler.emit = lambda record: seen.append(record.getMessage())
+    logger = logging.getLogger("data_fetch")     # its own handler: the command line may stop its propagation
+    logger.addHandler(handler)
+    try:
+        convert(make_packet_bag(tmp_path / "with_image", stream, 30, 40, image=True), tmp_path / "c.h5", progress=False)
+    finally:
+        logger.removeHandler(handler)
+    assert any("image topics ['/image'] are not stored" in m for m in seen)
+
+
+def test_event_packets_of_a_ros2_bag_without_message_definitions(tmp_path):
+    """Bags recorded before rosbag2 stored message definitions: the known EventPacket definition stands in."""
+    import sqlite3
+
+    from data_fetch import convert
+    from evinr_lite.io import load_recording
+
+    ev, stream = _packet_stream(800)
+    bag = make_packet_bag(tmp_path / "old", stream, 30, 40)
+    with sqlite3.connect(next(bag.glob("*.db3"))) as con:
+        con.execute("delete from message_definitions")
+    e = load_recording(convert(bag, tmp_path / "a.h5", progress=False)).events
+    np.testing.assert_array_equal(np.round((e.t + e.t_origin) * 1e6).astype(np.int64), ev["t"].astype(np.int64))
