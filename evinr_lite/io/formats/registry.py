@@ -32,8 +32,8 @@ UNSUPPORTED = {   # first bytes of files that are recognised but not read -> (sn
     b"#!AER-DAT1": ("aedat2", f"an AEDAT2 file; {_AEDAT_FIX}"),
     b"PK\x03\x04": ("zip", "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside"),
     b"#ROSBAG V2.0": ("rosbag", "a ROS1 bag, which is not read directly; convert it with `python -m data_fetch convert "
-                                "FILE.bag` (dvs_msgs event arrays and the APS images, to the canonical .h5 that "
-                                "evinr-lite reads)"),
+                                "FILE.bag` (dvs_msgs event arrays and the APS images, or event_camera_msgs packets, to "
+                                "the canonical .h5 that evinr-lite reads)"),
     b"\x89MCAP": ("mcap", f"an MCAP file, the storage of a ROS2 bag, which is not read directly; {_ROS2_FIX}"),
     b"SQLite format 3\x00": ("sqlite", "an SQLite database, such as a ROS2 bag's .db3 storage, which is not read "
                                        f"directly; for a bag, {_ROS2_FIX}"),
@@ -113,8 +113,8 @@ def detect_format(path) -> str:
                 return fmt.name
         if is_ros2_bag(path):
             raise EventDataError(f"{path}: a ROS2 bag, which is not read directly; convert it with `python -m data_fetch "
-                                 f"convert {path}` (dvs_msgs event arrays and the APS images, to the canonical .h5 "
-                                 "that evinr-lite reads)")
+                                 f"convert {path}` (dvs_msgs event arrays and the APS images, or event_camera_msgs "
+                                 "packets, to the canonical .h5 that evinr-lite reads)")
         raise EventDataError(f"{path}: folder of unknown format (no events.txt or events_ts.npy); "
                              f"supported formats: {SUPPORTED_FORMATS}")
     if path.stat().st_size == 0:
