@@ -181,3 +181,18 @@ def test_zoo_dark_scene_gets_noisier_as_light_falls():
     clean = zoo.simulate(replace(z, dark_noise_hz=0.0))[1]
     noise = len(events) - len(clean)
     assert noise > 0
+
+
+def test_large_scenes_are_new_larger_than_every_other_set_and_simulate():
+    """The 360x480 set: its own names and seeds, documented, larger than every scene of the other sets, and
+    its scenes simulate (quick sizes) with events and frames in range."""
+    names = [z.name for z in zoo.LARGE]
+    others = zoo.ZOO + zoo.HELDOUT + zoo.STRESS
+    assert len(names) == len(set(names)) >= 3 and not set(names) & {z.name for z in others}
+    assert all(len(z.doc) > 20 for z in zoo.LARGE)
+    assert not {z.seed for z in zoo.LARGE} & {z.seed for z in others}
+    assert zoo.get(names[0]) is zoo.LARGE[0]
+    assert min(z.size[0] * z.size[1] for z in zoo.LARGE) > max(z.size[0] * z.size[1] for z in others)
+    z = zoo.quick(zoo.LARGE[1])
+    _, events, _, gt = zoo.simulate(z)
+    assert gt.shape == (z.n_scored, *z.size) and len(events) > 1000 and 0 < gt.min() and gt.max() <= 1

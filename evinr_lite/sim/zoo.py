@@ -17,7 +17,8 @@ and hand-held shake (:class:`~evinr_lite.sim.scenes.OscillatingScene`). ``benchm
 them; the kit's defaults were chosen on their mean, never on one scene. ``HELDOUT`` holds ten more
 scenes built the same ways (other images, motions, sizes and seeds; one of 20 s) on which no default
 was chosen: ``quality_zoo.py --heldout`` checks that the defaults carry over to them. ``STRESS`` holds
-eleven built the same ways with settings outside both sets' ranges (``quality_zoo.py --stress``).
+eleven built the same ways with settings outside both sets' ranges (``quality_zoo.py --stress``), and
+``LARGE`` three at 360x480, twice the zoo's largest sensor along each side (``quality_zoo.py --large``).
 """
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ import numpy as np
 from . import scenes as sc
 from .simulate import add_background_noise, add_hot_pixels, add_light_noise, simulate_scene
 
-__all__ = ["ZooScene", "ZOO", "HELDOUT", "STRESS", "N_SCORED", "quick", "simulate", "effective_C", "imbalance", "get", "default_scenes",
+__all__ = ["ZooScene", "ZOO", "HELDOUT", "STRESS", "LARGE", "N_SCORED", "quick", "simulate", "effective_C", "imbalance", "get", "default_scenes",
            "SIGNAL", "BACKGROUND", "HOT"]
 
 N_SCORED = 10   # ground-truth times scored per scene, evenly spread over [0.1, 0.95] of the duration
@@ -224,6 +225,24 @@ STRESS = [
              noise_hz=0.3, hot_pixels=10, seed=41),
 ]
 
+# Twice the zoo's largest sensor along each side (360x480: 4x its pixels), the motions scaled with it in
+# pixels per second and the hot pixels with the pixel count; no default was chosen on them.
+LARGE = [
+    ZooScene("camera_360x480", "camera at 360x480, translation with a slight rotation and zoom; clean sensor",
+             lambda s, d: sc.MovingImageScene("camera", s, d, velocity=(40.0, 16.0), rotation=0.08, zoom=0.05),
+             size=(360, 480), seed=51),
+    ZooScene("gravel_360x480_noisy", "gravel at 360x480: 0.5 Hz background activity, 80 hot pixels, C+ 0.22 != "
+             "C- 0.18, 5 % mismatch",
+             lambda s, d: sc.MovingImageScene("gravel", s, d, velocity=(36.0, -20.0), rotation=0.05, zoom=0.05),
+             size=(360, 480), C_pos=0.22, C_neg=0.18, threshold_sigma=0.05, refractory=5e-4, noise_hz=0.5,
+             hot_pixels=80, seed=52),
+    ZooScene("astronaut_360x480_unequal", "astronaut at 360x480 turning and zooming: C+ 0.24 != C- 0.16 given as "
+             "0.2, 0.2 Hz background activity, 2.5 s",
+             lambda s, d: sc.MovingImageScene("astronaut", s, d, velocity=(8.0, -6.0), rotation=0.3, zoom=0.2),
+             size=(360, 480), duration=2.5, C_pos=0.24, C_neg=0.16, noise_hz=0.2, seed=53),
+]
+
+
 def quick(z: ZooScene) -> ZooScene:
     """A smaller, shorter version (--quick): 3/5 of the size, 3/4 of the length."""
     H, W = z.size
@@ -294,9 +313,9 @@ def default_scenes(long: bool = False) -> list:
 
 def get(name: str) -> ZooScene:
     """The zoo scene (or held-out or stress scene) called ``name``."""
-    for z in ZOO + HELDOUT + STRESS:
+    for z in ZOO + HELDOUT + STRESS + LARGE:
         if z.name == name:
             return z
     from ..core.events import EventDataError
 
-    raise EventDataError(f"no zoo scene {name!r}; the zoo holds {[z.name for z in ZOO + HELDOUT + STRESS]}")
+    raise EventDataError(f"no zoo scene {name!r}; the zoo holds {[z.name for z in ZOO + HELDOUT + STRESS + LARGE]}")
