@@ -385,13 +385,24 @@ def packets_to_raw(messages, raw: Path, path) -> tuple[int, int, str]:
     return first
 
 
+def _open_stream(raw: Path, path: Path, encoding: str):
+    """The Prophesee reader's source over the packets' stream ``raw``; ConversionError naming the bag when
+    the stream cannot be decoded."""
+    from evinr_lite.io.formats.prophesee import open_prophesee
+
+    try:
+        return open_prophesee(raw)
+    except EventDataError as err:
+        why = str(err).replace(f"{raw}: ", "")          # the temporary file is not the user's to look for
+        raise ConversionError(f"{path}: the {encoding} stream in the event packets could not be decoded ({why}); "
+                              "the bag is damaged or the packets are not in order") from None
+
+
 def _convert_packets(reader, conn, path: Path, out, *, sensor_size, C, eval_window, dataset, sequence, source,
                      source_url, progress) -> Path:
     """:func:`convert_bag` for a topic of event_camera_msgs/EventPacket: the packets' bytes into a temporary
     ``.raw`` beside ``out``, decoded by the Prophesee reader a second at a time into the canonical file."""
     from tqdm.auto import tqdm
-
-    from evinr_lite.io.formats.prophesee import open_prophesee
 
     store = _packet_store(conn)
     others = sorted(c.topic for c in reader.connections if c.msgtype == IMAGE_TYPE)
@@ -409,28 +420,18 @@ def _convert_packets(reader, conn, path: Path, out, *, sensor_size, C, eval_wind
         if sensor_size is not None and tuple(int(v) for v in sensor_size) != (H, W):
             log.warning("data_fetch: %s: the packets report a %dx%d sensor, not the expected %dx%d; using the "
                         "packets' size", path, W, H, int(sensor_size[1]), int(sensor_size[0]))
-        try:
-            source_ = open_prophesee(raw)
-            t0, t1 = source_.t_span
-        except EventDataError as err:
-            why = str(err).replace(f"{raw}: ", "")          # the temporary file is not the user's to look for
-            raise ConversionError(f"{path}: the {encoding} stream in the event packets could not be decoded ({why}); "
-                                  "the bag is damaged or the packets are not in order") from None
-        writer = CanonicalWriter(out, sensor_size=(H, W), t_origin=float(source_.t_origin), dataset=dataset,
-                                 sequence=sequence, source=source, source_url=source_url, raw_file=path.name, C=C,
-                                 eval_window=eval_window, converter="data_fetch.convert_bag",
-                                 meta={"event_topic": conn.topic, "image_topic": None, "packet_encoding": encoding,
-                                       "clock": "the camera's (microseconds), not the bag's"})
-        try:
-            edges = np.append(np.arange(t0, t1, 1.0), np.nextafter(t1, np.inf))
-            for a, b in zip(edges[:-1], edges[1:]):
-                ev = source_.events(float(a), float(b))
-                if len(ev):
-                    writer.add_events(ev.t, ev.x, ev.y, ev.p, where="packet events")
+        meta = {"event_topic": conn.topic, "image_topic": None, "packet_encoding": encoding,
+                "clock": "the camera's (microseconds), not the bag's"}
+        with _open_stream(raw, path, encoding) as stream, \
+                CanonicalWriter(out, sensor_size=(H, W), t_origin=float(stream.t_origin), dataset=dataset,
+                                sequence=sequence, source=source, source_url=source_url, raw_file=path.name, C=C,
+                                eval_window=eval_window, converter="data_fetch.convert_bag", meta=meta) as writer:
+            t0, t1 = stream.t_span
+            edges = np.append(np.arange(t0, t1, 1.0), np.nextafter(t1, np.inf))   # a second at a time, t1 included
+            for a, b in zip(edges[:-1].tolist(), edges[1:].tolist()):
+                ev = stream.events(a, b)
+                writer.add_events(ev.t, ev.x, ev.y, ev.p, where="packet events")
             writer.meta["n_event_messages"] = conn.msgcount
-            return writer.close()
-        finally:
-            writer.abort()
-            source_.close()
+        return writer.out
     finally:
         raw.unlink(missing_ok=True)

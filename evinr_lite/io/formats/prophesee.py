@@ -31,13 +31,18 @@ def prophesee_header(path: Path, limit: int = 1 << 16) -> list[str]:
     return percent_header(path, limit)[0]
 
 
+def _names_encoding(header: list[str]) -> bool:
+    """Whether a `%` header names a .raw file's encoding (an `evt ...` or `format EVT...` line)."""
+    return any(line.lower().startswith(("evt ", "format evt")) for line in header)
+
+
 def prophesee_kind(path, head: bytes | None) -> str | None:
     """'prophesee_raw' or 'prophesee_dat' for a file that opens with a `%` header (the header's words
     first, the suffix second), else None."""
     if head is None or not head.startswith(b"%"):
         return None
     header = [line.lower() for line in prophesee_header(Path(path))]
-    if any(line.startswith(("evt ", "format evt")) for line in header):
+    if _names_encoding(header):
         return "prophesee_raw"
     if any(line.startswith(("data file containing", "version ")) for line in header):
         return "prophesee_dat"
@@ -58,10 +63,9 @@ def _decoded(path: Path, sensor_size=None, version: str | None = None):
     if version is not None and version not in RAW_VERSIONS:
         raise EventDataError(f"version must be one of {RAW_VERSIONS}, got {version!r}")
     if kind == "prophesee_raw":
-        header = prophesee_header(path)
-        if is_evt21(header) or (version == "evt21" and not any(h.lower().startswith(("evt ", "format evt"))
-                                                                 for h in header)):
-            yield _evt21(path, header, sensor_size)
+        header, offset = percent_header(path)
+        if is_evt21(header) or (version == "evt21" and not _names_encoding(header)):
+            yield _evt21(path, header, offset, sensor_size)
             return
     elif version == "evt21":
         raise EventDataError(f"{path}: version='evt21' applies to .raw files, not to a DAT file")
@@ -115,15 +119,15 @@ def _decoded(path: Path, sensor_size=None, version: str | None = None):
         yield size, meta, packets()
 
 
-def _evt21(path: Path, header: list[str], sensor_size):
-    """(size, meta, packets) of an EVT 2.1 file, as :func:`_decoded` yields them."""
+def _evt21(path: Path, header: list[str], offset: int, sensor_size):
+    """(size, meta, packets) of an EVT 2.1 file (``header`` and the data's ``offset``: :func:`percent_header`),
+    as :func:`_decoded` yields them."""
     declared = header_sensor_size(header)
     if declared is None and sensor_size is None:
         raise EventDataError(f"{path}: the header does not give the sensor size; pass sensor_size=(H, W), e.g. "
                              "(320, 320) for a GenX320 sensor, (720, 1280) for an IMX636")
     size = (check_declared_size(path, declared, sensor_size, "header") if declared is not None
             else (int(sensor_size[0]), int(sensor_size[1])))
-    offset = percent_header(path)[1]
     order = word_order(path, offset, size)
     meta = {"format": "prophesee_raw", "path": str(path), "encoding": "evt21", "word_order": order,
             "sensor_size_from": "header" if declared is not None else "sensor_size argument"}
