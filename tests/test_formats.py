@@ -155,8 +155,8 @@ def test_detection_by_content_not_name(tmp_path):
 
 def test_unsupported_and_damaged_files(tmp_path):
     old = tmp_path / "old.aedat"
-    old.write_bytes(b"#!AER-DAT3.1\r\n" + bytes(64))
-    with pytest.raises(EventDataError, match=r"AEDAT3 file; only AEDAT4 is read.*DV"):
+    old.write_bytes(b"#!AER-DAT3.0\r\n" + bytes(64))
+    with pytest.raises(EventDataError, match=r"AEDAT 3.0 file \(not 3.1\); AEDAT 3.1 and AEDAT4 are read.*DV"):
         read_recording(old)
     junk = tmp_path / "junk.xyz"
     junk.write_bytes(bytes(range(256)))

@@ -152,6 +152,23 @@ def _fixtures(root: Path) -> dict:
     (d / "rec.raw").write_bytes(f"% evt 2.1\n% format EVT21;height={H};width={W}\n% end\n".encode()
                                 + words.astype("<u8").tobytes())
     out["prophesee_evt21"] = (d, "rec.raw", ["rec.raw"], {})
+    d = root / "aedat3"                 # decoded by the kit (io/formats/aedat3.py): libcaer's packets
+    d.mkdir()
+    t_us = np.round(t * 1e6).astype(np.int64) + ((1 << 31) - 25_000)      # across the 31-bit timestamp's overflow
+    packets = []
+    for lo, hi in ((0, 20), (20, 45), (45, len(t))):
+        ev = np.zeros(hi - lo, [("data", "<u4"), ("ts", "<i4")])
+        ev["data"] = (x[lo:hi] << 17) | (y[lo:hi] << 2) | ((p[lo:hi] > 0) << 1) | 1
+        ev["ts"] = t_us[lo:hi] & 0x7FFFFFFF
+        n, ovf = hi - lo, int(t_us[lo] >> 31)
+        packets.append(np.array([1, 1], "<i2").tobytes() + np.array([8, 4, ovf, n, n, n], "<i4").tobytes()
+                       + ev.tobytes())                 # type 1 (polarity), source 1; size, offset, overflow, counts
+    frame = np.array([3, 100, 200, 110, 190, W, H, 0, 0], "<i4").tobytes() + np.arange(H * W, dtype="<u2").tobytes()
+    packets.insert(1, np.array([2, 1], "<i2").tobytes() + np.array([len(frame), 4, 0, 1, 1, 1], "<i4").tobytes() + frame)
+    header = (f'#!AER-DAT3.1\r\n#Format: RAW\r\n#Source 1: PROTO\r\n#-Source 1: <attr key="dvsSizeX" type="short">{W}'
+              f'</attr><attr key="dvsSizeY" type="short">{H}</attr>\r\n#!END-HEADER\r\n')
+    (d / "rec.aedat").write_bytes(header.encode() + b"".join(packets))
+    out["aedat3"] = (d, "rec.aedat", ["rec.aedat"], {})
     return out
 
 
@@ -218,7 +235,7 @@ def read_and_classify(kind, path, kwargs):
 
 
 FORMATS = ["npy", "txt", "csv", "ijrr", "evreal", "h5", "dsec", "mvsec", "canonical", "aedat4", "prophesee_raw", "prophesee_dat",
-           "prophesee_evt21"]
+           "prophesee_evt21", "aedat3"]
 
 
 @pytest.mark.parametrize("kind", FORMATS)

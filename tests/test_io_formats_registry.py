@@ -24,7 +24,7 @@ def _declared():
 
 def test_every_format_module_declares_a_complete_format():
     declared = _declared()
-    assert set(declared) == {"ijrr", "evreal", "canonical", "h5", "aedat4", "prophesee_raw", "prophesee_dat",
+    assert set(declared) == {"ijrr", "evreal", "canonical", "h5", "aedat3", "aedat4", "prophesee_raw", "prophesee_dat",
                              "npy", "txt", "csv", "dsec", "mvsec"}
     for name, (module, fmt) in declared.items():
         assert isinstance(fmt, FileFormat) and callable(fmt.reader) and callable(fmt.sniff), name
@@ -75,7 +75,7 @@ def test_a_declared_format_is_detected_and_read_through_the_registry(tmp_path, m
         assert src.n_events == 2 and src.format == "demo"
 
 
-@pytest.mark.parametrize("content,problem", [(b"#!AER-DAT2.0\r\n", "AEDAT2"), (b"#!AER-DAT3.1\r\n", "AEDAT3"),
+@pytest.mark.parametrize("content,problem", [(b"#!AER-DAT2.0\r\n", "AEDAT2"), (b"#!AER-DAT3.0\r\n", "AEDAT 3.0"),
                                              (b"PK\x03\x04rest", "zip archive"),
                                              (b"\x00\x01binary", "unknown format")])
 def test_unsupported_files_are_named(tmp_path, content, problem):

@@ -15,10 +15,9 @@ import numpy as np
 
 from ...core.events import EventDataError
 from ...core.frames import Frames, to_grey_uint8
-from ...core.recording import Recording
 from .base import FileFormat, check_declared_size, check_reader_window, existing
-from .decoding import US, PacketCollector, decoder_failed, decoder_stderr, origin_us_of
-from .packets import PacketSource
+from .decoding import US, decoder_failed, decoder_stderr, origin_us_of
+from .packets import PacketSource, read_packets
 
 __all__ = ["read_aedat4", "FORMAT", "MAGIC"]
 
@@ -120,22 +119,8 @@ def read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: 
     with decoder_stderr():
         path = existing(path)
         check_reader_window(t_start, t_end)
-        collect = PacketCollector(t_start, t_end)
-        frame_t, images = [], []
-        with _decoded(path, sensor_size) as (size, meta, packets):
-            for kind, *item in packets:
-                if kind == "events":
-                    if not collect.add(item[0]):
-                        break
-                else:
-                    frame_t.append(item[0])
-                    images.append(item[1])
-        events = collect.events(path, size)
-        frames = frames_from(path, frame_t, images, collect.origin_us, size)
-        if frames is not None:
-            frames = frames.slice_time(t_start, t_end)
-            frames = frames if len(frames) else None
-    return Recording(events, frames, meta)
+        return read_packets(path, _decoded, sensor_size=sensor_size, t_start=t_start, t_end=t_end,
+                            frames_from=frames_from)
 
 
 def open_aedat4(path, *, sensor_size=None) -> PacketSource:

@@ -18,10 +18,33 @@ from pathlib import Path
 import numpy as np
 
 from ...core.events import EventDataError, Events
+from ...core.recording import Recording
 from ..source import RecordingSource
-from .decoding import US, decoder_stderr, origin_us_of
+from .decoding import US, PacketCollector, decoder_stderr, origin_us_of
 
-__all__ = ["PacketSource"]
+__all__ = ["PacketSource", "read_packets"]
+
+
+def read_packets(path: Path, decoded, *, sensor_size=None, t_start=None, t_end=None, frames_from=None) -> Recording:
+    """The Recording of a packet-format file read whole or in the window [t_start, t_end) (seconds relative to
+    ``t_origin``): ``decoded`` and ``frames_from`` as for :class:`PacketSource`. Events are kept only inside the
+    window and decoding stops after it, so memory holds the window; frames are gathered on the way."""
+    collect = PacketCollector(t_start, t_end)
+    frame_t, images = [], []
+    with decoded(path, sensor_size) as (size, meta, packets):
+        for kind, *item in packets:
+            if kind == "events":
+                if not collect.add(item[0]):
+                    break
+            else:
+                frame_t.append(item[0])
+                images.append(item[1])
+    events = collect.events(path, size)
+    frames = frames_from(path, frame_t, images, collect.origin_us, size) if frames_from else None
+    if frames is not None:
+        frames = frames.slice_time(t_start, t_end)
+        frames = frames if len(frames) else None
+    return Recording(events, frames, meta)
 
 
 class PacketSource(RecordingSource):

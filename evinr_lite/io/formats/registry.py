@@ -22,12 +22,12 @@ __all__ = ["FORMATS", "get_format", "detect_format", "read_recording", "read_eve
            "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder", "is_ros2_bag"]
 
 HEAD_BYTES = 64
-_AEDAT_FIX = "only AEDAT4 is read: convert it with iniVation's DV software (Convert to AEDAT4) or export the events " \
-             "to a `t x y p` text file"
+_AEDAT_FIX = "AEDAT 3.1 and AEDAT4 are read: convert it with iniVation's DV software (Convert to AEDAT4) or export " \
+             "the events to a `t x y p` text file"
 _ROS2_FIX = "pass the bag's folder (the one with metadata.yaml) to `python -m data_fetch convert FOLDER`, which " \
             "writes the canonical .h5 that evinr-lite reads"
 UNSUPPORTED = {   # first bytes of files that are recognised but not read -> (sniff_format's name, the fix)
-    b"#!AER-DAT3": ("aedat3", f"an AEDAT3 file; {_AEDAT_FIX}"),
+    b"#!AER-DAT3": ("aedat30", f"an AEDAT 3.0 file (not 3.1); {_AEDAT_FIX}"),
     b"#!AER-DAT2": ("aedat2", f"an AEDAT2 file; {_AEDAT_FIX}"),
     b"#!AER-DAT1": ("aedat2", f"an AEDAT2 file; {_AEDAT_FIX}"),
     b"PK\x03\x04": ("zip", "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside"),
@@ -146,7 +146,7 @@ def is_recording_folder(path) -> bool:
 
 def sniff_format(path) -> str | None:
     """The format of a file from its first bytes alone: a format's name, 'hdf5' for any HDF5 file,
-    'aedat2' / 'aedat3' / 'zip' / 'rosbag' / 'mcap' / 'sqlite' for files recognised but not read, or None (not
+    'aedat2' / 'aedat30' / 'zip' / 'rosbag' / 'mcap' / 'sqlite' for files recognised but not read, or None (not
     recognised: maybe text)."""
     path = Path(path)
     with open(path, "rb") as f:
