@@ -204,6 +204,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
         folder = resume_folder(target.path)
         made = False   # the resume folder is this run's to keep or remove once _prepare_resume has returned
         history = {}
+        writer = None
         try:
             with signals_deferred():   # a signal here is acted on after `made` is set, inside this try
                 state = _prepare_resume(folder, _key(path, config, times, (lo, hi)), resume, log)
@@ -217,8 +218,11 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
             for part in parts:
                 writer.add(part)
                 history = part.history
+            writer.png.close()   # every PNG on disk (or the first write's error) before the resume state goes
         except BaseException:   # interrupted or failed: finished windows stay for --resume, else nothing stays
             # (not made: refused before the folder was ready, e.g. one that is not this job's; left untouched)
+            if writer is not None:
+                writer.abort()
             if made and (folder / "state.npz").is_file():
                 log(f"the finished windows are kept in {folder}; the same command with --resume continues from them")
             elif made:
@@ -268,7 +272,10 @@ class _FrameWriter:
     and keeps the frames at the ground-truth times for scoring."""
 
     def __init__(self, staging: Path, times, query, gt_t, video: bool, log):
+        from ..io.output import PngWriter
+
         self.folder = staging / "frames"
+        self.png = PngWriter()   # encoded on worker threads while the next frames are computed
         self.folder.mkdir(parents=True, exist_ok=True)
         self.staging, self.log = staging, log
         self.export_at = np.searchsorted(query, times)          # query index of each exported frame
@@ -286,7 +293,6 @@ class _FrameWriter:
     def add(self, part) -> None:
         from ..core.checks import check_result_frames
         from ..core.frames import to_uint8
-        from ..io.output import save_png
         from ..method.solver import RESULT_FIX
 
         # as reconstruct refuses them: output that is not finite (here, per part), or constant (at the end)
@@ -297,7 +303,7 @@ class _FrameWriter:
         for j, q in enumerate(part.indices.tolist()):
             i = self.export_of.get(q)
             if i is not None:
-                save_png(self.folder / f"frame_{i:05d}.png", u8[j])
+                self.png.write(self.folder / f"frame_{i:05d}.png", u8[j])
                 if self.video:
                     self._video_frame(u8[j])
             g = self.gt_of.get(q)
@@ -321,6 +327,7 @@ class _FrameWriter:
         from ..io.export import save_gif
         from ..method.solver import RESULT_FIX
 
+        self.png.close()         # every PNG on disk, or the first write's error (a no-op when already closed)
         check_result_frames(np.array(self.range, np.float32)[:, None, None], what="EvINR's frames", input_varies=True,
                             fix=RESULT_FIX)
         written = []
@@ -330,6 +337,13 @@ class _FrameWriter:
             save_gif(self.staging / "reconstruction.gif", np.stack(self.gif), self.video_fps)
             written.append("reconstruction.gif")
         return written
+
+    def abort(self) -> None:
+        """Drop the PNGs not yet started and wait for the running ones: no thread writes into the staging
+        folder once the run has failed or been interrupted (it is removed next)."""
+        self.png.abort()
+        if self.mp4 is not None:
+            self.mp4.close()
 
     def gt_frames(self) -> np.ndarray:
         return np.stack(self.gt)

@@ -39,7 +39,7 @@ from ..core.events import InputError
 from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, termination_signals  # re-exported
 
 __all__ = ["atomic_output_dir", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
-           "termination_signals", "signals_deferred", "save_png", "save_json", "first_existing", "check_writable",
+           "termination_signals", "signals_deferred", "save_png", "PngWriter", "save_json", "first_existing", "check_writable",
            "TERMINATION_SIGNALS", "PARTIAL_MARKER", "mark_partial", "remove_stale_partials", "remove_lock_file",
            "resolve_path"]
 
@@ -426,6 +426,69 @@ def save_png(path, image) -> None:
     if image.dtype != np.uint8:
         image = (np.clip(image, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
     Image.fromarray(image).save(path, compress_level=PNG_COMPRESS_LEVEL)
+
+
+class PngWriter:
+    """PNGs written on worker threads while the caller goes on computing (zlib releases the GIL: 40 frames of
+    1280x720 took 0.68 s on two threads against 1.35 s in turn, ``python benchmarks/png_writer.py``).
+
+        with PngWriter() as png:
+            for i, frame in enumerate(frames):
+                png.write(folder / f"frame_{i:05d}.png", frame)     # returns at once (a copy is queued)
+        # here every file is written, or the first write's error was raised
+
+    The files are the ones :func:`save_png` writes, byte for byte. At most ``2 x threads`` frames wait at
+    once (``write`` blocks until one is done), so memory stays a few frames. Leaving the block on an
+    exception or an interruption cancels the writes not yet started and waits for the running ones, so no
+    thread writes into a folder its caller is about to remove (an :class:`OutputDir`'s staging folder).
+    ``threads``: None (the kit's CPU threads, :func:`~evinr_lite.core.runtime.cpu_threads`) or a number
+    (1 writes in turn on one worker).
+    """
+
+    def __init__(self, threads: int | None = None):
+        from concurrent.futures import ThreadPoolExecutor
+
+        from ..core.runtime import cpu_threads
+
+        self.threads = max(1, int(threads or cpu_threads()))
+        self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="evinr-png")
+        self._pending = []
+
+    def write(self, path, image) -> None:
+        """Queue ``image`` (as :func:`save_png` takes it) for ``path``; an earlier write's error is raised here."""
+        waiting = []
+        for f in self._pending:
+            if f.done():
+                f.result()                      # a finished write's error is raised here
+            else:
+                waiting.append(f)
+        self._pending = waiting
+        while len(self._pending) >= 2 * self.threads:
+            self._pending.pop(0).result()
+        self._pending.append(self._pool.submit(save_png, path, np.array(image, copy=True)))
+
+    def close(self) -> None:
+        """Wait for every queued write; raises the first one's error (the others are still waited for)."""
+        try:
+            for f in self._pending:
+                f.result()
+        finally:
+            self._pending = []
+            self._pool.shutdown(wait=True)
+
+    def abort(self) -> None:
+        """Drop the writes not yet started and wait for the running ones (their errors are not raised)."""
+        self._pool.shutdown(wait=True, cancel_futures=True)
+        self._pending = []
+
+    def __enter__(self) -> "PngWriter":
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
 
 
 def save_json(path, obj) -> None:
