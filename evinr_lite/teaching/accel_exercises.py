@@ -92,7 +92,9 @@ def _inputs_bisect(rng):
     # a busy start and a quiet end; one bin with no event and one with a single event
     t = np.sort(np.concatenate([rng.uniform(0.0, 0.3, 40), rng.uniform(0.3, 1.0, 12)]))
     cases.append(dict(t_events=t, boundaries=np.linspace(0.0, 1.0, 5)))
-    t = np.sort(np.concatenate([rng.uniform(0.0, 0.5, 9), [0.8]]))
+    # and a burst of 8 events at b_0 = 0, more than half of bin 0's: the cut between its middle events would
+    # land on the bin's first edge, so the bin is cut at its time mid-point (lo < median, not lo <= median)
+    t = np.sort(np.concatenate([rng.uniform(0.0, 0.5, 9), [0.8], np.zeros(8)]))
     cases.append(dict(t_events=t, boundaries=np.array([0.0, 0.25, 0.5, 0.75, 1.0])))
     t = np.sort(rng.uniform(0.0, 2.0, 101))
     # bins that start at b_0 = 0.0625, not at 0, with an event exactly there: bin 0 holds it (`t == b_0`, not
@@ -157,6 +159,18 @@ def _left_closed_bins(t_events, boundaries):
     return _median_cuts(t_events, boundaries, lambda t, i, lo, hi: (t >= lo) & (t < hi))
 
 
+def _cut_on_first_edge(t_events, boundaries):
+    """The mistake of a cut allowed on the bin's first edge (lo <= median): a burst at b_0 makes an empty half."""
+    t = np.asarray(t_events, dtype=np.float64)
+    out = _midpoints(t, boundaries)
+    for i, (lo, hi) in enumerate(zip(out[0:-1:2], out[2::2])):
+        inside = t[((t > lo) | ((i == 0) & (t == lo))) & (t <= hi)]
+        n = len(inside)
+        if n >= 2 and lo <= 0.5 * (inside[n // 2 - 1] + inside[n // 2]) < hi:
+            out[2 * i + 1] = 0.5 * (inside[n // 2 - 1] + inside[n // 2])
+    return out
+
+
 def _first_edge_at_zero(t_events, boundaries):
     """The mistake of bin 0's closed left edge written as `t == 0`: right only when b_0 = 0."""
     return _median_cuts(t_events, boundaries, lambda t, i, lo, hi: ((t > lo) | ((i == 0) & (t == 0))) & (t <= hi))
@@ -175,6 +189,8 @@ exercises.register(
         "sits on an edge": _cut_at_event,
         "bin 0 takes the events at exactly b_0 = boundaries[0], which need not be 0: test `t == b_0`, "
         "not `t == 0`": _first_edge_at_zero,
+        "a cut on the bin's first edge leaves its first half empty (a burst of events at b_0): when the "
+        "middle events sit on an edge, cut at the time mid-point (test lo < median < hi)": _cut_on_first_edge,
     })
 
 

@@ -85,8 +85,8 @@ def _inputs(rng):
     cases.append(dict(gx=rng.normal(size=(1, 5)), gy=np.zeros((0, 6))))
     cases.append(dict(gx=np.zeros((4, 0)), gy=rng.normal(size=(3, 1))))
     cases.append(dict(gx=np.zeros((1, 0)), gy=np.zeros((0, 1))))
-    # a zero field: g = 0
-    cases.append(dict(gx=np.zeros((3, 3)), gy=np.zeros((2, 4))))
+    # a zero field on a square image: g = 0 (a square one, where H and W cannot be told apart by shape alone)
+    cases.append(dict(gx=np.zeros((4, 3)), gy=np.zeros((3, 4))))
     return cases
 
 
