@@ -4,20 +4,17 @@ out), and each check must reject every mutant except the ones a person judged eq
 every input the exercise's contract allows (tests/exercise_mutants_judged.json, each with the reason). A new
 survivor is a wrong solution a check misses: make the exercise's inputs catch it (and add a hint naming it), or,
 when it is truly equivalent, judge it in the file."""
-import importlib.util
 import json
 from pathlib import Path
 
 from evinr_lite.teaching import exercises
+from tools import mutate_exercises
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _tool():
-    spec = importlib.util.spec_from_file_location("mutate_exercises", ROOT / "tools" / "mutate_exercises.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return mutate_exercises
 
 
 def test_every_surviving_mutant_was_judged_equivalent():
