@@ -9,7 +9,9 @@ Each reference solution's source is parsed and changed in one place at a time, t
 == and !=), a number moved by one (integers) or halved and doubled (floats), a unary minus dropped, "left"
 and "right" swapped (np.searchsorted's side), and / or swapped, a reduction or function swapped for its
 twin (sum and mean, max and min, exp and log, floor and ceil, argmax and argmin, cumsum and the values
-themselves), x and y (or H and W) read the wrong way round, an assignment or an update left out. Each mutant is compiled in the reference's own module
+themselves, a sort or a copy left out), x and y (or H and W) read the wrong way round, a keyword argument
+(axis=, side=, keepdims=) left out, a call's first two arguments swapped, the result transposed, an
+assignment or an update left out. Each mutant is compiled in the reference's own module
 and given to :func:`evinr_lite.teaching.exercises.check`. A mutant the check accepts *survives*: it is
 either equivalent to the reference on every input (a ``float(n)`` moved by one inside a ``max`` that
 never binds, say) or a wrong solution the check misses, which its inputs should then be made to catch.
@@ -43,7 +45,8 @@ CMPOPS = {ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt, as
 TWINS = {"sum": "mean", "mean": "sum", "max": "min", "min": "max", "amax": "amin", "amin": "amax", "exp": "log",
          "log": "exp", "floor": "ceil", "ceil": "floor", "argmax": "argmin", "argmin": "argmax",
          "maximum": "minimum", "minimum": "maximum", "float32": "float64", "float64": "float32",
-         "cumsum": "asarray", "log1p": "log", "expm1": "exp", "abs": "asarray", "sqrt": "asarray"}
+         "cumsum": "asarray", "log1p": "log", "expm1": "exp", "abs": "asarray", "sqrt": "asarray", "sort": "asarray",
+         "copy": "view"}
 STRINGS = {"left": "right", "right": "left"}
 AXES = {"x": "y", "y": "x", "H": "W", "W": "H", "xi": "yi", "yi": "xi", "dx": "dy", "dy": "dx", "gx": "gy", "gy": "gx"}
 
@@ -138,6 +141,33 @@ class Mutator(ast.NodeTransformer):
         elif isinstance(v, str) and v in STRINGS:
             new = self._site(node, f"{v!r} -> {STRINGS[v]!r}",
                              lambda: ast.copy_location(ast.Constant(STRINGS[v]), node))
+            if new is not None:
+                return new
+        return node
+
+    def visit_Call(self, node):
+        self.generic_visit(node)
+        for k, kw in enumerate(node.keywords):          # a keyword argument forgotten (axis=, keepdims=, side=, ...)
+            if kw.arg is None:
+                continue
+            keywords = node.keywords[:k] + node.keywords[k + 1:]
+            new = self._site(node, f"{kw.arg}= left out",
+                             lambda keywords=keywords: ast.copy_location(ast.Call(node.func, node.args, keywords), node))
+            if new is not None:
+                return new
+        if len(node.args) >= 2 and not any(isinstance(a, ast.Starred) for a in node.args[:2]):
+            args = [node.args[1], node.args[0], *node.args[2:]]   # the first two arguments swapped
+            new = self._site(node, "the first two arguments swapped",
+                             lambda: ast.copy_location(ast.Call(node.func, args, node.keywords), node))
+            if new is not None:
+                return new
+        return node
+
+    def visit_Return(self, node):
+        self.generic_visit(node)
+        if node.value is not None and not isinstance(node.value, (ast.Tuple, ast.Constant)):
+            new = self._site(node, "the result transposed", lambda: ast.copy_location(
+                ast.Return(ast.Attribute(node.value, "T", ast.Load())), node))
             if new is not None:
                 return new
         return node
