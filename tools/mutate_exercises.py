@@ -234,19 +234,33 @@ def _alarm(signum, frame):
     raise _TimeLimit()
 
 
-def passes(name: str, fn, limit: float) -> bool:
-    """Whether exercise ``name``'s check accepts ``fn`` (quietly, within ``limit`` seconds)."""
+def checked(name: str, fn, limit: float) -> tuple[bool, str]:
+    """(whether exercise ``name``'s check accepts ``fn``, the report it prints), within ``limit`` seconds."""
     old = signal.signal(signal.SIGALRM, _alarm)
     signal.setitimer(signal.ITIMER_REAL, limit)
+    out = io.StringIO()
     try:
-        with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
+        with contextlib.redirect_stdout(out), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return exercises.check(name, fn, verbose=False)
+            return exercises.check(name, fn), out.getvalue()
     except _TimeLimit:
-        return False
+        return False, f"(stopped after {limit} s)"
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, old)
+
+
+def passes(name: str, fn, limit: float) -> bool:
+    """Whether exercise ``name``'s check accepts ``fn`` (quietly, within ``limit`` seconds)."""
+    return checked(name, fn, limit)[0]
+
+
+def verdict(report: str) -> str:
+    """How a check rejected a mutant: "hint" (the report names a likely mistake), "raised" (the function
+    raised, with the line), or "values" (a bare difference: where the values differ, no diagnosis)."""
+    if "hint:" in report or "changed its input" in report:
+        return "hint"
+    return "raised" if " raised " in report else "values"
 
 
 def run(names, limit: float = 20.0, log=print) -> dict:
@@ -255,14 +269,18 @@ def run(names, limit: float = 20.0, log=print) -> dict:
         ref = exercises.reference(name)
         src_lines = inspect.getsource(inspect.getmodule(ref)).splitlines()
         t0 = time.perf_counter()
-        n, survivors = 0, []
+        n, survivors, caught = 0, [], {"hint": 0, "raised": 0, "values": 0}
         for line, what, fn in mutants(ref):
             n += 1
-            if passes(name, fn, limit):
+            ok, report = checked(name, fn, limit)
+            if ok:
                 survivors.append({"line": line, "change": what, "code": src_lines[line - 1].strip()})
-        out[name] = {"mutants": n, "survivors": survivors, "seconds": round(time.perf_counter() - t0, 1),
-                     "module": inspect.getmodule(ref).__name__}
-        log(f"{name}: {n} mutants, {len(survivors)} survive ({out[name]['seconds']} s)")
+            else:
+                caught[verdict(report)] += 1
+        out[name] = {"mutants": n, "survivors": survivors, "caught": caught,
+                     "seconds": round(time.perf_counter() - t0, 1), "module": inspect.getmodule(ref).__name__}
+        log(f"{name}: {n} mutants, {len(survivors)} survive; caught with a hint {caught['hint']}, as an error "
+            f"{caught['raised']}, as different values {caught['values']} ({out[name]['seconds']} s)")
         for s in survivors:
             log(f"    {out[name]['module']}:{s['line']}  {s['change']}")
     return out
@@ -281,8 +299,11 @@ def main(argv=None) -> int:
     out = run(names, a.limit)
     total = sum(r["mutants"] for r in out.values())
     alive = sum(len(r["survivors"]) for r in out.values())
+    caught = {k: sum(r["caught"][k] for r in out.values()) for k in ("hint", "raised", "values")}
     print(f"{len(out)} exercises, {total} mutants, {alive} survive ({alive / max(total, 1):.1%}); survivors are "
           "equivalent mutants or wrong solutions the checks miss")
+    print(f"caught: {caught['hint']} with a hint naming a likely mistake, {caught['raised']} as an error with its "
+          f"line, {caught['values']} as different values only")
     if a.json:
         Path(a.json).write_text(json.dumps(out, indent=1) + "\n")
     return 0
