@@ -28,6 +28,7 @@ import contextlib
 import inspect
 import io
 import json
+import re
 import signal
 import sys
 import textwrap
@@ -255,12 +256,18 @@ def passes(name: str, fn, limit: float) -> bool:
     return checked(name, fn, limit)[0]
 
 
+VERDICTS = ("hint", "shape", "raised", "values")
+
+
 def verdict(report: str) -> str:
-    """How a check rejected a mutant: "hint" (the report names a likely mistake), "raised" (the function
-    raised, with the line), or "values" (a bare difference: where the values differ, no diagnosis)."""
+    """How a check rejected a mutant: "hint" (the report names a likely mistake, or an input changed in
+    place), "shape" (a wrong shape, dtype or type, said as such), "raised" (the function raised, with the
+    line), or "values" (a bare difference: where the values differ, no diagnosis)."""
     if "hint:" in report or "changed its input" in report:
         return "hint"
-    return "raised" if " raised " in report else "values"
+    if " raised " in report:
+        return "raised"
+    return "shape" if re.search(r"wrong (shape|dtype|type)|returned a", report) else "values"
 
 
 def run(names, limit: float = 20.0, log=print) -> dict:
@@ -269,7 +276,7 @@ def run(names, limit: float = 20.0, log=print) -> dict:
         ref = exercises.reference(name)
         src_lines = inspect.getsource(inspect.getmodule(ref)).splitlines()
         t0 = time.perf_counter()
-        n, survivors, caught = 0, [], {"hint": 0, "raised": 0, "values": 0}
+        n, survivors, caught = 0, [], dict.fromkeys(VERDICTS, 0)
         for line, what, fn in mutants(ref):
             n += 1
             ok, report = checked(name, fn, limit)
@@ -279,8 +286,9 @@ def run(names, limit: float = 20.0, log=print) -> dict:
                 caught[verdict(report)] += 1
         out[name] = {"mutants": n, "survivors": survivors, "caught": caught,
                      "seconds": round(time.perf_counter() - t0, 1), "module": inspect.getmodule(ref).__name__}
-        log(f"{name}: {n} mutants, {len(survivors)} survive; caught with a hint {caught['hint']}, as an error "
-            f"{caught['raised']}, as different values {caught['values']} ({out[name]['seconds']} s)")
+        log(f"{name}: {n} mutants, {len(survivors)} survive; caught with a hint {caught['hint']}, as a wrong shape "
+            f"or dtype {caught['shape']}, as an error {caught['raised']}, as different values {caught['values']} "
+            f"({out[name]['seconds']} s)")
         for s in survivors:
             log(f"    {out[name]['module']}:{s['line']}  {s['change']}")
     return out
@@ -299,11 +307,11 @@ def main(argv=None) -> int:
     out = run(names, a.limit)
     total = sum(r["mutants"] for r in out.values())
     alive = sum(len(r["survivors"]) for r in out.values())
-    caught = {k: sum(r["caught"][k] for r in out.values()) for k in ("hint", "raised", "values")}
+    caught = {k: sum(r["caught"][k] for r in out.values()) for k in VERDICTS}
     print(f"{len(out)} exercises, {total} mutants, {alive} survive ({alive / max(total, 1):.1%}); survivors are "
           "equivalent mutants or wrong solutions the checks miss")
-    print(f"caught: {caught['hint']} with a hint naming a likely mistake, {caught['raised']} as an error with its "
-          f"line, {caught['values']} as different values only")
+    print(f"caught: {caught['hint']} with a hint naming a likely mistake, {caught['shape']} as a wrong shape or dtype, "
+          f"{caught['raised']} as an error with its line, {caught['values']} as different values only (where they differ)")
     if a.json:
         Path(a.json).write_text(json.dumps(out, indent=1) + "\n")
     return 0
