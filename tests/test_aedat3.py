@@ -166,6 +166,9 @@ def test_without_a_known_device_the_size_comes_from_the_header_or_is_needed(tmp_
         read_recording(tmp_path / "xml.aedat", sensor_size=(100, 100))
     with pytest.raises(EventDataError, match=r"outside|sensor"):
         read_recording(bare, sensor_size=(50, 50))
+    huge = ['-Source 1: <attr key="dvsSizeX" type="short">999999</attr><attr key="dvsSizeY" type="short">9</attr>']
+    with pytest.raises(EventDataError, match=r"larger than any event camera"):
+        read_recording(_file(tmp_path / "huge.aedat", packets, device="", extra_lines=huge))
 
 
 def test_damaged_compressed_and_older_files_are_refused_with_the_fix(tmp_path):

@@ -38,7 +38,7 @@ import numpy as np
 from ...core.events import EventDataError
 from ...core.frames import to_grey_uint8
 from .aedat4 import frames_from
-from .base import FileFormat, check_declared_size, check_reader_window, existing
+from .base import FileFormat, check_declared_size, check_reader_window, existing, size_value
 from .packets import PacketSource, read_packets
 
 __all__ = ["read_aedat3", "open_aedat3", "aedat3_header", "PacketHeader", "MAGIC", "DEVICE_SIZES", "FORMAT"]
@@ -235,10 +235,10 @@ def _decoded(path: Path, sensor_size=None):
             raise EventDataError(f"{path}: the AEDAT 3.1 file holds no polarity (DVS) events; record events "
                                  "with the camera's DVS enabled")
         device = sources.get(source)
-        declared = xml_size or _device_size(device)
+        declared = size_value(path, xml_size, "the header's dvsSizeY x dvsSizeX") if xml_size else _device_size(device)
         if declared is None and sensor_size is None:
             raise EventDataError(f"{path}: the header does not give the sensor size (source {source}: "
-                                 f"{device or 'no device named'}); pass sensor_size=(H, W) (--sensor HxW), e.g. "
+                                 f"{device or 'no device named'}); pass sensor_size=(H, W), e.g. "
                                  "(128, 128) for a DVS128, (180, 240) for a DAVIS240, (260, 346) for a DAVIS346")
         size = (check_declared_size(path, declared, sensor_size, "header") if declared is not None
                 else (int(sensor_size[0]), int(sensor_size[1])))
