@@ -5,12 +5,13 @@
     python tools/mutate_exercises.py --json mutants.json  # also every survivor, machine-readable
 
 Each reference solution's source is parsed and changed in one place at a time, the ways learners err
-(:class:`Mutator`): an arithmetic or comparison operator swapped (+ and -, * and /, // and /, < and <=,
-== and !=), a number moved by one (integers) or halved and doubled (floats), a unary minus dropped, "left"
+(:class:`Mutator`): an arithmetic or comparison operator swapped (+ and -, * and /, // and /, < and <= or
+>, == and !=), a number moved by one (integers) or halved and doubled (floats), a unary minus dropped, "left"
 and "right" swapped (np.searchsorted's side), and / or swapped, a reduction or function swapped for its
 twin (sum and mean, max and min, exp and log, floor and ceil, argmax and argmin, cumsum and the values
 themselves, a sort or a copy left out), x and y (or H and W) read the wrong way round, a keyword argument
-(axis=, side=, keepdims=) left out, a call's first two arguments swapped, the result transposed, an
+(axis=, side=, keepdims=) left out, a call's first two arguments swapped, the result transposed, a not or
+a ~ dropped, an update written as an assignment (= for +=), np.add.at written as a[idx] += v, an
 assignment or an update left out. Each mutant is compiled in the reference's own module
 and given to :func:`evinr_lite.teaching.exercises.check`. A mutant the check accepts *survives*: it is
 either equivalent to the reference on every input (a ``float(n)`` moved by one inside a ``max`` that
@@ -40,14 +41,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from evinr_lite.teaching import exercises  # noqa: E402
 
-BINOPS = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult, ast.FloorDiv: ast.Div,
-          ast.Pow: ast.Mult}
-CMPOPS = {ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt, ast.Eq: ast.NotEq, ast.NotEq: ast.Eq}
+BINOPS = {ast.Add: (ast.Sub,), ast.Sub: (ast.Add,), ast.Mult: (ast.Div,), ast.Div: (ast.Mult, ast.FloorDiv),
+          ast.FloorDiv: (ast.Div,), ast.Pow: (ast.Mult,)}
+CMPOPS = {ast.Lt: (ast.LtE, ast.Gt), ast.LtE: (ast.Lt, ast.GtE), ast.Gt: (ast.GtE, ast.Lt), ast.GtE: (ast.Gt, ast.LtE),
+          ast.Eq: (ast.NotEq,), ast.NotEq: (ast.Eq,)}
 TWINS = {"sum": "mean", "mean": "sum", "max": "min", "min": "max", "amax": "amin", "amin": "amax", "exp": "log",
          "log": "exp", "floor": "ceil", "ceil": "floor", "argmax": "argmin", "argmin": "argmax",
          "maximum": "minimum", "minimum": "maximum", "float32": "float64", "float64": "float32",
          "cumsum": "asarray", "log1p": "log", "expm1": "exp", "abs": "asarray", "sqrt": "asarray", "sort": "asarray",
-         "copy": "view"}
+         "copy": "view", "round": "floor", "rint": "floor"}
 STRINGS = {"left": "right", "right": "left"}
 AXES = {"x": "y", "y": "x", "H": "W", "W": "H", "xi": "yi", "yi": "xi", "dx": "dy", "dy": "dx", "gx": "gy", "gy": "gx"}
 
@@ -77,37 +79,39 @@ class Mutator(ast.NodeTransformer):
 
     def visit_BinOp(self, node):
         self.generic_visit(node)
-        swap = BINOPS.get(type(node.op))
-        if swap is not None:
+        for swap in BINOPS.get(type(node.op), ()):
             new = self._site(node, f"{type(node.op).__name__} -> {swap.__name__}",
-                             lambda: ast.copy_location(ast.BinOp(node.left, swap(), node.right), node))
+                             lambda swap=swap: ast.copy_location(ast.BinOp(node.left, swap(), node.right), node))
             if new is not None:
                 return new
         return node
 
     def visit_AugAssign(self, node):
         self.generic_visit(node)
-        swap = BINOPS.get(type(node.op))
-        if swap is not None:
+        for swap in BINOPS.get(type(node.op), ())[:1]:
             new = self._site(node, f"{type(node.op).__name__}= -> {swap.__name__}=",
-                             lambda: ast.copy_location(ast.AugAssign(node.target, swap(), node.value), node))
+                             lambda swap=swap: ast.copy_location(ast.AugAssign(node.target, swap(), node.value), node))
             if new is not None:
                 return new
+        target = ast.parse(ast.unparse(node.target), mode="eval").body     # the same target, to be stored to
+        target.ctx = ast.Store()
+        new = self._site(node, "an update written as an assignment (= for +=)",
+                         lambda: ast.copy_location(ast.Assign([target], node.value), node))
+        if new is not None:
+            return new
         new = self._site(node, "the update left out", lambda: ast.copy_location(ast.Pass(), node))
         return node if new is None else new
 
     def visit_Compare(self, node):
         self.generic_visit(node)
         for k, op in enumerate(node.ops):
-            swap = CMPOPS.get(type(op))
-            if swap is None:
-                continue
-            ops = list(node.ops)
-            ops[k] = swap()
-            new = self._site(node, f"{type(op).__name__} -> {swap.__name__}",
-                             lambda ops=ops: ast.copy_location(ast.Compare(node.left, ops, node.comparators), node))
-            if new is not None:
-                return new
+            for swap in CMPOPS.get(type(op), ()):
+                ops = list(node.ops)
+                ops[k] = swap()
+                new = self._site(node, f"{type(op).__name__} -> {swap.__name__}",
+                                 lambda ops=ops: ast.copy_location(ast.Compare(node.left, ops, node.comparators), node))
+                if new is not None:
+                    return new
         return node
 
     def visit_BoolOp(self, node):
@@ -119,8 +123,23 @@ class Mutator(ast.NodeTransformer):
 
     def visit_UnaryOp(self, node):
         self.generic_visit(node)
-        if isinstance(node.op, ast.USub):
-            new = self._site(node, "unary minus dropped", lambda: node.operand)
+        if isinstance(node.op, (ast.USub, ast.Not, ast.Invert)):
+            what = {ast.USub: "unary minus", ast.Not: "not", ast.Invert: "~"}[type(node.op)]
+            new = self._site(node, f"{what} dropped", lambda: node.operand)
+            if new is not None:
+                return new
+        return node
+
+    def visit_Expr(self, node):
+        self.generic_visit(node)
+        call = node.value
+        # np.add.at(a, idx, v) written as a[idx] += v: a repeated index then adds once
+        if (isinstance(call, ast.Call) and isinstance(call.func, ast.Attribute) and call.func.attr == "at"
+                and isinstance(call.func.value, ast.Attribute) and call.func.value.attr == "add"
+                and len(call.args) == 3):
+            target = ast.Subscript(call.args[0], call.args[1], ast.Store())
+            new = self._site(node, "np.add.at written as a[idx] += v",
+                             lambda: ast.copy_location(ast.AugAssign(target, ast.Add(), call.args[2]), node))
             if new is not None:
                 return new
         return node
