@@ -208,4 +208,4 @@ def test_the_command_reads_it(tmp_path, capsys):
     path = _file(tmp_path / "rec.aedat", _polarity_packets(t, x, y, on))
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "aedat3" in out and "180x240" in out.replace(" ", "") and "3,000" in out
+    assert "aedat3" in out and "180x240" in out.replace(" ", "") and "3,000" in out and "DAVIS240C" in out

@@ -230,7 +230,7 @@ def describe_recording(rec) -> dict:
         info.update(n_frames=len(fr), frame_size=list(fr.size), frames_t_first=float(fr.t[0]),
                     frames_t_last=float(fr.t[-1]),
                     frame_rate_per_s=(len(fr) - 1) / float(fr.t[-1] - fr.t[0]) if len(fr) > 1 and fr.t[-1] > fr.t[0] else None)
-    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "cfa", "read_notes"):
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "device", "frames_skipped", "cfa", "read_notes"):
         if meta.get(key) is not None:
             value = meta[key]
             info[key] = list(value) if isinstance(value, tuple) else value
@@ -262,9 +262,11 @@ def format_info(info: dict) -> str:
                      + (f" ({fr:.1f} per s)" if fr else "") + "  -> reconstructions are scored against them")
     else:
         lines.append("frames        none (nothing to score against)")
-    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "cfa"):
+    for key in ("C", "eval_window", "dataset", "sequence", "encoding", "device", "cfa"):
         if key in info:
             lines.append(f"{key:<13} {info[key]}")
+    if info.get("frames_skipped"):
+        lines.append(f"note          {info['frames_skipped']} frame(s) skipped: a region of interest or a colour filter")
     for text in info.get("read_notes", ()):
         lines.append(f"note          {text}")
     return "\n".join(lines)
