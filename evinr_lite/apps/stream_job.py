@@ -323,11 +323,11 @@ class _FrameWriter:
                 self.gif.append(img)
 
     def finish(self) -> list:
+        """The video files, once the PNGs are all written (``self.png`` closed by the caller); returns their names."""
         from ..core.checks import check_result_frames
         from ..io.export import save_gif
         from ..method.solver import RESULT_FIX
 
-        self.png.close()         # every PNG on disk, or the first write's error (a no-op when already closed)
         check_result_frames(np.array(self.range, np.float32)[:, None, None], what="EvINR's frames", input_varies=True,
                             fix=RESULT_FIX)
         written = []

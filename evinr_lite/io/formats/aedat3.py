@@ -37,9 +37,8 @@ import numpy as np
 
 from ...core.events import EventDataError
 from ...core.frames import to_grey_uint8
-from .aedat4 import frames_from
-from .base import FileFormat, check_declared_size, check_reader_window, existing, size_value
-from .packets import PacketSource, read_packets
+from .base import FileFormat, check_reader_window, declared_or_given_size, existing
+from .packets import PacketSource, frames_from, read_packets
 
 __all__ = ["read_aedat3", "open_aedat3", "aedat3_header", "PacketHeader", "MAGIC", "DEVICE_SIZES", "FORMAT"]
 
@@ -235,13 +234,11 @@ def _decoded(path: Path, sensor_size=None):
             raise EventDataError(f"{path}: the AEDAT 3.1 file holds no polarity (DVS) events; record events "
                                  "with the camera's DVS enabled")
         device = sources.get(source)
-        declared = size_value(path, xml_size, "the header's dvsSizeY x dvsSizeX") if xml_size else _device_size(device)
-        if declared is None and sensor_size is None:
-            raise EventDataError(f"{path}: the header does not give the sensor size (source {source}: "
-                                 f"{device or 'no device named'}); pass sensor_size=(H, W), e.g. "
-                                 "(128, 128) for a DVS128, (180, 240) for a DAVIS240, (260, 346) for a DAVIS346")
-        size = (check_declared_size(path, declared, sensor_size, "header") if declared is not None
-                else (int(sensor_size[0]), int(sensor_size[1])))
+        declared = xml_size or _device_size(device)
+        size = declared_or_given_size(path, declared, sensor_size, "header",
+                                      f"the header does not give the sensor size (source {source}: "
+                                      f"{device or 'no device named'}); pass sensor_size=(H, W), e.g. (128, 128) for a "
+                                      "DVS128, (180, 240) for a DAVIS240, (260, 346) for a DAVIS346")
         meta = {"format": "aedat3", "path": str(path), "source": source, "device": device,
                 "sources": {str(k): v for k, v in sorted(sources.items())},
                 "sensor_size_from": ("header" if xml_size else "device name") if declared is not None

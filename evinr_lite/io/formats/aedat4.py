@@ -11,13 +11,11 @@ from __future__ import annotations
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
-
 from ...core.events import EventDataError
-from ...core.frames import Frames, to_grey_uint8
+from ...core.frames import to_grey_uint8
 from .base import FileFormat, check_declared_size, check_reader_window, existing
-from .decoding import US, decoder_failed, decoder_stderr, origin_us_of
-from .packets import PacketSource, read_packets
+from .decoding import decoder_failed, decoder_stderr
+from .packets import PacketSource, frames_from, read_packets
 
 __all__ = ["read_aedat4", "FORMAT", "MAGIC"]
 
@@ -86,20 +84,6 @@ def _decoded(path: Path, sensor_size=None):
                 raise EventDataError(f"{path}: the AEDAT4 file is damaged or truncated ({err})") from None
 
         yield size, meta, packets()
-
-
-def frames_from(path, frame_t: list, images: list, origin_us: int | None, size) -> Frames | None:
-    """The APS frames decoded (microsecond stamps) on the events' clock, sorted; None without frames."""
-    if not images:
-        return None
-    if origin_us is None:   # frames but no events: the frames set the clock
-        origin_us = origin_us_of(frame_t[0])
-    shapes = {im.shape for im in images}
-    if shapes != {size}:
-        raise EventDataError(f"{path}: frames are {sorted(shapes)} but the events' sensor is {size} (H, W); "
-                             "frames with a region of interest are not supported")
-    t = (np.array(frame_t, np.int64) - origin_us) / US
-    return Frames(np.stack(images), t, float(origin_us // US)).sorted()
 
 
 def read_aedat4(path, *, sensor_size=None, t_start: float | None = None, t_end: float | None = None):

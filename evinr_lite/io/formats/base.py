@@ -20,7 +20,7 @@ from ...core.events import MAX_SENSOR_SIDE, EventDataError, Events, check_time_s
 from ..text import read_text_bytes
 
 __all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
-           "json_file", "size_value", "plain_attr", "check_declared_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
+           "json_file", "size_value", "plain_attr", "check_declared_size", "declared_or_given_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
            "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE",
            "check_time_spread", "same_time_message", "check_frame_times", "check_finite_images"]
 
@@ -192,6 +192,17 @@ def check_declared_size(path, declared, sensor_size, where: str):
                              f"size {tuple(int(v) for v in sensor_size)} was given; leave the sensor size out "
                              "(the file's is used) or pass the file's")
     return declared
+
+
+def declared_or_given_size(path, declared, sensor_size, where: str, missing: str) -> tuple[int, int]:
+    """The sensor size (H, W) of a file that may declare one: ``declared`` (checked as :func:`size_value` does,
+    then against ``sensor_size`` by :func:`check_declared_size`), else ``sensor_size``; with neither, an
+    EventDataError "{path}: {missing}" (which should say what to pass)."""
+    if declared is not None:
+        return check_declared_size(path, size_value(path, declared, f"the {where}'s sensor size"), sensor_size, where)
+    if sensor_size is None:
+        raise EventDataError(f"{path}: {missing}")
+    return int(sensor_size[0]), int(sensor_size[1])
 
 
 def json_file(path: Path) -> dict:

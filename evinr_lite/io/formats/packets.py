@@ -18,11 +18,26 @@ from pathlib import Path
 import numpy as np
 
 from ...core.events import EventDataError, Events
+from ...core.frames import Frames
 from ...core.recording import Recording
 from ..source import RecordingSource
 from .decoding import US, PacketCollector, decoder_stderr, origin_us_of
 
-__all__ = ["PacketSource", "read_packets"]
+__all__ = ["PacketSource", "read_packets", "frames_from"]
+
+
+def frames_from(path, frame_t: list, images: list, origin_us: int | None, size) -> Frames | None:
+    """The APS frames decoded (microsecond stamps) on the events' clock, sorted; None without frames."""
+    if not images:
+        return None
+    if origin_us is None:   # frames but no events: the frames set the clock
+        origin_us = origin_us_of(frame_t[0])
+    shapes = {im.shape for im in images}
+    if shapes != {size}:
+        raise EventDataError(f"{path}: frames are {sorted(shapes)} but the events' sensor is {size} (H, W); "
+                             "frames with a region of interest are not supported")
+    t = (np.array(frame_t, np.int64) - origin_us) / US
+    return Frames(np.stack(images), t, float(origin_us // US)).sorted()
 
 
 def read_packets(path: Path, decoded, *, sensor_size=None, t_start=None, t_end=None, frames_from=None) -> Recording:

@@ -15,7 +15,7 @@ import numpy as np
 
 from ...core.events import EventDataError
 from ...core.recording import Recording
-from .base import FileFormat, check_declared_size, check_reader_window, existing, size_value
+from .base import FileFormat, check_declared_size, check_reader_window, declared_or_given_size, existing
 from .decoding import PacketCollector, decoder_failed, decoder_stderr, percent_header
 from .evt21 import evt21_packets, header_sensor_size, is_evt21, word_order
 from .packets import PacketSource
@@ -123,13 +123,9 @@ def _evt21(path: Path, header: list[str], offset: int, sensor_size):
     """(size, meta, packets) of an EVT 2.1 file (``header`` and the data's ``offset``: :func:`percent_header`),
     as :func:`_decoded` yields them."""
     declared = header_sensor_size(header)
-    if declared is not None:
-        declared = size_value(path, declared, "the header's sensor size")
-    if declared is None and sensor_size is None:
-        raise EventDataError(f"{path}: the header does not give the sensor size; pass sensor_size=(H, W), e.g. "
-                             "(320, 320) for a GenX320 sensor, (720, 1280) for an IMX636")
-    size = (check_declared_size(path, declared, sensor_size, "header") if declared is not None
-            else (int(sensor_size[0]), int(sensor_size[1])))
+    size = declared_or_given_size(path, declared, sensor_size, "header",
+                                  "the header does not give the sensor size; pass sensor_size=(H, W), e.g. (320, 320) "
+                                  "for a GenX320 sensor, (720, 1280) for an IMX636")
     order = word_order(path, offset, size)
     meta = {"format": "prophesee_raw", "path": str(path), "encoding": "evt21", "word_order": order,
             "sensor_size_from": "header" if declared is not None else "sensor_size argument"}
