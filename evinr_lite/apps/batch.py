@@ -545,7 +545,7 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
         sequential: run the tasks one after the other in this process, without Dask (a reference).
         torch_threads: torch threads per task (default 1: one per worker process).
         options: a :class:`~evinr_lite.apps.options.RunOptions`, or its fields as keywords (the
-            keywords replace fields of ``options``): C, fps, n_iters, recipe, seed, device, video,
+            keywords replace fields of ``options``): C, fps, n_iters, recipe, seed, device, video, save_log,
             sensor_size, denoise, keep_background, static_camera, lam, anchor as for ``evinr-lite reconstruct`` (``video`` off by default:
             PNG frames and scores only; ``C`` may be a number, a pair (c_pos, c_neg) or "auto":
             fitted per recording from its APS frames), progress (the batch's progress bar).

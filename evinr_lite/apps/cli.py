@@ -132,6 +132,8 @@ STATIC_CAMERA_HELP = ("the camera stood still (a tripod) and things moved in fro
 KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-activity filter (an event is kept "
                         "when a neighbouring pixel fired one of the same polarity within 50 ms; EvINRConfig.background); "
                         "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
+SAVE_LOG_HELP = ("also write the frames' log intensity, unclipped, as float32 in log_intensity.h5 (4 bytes a pixel "
+                 "a frame): the dynamic range the 8-bit PNGs clip, to tone-map again or to use as data")
 CAMERA_CHOICES = ("left", "right")
 CAMERA_HELP = ("which camera of an MVSEC stereo file (davis/left or davis/right; default: the left one, or the "
                "one the file has); other formats hold one camera")
@@ -208,6 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--keep-background", action="store_true", help=KEEP_BACKGROUND_HELP)
     rec.add_argument("--static-camera", action="store_true", help=STATIC_CAMERA_HELP)
     rec.add_argument("--no-video", action="store_true", help="write PNGs only (no MP4 / GIF)")
+    rec.add_argument("--save-log", action="store_true", help=SAVE_LOG_HELP)
     rec.add_argument("--overwrite", action="store_true", help="replace --out if it exists")
     rec.add_argument("--resume", action="store_true",
                      help="continue a stopped run into the same --out from its last finished window (events-only "
@@ -262,6 +265,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
     batch.add_argument("--seed", type=_seed, default=0)
     batch.add_argument("--video", action="store_true", help="also write MP4 / GIF per recording")
+    batch.add_argument("--save-log", action="store_true", help=SAVE_LOG_HELP)
     batch.add_argument("--quiet", action="store_true", help="no progress bar")
     return parser
 
@@ -286,7 +290,7 @@ def _run_options(args):
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
                       keep_background=args.keep_background, static_camera=args.static_camera,
                       colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap, video=video,
-                      progress=not args.quiet)
+                      progress=not args.quiet, save_log=args.save_log)
 
 
 def _reconstruct(args) -> None:

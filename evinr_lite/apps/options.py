@@ -33,7 +33,7 @@ DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth 
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
 BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap",
-                "keep_background", "static_camera", "lam")
+                "keep_background", "static_camera", "lam", "save_log")
 MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
 _INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
 
@@ -162,6 +162,8 @@ class RunOptions:
         tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
             paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
         video: also write MP4 / GIF; progress: show a progress bar.
+        save_log: also write the frames' log intensity, unclipped, as float32 (``log_intensity.h5``,
+            :func:`evinr_lite.io.export.read_log_intensity`): the dynamic range the 8-bit PNGs clip.
     """
 
     sensor_size: tuple | None = None
@@ -185,6 +187,7 @@ class RunOptions:
     tonemap: str | None = None
     video: bool = True
     progress: bool = True
+    save_log: bool = False
 
     def __post_init__(self):
         checked = {"C": contrast_option(self.C)}
@@ -225,7 +228,7 @@ class RunOptions:
                                          for v in size):
                 raise EventDataError(f"sensor_size=(H, W) must be two positive whole numbers, got {self.sensor_size!r}")
             checked["sensor_size"] = (int(size[0]), int(size[1]))
-        for name in ("denoise", "keep_background", "static_camera", "colour", "video", "progress"):
+        for name in ("denoise", "keep_background", "static_camera", "colour", "video", "progress", "save_log"):
             checked[name] = _flag(name, getattr(self, name))
         if checked["static_camera"] and (self.recipe != "kit" or self.anchor != "none"):
             raise EventDataError(f"static_camera (--static-camera) changes the kit recipe's offset solve; the "

@@ -31,7 +31,7 @@ from ..method.recipes import (DEFAULT_C, RECIPES, contrast_option, format_contra
 from ..method.solver import Reconstruction, reconstruct
 from .options import DEFAULT_FPS, RunOptions, check_run_options, choose_times, parse_times  # noqa: F401
 from .results import EQUALIZATIONS, score_predictions, score_recording, write_results  # noqa: F401
-from .stream_job import report_balance, report_lam, run_streaming, streamable, video_fps
+from .stream_job import check_disk, log_display, report_balance, report_lam, run_streaming, streamable, video_fps
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
@@ -50,21 +50,19 @@ def reconstruct_recording(rec: Recording, times, config: EvINRConfig | None = No
     return reconstruct(rec.events, times, config, t_start=lo, t_end=hi, frames=frames)
 
 
-# ---- scoring ---------------------------------------------------------------------------------
-
 # ---- export ----------------------------------------------------------------------------------
-
-
 
 def export_reconstruction(out_dir, rec: Recording, result: Reconstruction, scores: dict | None = None, *,
                           settings: dict | None = None, overwrite: bool = False, video: bool = True,
-                          log=print) -> dict:
+                          save_log: bool = False, log=print) -> dict:
     """Write a finished reconstruction into ``out_dir`` (atomically: all or nothing).
 
     Layout: ``frames/frame_00000.png`` ... (the reconstruction), ``timestamps.txt`` (one time per
-    frame), ``reconstruction.mp4`` and ``.gif`` (``video``), ``gt/`` (the ground-truth frames in the
-    window) with ``metrics.json`` and ``metrics.csv`` (per frame, both protocols) when scored, and
-    ``run.json`` (input, format, window, settings, EvINR config, timings).
+    frame), ``reconstruction.mp4`` and ``.gif`` (``video``), ``log_intensity.h5`` (``save_log``: the
+    frames' log intensity, float32, unclipped; :func:`evinr_lite.io.export.read_log_intensity`),
+    ``gt/`` (the ground-truth frames in the window) with ``metrics.json`` and ``metrics.csv`` (per
+    frame, both protocols) when scored, and ``run.json`` (input, format, window, settings, EvINR
+    config, timings).
 
     ``out_dir`` may also be an :class:`~evinr_lite.io.output.OutputDir` opened (checked and locked)
     before the long work, as :func:`run_reconstruct` does; it is committed here.
@@ -78,24 +76,30 @@ def export_reconstruction(out_dir, rec: Recording, result: Reconstruction, score
     from ..io.output import OutputDir
 
     if isinstance(out_dir, OutputDir):
-        run = _write_reconstruction(out_dir.staging, rec, result, scores, settings=settings, video=video, log=log)
+        run = _write_reconstruction(out_dir.staging, rec, result, scores, settings=settings, video=video,
+                                    save_log=save_log, log=log)
         out_dir.commit()
         return run
     with OutputDir(out_dir, overwrite=overwrite, inputs=[rec.meta.get("path")], log=log) as target:
-        run = _write_reconstruction(target.staging, rec, result, scores, settings=settings, video=video, log=log)
+        run = _write_reconstruction(target.staging, rec, result, scores, settings=settings, video=video,
+                                    save_log=save_log, log=log)
         target.commit()
     return run
 
 
 def _write_reconstruction(tmp: Path, rec: Recording, result: Reconstruction, scores: dict | None, *,
-                          settings: dict | None, video: bool, log) -> dict:
-    from ..io.export import save_frames_png, save_gif, save_mp4, save_timestamps
+                          settings: dict | None, video: bool, save_log: bool, log) -> dict:
+    from ..io.export import LOG_INTENSITY_FILE, save_frames_png, save_gif, save_log_intensity, save_mp4, save_timestamps
 
     written = ["frames/", "timestamps.txt"]
     settings = dict(settings or {})
     # into the staging folder; the caller renames it into place
     save_frames_png(tmp / "frames", result.frames)
     save_timestamps(tmp / "timestamps.txt", result.times, rec.events.t_origin)
+    if save_log:
+        save_log_intensity(tmp / LOG_INTENSITY_FILE, result.log_intensity, result.times, t_origin=rec.events.t_origin,
+                           **log_display(result.config if isinstance(result, Reconstruction) else result.history["config"]))
+        written.append(LOG_INTENSITY_FILE)
     if video:
         fps = video_fps(result.times)
         save_gif(tmp / "reconstruction.gif", result.frames, fps)
@@ -108,8 +112,6 @@ def _write_reconstruction(tmp: Path, rec: Recording, result: Reconstruction, sco
         settings["video_fps"] = fps
     return write_results(tmp, rec, result.times, result.history, scores, settings=settings, written=written)
 
-
-# ---- the whole job ---------------------------------------------------------------------------
 
 # ---- the whole job ---------------------------------------------------------------------------
 
@@ -193,6 +195,8 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
         C, C_source, C_fit = resolve_contrast(rec, options.C, path, log, colour=colour)
         config = options.config(C)
         fits(len(times), config)
+        if options.save_log:   # the log intensities go to disk: 4 bytes a pixel a frame (and the PNGs)
+            check_disk(len(times), (H, W), target.staging)
         log(f"read {len(rec.events):,} events ({rec.meta['format']}, {H}x{W}) in [{lo:.6f}, {hi:.6f}] s"
             + (f", {len(rec.frames)} ground-truth frames" if rec.frames is not None else ", no frames")
             + f" in {time.perf_counter() - t0:.1f} s")
@@ -220,7 +224,8 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
         if colour:
             settings["colour"] = {"cfa": result.history["cfa"], "thresholds": result.history["thresholds"],
                                   "grid": list(result.frames.shape[1:3]), **(colour_scores or {})}
-        run = export_reconstruction(target, rec, result, scores, settings=settings, video=options.video, log=log)
+        run = export_reconstruction(target, rec, result, scores, settings=settings, video=options.video,
+                                    save_log=options.save_log, log=log)
     return _finish(run, times, scores, target.given, t0, options, log)
 
 

@@ -33,7 +33,7 @@ from ..core.frames import Frames
 from ..core.guard import signals_deferred
 from ..core.recording import Recording
 
-__all__ = ["streamable", "run_streaming", "check_disk", "resume_folder", "video_fps", "RESUME_MARKER", "GIF_LIMIT_BYTES"]
+__all__ = ["streamable", "run_streaming", "check_disk", "resume_folder", "video_fps", "log_display", "RESUME_MARKER", "GIF_LIMIT_BYTES"]
 
 RESUME_MARKER = ".evinr-resume.json"   # inside the resume folder: the proof it is this job's own
 GIF_LIMIT_BYTES = 512 << 20            # uint8 frames kept for the GIF; beyond, the GIF is skipped (the MP4 streams)
@@ -181,10 +181,11 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
         n_events = source.n_events if source.n_events is not None else 0
         gt_t = gt.t if gt is not None else np.zeros(0)
 
-        def fits(n_query: int, config) -> dict:   # memory, then disk
+        def fits(n_query: int, config, n_times: int | None = None) -> dict:   # memory, then disk
             est = check_memory((H, W), lo, hi, n_events, n_query, config, device_name, events_span=source.t_span,
                                streaming=True)
-            check_disk(n_query, (H, W), target.staging)
+            check_disk(n_query, (H, W), target.staging, log_frames=(n_query if n_times is None else n_times)
+                       if options.save_log else 0)
             return est
 
         # before the times are built (the memory estimate does not depend on C), and again once C is known
@@ -193,7 +194,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
         C, C_source, _ = resolve_contrast(rec, options.C, path, log)
         config = options.config(C)
         query = np.unique(np.concatenate([times, gt_t]))        # sorted: the exported times and the scored ones
-        est = fits(len(query), config)
+        est = fits(len(query), config, len(times))
         log(f"streaming {source.format} {H}x{W} over [{lo:.6f}, {hi:.6f}] s"
             + (f" ({n_events:,} events)" if source.n_events is not None else "")
             + (f", {len(gt)} ground-truth frames" if gt is not None else ", no frames")
@@ -209,7 +210,9 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
             with signals_deferred():   # a signal here is acted on after `made` is set, inside this try
                 state = _prepare_resume(folder, _key(path, config, times, (lo, hi)), resume, log)
                 made = True
-            writer = _FrameWriter(target.staging, times, query, gt_t, options.video, log)
+            writer = _FrameWriter(target.staging, times, query, gt_t, options.video, log,
+                                  log_intensity=dict(frame_shape=(H, W), t_origin=source.t_origin, **log_display(config))
+                                  if options.save_log else None)
             # the state after the last window is not saved: writing it (the offset grid: 240 MB at 1280x720)
             # took as long as a third of that window's training, which is all a resume from it would spare
             parts = stream_reconstruct(source, query, config, t_start=lo, t_end=hi, workdir=folder, state=state,
@@ -218,7 +221,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
             for part in parts:
                 writer.add(part)
                 history = part.history
-            writer.png.close()   # every PNG on disk (or the first write's error) before the resume state goes
+            writer.close()   # every PNG and log intensity on disk (or the first write's error) before the resume state goes
         except BaseException:   # interrupted or failed: finished windows stay for --resume, else nothing stays
             # (not made: refused before the folder was ready, e.g. one that is not this job's; left untouched)
             if writer is not None:
@@ -249,15 +252,16 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     return run, times, scores
 
 
-def check_disk(n_frames: int, sensor_size, folder, *, fraction: float = 0.8) -> dict:
+def check_disk(n_frames: int, sensor_size, folder, *, fraction: float = 0.8, log_frames: int = 0) -> dict:
     """Refuse (EventDataError) a streamed run whose frames would not fit on the disk of ``folder``.
 
     A streamed run keeps its frames on disk, not in memory: each one is spilled as float32 log
     intensities (4 bytes a pixel) until the offset is known, then written as a PNG (at most one byte a
-    pixel, and at least one 4 KiB file-system block). Returns {"total", "free"} in bytes.
+    pixel, and at least one 4 KiB file-system block). ``log_frames``: frames also kept as float32 log
+    intensities in the output (``save_log``; 4 bytes a pixel each). Returns {"total", "free"} in bytes.
     """
     H, W = sensor_size
-    need = float(n_frames) * (4.0 * H * W + max(4096.0, float(H * W)))
+    need = float(n_frames) * (4.0 * H * W + max(4096.0, float(H * W))) + float(log_frames) * 4.0 * H * W
     free = float(shutil.disk_usage(Path(folder).parent if not Path(folder).exists() else folder).free)
     if need > fraction * free:
         raise EventDataError(f"this reconstruction needs about {need / 2**30:,.1f} GiB of disk for its {n_frames:,} "
@@ -268,13 +272,17 @@ def check_disk(n_frames: int, sensor_size, folder, *, fraction: float = 0.8) -> 
 
 
 class _FrameWriter:
-    """Writes each finished frame of the exported times as a PNG (and into the MP4) as it arrives,
-    and keeps the frames at the ground-truth times for scoring."""
+    """Writes each finished frame of the exported times as a PNG (and into the MP4, and its log
+    intensity into log_intensity.h5 when ``log_intensity`` gives that file's attributes) as it
+    arrives, and keeps the frames at the ground-truth times for scoring."""
 
-    def __init__(self, staging: Path, times, query, gt_t, video: bool, log):
+    def __init__(self, staging: Path, times, query, gt_t, video: bool, log, log_intensity: dict | None = None):
+        from ..io.export import LOG_INTENSITY_FILE, LogIntensityWriter
         from ..io.output import PngWriter
 
         self.folder = staging / "frames"
+        self.hdr = None if log_intensity is None else \
+            LogIntensityWriter(staging / LOG_INTENSITY_FILE, times, **log_intensity)
         self.png = PngWriter()   # encoded on worker threads while the next frames are computed
         self.folder.mkdir(parents=True, exist_ok=True)
         self.staging, self.log = staging, log
@@ -304,6 +312,8 @@ class _FrameWriter:
             i = self.export_of.get(q)
             if i is not None:
                 self.png.write(self.folder / f"frame_{i:05d}.png", u8[j])
+                if self.hdr is not None:
+                    self.hdr.write(i, part.log_intensity[j])
                 if self.video:
                     self._video_frame(u8[j])
             g = self.gt_of.get(q)
@@ -322,15 +332,23 @@ class _FrameWriter:
             else:
                 self.gif.append(img)
 
+    def close(self) -> None:
+        """Wait for every PNG and close log_intensity.h5; raises the first write's error, or the file's when a
+        frame is missing from it."""
+        self.png.close()
+        if self.hdr is not None:
+            self.hdr.close()
+
     def finish(self) -> list:
-        """The video files, once the PNGs are all written (``self.png`` closed by the caller); returns their names."""
+        """The video files, once the PNGs are all written (:meth:`close`); returns the names of every file
+        written beside the PNGs."""
         from ..core.checks import check_result_frames
         from ..io.export import save_gif
         from ..method.solver import RESULT_FIX
 
         check_result_frames(np.array(self.range, np.float32)[:, None, None], what="EvINR's frames", input_varies=True,
                             fix=RESULT_FIX)
-        written = []
+        written = [] if self.hdr is None else [self.hdr.path.name]
         if self.mp4 is not None and self.mp4.close():
             written.append("reconstruction.mp4")
         if self.gif:
@@ -342,6 +360,8 @@ class _FrameWriter:
         """Drop the PNGs not yet started and wait for the running ones: no thread writes into the staging
         folder once the run has failed or been interrupted (it is removed next)."""
         self.png.abort()
+        if self.hdr is not None:
+            self.hdr.abort()
         if self.mp4 is not None:
             self.mp4.close()
 
@@ -370,6 +390,15 @@ class _Mp4:
     def close(self) -> bool:
         self.writer.release()
         return self.ok
+
+
+def log_display(config) -> dict:
+    """The tone map, gamma and display formula of an EvINRConfig (or its dict): the attributes of a
+    ``log_intensity.h5`` (:class:`~evinr_lite.io.export.LogIntensityWriter`)."""
+    from ..method.tonemap import display_formula
+
+    get = config.get if isinstance(config, dict) else lambda name: getattr(config, name)
+    return {"tonemap": get("tonemap"), "gamma": get("gamma"), "display": display_formula(get("tonemap"), get("gamma"))}
 
 
 def video_fps(times: np.ndarray) -> float:

@@ -59,6 +59,7 @@ from ..core.cfa import CFA_NAMES, cfa_phase, check_cfa  # the colour filter's on
 from ..core.events import MAX_SENSOR_SIDE, EventDataError, Events
 from ..core.frames import Frames, to_grey_uint8
 from .notes import note
+from .output import CloseOrAbort
 from .source import RecordingSource
 
 __all__ = [
@@ -539,7 +540,7 @@ def repair_frame_times(t: np.ndarray) -> tuple[np.ndarray, list[int]]:
     return t, fixed
 
 
-class CanonicalWriter:
+class CanonicalWriter(CloseOrAbort):
     """Stream events and frames into a canonical ``.h5`` file.
 
     Args:
@@ -755,12 +756,3 @@ class CanonicalWriter:
                 self.tmp.unlink(missing_ok=True)
                 self.closed = True
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, exc_type, exc, tb):
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
-        return False

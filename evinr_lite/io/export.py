@@ -1,4 +1,5 @@
-"""Writing reconstructed frames: numbered PNGs, an animated GIF (Pillow), an MP4 (OpenCV).
+"""Writing reconstructed frames: numbered PNGs, an animated GIF (Pillow), an MP4 (OpenCV), and the
+log intensity itself (HDF5, float32), which the 8-bit files clip.
 
 Frames are grey float arrays [F, H, W] or colour (R, G, B) arrays [F, H, W, 3], in [0, 1] (or
 uint8); colour frames give colour PNGs, GIF and MP4. These functions write into a folder
@@ -16,9 +17,12 @@ from PIL import Image
 from ..core.checks import check_image_values, real_number, seconds_array
 from ..core.events import EventDataError
 from ..core.frames import Frames, to_uint8
-from .output import PngWriter
+from .output import CloseOrAbort, PngWriter
 
-__all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv"]
+__all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv", "LogIntensityWriter",
+           "save_log_intensity", "read_log_intensity", "LOG_INTENSITY_FILE"]
+
+LOG_INTENSITY_FILE = "log_intensity.h5"   # its name in a run folder
 
 
 def _stack_uint8(frames) -> np.ndarray:
@@ -122,3 +126,108 @@ def save_csv(path, rows: list[dict]) -> Path:
         writer.writeheader()
         writer.writerows(rows)
     return Path(path)
+
+
+# ---- the log intensity, unclipped ---------------------------------------------------------------
+# An event camera's reason to exist is its dynamic range: the reconstruction's log intensity spans
+# whatever the scene did, while a PNG holds 256 levels of what the display shows, with every highlight
+# above the display's white clipped. The HDF5 file keeps the float32 values, so a user can tone-map
+# them again (another level, another curve) or feed them to their own pipeline.
+
+class LogIntensityWriter(CloseOrAbort):
+    """An HDF5 file of log intensities written frame by frame (a streamed run's frames arrive in parts).
+
+    Layout: ``log_intensity`` float32 [F, H, W] (or [F, H, W, 3] for colour), one chunk per frame,
+    uncompressed (float noise barely compresses and a chunk per frame keeps the writes streaming);
+    ``t`` float64 [F], seconds relative to the attribute ``t_origin``; attributes saying what the
+    values are (``units``) and how the run's frames were drawn from them (``display``, ``tonemap``,
+    ``gamma``). Rows not yet written read as NaN, so a file closed early cannot pass for complete;
+    :meth:`close` refuses one with rows missing.
+
+    Args:
+        path: the file to create (inside a staging folder: the caller renames the folder into place).
+        times: float64 [F] the frames' times (seconds on the events' clock, relative to ``t_origin``).
+        frame_shape: (H, W) or (H, W, 3).
+        t_origin: seconds, the absolute time of t = 0 (0 when relative).
+        tonemap, gamma, display: the display the run used (``display``: its formula in words).
+    """
+
+    def __init__(self, path, times, frame_shape, *, t_origin: float = 0.0, tonemap: str = "linear",
+                 gamma: float = 0.6, display: str = ""):
+        import h5py
+
+        times = seconds_array(times, "times")
+        t_origin = real_number(t_origin, "t_origin", hint="seconds: the absolute time of t = 0 (0 when relative)")
+        frame_shape = tuple(int(v) for v in frame_shape)
+        if len(frame_shape) not in (2, 3) or min(frame_shape) < 1 or (len(frame_shape) == 3 and frame_shape[2] != 3):
+            raise EventDataError(f"frame_shape must be (H, W) or (H, W, 3), got {frame_shape}")
+        self.path = Path(path)
+        self.shape = (len(times), *frame_shape)
+        self.done = np.zeros(len(times), bool)
+        self.file = h5py.File(self.path, "w")
+        try:
+            self.data = self.file.create_dataset("log_intensity", shape=self.shape, dtype="float32",
+                                                 chunks=(1, *frame_shape), fillvalue=np.nan)
+            self.file.create_dataset("t", data=times)
+            self.file.attrs.update({
+                "units": "natural log of intensity; events fix it up to one constant per recording, which the "
+                         "display's level set (docs/defaults.md, 'The display')",
+                "t_units": "seconds relative to t_origin", "t_origin": t_origin, "tonemap": tonemap,
+                "gamma": float(gamma), "display": display, "writer": "evinr-lite"})
+        except BaseException:
+            self.file.close()
+            raise
+
+    def write(self, i: int, image) -> None:
+        """Frame ``i`` (0-based, in the order of ``times``): an array of ``frame_shape``."""
+        image = np.asarray(image, np.float32)
+        if image.shape != self.shape[1:]:
+            raise EventDataError(f"frame {i} has shape {image.shape}, expected {self.shape[1:]}")
+        self.data[i] = image
+        self.done[i] = True
+
+    def close(self) -> None:
+        """Close the file; EventDataError when a frame was never written (the file is then incomplete)."""
+        if self.file.id.valid:
+            self.file.close()
+        if not self.done.all():
+            missing = np.flatnonzero(~self.done)
+            raise EventDataError(f"{self.path}: {missing.size} of {self.done.size} frames were never written (first: "
+                                 f"{int(missing[0])}); the file is incomplete")
+
+    def abort(self) -> None:
+        """Close the file without the completeness check (a failed or interrupted run; its folder goes)."""
+        if self.file.id.valid:
+            self.file.close()
+
+
+def save_log_intensity(path, log_intensity, times, **kw) -> Path:
+    """Write log intensities [F, H, W] (or [F, H, W, 3]) at ``times`` [F] (s) as one HDF5 file
+    (:class:`LogIntensityWriter`'s layout; keywords: its t_origin, tonemap, gamma, display)."""
+    L = np.asarray(log_intensity)
+    if L.ndim not in (3, 4) or L.shape[0] != len(np.atleast_1d(times)):
+        raise EventDataError(f"log_intensity must be [F, H, W] or [F, H, W, 3] with one frame per time, got shape "
+                             f"{L.shape} for {len(np.atleast_1d(times))} time(s)")
+    with LogIntensityWriter(path, times, L.shape[1:], **kw) as out:
+        for i, img in enumerate(L):
+            out.write(i, img)
+    return Path(path)
+
+
+def read_log_intensity(path) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(log intensity float32 [F, H, W] or [F, H, W, 3], times float64 [F] s, attributes) of a file
+    :class:`LogIntensityWriter` wrote (``evinr-lite reconstruct --save-log``: ``log_intensity.h5``).
+
+    The run's frames are ``clip(exp(L), 0, 1)`` for ``attrs["tonemap"] == "linear"`` (the
+    kit's display), ``sigmoid(L) ** gamma`` for "reinhard" (``evinr_lite.method.tonemap.to_display``).
+    """
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            if "log_intensity" not in f or "t" not in f:
+                raise EventDataError(f"{path}: not a log-intensity file (no 'log_intensity' and 't' datasets); it is "
+                                     "written by `evinr-lite reconstruct --save-log` as log_intensity.h5")
+            return f["log_intensity"][()], f["t"][()], dict(f.attrs)
+    except OSError as err:
+        raise EventDataError(f"{path}: cannot be read as HDF5 ({err}); pass the log_intensity.h5 of a run folder") from None

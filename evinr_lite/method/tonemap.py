@@ -32,7 +32,7 @@ import numpy as np
 
 from ..core.events import EventDataError
 
-__all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "DISPLAY_MEANS", "tonemap_reinhard", "tonemap_linear", "to_display", "display_shift", "anchor_level",
+__all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "DISPLAY_MEANS", "tonemap_reinhard", "tonemap_linear", "to_display", "display_formula", "display_shift", "anchor_level",
            "anchor_mean", "reinhard_unchecked"]
 
 TONEMAPS = ("linear", "reinhard")
@@ -87,6 +87,15 @@ def to_display(L, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6):
         return tonemap_linear(L)
     if tonemap == "reinhard":
         return reinhard_unchecked(L, gamma)
+    raise EventDataError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
+
+
+def display_formula(tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6) -> str:
+    """:func:`to_display` in words, for files that keep the log intensity L (``log_intensity.h5``)."""
+    if tonemap == "linear":
+        return "frames = clip(exp(L), 0, 1)"
+    if tonemap == "reinhard":
+        return f"frames = sigmoid(L) ** {gamma:g}"
     raise EventDataError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
 
 
