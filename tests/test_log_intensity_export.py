@@ -161,3 +161,12 @@ def test_batch_writes_one_file_per_recording(tmp_path):
     run_batch([folder], tmp_path / "out", sequential=True, save_log=True, progress=False, log=lambda *a, **k: None)
     for scene in ("camera", "moon"):
         _check_run(tmp_path / "out" / f"rec_{scene}")
+
+
+def test_given_as_a_recording_it_is_named_for_what_it_is(tmp_path, capsys):
+    path = save_log_intensity(tmp_path / LOG_INTENSITY_FILE, np.zeros((2, 4, 5)), [0.1, 0.2])
+    for command in (["info", str(path)], ["reconstruct", str(path), "--out", str(tmp_path / "o")]):
+        assert main(command) == 2
+        err = capsys.readouterr().err
+        assert "a reconstruction's log intensity" in err and "the recording it came from" in err
+    assert not (tmp_path / "o").exists()

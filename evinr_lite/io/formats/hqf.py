@@ -36,6 +36,11 @@ class _Layout(TimeIndexed):
                                  "ECF codec, which no h5py plugin here decodes); convert it with Metavision's "
                                  "metavision_file_to_dat (a .dat file) or metavision_file_to_csv (a .csv file) and "
                                  "read that")
+        if missing and isinstance(f.get("log_intensity"), h5py.Dataset) and f.attrs.get("writer") == "evinr-lite":
+            raise EventDataError(f"{path}: a reconstruction's log intensity (evinr-lite reconstruct --save-log), not "
+                                 "a recording: it holds frames, not events; read it with "
+                                 "evinr_lite.io.export.read_log_intensity, and give reconstruct or info the "
+                                 "recording it came from (its run.json's \"input\")")
         if missing:
             raise EventDataError(f"{path}: missing datasets {missing} (or groups where datasets belong); expected "
                                  f"the HQF layout {list(EVENT_NAMES)}, each a 1-D dataset")
