@@ -31,7 +31,7 @@ from ..method.recipes import (DEFAULT_C, RECIPES, contrast_option, format_contra
 from ..method.solver import Reconstruction, reconstruct
 from .options import DEFAULT_FPS, RunOptions, check_run_options, choose_times, parse_times  # noqa: F401
 from .results import EQUALIZATIONS, score_predictions, score_recording, write_results  # noqa: F401
-from .stream_job import check_disk, log_display, report_balance, report_lam, run_streaming, streamable, video_fps
+from .stream_job import check_disk, display_attrs, report_balance, report_lam, run_streaming, streamable, video_fps
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
@@ -98,7 +98,7 @@ def _write_reconstruction(tmp: Path, rec: Recording, result: Reconstruction, sco
     save_timestamps(tmp / "timestamps.txt", result.times, rec.events.t_origin)
     if save_log:
         save_log_intensity(tmp / LOG_INTENSITY_FILE, result.log_intensity, result.times, t_origin=rec.events.t_origin,
-                           **log_display(result.config if isinstance(result, Reconstruction) else result.history["config"]))
+                           **display_attrs(result.config if isinstance(result, Reconstruction) else result.history["config"]))
         written.append(LOG_INTENSITY_FILE)
     if video:
         fps = video_fps(result.times)

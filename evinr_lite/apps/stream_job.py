@@ -33,7 +33,8 @@ from ..core.frames import Frames
 from ..core.guard import signals_deferred
 from ..core.recording import Recording
 
-__all__ = ["streamable", "run_streaming", "check_disk", "resume_folder", "video_fps", "log_display", "RESUME_MARKER", "GIF_LIMIT_BYTES"]
+__all__ = ["streamable", "run_streaming", "check_disk", "resume_folder", "video_fps", "display_attrs", "RESUME_MARKER",
+           "GIF_LIMIT_BYTES"]
 
 RESUME_MARKER = ".evinr-resume.json"   # inside the resume folder: the proof it is this job's own
 GIF_LIMIT_BYTES = 512 << 20            # uint8 frames kept for the GIF; beyond, the GIF is skipped (the MP4 streams)
@@ -211,7 +212,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
                 state = _prepare_resume(folder, _key(path, config, times, (lo, hi)), resume, log)
                 made = True
             writer = _FrameWriter(target.staging, times, query, gt_t, options.video, log,
-                                  log_intensity=dict(frame_shape=(H, W), t_origin=source.t_origin, **log_display(config))
+                                  log_intensity=dict(frame_shape=(H, W), t_origin=source.t_origin, **display_attrs(config))
                                   if options.save_log else None)
             # the state after the last window is not saved: writing it (the offset grid: 240 MB at 1280x720)
             # took as long as a third of that window's training, which is all a resume from it would spare
@@ -253,7 +254,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
 
 
 def check_disk(n_frames: int, sensor_size, folder, *, fraction: float = 0.8, log_frames: int = 0) -> dict:
-    """Refuse (EventDataError) a streamed run whose frames would not fit on the disk of ``folder``.
+    """Refuse (EventDataError) a run whose frames would not fit on the disk of ``folder``.
 
     A streamed run keeps its frames on disk, not in memory: each one is spilled as float32 log
     intensities (4 bytes a pixel) until the offset is known, then written as a PNG (at most one byte a
@@ -392,7 +393,7 @@ class _Mp4:
         return self.ok
 
 
-def log_display(config) -> dict:
+def display_attrs(config) -> dict:
     """The tone map, gamma and display formula of an EvINRConfig (or its dict): the attributes of a
     ``log_intensity.h5`` (:class:`~evinr_lite.io.export.LogIntensityWriter`)."""
     from ..method.tonemap import display_formula

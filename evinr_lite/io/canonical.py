@@ -755,4 +755,3 @@ class CanonicalWriter(CloseOrAbort):
             finally:
                 self.tmp.unlink(missing_ok=True)
                 self.closed = True
-
