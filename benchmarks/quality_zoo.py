@@ -6,6 +6,7 @@
     python benchmarks/quality_zoo.py --heldout             # the held-out scenes no default was chosen on
     python benchmarks/quality_zoo.py --stress              # scenes with settings outside both sets' ranges
     python benchmarks/quality_zoo.py --large               # three scenes at 360x480 (4x the zoo's largest)
+    python benchmarks/quality_zoo.py --fresh 2026          # 16 scenes drawn at random the zoo's ways (--n-fresh N)
     python benchmarks/quality_zoo.py --scenes camera_translate,noisy_gravel --methods kit,integration
     python benchmarks/quality_zoo.py --variant "lam 0.1=lam=0.1"        # add an EvINR variant (NAME=field=value,...)
     python -m benchmarks --only zoo                        # the same, from the benchmark runner
@@ -26,6 +27,9 @@ or 0.45, 64x64 and 90x320 sensors, a speed that nearly stops, 2 Hz of background
 pair, 15 % mismatch, a bar sweeping over a flat background); results in ``zoo_results_stress.*``.
 ``--large`` scores ``evinr_lite.sim.zoo.LARGE``: three scenes at 360x480 (twice the zoo's largest sensor
 along each side, motions and hot pixels scaled with it); results in ``zoo_results_large.*``.
+``--fresh SEED`` scores ``evinr_lite.sim.zoo.fresh(SEED, N)``: N scenes (16 by default) drawn at random
+from the zoo's scene classes, images, motions and sensor faults, none of which anyone looked at
+before the run; results in ``zoo_results_fresh.*`` (the seed in the JSON).
 
 Methods: ``kit`` (``EvINRConfig()``, the kit's default), ``paper`` (``EvINRConfig.paper()``, the
 paper's recipe exactly), ``v0_1`` (the kit's default before the zoo; paper and v0_1 are skipped on the
@@ -74,6 +78,7 @@ from evinr_lite.evaluation.scoring import frames_to_score, score_sequence  # noq
 from evinr_lite.method import EvINRConfig, integrate_events, reconstruct, reconstruct_baseline  # noqa: E402
 from evinr_lite.method.tonemap import anchor_mean, to_display  # noqa: E402
 from evinr_lite.sim.zoo import HELDOUT, LARGE, STRESS, ZOO, default_scenes, effective_C, quick, simulate  # noqa: E402
+from evinr_lite.sim.zoo import fresh as zoo_fresh  # noqa: E402
 
 BASELINES = ("integration", "hf")                   # the baselines at their default settings
 SWEPT = ("hf_best", "leaky_best")                   # HF's cutoff / leaky integration's leak picked per scene
@@ -561,15 +566,21 @@ def zoo_main(argv=None) -> dict:
                    help="the stress scenes (zoo.STRESS) instead of the zoo; no real chunk; *_stress.* outputs")
     p.add_argument("--large", action="store_true",
                    help="the 360x480 scenes (zoo.LARGE) instead of the zoo; no real chunk; *_large.* outputs")
+    p.add_argument("--fresh", type=int, default=None, metavar="SEED",
+                   help="scenes drawn at random the zoo's ways from SEED (zoo.fresh) instead of the zoo; no real "
+                        "chunk; *_fresh.* outputs")
+    p.add_argument("--n-fresh", type=int, default=16, help="how many --fresh scenes (default 16)")
     p.add_argument("--no-real", action="store_true", help="skip the real slider_depth chunk")
     p.add_argument("--json", default=None, help="default benchmarks/zoo_results[_heldout|_stress|_large].json")
     p.add_argument("--md", default=None, help="default benchmarks/zoo_results[_heldout|_stress|_large].md")
     p.add_argument("--figure", default=None, help="default benchmarks/zoo_figure[_heldout|_stress|_large].png")
     a = p.parse_args(argv)
-    if a.heldout + a.stress + a.large > 1:
-        p.error("--heldout, --stress and --large are other sets of scenes: give one of them")
-    other = a.heldout or a.stress or a.large          # a set other than the zoo: all its scenes, no real chunk
-    suffix = "_heldout" if a.heldout else "_stress" if a.stress else "_large" if a.large else ""
+    fresh_set = a.fresh is not None
+    if a.heldout + a.stress + a.large + fresh_set > 1:
+        p.error("--heldout, --stress, --large and --fresh are other sets of scenes: give one of them")
+    other = a.heldout or a.stress or a.large or fresh_set   # a set other than the zoo: all its scenes, no real chunk
+    suffix = "_heldout" if a.heldout else "_stress" if a.stress else "_large" if a.large else \
+        "_fresh" if fresh_set else ""
     a.json = f"benchmarks/zoo_results{suffix}.json" if a.json is None else a.json
     a.md = f"benchmarks/zoo_results{suffix}.md" if a.md is None else a.md
     a.figure = f"benchmarks/zoo_figure{suffix}.png" if a.figure is None else a.figure
@@ -578,7 +589,8 @@ def zoo_main(argv=None) -> dict:
     unknown = [m for m in methods if m not in METHODS + OPTIONAL and m not in variants]
     if unknown:
         p.error(f"unknown methods {unknown}; use {METHODS + OPTIONAL} or add --variant NAME=...")
-    pool = HELDOUT if a.heldout else STRESS if a.stress else LARGE if a.large else ZOO
+    pool = HELDOUT if a.heldout else STRESS if a.stress else LARGE if a.large else \
+        zoo_fresh(a.fresh, a.n_fresh) if fresh_set else ZOO
     if a.scenes is None:
         scenes = list(pool) if other else default_scenes(a.long)
     else:
@@ -608,7 +620,7 @@ def zoo_main(argv=None) -> dict:
         Path(a.md).write_text(md + "\n")
     if a.json:
         clean = {n: {k: v for k, v in r.items() if k != "figure"} for n, r in results.items()}
-        Path(a.json).write_text(json.dumps({"quick": a.quick, "long": a.long, "heldout": a.heldout, "stress": a.stress, "large": a.large, "methods": methods, "variants": variants,
+        Path(a.json).write_text(json.dumps({"quick": a.quick, "long": a.long, "heldout": a.heldout, "stress": a.stress, "large": a.large, "fresh_seed": a.fresh, "methods": methods, "variants": variants,
                                             "scenes": clean, "targets": target_rows(results)}, indent=2,
                                            default=float) + "\n")
         print(f"json: {a.json}")

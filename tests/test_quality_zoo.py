@@ -66,3 +66,18 @@ def test_windows_answer_every_time_and_summary_has_the_targets(small):
     # at the truth's level the level error is drift alone: its mean over the quarters is about 0
     assert abs(np.mean(rows["kit"]["level_error_at_level"])) < 0.02
     assert "What each MSE is made of" in qz.markdown(results, list(rows))
+
+
+def test_fresh_is_one_set_among_the_others(capsys, tmp_path):
+    """--fresh SEED is another set of scenes: refused beside --heldout, and a run of one quick fresh scene
+    writes the *_fresh outputs with its seed."""
+    with pytest.raises(SystemExit):
+        qz.zoo_main(["--fresh", "3", "--heldout"])
+    assert "give one of them" in capsys.readouterr().err
+    out = tmp_path / "f.json"
+    results = qz.zoo_main(["--fresh", "3", "--n-fresh", "1", "--quick", "--methods", "kit,integration_offset",
+                           "--json", str(out), "--md", str(tmp_path / "f.md"), "--figure", ""])
+    assert list(results) == [zoo.fresh(3, 1)[0].name]
+    import json
+    saved = json.loads(out.read_text())
+    assert saved["fresh_seed"] == 3 and saved["scenes"][zoo.fresh(3, 1)[0].name]["rows"]["kit"]["ssim_clahe"] > 0

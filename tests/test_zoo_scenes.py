@@ -196,3 +196,26 @@ def test_large_scenes_are_new_larger_than_every_other_set_and_simulate():
     z = zoo.quick(zoo.LARGE[1])
     _, events, _, gt = zoo.simulate(z)
     assert gt.shape == (z.n_scored, *z.size) and len(events) > 1000 and 0 < gt.min() and gt.max() <= 1
+
+
+def test_fresh_scenes_are_seeded_varied_documented_and_simulate():
+    """zoo.fresh: the same scenes for the same seed, others for another; every scene class and both a clean
+    and a noisy sensor among 40 draws; unequal thresholds given as their mean; names and docs say what was
+    drawn; the builders pickle (Dask); a few simulate (quick sizes) with events and frames in range."""
+    import pickle
+
+    a, b, c = zoo.fresh(5, 40), zoo.fresh(5, 40), zoo.fresh(6, 40)
+    assert [z.doc for z in a] == [z.doc for z in b] and [z.seed for z in a] == [z.seed for z in b]
+    assert [z.doc for z in a] != [z.doc for z in c]
+    assert len({z.name for z in a}) == 40 and not {z.name for z in a} & {z.name for z in zoo.ZOO + zoo.HELDOUT}
+    assert {z.tags[1] for z in a} == set(zoo.FRESH_KINDS) and {z.noise_free for z in a} == {True, False}
+    for z in a:
+        assert z.name.split("_")[2] in zoo.FRESH_KINDS and "given as" in z.doc
+        assert abs(zoo.effective_C(z) - z.C) < 1e-9 and 0.74 < z.C_pos / z.C_neg < 1.34
+        assert not z.long and 2.0 <= z.duration <= 3.0
+    pickle.loads(pickle.dumps(a[0]))
+    for z in [next(z for z in a if z.tags[1] == kind) for kind in ("static", "light")]:
+        z = zoo.quick(z)
+        scene, events, times, gt = zoo.simulate(z)
+        assert gt.shape == (z.n_scored, *z.size) and len(events) > 100 and 0 < gt.min() and gt.max() <= 1
+    assert zoo.fresh(5, 0) == []

@@ -19,17 +19,19 @@ scenes built the same ways (other images, motions, sizes and seeds; one of 20 s)
 was chosen: ``quality_zoo.py --heldout`` checks that the defaults carry over to them. ``STRESS`` holds
 eleven built the same ways with settings outside both sets' ranges (``quality_zoo.py --stress``), and
 ``LARGE`` three at 360x480, twice the zoo's largest sensor along each side (``quality_zoo.py --large``).
+:func:`fresh` draws any number more at random from a seed, the same ways (``quality_zoo.py --fresh SEED``).
 """
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from functools import partial
 
 import numpy as np
 
 from . import scenes as sc
 from .simulate import add_background_noise, add_hot_pixels, add_light_noise, simulate_scene
 
-__all__ = ["ZooScene", "ZOO", "HELDOUT", "STRESS", "LARGE", "N_SCORED", "quick", "simulate", "effective_C", "imbalance", "get", "default_scenes",
+__all__ = ["ZooScene", "ZOO", "HELDOUT", "STRESS", "LARGE", "N_SCORED", "fresh", "FRESH_KINDS", "quick", "simulate", "effective_C", "imbalance", "get", "default_scenes",
            "SIGNAL", "BACKGROUND", "HOT"]
 
 N_SCORED = 10   # ground-truth times scored per scene, evenly spread over [0.1, 0.95] of the duration
@@ -241,6 +243,94 @@ LARGE = [
              lambda s, d: sc.MovingImageScene("astronaut", s, d, velocity=(8.0, -6.0), rotation=0.3, zoom=0.2),
              size=(360, 480), duration=2.5, C_pos=0.24, C_neg=0.16, noise_hz=0.2, seed=53),
 ]
+
+
+FRESH_KINDS = ("pan", "shake", "warp", "speed", "light", "static")   # the zoo's scene classes
+FRESH_SIZES = ((90, 120), (120, 160), (150, 200), (180, 240))
+
+
+def fresh(seed: int, n: int = 16) -> list:
+    """``n`` scenes drawn at random (a generator seeded ``seed``) the ways the zoo's are built, for a check
+    no default was chosen on: one of the zoo's scene classes (a pan with rotation and zoom, a hand-held
+    shake, a warp, a speed that swings, a change of light over a pan, an object crossing a static
+    background), any of the images, a sensor size, a duration and motion in the zoo's ranges, and a
+    sensor: C 0.15-0.3 with C+ / C- 0.75-1.33 (given as their mean), 0-5 % mismatch, a refractory
+    period, and on half the scenes background activity and hot pixels (ON-only on half of those). Each
+    scene's ``doc`` says what was drawn (``python benchmarks/quality_zoo.py --fresh SEED``)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(int(n)):
+        img = str(rng.choice(sc.IMAGE_NAMES))
+        size = FRESH_SIZES[int(rng.integers(len(FRESH_SIZES)))]
+        duration = float(rng.choice([2.0, 2.5, 3.0]))
+        v = (round(float(rng.uniform(-30, 30)), 1), round(float(rng.uniform(-20, 20)), 1))
+        rot, zoom = round(float(rng.uniform(-0.3, 0.3)), 3), round(float(rng.uniform(-0.2, 0.2)), 3)
+        kind = str(rng.choice(FRESH_KINDS, p=[0.3, 0.15, 0.15, 0.1, 0.2, 0.1]))
+        if kind == "pan":
+            what = f"{img} panned at {v} px/s, rotation {rot} rad/s, zoom {zoom}/s"
+            build = partial(_pan, img, v, rot, zoom)
+        elif kind == "shake":
+            A, P, ph = round(float(rng.uniform(5, 30)), 1), round(float(rng.uniform(0.5, 3)), 2), round(float(rng.uniform(0, 3)), 2)
+            what = f"{img} shaken {A} x {round(A / 3, 1)} px with a {P} s period"
+            build = partial(_shake, img, A, P, ph)
+        elif kind == "warp":
+            shear = (round(float(rng.uniform(0, 0.3)), 3), round(float(rng.uniform(0, 0.2)), 3))
+            tilt = (round(float(rng.uniform(0, 0.3)), 3), round(float(rng.uniform(0, 0.3)), 3))
+            what = f"{img} sheared {shear} and tilted {tilt}, drifting at {(v[0] / 2, v[1] / 2)} px/s"
+            build = partial(_warp, img, (v[0] / 2, v[1] / 2), shear, tilt)
+        elif kind == "speed":
+            what = f"{img} panned at {v} px/s with a speed swinging 0.2x-1.8x"
+            build = partial(_speed, img, v, round(rot / 3, 3))
+        elif kind == "light":
+            g, vg = round(float(rng.uniform(-1.5, 1.0)), 2), round(float(rng.uniform(-0.6, 0.2)), 2)
+            what = f"{img} panned at {v} px/s while the light changes by {g} (log) and the corners by {vg}"
+            build = partial(_light, img, v, round(rot / 2, 3), g, vg)
+        else:
+            obj = str(rng.choice(sc.IMAGE_NAMES))
+            what = f"static camera: a {obj}-textured disc crossing a static {img}"
+            build = partial(_static, img, obj)
+        C = round(float(rng.uniform(0.15, 0.3)), 3)
+        ratio = float(np.exp(rng.uniform(np.log(0.75), np.log(1.33))))
+        sigma, refractory = round(float(rng.uniform(0, 0.05)), 3), float(rng.choice([0.0, 5e-4, 1e-3]))
+        noisy = bool(rng.random() < 0.5)
+        noise_hz = round(float(rng.uniform(0.05, 0.6)), 2) if noisy else 0.0
+        hot = int(rng.integers(5, 30)) if noisy else 0
+        on_only = bool(rng.random() < 0.5)
+        c_pos, c_neg = C * 2 * ratio / (1 + ratio), C * 2 / (1 + ratio)
+        sensor = (f"C+ {c_pos:.3f}, C- {c_neg:.3f} given as {C}, {100 * sigma:.1f} % mismatch"
+                  + (f", {noise_hz} Hz background, {hot} {'ON-only ' if on_only else ''}hot pixels" if noisy
+                     else ", no noise"))
+        out.append(ZooScene(f"fresh{seed}_{k:02d}_{kind}_{img}", f"{what}; {sensor}", build, size=size,
+                            duration=duration, C=C, C_pos=c_pos, C_neg=c_neg, threshold_sigma=sigma,
+                            refractory=refractory, noise_hz=noise_hz, hot_pixels=hot, hot_on_only=on_only,
+                            seed=int(rng.integers(1000, 9999)), tags=("fresh", kind)))
+    return out
+
+
+# the fresh scenes' builders: module functions (with functools.partial) so a scene pickles for Dask
+def _pan(img, v, rot, zoom, s, d):
+    return sc.MovingImageScene(img, s, d, velocity=v, rotation=rot, zoom=zoom)
+
+
+def _shake(img, A, P, ph, s, d):
+    return sc.OscillatingScene(img, s, d, path=((A, A / 3, P, ph),), rotation=(0.03, 2 * P))
+
+
+def _warp(img, v, shear, tilt, s, d):
+    return sc.WarpedImageScene(img, s, d, velocity=v, rotation=0.0, zoom=0.0, shear=shear, tilt=tilt)
+
+
+def _speed(img, v, rot, s, d):
+    return sc.VaryingSpeedScene(sc.MovingImageScene(img, s, d, velocity=v, rotation=rot, zoom=0.0), depth=0.8, period=d)
+
+
+def _light(img, v, rot, g, vg, s, d):
+    return sc.LightingScene(sc.MovingImageScene(img, s, d, velocity=v, rotation=rot, zoom=0.0), global_change=g,
+                            vignette=vg)
+
+
+def _static(img, obj, s, d):
+    return sc.ObjectOverBackgroundScene(img, obj, s, d)
 
 
 def quick(z: ZooScene) -> ZooScene:
