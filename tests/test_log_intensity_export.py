@@ -170,3 +170,17 @@ def test_given_as_a_recording_it_is_named_for_what_it_is(tmp_path, capsys):
         err = capsys.readouterr().err
         assert "a reconstruction's log intensity" in err and "the recording it came from" in err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_time_asked_for_twice_is_written_twice_by_both_jobs(example, tmp_path):
+    """--at with a repeated time: every frame of timestamps.txt has its PNG and its row in log_intensity.h5, in
+    the streamed job (which once wrote only the last of them) as in the in-memory one."""
+    at = [0.1, 0.1, 0.2]
+    for name, extra in (("streamed", {}), ("in_memory", {"denoise": True})):
+        out = tmp_path / name
+        run_reconstruct(example, out, C=0.25, at=at, save_log=True, video=False, progress=False,
+                        log=lambda *a: None, **extra)
+        png = _pngs(out)
+        assert png.shape[0] == 3 and np.array_equal(png[0], png[1])
+        L = _check_run(out)
+        assert np.array_equal(L[0], L[1])

@@ -289,7 +289,9 @@ class _FrameWriter:
         self.staging, self.log = staging, log
         self.export_at = np.searchsorted(query, times)          # query index of each exported frame
         self.gt_at = np.searchsorted(query, gt_t)
-        self.export_of = {int(q): i for i, q in enumerate(self.export_at)}
+        self.export_of = {}                                      # query index -> the exported frames at that time
+        for i, q in enumerate(self.export_at.tolist()):          # (a time asked for twice is written twice)
+            self.export_of.setdefault(q, []).append(i)
         self.gt_of = {int(q): i for i, q in enumerate(self.gt_at)}
         self.gt = [None] * len(gt_t)
         self.video = video
@@ -310,8 +312,7 @@ class _FrameWriter:
             self.range = (min(self.range[0], float(part.frames.min())), max(self.range[1], float(part.frames.max())))
         u8 = to_uint8(part.frames)
         for j, q in enumerate(part.indices.tolist()):
-            i = self.export_of.get(q)
-            if i is not None:
+            for i in self.export_of.get(q, ()):
                 self.png.write(self.folder / f"frame_{i:05d}.png", u8[j])
                 if self.hdr is not None:
                     self.hdr.write(i, part.log_intensity[j])
