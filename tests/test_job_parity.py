@@ -1,0 +1,56 @@
+"""The streamed job and the in-memory job give the same run folder for the same options: the same
+timestamps, the same frames (to one grey level: float rounding of two equal solves), the same log
+intensities and scores, and the same refusals. A difference between the two found a streamed run that
+lost a frame asked for twice (tests/test_log_intensity_export.py)."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import evinr_lite.apps.recon_job as recon_job
+from evinr_lite.core.events import EventDataError
+from evinr_lite.io.export import LOG_INTENSITY_FILE, read_log_intensity
+from evinr_lite.sim.recordings import write_example_recording
+
+CASES = [dict(fps=33.3), dict(at=[0.1, 0.1, 0.3]), dict(t_start=0.2, t_end=0.5, fps=7), dict(at=[0.25]),
+         dict(t_end=0.31, at=[0.3, 0.31]), dict(t_start=0.05)]
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    return write_example_recording(tmp_path_factory.mktemp("parity") / "rec", sensor_size=(30, 40), duration=0.6,
+                                   C=0.25, frame_rate=20.0, seed=4)
+
+
+def _run(recording, out, streamed: bool, monkeypatch, **opts):
+    with monkeypatch.context() as m:
+        if not streamed:
+            m.setattr(recon_job, "streamable", lambda options: False)
+        run = recon_job.run_reconstruct(recording, out, C=0.25, video=False, progress=False, save_log=True,
+                                        log=lambda *a: None, **opts)
+    pngs = np.stack([np.asarray(Image.open(p)) for p in sorted((out / "frames").glob("frame_*.png"))])
+    return run, pngs, (out / "timestamps.txt").read_text(), read_log_intensity(out / LOG_INTENSITY_FILE)[0]
+
+
+@pytest.mark.parametrize("opts", CASES, ids=lambda o: ",".join(f"{k}={v}" for k, v in o.items()) or "defaults")
+def test_streamed_and_in_memory_runs_agree(recording, tmp_path, monkeypatch, opts):
+    s_run, s_png, s_t, s_L = _run(recording, tmp_path / "s", True, monkeypatch, **opts)
+    m_run, m_png, m_t, m_L = _run(recording, tmp_path / "m", False, monkeypatch, **opts)
+    assert s_t == m_t and s_run["n_frames_written"] == m_run["n_frames_written"] == len(s_png) == len(m_png)
+    assert np.abs(s_png.astype(int) - m_png.astype(int)).max() <= 1
+    np.testing.assert_allclose(s_L, m_L, atol=1e-3)
+    assert set(s_run["files"]) == set(m_run["files"])
+    if "scores" in m_run:
+        for eq in m_run["scores"]:
+            assert s_run["scores"][eq]["ssim"] == pytest.approx(m_run["scores"][eq]["ssim"], abs=1e-4)
+    assert json.loads((tmp_path / "s" / "run.json").read_text())["times_s"] == m_run["times_s"]
+
+
+def test_both_jobs_refuse_a_time_outside_the_events(recording, tmp_path, monkeypatch):
+    for streamed in (True, False):
+        with pytest.raises(EventDataError, match="outside the reconstructed window"):
+            _run(recording, tmp_path / f"o{streamed}", streamed, monkeypatch, at=[0.0, 0.3])
+        assert not (tmp_path / f"o{streamed}").exists()
