@@ -6,7 +6,7 @@
     python benchmarks/quality_zoo.py --heldout             # the held-out scenes no default was chosen on
     python benchmarks/quality_zoo.py --stress              # scenes with settings outside both sets' ranges
     python benchmarks/quality_zoo.py --large               # three scenes at 360x480 (4x the zoo's largest)
-    python benchmarks/quality_zoo.py --fresh 2026          # 16 scenes drawn at random the zoo's ways (--n-fresh N)
+    python benchmarks/quality_zoo.py --fresh 11            # 16 scenes drawn at random the zoo's ways (--n-fresh N)
     python benchmarks/quality_zoo.py --scenes camera_translate,noisy_gravel --methods kit,integration
     python benchmarks/quality_zoo.py --variant "lam 0.1=lam=0.1"        # add an EvINR variant (NAME=field=value,...)
     python -m benchmarks --only zoo                        # the same, from the benchmark runner
@@ -571,11 +571,13 @@ def zoo_main(argv=None) -> dict:
                         "chunk; *_fresh.* outputs")
     p.add_argument("--n-fresh", type=int, default=16, help="how many --fresh scenes (default 16)")
     p.add_argument("--no-real", action="store_true", help="skip the real slider_depth chunk")
-    p.add_argument("--json", default=None, help="default benchmarks/zoo_results[_heldout|_stress|_large].json")
-    p.add_argument("--md", default=None, help="default benchmarks/zoo_results[_heldout|_stress|_large].md")
-    p.add_argument("--figure", default=None, help="default benchmarks/zoo_figure[_heldout|_stress|_large].png")
+    p.add_argument("--json", default=None, help="default benchmarks/zoo_results[_heldout|_stress|_large|_fresh].json")
+    p.add_argument("--md", default=None, help="default benchmarks/zoo_results[_heldout|_stress|_large|_fresh].md")
+    p.add_argument("--figure", default=None, help="default benchmarks/zoo_figure[_heldout|_stress|_large|_fresh].png")
     a = p.parse_args(argv)
     fresh_set = a.fresh is not None
+    if fresh_set and a.n_fresh < 1:
+        p.error(f"--n-fresh must be at least 1, got {a.n_fresh}")
     if a.heldout + a.stress + a.large + fresh_set > 1:
         p.error("--heldout, --stress, --large and --fresh are other sets of scenes: give one of them")
     other = a.heldout or a.stress or a.large or fresh_set   # a set other than the zoo: all its scenes, no real chunk
