@@ -184,3 +184,15 @@ def test_a_time_asked_for_twice_is_written_twice_by_both_jobs(example, tmp_path)
         assert png.shape[0] == 3 and np.array_equal(png[0], png[1])
         L = _check_run(out)
         assert np.array_equal(L[0], L[1])
+
+
+def test_a_part_is_read_without_the_rest(tmp_path):
+    L = np.arange(5 * 2 * 3, dtype=np.float32).reshape(5, 2, 3)
+    path = save_log_intensity(tmp_path / "L.h5", L, [0.1, 0.2, 0.3, 0.4, 0.5])
+    part, t, _ = read_log_intensity(path, frames=slice(1, 3))
+    assert np.array_equal(part, L[1:3]) and list(t) == [0.2, 0.3]
+    one, t1, _ = read_log_intensity(path, frames=-1)
+    assert np.array_equal(one, L[-1]) and t1 == 0.5
+    for bad, match in ((7, "does not exist; the file holds 5"), ([0, 1], "a slice or an index"), (True, "slice")):
+        with pytest.raises(EventDataError, match=match):
+            read_log_intensity(path, frames=bad)
