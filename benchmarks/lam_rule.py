@@ -5,6 +5,7 @@
     python benchmarks/lam_rule.py --quick     # the quick zoo's smaller scenes
     python benchmarks/lam_rule.py --heldout   # the held-out scenes the rule was not chosen on (zoo.HELDOUT)
     python benchmarks/lam_rule.py --stress    # the stress scenes, settings outside both sets' ranges (zoo.STRESS)
+    python benchmarks/lam_rule.py --fresh 11  # 16 scenes drawn at random the zoo's ways (zoo.fresh), as quality_zoo.py --fresh
 
 For each scene: the activity m (events per pixel per network window that came and went,
 ``evinr_lite.method.smoothing.activity``), the lam that ``EvINRConfig(lam="auto")`` gives, and
@@ -30,7 +31,7 @@ from evinr_lite.method.prepare import prepare_events  # noqa: E402
 from evinr_lite.method.config import EvINRConfig  # noqa: E402
 from evinr_lite.method.smoothing import activity, window_fraction  # noqa: E402
 from evinr_lite.method.solver import reconstruct  # noqa: E402
-from evinr_lite.sim.zoo import HELDOUT, STRESS, default_scenes, effective_C, quick, simulate  # noqa: E402
+from evinr_lite.sim.zoo import HELDOUT, STRESS, default_scenes, effective_C, fresh, quick, simulate  # noqa: E402
 
 SWEEP = (0.001, 0.002, 0.005, 0.01, 0.03, 0.1)
 
@@ -81,25 +82,31 @@ def main(argv=None) -> int:
     p.add_argument("--long", action="store_true")
     p.add_argument("--heldout", action="store_true", help="the held-out scenes instead (no real chunk)")
     p.add_argument("--stress", action="store_true", help="the stress scenes instead (no real chunk)")
-    p.add_argument("--json", default=None, help="default benchmarks/lam_rule_results[_heldout|_stress].json")
-    p.add_argument("--md", default=None, help="default benchmarks/lam_rule_results[_heldout|_stress].md")
+    p.add_argument("--fresh", type=int, default=None, metavar="SEED",
+                   help="16 scenes drawn at random the zoo's ways from SEED instead (zoo.fresh; no real chunk)")
+    p.add_argument("--json", default=None, help="default benchmarks/lam_rule_results[_heldout|_stress|_fresh].json")
+    p.add_argument("--md", default=None, help="default benchmarks/lam_rule_results[_heldout|_stress|_fresh].md")
     a = p.parse_args(argv)
-    if a.heldout and a.stress:
-        p.error("--heldout and --stress are two other sets of scenes: give one of them")
-    suffix = "_heldout" if a.heldout else "_stress" if a.stress else ""
+    if a.heldout + a.stress + (a.fresh is not None) > 1:
+        p.error("--heldout, --stress and --fresh are other sets of scenes: give one of them")
+    suffix = "_heldout" if a.heldout else "_stress" if a.stress else "_fresh" if a.fresh is not None else ""
     a.json = a.json or f"benchmarks/lam_rule_results{suffix}.json"
     a.md = a.md or f"benchmarks/lam_rule_results{suffix}.md"
     rows = {}
-    for z in (HELDOUT if a.heldout else STRESS if a.stress else default_scenes(long=a.long)):
+    pool = HELDOUT if a.heldout else STRESS if a.stress else fresh(a.fresh) if a.fresh is not None else \
+        default_scenes(long=a.long)
+    for z in pool:
         z = quick(z) if a.quick else z
         scene, events, times, gt = simulate(z)
         rows[z.name] = {**scene_row(z.name, events, times, gt, effective_C(z)), "long": z.long}
-    found = None if a.heldout or a.stress else real_chunk()
+    found = None if a.heldout or a.stress or a.fresh is not None else real_chunk()
     if found is not None:
         rec, gt, gt_t = found
         rows["real_slider_chunk"] = scene_row("real_slider_chunk", rec.events, gt_t, gt, 1.0)
-    write_json(a.json, {"quick": a.quick, "heldout": a.heldout, "stress": a.stress, "sweep": list(SWEEP), "scenes": rows})
-    Path(a.md).write_text(markdown(rows, a.heldout, "stress" if a.stress else None))
+    write_json(a.json, {"quick": a.quick, "heldout": a.heldout, "stress": a.stress, "fresh_seed": a.fresh,
+                        "sweep": list(SWEEP), "scenes": rows})
+    Path(a.md).write_text(markdown(rows, a.heldout, "stress" if a.stress else f"fresh (seed {a.fresh})"
+                                   if a.fresh is not None else None))
     print(f"json: {a.json}\nmarkdown: {a.md}")
     return 0
 
