@@ -201,25 +201,13 @@ def test_a_part_is_read_without_the_rest(tmp_path):
 def test_a_resumed_run_writes_the_whole_file(tmp_path, monkeypatch):
     """Stopped after two windows and resumed with --resume, a streamed run's log_intensity.h5 holds every frame,
     the same as a run never stopped (the finished windows' frames come back from the resume folder's spill)."""
-    from evinr_lite.io.canonical import CanonicalWriter
     from evinr_lite.method.streaming import StreamState
-    from evinr_lite.sim import make_scene, simulate_scene
+    from test_streaming import recording_file, stop_command_after
 
-    ev = simulate_scene(make_scene("camera", sensor_size=(24, 32), duration=2.0), C=0.2, seed=0)
-    path = tmp_path / "rec.h5"
-    with CanonicalWriter(path, sensor_size=(24, 32), C=0.2) as w:
-        for k in range(5):                                               # 10 s: several windows
-            w.add_events(ev.t + 2.0 * k, ev.x, ev.y, ev.p)
+    path = recording_file(tmp_path / "rec.h5")                            # 10 s: several windows
     quiet = dict(fps=5, video=False, progress=False, save_log=True, log=lambda *a: None)
     run_reconstruct(path, tmp_path / "whole", **quiet)
-    save = StreamState.save
-
-    def killed_after_two(self, file):
-        save(self, file)
-        if self.next_window == 2:
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(StreamState, "save", killed_after_two)
+    save = stop_command_after(monkeypatch, 2)
     with pytest.raises(KeyboardInterrupt):
         run_reconstruct(path, tmp_path / "out", **quiet)
     monkeypatch.setattr(StreamState, "save", save)

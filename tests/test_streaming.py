@@ -192,7 +192,7 @@ def test_bad_requests_are_refused_before_any_training(scene_events):
         next(stream_reconstruct(events, [5.0], _config(), t_start=0.0, t_end=3.0))
 
 
-def _recording_file(path, seconds=10.0, size=SIZE):
+def recording_file(path, seconds=10.0, size=SIZE):
     """A canonical file of a 2 s scene repeated (as benchmarks/scale.py builds long recordings)."""
     from evinr_lite.io.canonical import CanonicalWriter
 
@@ -204,27 +204,34 @@ def _recording_file(path, seconds=10.0, size=SIZE):
     return path
 
 
+def stop_command_after(monkeypatch, k: int):
+    """StreamState.save patched so that a streamed command stops (KeyboardInterrupt) once the state after
+    window k is saved, as a killed process would; returns the original save (to set back)."""
+    save = StreamState.save
+
+    def killed(self, file):
+        save(self, file)
+        if self.next_window == k:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(StreamState, "save", killed)
+    return save
+
+
 def test_a_killed_command_resumes_without_recomputing_finished_windows(tmp_path, monkeypatch):
     from PIL import Image
 
     from evinr_lite.apps.recon_job import run_reconstruct
     from evinr_lite.method import streaming
 
-    path = _recording_file(tmp_path / "rec.h5")
+    path = recording_file(tmp_path / "rec.h5")
     quiet = dict(fps=5, video=False, progress=False, log=lambda *a: None)
     whole = run_reconstruct(path, tmp_path / "whole", **quiet)
     assert len(whole["times_s"]) >= 45
     trained = []
     train = streaming.train_window
     monkeypatch.setattr(streaming, "train_window", lambda ev, w, k, cfg: (trained.append(k), train(ev, w, k, cfg))[1])
-    save = StreamState.save
-
-    def killed_after_two(self, file):
-        save(self, file)
-        if self.next_window == 2:
-            raise KeyboardInterrupt
-
-    monkeypatch.setattr(StreamState, "save", killed_after_two)
+    save = stop_command_after(monkeypatch, 2)
     with pytest.raises(KeyboardInterrupt):
         run_reconstruct(path, tmp_path / "out", **quiet)
     assert trained == [0, 1]
@@ -250,7 +257,7 @@ def test_the_command_saves_the_state_after_every_window_but_the_last(tmp_path, m
     # grid) cost a third of that at 1280x720: the command skips it
     from evinr_lite.apps.recon_job import run_reconstruct
 
-    path = _recording_file(tmp_path / "rec.h5")
+    path = recording_file(tmp_path / "rec.h5")
     saved = []
     save = StreamState.save
     monkeypatch.setattr(StreamState, "save", lambda self, file: (saved.append((self.next_window, len(self.windows))),
