@@ -523,9 +523,9 @@ def check_scheduler_address(address: str) -> str:
 
 
 RESULT_SETTINGS = ("C", "fps", "n_iters", "recipe", "seed", "sensor_size", "denoise", "anchor",
-                   "keep_background", "static_camera", "lam")   # change the scores
+                   "keep_background", "static_camera", "lam", "tonemap", "display_mean")   # change the frames and scores
 SETTING_DEFAULTS = {"denoise": False, "anchor": "none", "keep_background": False, "static_camera": False,
-                    "lam": None}   # what a batch.json written before these options meant
+                    "lam": None, "tonemap": None, "display_mean": None}   # what a batch.json written before these options meant
 
 
 def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: str | None = None,

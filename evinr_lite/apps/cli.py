@@ -47,6 +47,15 @@ def _positive(text: str) -> float:
     return value
 
 
+def _unit_open(text: str) -> float:
+    """--display-mean: a number strictly between 0 and 1."""
+    value = _finite(text)
+    if not 0 < value < 1:
+        raise argparse.ArgumentTypeError(f"must lie between 0 and 1 (the frames' mean brightness; 0.4 is the kit's), "
+                                         f"got {text!r}")
+    return value
+
+
 def _contrast(text: str):
     """--C of reconstruct: a positive number, a pair "C+,C-" of positive numbers, or "auto"."""
     if text.strip().lower() == "auto":
@@ -134,6 +143,9 @@ KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-
                         "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
 SAVE_LOG_HELP = ("also write the frames' log intensity, unclipped, as float32 in log_intensity.h5 (4 bytes a pixel "
                  "a frame): the dynamic range the 8-bit PNGs clip, to tone-map again or to use as data")
+DISPLAY_MEAN_HELP = ("the frames' mean brightness over the window, between 0 and 1: the level events never give "
+                     "(default: the tone map's own, 0.4 for linear, 0.5 for reinhard); lower for a dark scene, higher "
+                     "for a bright one. Not with --anchor, whose APS frames give the level")
 CAMERA_CHOICES = ("left", "right")
 CAMERA_HELP = ("which camera of an MVSEC stereo file (davis/left or davis/right; default: the left one, or the "
                "one the file has); other formats hold one camera")
@@ -190,6 +202,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
     rec.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     rec.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
+    rec.add_argument("--display-mean", type=_unit_open, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
     rec.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     rec.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
     rec.add_argument("--seed", type=_seed, default=0)
@@ -261,6 +274,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
     batch.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     batch.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
+    batch.add_argument("--display-mean", type=_unit_open, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
     batch.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     batch.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
     batch.add_argument("--seed", type=_seed, default=0)
@@ -289,7 +303,7 @@ def _run_options(args):
                       device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
                       keep_background=args.keep_background, static_camera=args.static_camera,
-                      colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap, video=video,
+                      colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap, display_mean=args.display_mean, video=video,
                       progress=not args.quiet, save_log=args.save_log)
 
 

@@ -33,7 +33,7 @@ DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth 
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
 BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap",
-                "keep_background", "static_camera", "lam", "save_log")
+                "keep_background", "static_camera", "lam", "save_log", "display_mean")
 MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
 _INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
 
@@ -161,6 +161,9 @@ class RunOptions:
             background activity wants about 0.1), less for a busy, clean one.
         tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
             paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
+        display_mean: the frames' mean brightness over the window, in (0, 1): the level events never give
+            (``EvINRConfig.display_mean``; None: the tone map's own, 0.4 for linear, 0.5 for reinhard). Lower
+            for a dark scene, higher for a bright one; refused with an anchor, whose APS frames give the level.
         video: also write MP4 / GIF; progress: show a progress bar.
         save_log: also write the frames' log intensity, unclipped, as float32 (``log_intensity.h5``,
             :func:`evinr_lite.io.export.read_log_intensity`): the dynamic range the 8-bit PNGs clip.
@@ -185,6 +188,7 @@ class RunOptions:
     colour: bool = False
     lam: float | str | None = None
     tonemap: str | None = None
+    display_mean: float | None = None
     video: bool = True
     progress: bool = True
     save_log: bool = False
@@ -239,6 +243,16 @@ class RunOptions:
             raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
         if self.lam is not None:
             checked["lam"] = lam_option(self.lam)
+        if self.display_mean is not None:
+            level = _finite("display_mean=", self.display_mean)
+            if not 0 < level < 1:
+                raise EventDataError(f"display_mean= is the frames' mean brightness, in (0, 1) (0.4 is the kit's; "
+                                     f"lower for a dark scene), got {self.display_mean!r}")
+            if self.anchor != "none":
+                raise EventDataError(f"display_mean= sets the level that events never give; with anchor="
+                                     f"{self.anchor!r} the APS frames give it: leave display_mean out, or use "
+                                     "anchor='none'")
+            checked["display_mean"] = level
         if self.n_iters is not None:
             checked["n_iters"] = int(self.n_iters)
         checked["seed"] = int(self.seed)
@@ -278,6 +292,8 @@ class RunOptions:
             extra["camera"] = "static"
         if self.lam is not None:
             extra["lam"] = self.lam
+        if self.display_mean is not None:
+            extra["display_mean"] = self.display_mean
         return recipe_config(self.recipe, self.n_iters, self.tonemap, C=C, seed=self.seed, device=self.device,
                              progress=self.progress, anchor=self.anchor, **extra)
 

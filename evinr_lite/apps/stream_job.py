@@ -85,6 +85,15 @@ def report_lam(lam, used, settings: dict, log) -> None:
         "smooths more, e.g. 0.03-0.1 under heavy background activity)")
 
 
+def report_level(options, config, log) -> None:
+    """When the frames' level is the tone map's prior (no ``display_mean`` given, no APS anchor): say so once,
+    with the option that sets it (the in-memory and the streamed job both)."""
+    if options.display_mean is not None or options.anchor != "none":
+        return
+    log(f"frames shown at a mean brightness of {config.display_mean:g} over the window: events never give the "
+        "level (pass --display-mean to set it, e.g. 0.2 for a dark scene)")
+
+
 def _key(path, config, times, window) -> dict:
     """What a saved state must match to be resumed: the input, the settings, the times and the span."""
     digest = hashlib.sha256(np.ascontiguousarray(times, np.float64).tobytes()).hexdigest()
@@ -245,6 +254,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
                 "seed": options.seed, "memory_estimate_bytes": est["total"]}
     report_balance(C, used, settings, log)
     report_lam(config.lam, history.get("lam_used"), settings, log)
+    report_level(options, config, log)
     if writer.video_fps is not None:
         settings["video_fps"] = writer.video_fps
     run = write_results(target.staging, rec, times, history, scores, settings=settings, written=written,

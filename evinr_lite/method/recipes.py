@@ -32,7 +32,8 @@ def recipe_config(recipe: str = "kit", n_iters: int | None = None, tonemap: str 
     form; paper: 300). Given, it sets the Adam iterations; for the recipes with coarse-to-fine the two
     bisections move to n_iters / 3 and 2 n_iters / 3 (the paper's 100 and 200 of 300).
     ``tonemap`` None keeps the recipe's own display; "linear" or "reinhard" shows it that way, at that
-    tone map's own level (:data:`~evinr_lite.method.tonemap.DISPLAY_MEANS`).
+    tone map's own level (:data:`~evinr_lite.method.tonemap.DISPLAY_MEANS`) unless ``display_mean`` is
+    among ``fields``.
     """
     if recipe not in RECIPES:
         raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {recipe!r}")
@@ -46,7 +47,8 @@ def recipe_config(recipe: str = "kit", n_iters: int | None = None, tonemap: str 
         if tonemap not in DISPLAY_MEANS:
             raise EventDataError(f"tonemap= must be one of {tuple(DISPLAY_MEANS)} (or None: the recipe's own), "
                                  f"got {tonemap!r}")
-        fields.update(tonemap=tonemap, display_mean=DISPLAY_MEANS[tonemap])
+        fields["tonemap"] = tonemap
+        fields.setdefault("display_mean", DISPLAY_MEANS[tonemap])   # a display_mean given stays
     return make(**fields)
 
 
