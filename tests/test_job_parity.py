@@ -54,3 +54,27 @@ def test_both_jobs_refuse_a_time_outside_the_events(recording, tmp_path, monkeyp
         with pytest.raises(EventDataError, match="outside the reconstructed window"):
             _run(recording, tmp_path / f"o{streamed}", streamed, monkeypatch, at=[0.0, 0.3])
         assert not (tmp_path / f"o{streamed}").exists()
+
+
+def test_a_pause_without_events_is_reconstructed_by_both_jobs(tmp_path, monkeypatch):
+    """A recording that pauses longer than a network's window (the sensor covered, two takes in one file):
+    the streamed job refused the empty window, the in-memory one took it. Now both do, alike, and the
+    frames stay put while nothing fires (the event model: no event, no change) once the INR's temporal
+    smoothness (a few seconds at the first layer's 5 per second) has let go of the takes."""
+    from evinr_lite import make_scene, simulate_scene
+
+    ev = simulate_scene(make_scene("camera", sensor_size=(30, 40), duration=1.0), C=0.25, seed=2)
+    take = np.stack([ev.t, ev.x, ev.y, ev.p], axis=1)
+    path = tmp_path / "two_takes.npy"
+    np.save(path, np.concatenate([take, take + [20.0, 0, 0, 0]]))        # nothing between 1 s and 20 s
+    opts = dict(sensor_size=(30, 40), fps=2.0)
+    s_run, s_png, s_t, s_L = _run(path, tmp_path / "s", True, monkeypatch, **opts)
+    m_run, m_png, m_t, m_L = _run(path, tmp_path / "m", False, monkeypatch, **opts)
+    assert s_t == m_t and len(s_png) == len(m_png) == s_run["n_frames_written"]
+    assert np.abs(s_png.astype(int) - m_png.astype(int)).max() <= 1
+    np.testing.assert_allclose(s_L, m_L, atol=1e-3)
+    times = np.asarray(s_run["times_s"])
+    pause = (times > 7.0) & (times < 14.0)                                # 6 s from either take
+    assert pause.sum() >= 10
+    assert np.abs(np.diff(s_L[pause], axis=0)).max() < 1e-3          # no event, no change
+    assert np.abs(s_L[0] - s_L[pause][0]).max() > 0.05 and np.abs(s_L[-1] - s_L[pause][-1]).max() > 0.05

@@ -389,9 +389,6 @@ def _windows(source, q, grid, cfg, state, spill, on_state, progress):
         for k in range(state.next_window, N):
             lo, hi = windows[k]
             events = source.events(lo, np.nextafter(hi, np.inf))   # the last window's end is inclusive
-            if len(events) < 2:
-                raise EventDataError(f"window {k} [{lo:.6f}, {hi:.6f}] s holds {len(events)} event(s); EvINR needs "
-                                     "events in every window: choose a span with events throughout or a longer tau")
             t0 = time.perf_counter()
             model, history = train_window(events, windows, k, quiet)
             n_events = len(events)
