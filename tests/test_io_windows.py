@@ -207,8 +207,13 @@ def test_npy_window_refuses_unsorted_times(tmp_path):
     np.save(tmp_path / "rev.npy", np.stack([t, x, y, p], 1))
     with pytest.raises(EventDataError, match="not sorted"):
         read_recording(tmp_path / "rev.npy", sensor_size=(H, W), t_start=0.1, t_end=0.5)
-    with pytest.raises(EventDataError, match="not sorted"):
+    with pytest.raises(EventDataError, match="not sorted") as err:
         open_recording(tmp_path / "rev.npy", sensor_size=(H, W))
+    # the fix a command-line user can run (the CLI has no sort option), and plain numbers, not np.float64(...)
+    assert "np.argsort(a[:, 0]" in str(err.value) and "sort=True" in str(err.value) and "np.float" not in str(err.value)
+    fixed = np.load(tmp_path / "rev.npy")
+    np.save(tmp_path / "rev.npy", fixed[np.argsort(fixed[:, 0], kind="stable")])   # the message's own fix
+    assert len(open_recording(tmp_path / "rev.npy", sensor_size=(H, W)).events(0.1, 0.5)) > 0
     ev = read_recording(tmp_path / "rev.npy", sensor_size=(H, W), sort=True, t_start=0.1, t_end=0.5).events
     assert np.all(np.diff(ev.t) >= 0) and ev.t[0] >= 0.1 and ev.t[-1] < 0.5
 

@@ -235,7 +235,7 @@ def _finish(run: dict, times, scores, out_dir, t0: float, options, log) -> dict:
     """The run's closing line (frames, time, scores, anchors, colour) and its total time."""
     anchor = options.anchor
     seconds = time.perf_counter() - t0
-    line = (f"wrote {len(times)} frames to {out_dir}/ in {seconds:.1f} s "
+    line = (f"wrote {len(times)} frame{'' if len(times) == 1 else 's'} to {out_dir}/ in {seconds:.1f} s "
             f"(training {run.get('train_time_s') or 0.0:.1f} s)")
     if scores:
         parts = [f"{eq}: MSE {s['mse']:.4f} SSIM {s['ssim']:.3f}" + (f" LPIPS {s['lpips']:.3f}" if s.get("lpips") else "")

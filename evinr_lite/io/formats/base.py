@@ -302,9 +302,10 @@ def bisect_seconds(column, clock: Clock, value: float, lo: int, hi: int, source=
     return lo
 
 
-def probe_sorted(column, source, n_probe: int = 1025) -> None:
+def probe_sorted(column, source, n_probe: int = 1025, also: str = "") -> None:
     """Refuse a timestamp column that is evidently not sorted, from about ``n_probe`` evenly spaced
-    elements (a window is found by bisection, which needs sorted times); a full read checks them all."""
+    elements (a window is found by bisection, which needs sorted times); a full read checks them all.
+    ``also``: a format's own way out, added to the fix (e.g. its reader's ``sort=True``)."""
     n = column.shape[0]
     if n < 2:
         return
@@ -317,9 +318,9 @@ def probe_sorted(column, source, n_probe: int = 1025) -> None:
     down = np.flatnonzero(np.diff(values) < 0)
     if down.size:
         a, b = int(idx[down[0]]), int(idx[down[0] + 1])
-        raise EventDataError(f"{source}: the timestamps are not sorted (t[{a}] = {values[down[0]]!r} > t[{b}] = "
-                             f"{values[down[0] + 1]!r}), so a time window cannot be found without reading "
-                             "everything; read the whole file with sort=True, or sort it and save it again")
+        raise EventDataError(f"{source}: the timestamps are not sorted (t[{a}] = {float(values[down[0]])!r} > "
+                             f"t[{b}] = {float(values[down[0] + 1])!r}), so a time window cannot be found without "
+                             f"reading everything; sort the events by time and save the file again{also}")
 
 
 # ---- one clock, plausible units ------------------------------------------------------------

@@ -120,6 +120,11 @@ class _Opened:
         return lo, hi
 
 
+# the .npy's own ways out of unsorted times: its reader sorts in memory, numpy sorts the file
+NPY_SORT = (" (numpy: a = np.load(path); np.save(path, a[np.argsort(a[:, 0], kind='stable')]), with the time "
+            "in column 0; or read it in Python with evinr_lite.io.read_events_npy(path, sort=True))")
+
+
 def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", time_unit="auto",
                     sort=False, t_start: float | None = None, t_end: float | None = None,
                     meta: dict | None = None) -> Events:
@@ -149,7 +154,7 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
         return events if t_start is None and t_end is None else events.slice_time(t_start, t_end)
     if t_start is None and t_end is None:
         return opened.rows(0, len(opened.array), polarity)
-    probe_sorted(opened.t, opened.path)
+    probe_sorted(opened.t, opened.path, also=NPY_SORT)
     lo, hi = opened.window(t_start, t_end)
     if hi <= lo:
         n = len(opened.array)
@@ -171,7 +176,7 @@ class NpySource(RecordingSource):
 
     def __init__(self, path, *, sensor_size=None, columns="txyp", polarity="auto", time_unit="auto"):
         self._opened = opened = _Opened(path, sensor_size, columns, time_unit)
-        probe_sorted(opened.t, opened.path)
+        probe_sorted(opened.t, opened.path, also=NPY_SORT)
         self.meta = {"format": "npy", "path": str(opened.path)}
         opened.note_units(time_unit, self.meta)
         self._polarity = polarity
