@@ -264,3 +264,24 @@ def test_large_npy_is_read_in_bounded_memory(tmp_path):
     assert result["n_events"] == n
     assert result["n_read"] > 8_000_000   # 11 windows of 2 % and 0.5 s: the windows were really read
     assert result["peak_mb"] < size_mb / 4, (result, size_mb)
+
+
+def test_times_that_fall_back_once_are_named_as_joined_recordings(tmp_path):
+    """Two takes joined (or a clock that restarted) fall back once: sorting would interleave them, and the
+    refusal says so; a shuffled file falls back many times and gets the sort alone."""
+    from evinr_lite.core.events import Events
+
+    t, x, y, p = _events()
+    half = len(t) // 2
+    joined = np.concatenate([t[half:], t[:half]])                       # the second part's clock starts again
+    np.save(tmp_path / "joined.npy", np.stack([joined, x, y, p], 1))
+    for refuse in (lambda: open_recording(tmp_path / "joined.npy", sensor_size=(H, W)),
+                   lambda: Events(joined, x, y, p, (H, W))):
+        with pytest.raises(EventDataError, match="not sorted.*fall back only once.*interleave") as err:
+            refuse()
+        assert "split the file" in str(err.value)
+    shuffled = np.random.default_rng(0).permutation(t)
+    np.save(tmp_path / "shuffled.npy", np.stack([shuffled, x, y, p], 1))
+    with pytest.raises(EventDataError, match="not sorted") as err:
+        open_recording(tmp_path / "shuffled.npy", sensor_size=(H, W))
+    assert "fall back only once" not in str(err.value)

@@ -25,7 +25,18 @@ from .guard import InputError   # the guard maps it to exit status 2; defined th
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
            "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S",
-           "MAX_SENSOR_SIDE"]
+           "MAX_SENSOR_SIDE", "fall_back_hint"]
+
+def fall_back_hint(n_falls: int) -> str:
+    """What to add to an unsorted-times refusal when the times fall back exactly once (``n_falls``, the
+    decreasing steps found): two recordings joined, or a clock that restarted, where a sort would
+    interleave the two parts instead of repairing them."""
+    if n_falls != 1:
+        return ""
+    return ("; they fall back only once, so if two recordings were joined or the clock restarted there, a sort would "
+            "interleave the two parts: split the file at that event, or shift the second part's times past the "
+            "first part's last one")
+
 
 # Seconds per unit for timestamps given in other units.
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
@@ -299,7 +310,7 @@ class Events:
                 raise EventDataError(
                     f"timestamps are not sorted: t[{i}] = {float(t[i])!r} > t[{i + 1}] = {float(t[i + 1])!r} "
                     f"({dec.size} decreasing steps); sort the events by time, e.g. "
-                    "Events.from_arrays(..., sort=True)"
+                    "Events.from_arrays(..., sort=True)" + fall_back_hint(dec.size)
                 )
         for name, a, size, axis in (("x", x, W, "column, width W"), ("y", y, H, "row, height H")):
             if a.dtype.kind == "f":

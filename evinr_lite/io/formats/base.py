@@ -16,7 +16,8 @@ from typing import Callable
 
 import numpy as np
 
-from ...core.events import MAX_SENSOR_SIDE, EventDataError, Events, check_time_span, relative_seconds, resolve_time_unit
+from ...core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_time_span, fall_back_hint, relative_seconds,
+                            resolve_time_unit)
 from ..text import read_text_bytes
 
 __all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
@@ -320,7 +321,8 @@ def probe_sorted(column, source, n_probe: int = 1025, also: str = "") -> None:
         a, b = int(idx[down[0]]), int(idx[down[0] + 1])
         raise EventDataError(f"{source}: the timestamps are not sorted (t[{a}] = {float(values[down[0]])!r} > "
                              f"t[{b}] = {float(values[down[0] + 1])!r}), so a time window cannot be found without "
-                             f"reading everything; sort the events by time and save the file again{also}")
+                             f"reading everything; sort the events by time and save the file again{also}"
+                             + fall_back_hint(down.size))
 
 
 # ---- one clock, plausible units ------------------------------------------------------------
