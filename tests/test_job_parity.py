@@ -78,3 +78,24 @@ def test_a_pause_without_events_is_reconstructed_by_both_jobs(tmp_path, monkeypa
     assert pause.sum() >= 10
     assert np.abs(np.diff(s_L[pause], axis=0)).max() < 1e-3          # no event, no change
     assert np.abs(s_L[0] - s_L[pause][0]).max() > 0.05 and np.abs(s_L[-1] - s_L[pause][-1]).max() > 0.05
+
+
+def test_a_window_past_the_events_is_noted_by_both_jobs(recording, tmp_path, monkeypatch):
+    """--end (or --start) seconds beyond the recording is taken (the frames there hold still) and noted,
+    so a typo in the window does not pass unseen."""
+    for streamed in (True, False):
+        said = []
+        with monkeypatch.context() as m:
+            if not streamed:
+                m.setattr(recon_job, "streamable", lambda options: False)
+            recon_job.run_reconstruct(recording, tmp_path / f"o{streamed}", C=0.25, video=False, progress=False,
+                                      t_end=5.0, fps=2, log=said.append)
+        notes = [s for s in said if s.startswith("note: the window")]
+        assert len(notes) == 1 and "s after the last" in notes[0] and "before" not in notes[0], said
+        said.clear()
+        with monkeypatch.context() as m:
+            if not streamed:
+                m.setattr(recon_job, "streamable", lambda options: False)
+            recon_job.run_reconstruct(recording, tmp_path / f"p{streamed}", C=0.25, video=False, progress=False,
+                                      t_end=0.5, fps=5, log=said.append)
+        assert not [s for s in said if s.startswith("note: the window")], said

@@ -31,8 +31,8 @@ from ..method.recipes import (DEFAULT_C, RECIPES, contrast_option, format_contra
 from ..method.solver import Reconstruction, reconstruct
 from .options import DEFAULT_FPS, RunOptions, check_run_options, choose_times, parse_times  # noqa: F401
 from .results import EQUALIZATIONS, score_predictions, score_recording, write_results  # noqa: F401
-from .stream_job import (check_disk, display_attrs, report_balance, report_lam, report_level, run_streaming, streamable,
-                         video_fps)
+from .stream_job import (check_disk, display_attrs, report_balance, report_lam, report_level, report_reach, run_streaming,
+                         streamable, video_fps)
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
@@ -184,6 +184,8 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
 
             check_colour_recording(rec)
         lo, hi = rec.meta["window"]
+        if len(rec.events):
+            report_reach(lo, hi, float(rec.events.t[0]), float(rec.events.t[-1]), log)
         H, W = rec.events.sensor_size
 
         def fits(n_times: int, config) -> None:

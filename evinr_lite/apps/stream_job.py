@@ -94,6 +94,16 @@ def report_level(options, config, log) -> None:
         "level (pass --display-mean to set it, e.g. 0.2 for a dark scene)")
 
 
+def report_reach(lo: float, hi: float, first: float, last: float, log, slack: float = 1.0) -> None:
+    """A note when the window [lo, hi] (s) reaches more than ``slack`` seconds beyond the events, which lie
+    in [first, last] (s): frames there are asked of a time nothing was recorded in (both jobs)."""
+    parts = ([f"{first - lo:.1f} s before the first event ({first:.6f} s)"] if first - lo > slack else []) + \
+            ([f"{hi - last:.1f} s after the last ({last:.6f} s)"] if hi - last > slack else [])
+    if parts:
+        log(f"note: the window [{lo:.6f}, {hi:.6f}] s reaches {' and '.join(parts)}; nothing fires there, so its "
+            "frames repeat the state at the nearest event (compare --start / --end with `evinr-lite info`)")
+
+
 def _key(path, config, times, window) -> dict:
     """What a saved state must match to be resumed: the input, the settings, the times and the span."""
     digest = hashlib.sha256(np.ascontiguousarray(times, np.float64).tobytes()).hexdigest()
@@ -158,6 +168,7 @@ def _header(path, options, log):
         source.close()
         raise EventDataError(f"{path}: no events in the window [{options.t_start}, {options.t_end}) s; the events "
                              f"cover [{first:.6f}, {last:.6f}] s; choose a window inside it (see `evinr-lite info`)")
+    report_reach(lo, hi, first, last, log)
     frames = source.frames
     if frames is not None:   # only frames the events can reach: inside [lo, hi]
         keep = (frames.t >= lo) & (frames.t <= hi)
