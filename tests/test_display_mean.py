@@ -83,3 +83,14 @@ def test_a_batch_keeps_the_level_and_refuses_to_resume_at_another(recording, tmp
     for other in (dict(display_mean=0.4), dict(display_mean=0.25, tonemap="reinhard")):
         with pytest.raises(EventDataError, match="other settings"):
             run_batch([recording], out, sequential=True, C=0.25, log=lambda *a: None, **other)
+
+
+def test_the_colour_job_shows_every_channel_at_the_level(tmp_path):
+    from evinr_lite.sim.colour_davis import write_colour_davis_recording
+
+    path = write_colour_davis_recording(tmp_path / "coffee.h5", "coffee", sensor_size=(48, 64), duration=0.5, C=0.2,
+                                        frame_rate=20.0, seed=0)
+    assert main(["reconstruct", str(path), "--out", str(tmp_path / "c"), "--colour", "--display-mean", "0.25",
+                 "--no-video", "--quiet"]) == 0
+    rgb = _pngs(tmp_path / "c")
+    assert rgb.ndim == 4 and np.allclose(rgb.mean(axis=(0, 1, 2)), 0.25, atol=0.02)   # grey world: each channel
