@@ -97,7 +97,8 @@ def resolve_contrast(rec: Recording, C, path=None, log=print, *, colour: bool = 
     elif C is not None:
         source = "given"
     else:
-        source = "from the file" if rec.meta.get("C") else "default (pass C=)"
+        source = ("from the file" if rec.meta.get("C") else
+                  "default, the paper's (set it with --C, or C= in Python; --C auto fits it from APS frames)")
         C = float(rec.meta.get("C") or DEFAULT_C)
     if colour and np.ndim(C) != 0:
         raise EventDataError("colour reconstruction takes one C (the photosites' threshold), not a pair or 'auto'; "
