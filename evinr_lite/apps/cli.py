@@ -143,9 +143,10 @@ KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-
                         "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
 SAVE_LOG_HELP = ("also write the frames' log intensity, unclipped, as float32 in log_intensity.h5 (4 bytes a pixel "
                  "a frame): the dynamic range the 8-bit PNGs clip, to tone-map again or to use as data")
-DISPLAY_MEAN_HELP = ("the frames' mean brightness over the window, between 0 and 1: the level events never give "
-                     "(default: the tone map's own, 0.4 for linear, 0.5 for reinhard); lower for a dark scene, higher "
-                     "for a bright one. Not with --anchor, whose APS frames give the level")
+DISPLAY_MEAN_HELP = ("how bright the frames are, between 0 and 1: the level events never give. linear: the frames' "
+                     "mean over the window (default 0.4); reinhard: the value the mean log intensity is shown at "
+                     "(default 0.5). Lower for a dark scene, higher for a bright one. Not with --anchor, whose APS "
+                     "frames give the level")
 CAMERA_CHOICES = ("left", "right")
 CAMERA_HELP = ("which camera of an MVSEC stereo file (davis/left or davis/right; default: the left one, or the "
                "one the file has); other formats hold one camera")
