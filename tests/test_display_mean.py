@@ -50,7 +50,7 @@ def test_both_jobs_show_the_frames_at_the_level_asked_for(recording, tmp_path, m
             recon_job.run_reconstruct(recording, tmp_path / f"o{level}", C=0.25, video=False, progress=False,
                                       display_mean=level, fps=20, log=said.append)
         means[level] = _pngs(tmp_path / f"o{level}").mean()
-        lines[level] = [s for s in said if "mean brightness" in s]
+        lines[level] = [s for s in said if "frames shown" in s]
         run = json.loads((tmp_path / f"o{level}" / "run.json").read_text())
         assert run["evinr_config"]["display_mean"] == pytest.approx(level or 0.4)
     # the level is set over the window's offset grid, the PNGs are the frames asked for: close, not equal

@@ -90,8 +90,9 @@ def report_level(options, config, log) -> None:
     with the option that sets it (the in-memory and the streamed job both)."""
     if options.display_mean is not None or options.anchor != "none":
         return
-    log(f"frames shown at a mean brightness of {config.display_mean:g} over the window: events never give the "
-        "level (pass --display-mean to set it, e.g. 0.2 for a dark scene)")
+    level = ("at a mean brightness of" if config.tonemap == "linear" else "with their mean log intensity at")
+    log(f"frames shown {level} {config.display_mean:g} over the window: events never give the level (pass "
+        "--display-mean to set it, e.g. 0.2 for a dark scene)")
 
 
 def report_reach(lo: float, hi: float, first: float, last: float, log, slack: float = 1.0) -> None:
