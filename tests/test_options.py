@@ -298,3 +298,14 @@ def test_reconstruct_says_which_lam_it_chose_and_uses_a_given_one(tmp_path, caps
     log = capsys.readouterr().out
     run = json.loads((tmp_path / "b" / "run.json").read_text())
     assert run["evinr_config"]["lam"] == 0.2 and "lam_used" not in run and "chosen from the events' activity" not in log
+
+
+def test_a_times_file_with_a_header_line_is_refused_naming_the_file_and_the_word(tmp_path):
+    f = tmp_path / "times.csv"
+    f.write_text("time\n0.1\n0.5\n")
+    with pytest.raises(EventDataError, match=r"times\.csv.*'time' is not a number of seconds; a header line"):
+        parse_times(str(f))
+    f.write_text("# time\n0.1\n0.5\n")                              # the fix the message gives
+    assert parse_times(str(f)).tolist() == [0.1, 0.5]
+    with pytest.raises(EventDataError, match=r"'x' is not a number of seconds\)"):
+        parse_times("0.1,x")

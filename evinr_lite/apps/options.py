@@ -53,6 +53,18 @@ def _time_tokens(text: str) -> list[str]:
     return [tok for line in data for tok in line.replace(",", " ").split()]
 
 
+def _first_non_number(tokens):
+    """The first of ``tokens`` (a list of texts or values) that float() refuses, or None."""
+    if not isinstance(tokens, (list, tuple)):
+        return None
+    for tok in tokens:
+        try:
+            float(tok)
+        except (ValueError, TypeError):
+            return tok
+    return None
+
+
 def _times_file(at) -> Path | None:
     """``at`` as the path of a file of times, or None when it is a list written out in text."""
     if isinstance(at, Path):
@@ -84,6 +96,7 @@ def parse_times(at) -> np.ndarray:
             or a time that is not finite.
     """
     path = _times_file(at)
+    given = at
     if path is not None:
         try:
             text = path.read_bytes().decode("utf-8-sig")
@@ -96,7 +109,11 @@ def parse_times(at) -> np.ndarray:
     try:
         times = np.atleast_1d(np.asarray(at, dtype=np.float64))
     except (ValueError, TypeError):
-        raise EventDataError(f"could not read times from at={at!r}; give seconds separated by commas "
+        bad = _first_non_number(at)
+        where = f"the file {str(path)!r}" if path is not None else f"at={given!r}"
+        what = "" if bad is None else f" ({bad!r} is not a number of seconds" + \
+            ("; a header line? remove it or start it with #)" if path is not None else ")")
+        raise EventDataError(f"could not read times from {where}{what}; give seconds separated by commas "
                              "(e.g. 0.5,0.75,1.0) or a file with one time per line") from None
     if times.ndim != 1:
         raise EventDataError(f"at= must be a flat list of seconds, got an array of shape {times.shape}")
