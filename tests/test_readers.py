@@ -417,3 +417,25 @@ def test_a_ros_bag_names_the_conversion(tmp_path):
     assert sniff_format(path) == "rosbag"
     with pytest.raises(EventDataError, match=r"a ROS1 bag.*python -m data_fetch convert"):
         read_recording(path)
+
+
+def test_an_ijrr_folder_missing_its_images_says_how_many_and_the_fixes(tmp_path):
+    import shutil
+
+    from evinr_lite.io import read_recording
+    from evinr_lite.io.sample_data import find_shared_data
+
+    data = find_shared_data()
+    src = None if data is None else data / "ijrr_slider_depth_chunk"
+    if src is None or not src.is_dir():
+        pytest.skip("the shared slider_depth chunk is not here")
+    folder = tmp_path / "chunk"
+    shutil.copytree(src, folder)
+    (folder / "images" / "frame_00000003.png").unlink()
+    with pytest.raises(EventDataError, match=r"frame_00000003\.png does not exist.*copy the images back.*--sensor"):
+        read_recording(folder)
+    shutil.rmtree(folder / "images")
+    with pytest.raises(EventDataError, match=r"6 of its 6 frames are missing"):
+        read_recording(folder)
+    (folder / "images.txt").rename(tmp_path / "images.txt")        # the last fix the message gives
+    assert read_recording(folder, sensor_size=(180, 240)).frames is None

@@ -86,7 +86,11 @@ def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s", events_span=
     for name in names:
         image_path = folder / name
         if not image_path.is_file():
-            raise EventDataError(f"{listing} lists {image_path.name}, but {image_path} does not exist (or is not a file)")
+            missing = sum(not (folder / n).is_file() for n in names)
+            raise EventDataError(f"{listing} lists {image_path.name}, but {image_path} does not exist (or is not a file)"
+                                 + (f"; {missing} of its {len(names)} frames are missing" if missing > 1 else "")
+                                 + ": copy the images back, remove the missing ones' lines from images.txt, or move "
+                                 "images.txt aside to read the events alone (with --sensor HxW)")
         _check_image_file(image_path, listing)
         try:
             image = imread(image_path)
