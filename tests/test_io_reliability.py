@@ -268,3 +268,16 @@ def test_an_hqf_dataset_stored_as_a_group_is_refused(tmp_path, name):
         f.create_group(name)
     with pytest.raises(EventDataError, match="group"):
         read_recording(path)
+
+
+def test_hqf_frames_of_another_size_than_sensor_resolution_give_the_fix_that_works(tmp_path):
+    path = _hqf(tmp_path / "a.h5", [0.2, 1.1])
+    with h5py.File(path, "r+") as f:
+        f.attrs["sensor_resolution"] = (H + 2, W)                          # the camera's size, written wrong
+    with pytest.raises(EventDataError, match=r"frames are .* but sensor_resolution is .*set the attribute") as err:
+        read_recording(path)
+    fix = str(err.value).split("e.g. ")[1]                                 # run the message's own fix
+    assert fix.startswith("h5py.File(path, 'r+').attrs['sensor_resolution'] = ")
+    with h5py.File(path, "r+") as f:
+        f.attrs["sensor_resolution"] = eval(fix.split(" = ")[1])
+    assert read_recording(path).frames.size == (H, W)

@@ -83,7 +83,8 @@ def existing(path, kind: str = "file") -> Path:
     if kind == "file" and not stat.S_ISREG(mode):
         raise EventDataError(f"{path} is not a regular file (a FIFO, pipe or device); save the data to a file first")
     if kind == "file" and path.stat().st_size == 0:
-        raise EventDataError(f"{path} is empty")
+        raise EventDataError(f"{path} is empty (0 bytes): a copy, download or export that did not finish; get "
+                             "the recording again")
     return path
 
 

@@ -80,7 +80,8 @@ def read_evreal_folder(folder, *, time_unit="auto") -> Recording:
             raise EventDataError(f"{folder / 'images.npy'}: {err}") from None
         if frames.size != sensor_size:
             raise EventDataError(f"{folder}: frames are {frames.size} but sensor_resolution is "
-                                 f"{sensor_size} (both (H, W))")
+                                 f"{sensor_size} (both (H, W)); one of them is wrong: if the frames are the "
+                                 f"camera's, set metadata.json's sensor_resolution to {list(frames.size)}")
     if (folder / "image_event_indices.npy").exists():
         meta["image_event_indices"] = load("image_event_indices.npy")
     return Recording(events, frames, meta)

@@ -92,7 +92,8 @@ def word_order(path: Path, offset: int, sensor_size=None) -> str:
     both fit."""
     raw = np.fromfile(path, dtype="<u8", count=SAMPLE_WORDS, offset=offset)
     if len(raw) == 0:
-        raise EventDataError(f"{path}: an EVT 2.1 file with no event words after its header")
+        raise EventDataError(f"{path}: an EVT 2.1 file with no event words after its header: the recording "
+                             "stopped before any event, or the file was cut short; record or copy it again")
     fits = []
     for order in ORDERS:
         share, n_time, forward = _plausible(_as_words(raw, order), sensor_size)

@@ -134,7 +134,9 @@ class _Layout(TimeIndexed):
         frames = Frames(np.stack(images), stamps, self.origin)
         if frames.size != self.sensor_size:
             raise EventDataError(f"{path}: frames are {frames.size} but sensor_resolution is "
-                                 f"{self.sensor_size} (both (H, W))")
+                                 f"{self.sensor_size} (both (H, W)); one of them is wrong: if the frames are the "
+                                 "camera's, set the attribute to their size, e.g. h5py.File(path, 'r+').attrs"
+                                 f"['sensor_resolution'] = {tuple(frames.size)}")
         if meta is not None and all("event_idx" in group[k].attrs for k in keys):  # indices into the file's events
             meta["frame_event_idx"] = np.array([int(np.asarray(group[k].attrs["event_idx"]).reshape(()))
                                                 for k in keys])
