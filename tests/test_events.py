@@ -155,3 +155,13 @@ def test_us_conversion_is_correctly_rounded():
     t_us = np.arange(0, 100_000, 7)
     ev = Events.from_arrays(t_us, np.zeros_like(t_us), np.zeros_like(t_us), np.ones_like(t_us), (1, 1), time_unit="us")
     np.testing.assert_array_equal(ev.t, t_us / 1e6)
+
+
+def test_a_sensor_size_given_the_wrong_way_round_is_named():
+    x, y = np.array([0, 39]), np.array([0, 29])
+    with pytest.raises(EventDataError, match=r"the events fit \(30, 40\), the size given the other way round "
+                                             r"\(on the command line --sensor 30x40\)"):
+        Events(np.array([0.0, 1.0]), x, y, np.array([1, -1]), (40, 30))
+    with pytest.raises(EventDataError) as err:                    # too small both ways: no such suggestion
+        Events(np.array([0.0, 1.0]), np.array([0, 50]), y, np.array([1, -1]), (40, 30))
+    assert "other way round" not in str(err.value)

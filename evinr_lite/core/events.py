@@ -319,10 +319,14 @@ class Events:
             elif a.dtype.kind not in "iu":
                 raise EventDataError(f"{name} coordinates must be integers, got dtype {a.dtype}")
             if a.size and (a.min() < 0 or a.max() >= size):
+                swapped = (x.size and y.size and x.min() >= 0 and y.min() >= 0 and x.max() < H and y.max() < W
+                           and H != W)
                 raise EventDataError(
                     f"{name} ({axis}) coordinates span [{a.min()}, {a.max()}] but sensor_size (H, W) = "
                     f"{(H, W)} allows [0, {size - 1}]; check the sensor size (it is (H, W), rows first) "
                     "and that x is the column and y the row"
+                    + (f"; the events fit ({W}, {H}), the size given the other way round (on the command line "
+                       f"--sensor {W}x{H})" if swapped else "")
                 )
         p = normalize_polarity(arrays["p"], self.polarity_encoding)
         object.__setattr__(self, "t", t)
