@@ -160,7 +160,7 @@ def test_us_conversion_is_correctly_rounded():
 def test_a_sensor_size_given_the_wrong_way_round_is_named():
     x, y = np.array([0, 39]), np.array([0, 29])
     with pytest.raises(EventDataError, match=r"the events fit \(30, 40\), the size given the other way round "
-                                             r"\(on the command line --sensor 30x40\)"):
+                                             r"\(on the command line --sensor 30x40, or correct"):
         Events(np.array([0.0, 1.0]), x, y, np.array([1, -1]), (40, 30))
     with pytest.raises(EventDataError) as err:                    # too small both ways: no such suggestion
         Events(np.array([0.0, 1.0]), np.array([0, 50]), y, np.array([1, -1]), (40, 30))

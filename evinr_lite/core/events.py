@@ -326,7 +326,7 @@ class Events:
                     f"{(H, W)} allows [0, {size - 1}]; check the sensor size (it is (H, W), rows first) "
                     "and that x is the column and y the row"
                     + (f"; the events fit ({W}, {H}), the size given the other way round (on the command line "
-                       f"--sensor {W}x{H})" if swapped else "")
+                       f"--sensor {W}x{H}, or correct the size the file records)" if swapped else "")
                 )
         p = normalize_polarity(arrays["p"], self.polarity_encoding)
         object.__setattr__(self, "t", t)
