@@ -633,8 +633,8 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
             _rmdir_quietly(real)          # only when empty: a batch that did nothing leaves nothing
     done = sum(r["status"] in ("done", "unscored") for r in rows)
     skipped = sum(r["status"].startswith("skipped") for r in rows)
-    log(f"batch: {done} recording(s) run, {skipped} already finished, {len(summary['failed'])} failed; "
-        f"summary in {out_dir}/summary.md")
+    log(f"batch: {len(rows)} recording(s): {done} reconstructed now, {skipped} already finished, "
+        f"{len(summary['failed'])} failed; summary in {out_dir}/summary.md")
     for p in summary["pooled"]:
         log(f"  {p['dataset']:<16} {p['equalization']:<6} MSE {p['mse']:.4f}  SSIM {p['ssim']:.3f}  "
             f"({p['n_sequences']} sequences, {p['n_frames']} frames)")
