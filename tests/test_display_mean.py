@@ -28,7 +28,7 @@ def test_options_check_the_level_and_pass_it_to_every_recipe():
         assert RunOptions(recipe=recipe, tonemap=tonemap).config(0.2).display_mean == pytest.approx(own)
         cfg = RunOptions(recipe=recipe, tonemap=tonemap, display_mean=0.25).config(0.2)
         assert cfg.display_mean == pytest.approx(0.25) and cfg.tonemap == (tonemap or cfg.tonemap)
-    for bad in (0, 1, 1.5, -0.2, float("nan"), "dark", True):
+    for bad in (0, 1, 1.5, -0.2, 0.005, 0.995, 1e-300, float("nan"), "dark", True):
         with pytest.raises(EventDataError, match="display_mean"):
             RunOptions(display_mean=bad)
     with pytest.raises(EventDataError, match="APS frames give it"):
@@ -63,7 +63,7 @@ def test_the_command_line_takes_it_and_refuses_what_it_cannot_use(recording, tmp
     assert main(["reconstruct", str(recording), "--out", str(tmp_path / "a"), "--display-mean", "0.3", "--no-video",
                  "--quiet", "--fps", "10"]) == 0
     assert json.loads((tmp_path / "a" / "run.json").read_text())["evinr_config"]["display_mean"] == pytest.approx(0.3)
-    for args, says in ((["--display-mean", "1.5"], "between 0 and 1"), (["--display-mean", "x"], "expected a number"),
+    for args, says in ((["--display-mean", "1.5"], "between 0.01 and 0.99"), (["--display-mean", "0.999999"], "between 0.01"), (["--display-mean", "x"], "expected a number"),
                        (["--display-mean", "0.3", "--anchor", "first"], "APS frames give it")):
         capsys.readouterr()
         assert main(["reconstruct", str(recording), "--out", str(tmp_path / "b"), *args]) == 2

@@ -47,12 +47,12 @@ def _positive(text: str) -> float:
     return value
 
 
-def _unit_open(text: str) -> float:
-    """--display-mean: a number strictly between 0 and 1."""
+def _level(text: str) -> float:
+    """--display-mean: a number from 0.01 to 0.99 (options.DISPLAY_MEAN_RANGE, spelled here: no import at start)."""
     value = _finite(text)
-    if not 0 < value < 1:
-        raise argparse.ArgumentTypeError(f"must lie between 0 and 1 (the frames' mean brightness; 0.4 is the kit's), "
-                                         f"got {text!r}")
+    if not 0.01 <= value <= 0.99:
+        raise argparse.ArgumentTypeError(f"must lie between 0.01 and 0.99 (how bright the frames are; 0.4 is the "
+                                         f"kit's; beyond that every frame is black or white), got {text!r}")
     return value
 
 
@@ -143,7 +143,7 @@ KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-
                         "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
 SAVE_LOG_HELP = ("also write the frames' log intensity, unclipped, as float32 in log_intensity.h5 (4 bytes a pixel "
                  "a frame): the dynamic range the 8-bit PNGs clip, to tone-map again or to use as data")
-DISPLAY_MEAN_HELP = ("how bright the frames are, between 0 and 1: the level events never give. linear: the frames' "
+DISPLAY_MEAN_HELP = ("how bright the frames are, from 0.01 to 0.99: the level events never give. linear: the frames' "
                      "mean over the window (default 0.4); reinhard: the value the mean log intensity is shown at "
                      "(default 0.5). Lower for a dark scene, higher for a bright one. Not with --anchor, whose APS "
                      "frames give the level")
@@ -203,7 +203,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
     rec.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     rec.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
-    rec.add_argument("--display-mean", type=_unit_open, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
+    rec.add_argument("--display-mean", type=_level, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
     rec.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     rec.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
     rec.add_argument("--seed", type=_seed, default=0)
@@ -275,7 +275,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--device", choices=("cpu", "cuda"), help="where to train (default: a GPU when present)")
     batch.add_argument("--recipe", choices=RECIPE_CHOICES, default="kit", help=RECIPE_HELP)
     batch.add_argument("--tonemap", choices=TONEMAP_CHOICES, default=None, help=TONEMAP_HELP)
-    batch.add_argument("--display-mean", type=_unit_open, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
+    batch.add_argument("--display-mean", type=_level, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
     batch.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     batch.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
     batch.add_argument("--seed", type=_seed, default=0)

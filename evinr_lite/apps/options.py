@@ -30,6 +30,8 @@ from ..method.tonemap import TONEMAPS
 __all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "lam_option", "BATCH_FIELDS", "DEFAULT_FPS"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
+DISPLAY_MEAN_RANGE = (0.01, 0.99)   # --display-mean: beyond it the frames clip to black or white (a mean of
+                                    # 0.999999 left every pixel at 1, refused as constant frames)
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
 BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap",
@@ -178,7 +180,7 @@ class RunOptions:
             background activity wants about 0.1), less for a busy, clean one.
         tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
             paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
-        display_mean: the frames' mean brightness over the window, in (0, 1): the level events never give
+        display_mean: the frames' mean brightness over the window, in [0.01, 0.99]: the level events never give
             (``EvINRConfig.display_mean``; None: the tone map's own, 0.4 for linear, 0.5 for reinhard). Lower
             for a dark scene, higher for a bright one; refused with an anchor, whose APS frames give the level.
         video: also write MP4 / GIF; progress: show a progress bar.
@@ -262,9 +264,10 @@ class RunOptions:
             checked["lam"] = lam_option(self.lam)
         if self.display_mean is not None:
             level = _finite("display_mean=", self.display_mean)
-            if not 0 < level < 1:
-                raise EventDataError(f"display_mean= is the frames' mean brightness, in (0, 1) (0.4 is the kit's; "
-                                     f"lower for a dark scene), got {self.display_mean!r}")
+            if not DISPLAY_MEAN_RANGE[0] <= level <= DISPLAY_MEAN_RANGE[1]:
+                raise EventDataError(f"display_mean= is how bright the frames are, from {DISPLAY_MEAN_RANGE[0]} to "
+                                     f"{DISPLAY_MEAN_RANGE[1]} (0.4 is the kit's; lower for a dark scene; beyond that "
+                                     f"range every frame is black or white), got {self.display_mean!r}")
             if self.anchor != "none":
                 raise EventDataError(f"display_mean= sets the level that events never give; with anchor="
                                      f"{self.anchor!r} the APS frames give it: leave display_mean out, or use "
