@@ -304,7 +304,8 @@ class EvINRConfig:
         gamma: Reinhard's exponent (paper: 0.6; unused by "linear"). display_mean: the level events
             never fix: linear, the mean of the displayed frames over the sequence (0.4, a little below
             mid-grey); reinhard, the display value of the mean log intensity (the
-            paper's 0.5).
+            paper's 0.5). A user who knows the scene is dark or bright sets it (``evinr-lite
+            reconstruct --display-mean``; on dark_falling 0.18, its truth's level, takes MSE 0.0623 -> 0.0049).
     Runtime:
         seed: seeds the initialisation. device: "cpu", "cuda" or None (GPU when present).
         progress: show a progress bar (terminal or notebook).
