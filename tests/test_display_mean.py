@@ -94,3 +94,17 @@ def test_the_colour_job_shows_every_channel_at_the_level(tmp_path):
                  "--no-video", "--quiet"]) == 0
     rgb = _pngs(tmp_path / "c")
     assert rgb.ndim == 4 and np.allclose(rgb.mean(axis=(0, 1, 2)), 0.25, atol=0.02)   # grey world: each channel
+
+
+def test_the_command_line_and_the_options_take_the_same_range(recording, tmp_path):
+    from evinr_lite.apps.options import DISPLAY_MEAN_RANGE
+
+    parser = __import__("evinr_lite.apps.cli", fromlist=["build_parser"]).build_parser()
+    lo, hi = DISPLAY_MEAN_RANGE
+    for value in (lo, hi):
+        args = parser.parse_args(["reconstruct", str(recording), "--out", "o", "--display-mean", str(value)])
+        assert RunOptions(display_mean=args.display_mean).display_mean == value
+    for value in (lo * 0.99, hi + 0.001):
+        with pytest.raises(EventDataError):
+            RunOptions(display_mean=value)
+        assert main(["reconstruct", str(recording), "--out", str(tmp_path / "x"), "--display-mean", str(value)]) == 2

@@ -304,7 +304,8 @@ def _run_options(args):
                       device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
                       keep_background=args.keep_background, static_camera=args.static_camera,
-                      colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap, display_mean=args.display_mean, video=video,
+                      colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap,
+                      display_mean=args.display_mean, video=video,
                       progress=not args.quiet, save_log=args.save_log)
 
 
