@@ -213,6 +213,11 @@ class EvINRConfig:
         lam: weight lambda of the regularizer (paper: 0.05; finite differences in pixel units), or
             "auto": chosen from the events' activity per network window, LAM_SCALE / m^2 within
             [0.002, 0.01] (:mod:`~evinr_lite.method.smoothing`; m: events per pixel that came and went).
+        spatial_order: the Tikhonov regularizer's order in the closed-form head (``head_solve``): 1, the
+            gradient's energy |D F|^2 (the paper's Eq. 9, what Adam's loss uses); 2 (the kit's), the
+            Laplacian's energy |D^T D F|^2, equal to order 1 at a wavelength of 8 px, so lam keeps its
+            meaning there: coarser structure is smoothed less, finer more
+            (:func:`~evinr_lite.method.head_solve.penalty_spectrum`). Adam's loss stays first-order.
     Network (SIREN):
         hidden_features, hidden_layers: width and depth (paper: 512, 3).
         omega_0: frequency factor of the hidden layers (SIREN's default 30).
@@ -319,6 +324,7 @@ class EvINRConfig:
     temporal_loss: str = "difference"
     regularizer: str = "tikhonov"
     lam: float | str = "auto"
+    spatial_order: int = 2
     hidden_features: int = 128
     hidden_layers: int = 3
     omega_0: float = 30.0
@@ -360,6 +366,9 @@ class EvINRConfig:
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+        if isinstance(self.spatial_order, bool) or self.spatial_order not in (1, 2):
+            raise EventDataError(f"spatial_order must be 1 (the gradient's energy) or 2 (the Laplacian's), got "
+                                 f"{self.spatial_order!r}")
         if self.head_solve and self.regularizer == "tv":
             raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
                                  "pass head_solve=False to train the head with Adam")
@@ -465,7 +474,7 @@ class EvINRConfig:
                       "omega_0": 30.0, "first_omega_0": None, "first_omega_per_s": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
                       "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": DISPLAY_MEANS["reinhard"], "head_solve": False, "offset_solve": "none", "offset_coarse_px": None,
-                      "balance": "none", "hot_pixels": "keep", "background": "keep", **overrides})
+                      "balance": "none", "hot_pixels": "keep", "background": "keep", "spatial_order": 1, **overrides})
 
     @classmethod
     def v0_1(cls, **overrides) -> "EvINRConfig":

@@ -30,7 +30,25 @@ import torch
 
 from ..core.runtime import cpu_threads
 
-__all__ = ["solve_head", "laplacian_eigenvalues"]
+__all__ = ["solve_head", "laplacian_eigenvalues", "penalty_spectrum"]
+
+
+# the spatial frequency (a fraction of Nyquist along both axes: a wavelength of 8 px) at which the second-order
+# penalty equals the first-order one, so lam means the same at that scale whatever the order
+ORDER_REFERENCE = 0.25
+
+
+def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int = 1) -> np.ndarray:
+    """The spatial penalty's weight per DCT frequency, from the weighted Laplacian's eigenvalues ``mu``
+    (:func:`laplacian_eigenvalues` with ``cx``, ``cy``): order 1, mu itself (the gradient's energy,
+    |D f|^2); order 2, mu^2 / mu_ref (the Laplacian's energy, |D^T D f|^2, scaled to equal order 1 at
+    ``ORDER_REFERENCE`` of Nyquist): less smoothing of the coarser structure, more of the finer."""
+    if order == 1:
+        return mu
+    if order != 2:
+        raise ValueError(f"order must be 1 (the gradient) or 2 (the Laplacian), got {order!r}")
+    ref = (cx + cy) * (2 - 2 * np.cos(np.pi * ORDER_REFERENCE))
+    return mu * mu / ref if ref > 0 else mu
 
 
 def laplacian_eigenvalues(sensor_size, cx: float = 1.0, cy: float = 1.0) -> np.ndarray:
@@ -94,7 +112,7 @@ def _solve_frequencies(X: np.ndarray, M: np.ndarray, E_hat: np.ndarray, V: np.nd
 
 @torch.no_grad()
 def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temporal_loss: str = "difference",
-               regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7) -> dict:
+               regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7, order: int = 1) -> dict:
     """Set ``model.head_weight`` and ``model.head_bias`` to the loss's optimum for its hidden layers.
 
     Args:
@@ -104,6 +122,9 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
         regularizer: "tikhonov" or "none" (TV has no closed form; train it with Adam instead).
         lam: the regularizer's weight, as in the training loss.
         ridge: relative ridge added to both Gram matrices (numerical safety; 1e-7 of their trace / d).
+        order: the Tikhonov regularizer's order: 1, the training loss's |D F|^2 (what Adam minimises);
+            2, the Laplacian's |D^T D F|^2 at the same weight at a wavelength of 8 px
+            (:func:`penalty_spectrum`; ``EvINRConfig.spatial_order``).
 
     Memory: the solution is written in place in float32 (in the head's own storage on a CPU), the
     DCTs a few rows and the frequencies a few columns at a time in float64; beyond the model and the
@@ -148,7 +169,7 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
     target = model.head_weight.data if in_place else torch.empty((N, d, P), dtype=torch.float32)
     weights = target.numpy()
     cx, cy = _weights(B, T, (H, W), lam if regularizer == "tikhonov" else 0.0)
-    mu = laplacian_eigenvalues((H, W), cx, cy).ravel()                  # [P]
+    mu = penalty_spectrum(laplacian_eigenvalues((H, W), cx, cy), cx, cy, order).ravel()   # [P]
     total = 0.0
     for n in range(N):
         S = A64[n].T @ A64[n]
