@@ -92,6 +92,13 @@ class EvINRConfig:
       0.545 / 0.591 / 0.0343, long_ijrr_60s 0.489 / 0.471 / 0.0161 -> 0.516 / 0.483 / 0.0157,
       drift_clock 0.747 -> 0.752; windows of 1-2 s lost on every short scene (0.602 -> 0.582 at 1 s
       on astronaut_rotzoom).
+    - spatial_order=2 (2026-12-06): the closed-form head's Tikhonov term is the Laplacian's energy
+      |D^T D F|^2, equal to the paper's gradient energy |D F|^2 at a wavelength of 8 px: coarser
+      structure is smoothed less, finer more. Kit-only means, order 1 -> 2 (CLAHE-SSIM / SSIM / MSE): zoo
+      0.648 / 0.710 / 0.0339 -> 0.657 / 0.716 / 0.0339, held out 0.540 -> 0.555, stress 0.596 -> 0.613,
+      fresh seeds 11 / 12 / 13 0.576 / 0.594 / 0.615 -> 0.590 / 0.603 / 0.630, long_pan_20s 0.647 -> 0.676,
+      long_ijrr_60s 0.697 -> 0.722, real chunk 0.372 / 0.451 / 0.0656 -> 0.376 / 0.453 / 0.0671; the same
+      time (docs/defaults.md, "The spatial prior's order").
     - lam="auto" instead of 0.05 (0.01 before issue 21): with the exact head, less smoothing wins where
       much texture passes each pixel, and more where little does (quick zoo, fixed lam, CLAHE-SSIM
       mean: 0.293 at lam 1, 0.403 at 0.2, 0.482 at 0.05, 0.528 at 0.01). The Tikhonov term damps the
