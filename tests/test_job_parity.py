@@ -44,8 +44,11 @@ def test_streamed_and_in_memory_runs_agree(recording, tmp_path, monkeypatch, opt
     np.testing.assert_allclose(s_L, m_L, atol=1e-3)
     assert set(s_run["files"]) == set(m_run["files"])
     if "scores" in m_run:
-        for eq in m_run["scores"]:
-            assert s_run["scores"][eq]["ssim"] == pytest.approx(m_run["scores"][eq]["ssim"], abs=1e-4)
+        # the scored frames are the same solve's up to float rounding (the in-memory job queries the network at
+        # the frames' times, the streamed one takes them from its batches); CLAHE equalises 8-bit images, where a
+        # rounding that crosses a grey level moves its SSIM by about 1e-4 (1.3e-4 seen with fps=33.3)
+        for eq, tol in (("none", 1e-4), ("clahe", 5e-4)):
+            assert s_run["scores"][eq]["ssim"] == pytest.approx(m_run["scores"][eq]["ssim"], abs=tol)
     assert json.loads((tmp_path / "s" / "run.json").read_text())["times_s"] == m_run["times_s"]
 
 
