@@ -10,7 +10,7 @@ import pytest
 from PIL import Image
 
 import evinr_lite.apps.recon_job as recon_job
-from evinr_lite.apps.cli import main
+from evinr_lite.apps.cli import build_parser, main
 from evinr_lite.apps.options import RunOptions
 from evinr_lite.core.events import EventDataError
 from evinr_lite.sim.recordings import write_example_recording
@@ -99,7 +99,7 @@ def test_the_colour_job_shows_every_channel_at_the_level(tmp_path):
 def test_the_command_line_and_the_options_take_the_same_range(recording, tmp_path):
     from evinr_lite.apps.options import DISPLAY_MEAN_RANGE
 
-    parser = __import__("evinr_lite.apps.cli", fromlist=["build_parser"]).build_parser()
+    parser = build_parser()
     lo, hi = DISPLAY_MEAN_RANGE
     for value in (lo, hi):
         args = parser.parse_args(["reconstruct", str(recording), "--out", "o", "--display-mean", str(value)])
