@@ -444,3 +444,7 @@ def main(argv=None) -> int:
     return run_guarded("evinr-lite", body, argv, describe=_message, interrupted_note=interrupted_note,
                        out_of_memory=_out_of_memory, debug=lambda: getattr(seen.get("args"), "debug", False),
                        owns_process=owns_process)
+
+
+if __name__ == "__main__":   # `python -m evinr_lite.apps.cli ...` runs the command (it did nothing, with status 0)
+    sys.exit(main())

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
@@ -35,6 +36,7 @@ EVENT_COLUMNS = "`t x y p` (time in seconds, x = column, y = row, polarity)"
 MAX_PIXEL = 1 << 31     # a coordinate at or beyond this is no pixel of any sensor (nor fits the int64 cast exactly)
 MAX_CLOCK_S = 2.0**53   # seconds (285 million years): a timestamp beyond it is no clock, whatever its unit
 FRAME_COLUMNS = "`t images/frame_%08d.png`"
+_WORD = re.compile(r"^[A-Za-z_][\w\[\]()\u00b5.-]*$")   # a column's name, e.g. t, timestamp_us, time[ms]
 
 
 @dataclass(frozen=True)
@@ -154,6 +156,20 @@ def _parse_digits(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.n
             return None
         value = np.where(inside, value * 10 + digit, value)
     return value
+
+
+def _parse_bool(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> np.ndarray | None:
+    """Tokens that are all `True` / `False` (any case: pandas writes a bool column so) -> int64 [N] 1 / 0;
+    None when some token is neither."""
+    lengths = ends - starts
+    if not len(starts) or int(lengths.max()) > 5:
+        return None
+    chars = _char_matrix(buf, starts, ends)
+    words = np.char.lower(chars.view(f"S{chars.shape[1]}").ravel())
+    true = words == b"true"
+    if not np.all(true | (words == b"false")):
+        return None
+    return true.astype(np.int64)
 
 
 def _parse_decimal(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray):
@@ -314,6 +330,15 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         raise EventDataError(f"{source}, line {line_base + line + 1}: {problem} "
                              f"(line reads {_line_text(buf, newlines, line)!r})")
 
+    def names_hint(line):  # a first line of column names in a `t x y p` file: say what it is and the ways out
+        if not (first and layout.size_line and line == int(np.flatnonzero(counts)[0])):
+            return ""
+        words = re.split(r"[\s,;]+", _line_text(buf, newlines, line).strip("\ufeff \t\"'"))
+        if not all(_WORD.match(w) for w in words):
+            return ""
+        return ("; it names the columns, but a `t x y p` text file holds only numbers: start that line with `#` "
+                "(a comment), or name the file .csv, whose reader takes a first line naming the columns in any order")
+
     def row_line(row):  # 0-based line (in this block) of event row `row`
         return int(np.searchsorted(newlines, starts[row, 0]))
 
@@ -328,7 +353,7 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     if bad.size:
         i = int(bad[0])
         hint = " (a `W H` header is allowed only as the first line)" if counts[i] == 2 else ""
-        fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}")
+        fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}{names_hint(i)}")
     empty = np.zeros(0, dtype=np.int64)
     if time_unit not in TIME_UNITS and time_unit != "auto":
         raise EventDataError(f"unknown time_unit={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
@@ -345,13 +370,17 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     try:
         t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns, time_unit)
     except _BadToken as err:
-        fail(row_line(err.row), f"the timestamp is not a number; expected {layout.columns}")
+        fail(row_line(err.row), f"the timestamp is not a number; expected {layout.columns}"
+             f"{names_hint(row_line(err.row))}")
     xyp = []
     for c, name in ((1, "x"), (2, "y"), (3, "p")):
         try:
             xyp.append(_parse_number(buf, starts[:, c], ends[:, c]))
         except _BadToken as err:
-            fail(row_line(err.row), f"{name} is not a number; expected {layout.columns}")
+            words = _parse_bool(buf, starts[:, c], ends[:, c]) if name == "p" else None
+            if words is None:   # a polarity column of True / False (pandas' bool column) is 1 / 0
+                fail(row_line(err.row), f"{name} is not a number; expected {layout.columns}")
+            xyp.append(words)
     x, y, p = xyp
 
     nonfinite = np.flatnonzero(~np.isfinite(t))
@@ -413,10 +442,37 @@ def read_text_bytes(path, what: str = "file") -> bytes:
     return data
 
 
+def _blank_leading_comments(data: bytes) -> tuple[bytes | bytearray, list[int]]:
+    """(``data`` with the comment lines (`#` or `%` first) before the first event blanked (same length: byte
+    offsets and line numbers kept), as a tool or a hand writes a note or the columns' names on top; the
+    1-based numbers of those lines)."""
+    spans, lines, pos = [], [], 0
+    while pos < min(len(data), CHUNK_BYTES):
+        end = data.find(b"\n", pos)
+        end = len(data) if end < 0 else end
+        raw = data[pos:end]
+        line = raw.strip()
+        if b"\r" in raw.rstrip(b"\r"):   # old Mac line ends (CR only): no lines to tell apart here
+            break
+        if line.startswith((b"#", b"%")):
+            spans.append((pos, end))
+            lines.append(data.count(b"\n", 0, pos) + 1)
+        elif line and not (len(line.split()) == 2 and all(w.isdigit() for w in line.split())):   # not `W H`
+            break
+        pos = end + 1
+    if not spans:
+        return data, lines
+    data = bytearray(data)
+    for lo, hi in spans:
+        data[lo:hi] = b" " * (hi - lo)
+    return data, lines
+
+
 def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto", data: bytes | bytearray | None = None,
                      layout: TextLayout = TXT_LAYOUT) -> EventBlock:
     """A whole `t x y p` text file (optionally after a `W H` header), block by block.
 
+    Comment lines (`#` or `%` first) before the first event are skipped.
     Timestamps must be finite and non-decreasing. ``origin_ns`` None picks the origin from the
     first timestamp. ``time_unit``: see :func:`parse_event_block` ('auto': integers are
     microseconds, decimals seconds). ``data``: the file's bytes when the caller has read (and
@@ -424,7 +480,9 @@ def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "au
     may open the file (:class:`TextLayout`). Raises EventDataError naming the file and line.
     """
     path = Path(path)
-    data = read_text_bytes(path, "event file") if data is None else data
+    comments = []
+    if data is None:
+        data, comments = _blank_leading_comments(read_text_bytes(path, "event file"))
     everything = np.frombuffer(data, dtype=np.uint8)
     parts, header, line_base, t_last = [], None, 0, -np.inf
     for lo, hi in line_blocks(data, CHUNK_BYTES):
@@ -438,7 +496,9 @@ def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "au
             parts.append((block.t, block.x, block.y, block.p))
             t_last = block.t[-1]
     if not parts:
-        raise EventDataError(f"{path}: no events found; expected lines {layout.columns}")
+        said = "" if not comments else (f" (line {comments[0]} is a comment)" if len(comments) == 1 else
+                                        f" (lines {', '.join(map(str, comments))} are comments)")
+        raise EventDataError(f"{path}: no events found{said}; expected lines {layout.columns}")
     t, x, y, p = (np.concatenate(c) for c in zip(*parts))
     return EventBlock(t, x, y, p, header, origin_ns, line_base, time_unit)
 

@@ -11,8 +11,10 @@ Two layouts are read, both parsed by :mod:`evinr_lite.io.text` (vectorised, exac
 Without a names line the order is read off the first rows: `t,x,y,p` when the first column never
 decreases and the last holds polarities, `x,y,p,t` (Metavision) when the last column never
 decreases and the third holds polarities; anything else is refused with the fix (add a names line).
-Lines that open the file with `%` or `#` are comments. Commas, semicolons and white space all
-separate values. The whole file is read; a source over it slices the events in memory.
+Lines that open the file with `%` or `#` are comments. Commas, semicolons, double quotes and white
+space all separate values; in a file whose values are separated by semicolons, a comma is the decimal
+mark (`0,0125;12;7;1`, as spreadsheets in many locales write). The polarity may be written `True` /
+`False` (pandas' bool column). The whole file is read; a source over it slices the events in memory.
 """
 from __future__ import annotations
 
@@ -36,7 +38,7 @@ SNIFF_ROWS = 1000          # rows read to tell the order when no line names the 
 SNIFF_BYTES = 1 << 16      # at most this many bytes of them
 _NAME = re.compile(r"^(?P<name>[a-z]+)(?:[\s_]*[\[(]?(?P<unit>s|ms|us|\u00b5s|ns)[\])]?)?$")
 _GEOMETRY = re.compile(rb"^%\s*geometry\s*:\s*(\d+)\s*[,x ]\s*(\d+)\s*$", re.IGNORECASE)
-SEPARATORS = b",;"          # besides white space
+SEPARATORS = b",;\""        # besides white space (a quote around a value, as csv.QUOTE_ALL writes, separates too)
 _SEPARATORS = bytes.maketrans(SEPARATORS, b" " * len(SEPARATORS))
 NAMED = "a first line naming the columns, e.g. `t,x,y,p` or `x,y,p,t` (t in seconds unless named `t_us`, `t_ms`...)"
 SORT_HINT = "sort the rows by the time column"
@@ -79,13 +81,42 @@ def _header(path: Path, data: bytes) -> tuple[list, tuple | None, list | None, s
     return spans, geometry, roles, unit
 
 
+def _value(token: bytes) -> float:
+    """A value of a row for telling the columns apart: a number, or True / False as 1 / 0."""
+    word = token.lower()
+    return 1.0 if word == b"true" else 0.0 if word == b"false" else float(token)
+
+
+def _decimal_comma(data: bytes, start: int) -> bool:
+    """The first row after the header separates its values with semicolons and holds a comma: a spreadsheet's
+    export in a locale whose decimal mark is the comma (`0,0125;12;7;1`)."""
+    for line in bytes(data[start:start + SNIFF_BYTES]).split(b"\n", SNIFF_ROWS)[:SNIFF_ROWS]:
+        line = line.strip()
+        if line and not line.startswith((b"%", b"#")):
+            return b";" in line and b"," in line
+    return False
+
+
 def _numbers(line: bytes) -> bool:
-    """Every value of the line parses as a number."""
+    """Every value of the line parses as a number (or is True / False)."""
     try:
-        [float(v) for v in line.translate(_SEPARATORS).split()]
+        [_value(v) for v in line.translate(_SEPARATORS).split()]
     except ValueError:
         return False
     return True
+
+
+def _roles(names: list) -> tuple[list | None, str | None]:
+    """The role (t, x, y, p) of each of ``names`` (None when one names no role) and the time's unit (or None)."""
+    roles, unit = [], None
+    for n in names:
+        m = _NAME.match(n)
+        role = next((r for r, known in ROLE_NAMES.items() if m and m.group("name") in known), None)
+        if role is None or (m.group("unit") and role != "t"):
+            return None, None
+        roles.append(role)
+        unit = UNITS[m.group("unit")] if role == "t" and m.group("unit") else unit
+    return roles, unit
 
 
 def _names(path: Path, line: bytes) -> tuple[list, str | None]:
@@ -95,15 +126,12 @@ def _names(path: Path, line: bytes) -> tuple[list, str | None]:
     names = [n.strip().strip("'\"").lower() for n in re.split(separator, text.strip())]
     while names and not names[-1]:   # a trailing separator (as on every row of some exports)
         names.pop()
-    roles, unit = [], None
-    for n in names:
-        m = _NAME.match(n)
-        role = next((r for r, known in ROLE_NAMES.items() if m and m.group("name") in known), None)
-        if role is None or (m.group("unit") and role != "t"):
-            roles = None
-            break
-        roles.append(role)
-        unit = UNITS[m.group("unit")] if role == "t" and m.group("unit") else unit
+    roles, unit = _roles(names)
+    if roles is None and len(names) == 5 and names[0] in ("", "unnamed: 0", "index") and \
+            sorted(_roles(names[1:])[0] or ()) == ["p", "t", "x", "y"]:
+        raise EventDataError(f"{path}: the first line names the columns {names}: the first, {names[0]!r}, is an "
+                             "index column, as pandas writes by default, not a value of an event; write the file "
+                             "again with df.to_csv(path, index=False), or drop that column")
     if roles is None or sorted(roles) != ["p", "t", "x", "y"]:
         raise EventDataError(f"{path}: the first line names the columns {names}, but an event file needs exactly "
                              "four: the time (t, ts, time or timestamp, optionally with a unit: t_us, time [ms]), "
@@ -119,7 +147,7 @@ def _guess_order(path: Path, data: bytes, start: int) -> tuple:
         if not values:
             continue
         try:
-            rows.append([float(v) for v in values])
+            rows.append([_value(v) for v in values])
         except ValueError:
             break
         if len(values) != 4:
@@ -147,6 +175,8 @@ def csv_layout(path, data: bytes, time_unit: str = "auto") -> tuple[bytes | byte
     to read with), from the raw bytes ``data`` of the .csv file ``path``."""
     path = Path(path)
     spans, geometry, roles, unit = _header(path, data)
+    if _decimal_comma(data, spans[-1][1] + 1 if spans else 0):   # `0,0125;12;7;1`: the comma is the decimal mark
+        data = bytes(data).replace(b",", b".")                     # same length: byte offsets and line numbers kept
     if roles is not None:
         if unit is not None and time_unit not in ("auto", unit):
             raise EventDataError(f"{path}: the header names the time in {unit!r}, but time_unit={time_unit!r} was "

@@ -14,8 +14,8 @@ from ...core.events import TIME_UNITS, EventDataError, Events, check_time_span, 
 from ...core.frames import Frames, in_window, to_grey_uint8
 from ...core.recording import Recording
 from ..notes import note
-from .base import (Clock, FileFormat, build_events, check_finite_images, check_time_spread, frames_on_event_clock,
-                   note_decimal_seconds, plain_attr, size_value)
+from .base import (Clock, FileFormat, build_events, check_declared_size, check_finite_images, check_time_spread,
+                   frames_on_event_clock, note_decimal_seconds, plain_attr, size_value)
 from .h5window import HDF5_MAGIC, H5Source, TimeIndexed, check_filters, column_count, read_window
 
 __all__ = ["read_h5", "HqfSource", "FORMAT"]
@@ -26,7 +26,7 @@ EVENT_NAMES = ("events/xs", "events/ys", "events/ts", "events/ps")
 class _Layout(TimeIndexed):
     """The checked layout of an open HQF file: sensor size, event count, clock, time unit."""
 
-    def __init__(self, f, path, time_unit):
+    def __init__(self, f, path, time_unit, sensor_size=None):
         import h5py
 
         self.f, self.path = f, path
@@ -44,10 +44,16 @@ class _Layout(TimeIndexed):
         if missing:
             raise EventDataError(f"{path}: missing datasets {missing} (or groups where datasets belong); expected "
                                  f"the HQF layout {list(EVENT_NAMES)}, each a 1-D dataset")
-        if "sensor_resolution" not in f.attrs:
-            raise EventDataError(f"{path}: no root attribute 'sensor_resolution' (H, W); add it, e.g. "
+        if "sensor_resolution" in f.attrs:
+            self.sensor_size = check_declared_size(
+                path, size_value(path, f.attrs["sensor_resolution"], "the attribute sensor_resolution"), sensor_size,
+                "attribute sensor_resolution")
+        elif sensor_size is not None:   # a writer that left the attribute out: the size given stands in for it
+            self.sensor_size = size_value(path, sensor_size, "sensor_size")
+        else:
+            raise EventDataError(f"{path}: no root attribute 'sensor_resolution' (H, W), so the sensor size is "
+                                 "unknown; pass it (sensor_size=(H, W)), or add the attribute, e.g. "
                                  "h5py.File(path, 'r+').attrs['sensor_resolution'] = (H, W)")
-        self.sensor_size = size_value(path, f.attrs["sensor_resolution"], "the attribute sensor_resolution")
         ts = self.t = f["events/ts"]
         self.time_unit = time_unit
         n = self.n = column_count(f, path, ("events/ts", "events/xs", "events/ys", "events/ps"), "iufb", "numeric")
@@ -143,7 +149,7 @@ class _Layout(TimeIndexed):
         return frames
 
 
-def read_h5(path, *, t_start=None, t_end=None, time_unit="auto") -> Recording:
+def read_h5(path, *, t_start=None, t_end=None, time_unit="auto", sensor_size=None) -> Recording:
     """An HQF-style h5 file, optionally only the time window [t_start, t_end).
 
     Args:
@@ -152,17 +158,18 @@ def read_h5(path, *, t_start=None, t_end=None, time_unit="auto") -> Recording:
             are restricted to the same window. Frames come sorted by timestamp.
         time_unit: unit of events/ts and the frames' timestamps; 'auto': an integer dataset is
             microseconds (with a TimeUnitWarning), floats seconds.
+        sensor_size: (H, W), for a file without the attribute 'sensor_resolution' (checked against it otherwise).
     Raises:
         EventDataError for a missing, damaged or incomplete file, missing datasets or attributes.
     """
-    return read_window(path, lambda f, p: _Layout(f, p, time_unit), t_start, t_end)
+    return read_window(path, lambda f, p: _Layout(f, p, time_unit, sensor_size), t_start, t_end)
 
 
 class HqfSource(H5Source):
     """Windows of an HQF h5 file: each found by bisection on events/ts, only its slice read. Holds the file open."""
 
-    def __init__(self, path, *, time_unit="auto"):
-        super().__init__(path, lambda f, p: _Layout(f, p, time_unit), "h5")
+    def __init__(self, path, *, time_unit="auto", sensor_size=None):
+        super().__init__(path, lambda f, p: _Layout(f, p, time_unit, sensor_size), "h5")
 
 
 def _sniff(path, head) -> bool:
@@ -171,4 +178,4 @@ def _sniff(path, head) -> bool:
 
 FORMAT = FileFormat(
     name="h5", description="an HQF-style .h5/.hdf5 file", reader=read_h5, suffixes=(".h5", ".hdf5"),
-    sniff=_sniff, windowed=True, open_source=HqfSource, options=("time_unit",), priority=20)
+    sniff=_sniff, windowed=True, open_source=HqfSource, takes_sensor_size=True, options=("time_unit",), priority=20)

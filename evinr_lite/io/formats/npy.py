@@ -70,6 +70,18 @@ class _Opened:
         if not isinstance(columns, str) or sorted(columns) != sorted("txyp"):
             raise EventDataError(f"columns must be a permutation of 'txyp' (e.g. 'txyp' or 'xytp'), got {columns!r}")
         a = load_npy(path, mmap=True)
+        if a.dtype.names:   # a structured array (Metavision's EventCD buffers, tonic): one record per event
+            names = list(a.dtype.names)
+            raise EventDataError(
+                f"{path}: a structured array with fields {names} (one record per event), not the [N, 4] array read "
+                "here; save its fields as columns t, x, y, p, e.g. a = np.load(path); np.save('events.npy', "
+                "np.stack([a['t'], a['x'], a['y'], a['p']], axis=1)) with your fields' names (an integer t is "
+                "read as microseconds), and pass that with --sensor HxW")
+        if a.ndim == 2 and a.shape[0] == 4 and a.shape[1] != 4 and a.dtype.kind in "iuf":
+            raise EventDataError(
+                f"{path}: the array has shape {a.shape}: 4 rows of {a.shape[1]} values, the events' columns stored "
+                f"as rows (transposed); save it the other way round, np.save(path, np.load(path).T), so that it is "
+                f"[N, 4] with columns {' '.join(columns)}")
         if a.ndim != 2 or a.shape[1] != 4 or a.dtype.kind not in "iuf":
             raise EventDataError(
                 f"{path}: expected a numeric array of shape [N, 4] with columns {' '.join(columns)} "

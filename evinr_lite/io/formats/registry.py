@@ -26,11 +26,18 @@ _AEDAT_FIX = "AEDAT 3.1 and AEDAT4 are read: convert it with iniVation's DV soft
              "the events to a `t x y p` text file"
 _ROS2_FIX = "pass the bag's folder (the one with metadata.yaml) to `python -m data_fetch convert FOLDER`, which " \
             "writes the canonical .h5 that evinr-lite reads"
+_UNPACK = "decompress it first ({tool} FILE) and pass the file it gives"
 UNSUPPORTED = {   # first bytes of files that are recognised but not read -> (sniff_format's name, the fix)
     b"#!AER-DAT3": ("aedat30", f"an AEDAT 3.0 file (not 3.1); {_AEDAT_FIX}"),
     b"#!AER-DAT2": ("aedat2", f"an AEDAT2 file; {_AEDAT_FIX}"),
     b"#!AER-DAT1": ("aedat2", f"an AEDAT2 file; {_AEDAT_FIX}"),
     b"PK\x03\x04": ("zip", "a zip archive; unzip it first and pass the folder (IJRR / EVREAL) or the file inside"),
+    b"\x1f\x8b": ("gzip", f"a gzip-compressed file; {_UNPACK.format(tool='gunzip -k')}"),
+    b"BZh": ("bzip2", f"a bzip2-compressed file; {_UNPACK.format(tool='bunzip2 -k')}"),
+    b"\xfd7zXZ\x00": ("xz", f"an xz-compressed file; {_UNPACK.format(tool='unxz -k')}"),
+    b"\x28\xb5\x2f\xfd": ("zstd", f"a zstd-compressed file; {_UNPACK.format(tool='unzstd')}"),
+    b"7z\xbc\xaf\x27\x1c": ("7z", "a 7-Zip archive; extract it first (7z x FILE) and pass the folder (IJRR / EVREAL) "
+                                 "or the file inside"),
     b"#ROSBAG V2.0": ("rosbag", "a ROS1 bag, which is not read directly; convert it with `python -m data_fetch convert "
                                 "FILE.bag` (dvs_msgs event arrays and the APS images, or event_camera_msgs packets, to "
                                 "the canonical .h5 that evinr-lite reads)"),
@@ -127,6 +134,8 @@ def detect_format(path) -> str:
                 return fmt.name
     except OSError as err:
         raise EventDataError(f"{path}: cannot be read ({err.strerror}); check its permissions") from None
+    if head.startswith(b"PK\x03\x04"):
+        _refuse_npz(path)
     for magic, (_, problem) in UNSUPPORTED.items():
         if head.startswith(magic):
             raise EventDataError(f"{path}: {problem}")
@@ -138,6 +147,25 @@ def detect_format(path) -> str:
                          f"the known ones); supported formats: {SUPPORTED_FORMATS}")
 
 
+def _refuse_npz(path: Path) -> None:
+    """Refuse numpy's .npz (a zip of .npy arrays) with the fix: unzipped, its arrays are no recording either."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as archive:
+            members = archive.namelist()
+    except (zipfile.BadZipFile, OSError, ValueError):
+        return   # a damaged zip: the zip message applies
+    if not members or not all(m.endswith(".npy") for m in members):
+        return
+    keys = [m[:-4] for m in members]
+    shown = ", ".join(keys[:8]) + (", ..." if len(keys) > 8 else "")
+    raise EventDataError(f"{path}: a numpy .npz archive (arrays {shown}), which is not read; save the events as one "
+                         "[N, 4] .npy array with columns t, x, y, p, e.g. a = np.load(path); np.save('events.npy', "
+                         "np.stack([a['t'], a['x'], a['y'], a['p']], axis=1)) with your arrays' names, and pass "
+                         "that with --sensor HxW")
+
+
 def is_recording_folder(path) -> bool:
     """True when ``path`` is a folder in a recording format (IJRR, EVREAL), not a folder of recordings."""
     path = Path(path)
@@ -146,8 +174,8 @@ def is_recording_folder(path) -> bool:
 
 def sniff_format(path) -> str | None:
     """The format of a file from its first bytes alone: a format's name, 'hdf5' for any HDF5 file,
-    'aedat2' / 'aedat30' / 'zip' / 'rosbag' / 'mcap' / 'sqlite' for files recognised but not read, or None (not
-    recognised: maybe text)."""
+    'aedat2' / 'aedat30' / 'zip' / 'gzip' (and the other compressors) / 'rosbag' / 'mcap' / 'sqlite' for files
+    recognised but not read, or None (not recognised: maybe text)."""
     path = Path(path)
     with open(path, "rb") as f:
         head = f.read(HEAD_BYTES)
