@@ -77,10 +77,19 @@ def _cost_reversed(cost, quality):
     return pareto_front(-np.asarray(cost, float), quality)
 
 
+def _dominated_any_over_rows(cost, quality):
+    c = np.asarray(cost, dtype=np.float64)[:, None]
+    q = np.asarray(quality, dtype=np.float64)[:, None]
+    dominated = (c.T <= c) & (q.T >= q) & ((c.T < c) | (q.T > q))
+    return ~dominated.any(axis=0)
+
+
 exercises.register(
     "pareto_front", pareto_front, _inputs_front,
     hints={"two variants tied in both cost and quality do not dominate each other: j dominates i only if it "
            "is also strictly better in at least one of the two": _ties_dominate,
            "a variant that is as cheap and strictly better in quality (or as good and strictly cheaper) "
            "dominates too: 'strictly better in both' is too strict": _strict_in_both,
-           "lower cost is better: j dominates i when cost[j] <= cost[i]": _cost_reversed})
+           "lower cost is better: j dominates i when cost[j] <= cost[i]": _cost_reversed,
+           "dominated[i, j] says j dominates i: variant i is on the front when no j does, any over axis 1 "
+           "(axis 0 asks whether i dominates some other variant)": _dominated_any_over_rows})

@@ -176,6 +176,24 @@ def _first_edge_at_zero(t_events, boundaries):
     return _median_cuts(t_events, boundaries, lambda t, i, lo, hi: ((t > lo) | ((i == 0) & (t == 0))) & (t <= hi))
 
 
+def _bisect_np_median(t_events, boundaries):
+    """np.median of the bin's events: for an odd count, that is the middle event itself."""
+    t = np.asarray(t_events, dtype=np.float64)
+    b = np.asarray(boundaries, dtype=np.float64)
+    out = [b[0]]
+    for i, (lo, hi) in enumerate(zip(b[:-1], b[1:])):
+        in_bin = t[((t > lo) | ((i == 0) & (t == lo))) & (t <= hi)]
+        cut = 0.5 * (lo + hi)
+        if len(in_bin) >= 2 and lo < np.median(in_bin) < hi:
+            cut = np.median(in_bin)
+        out += [cut, hi]
+    return np.array(out)
+
+
+def _bisect_cuts_only(t_events, boundaries):
+    return bisect_equal_count(t_events, boundaries)[1::2]
+
+
 exercises.register(
     "bisect_equal_count", bisect_equal_count, _inputs_bisect,
     hints={
@@ -191,6 +209,11 @@ exercises.register(
         "not `t == 0`": _first_edge_at_zero,
         "a cut on the bin's first edge leaves its first half empty (a burst of events at b_0): when the "
         "middle events sit on an edge, cut at the time mid-point (test lo < median < hi)": _cut_on_first_edge,
+        "np.median of an odd number of events is the middle event itself; cut half-way between events n//2 - "
+        "1 and n//2 (0-based) whatever n":
+            _bisect_np_median,
+        "return the old edges too, the cuts between them: [b_0, cut_0, b_1, cut_1, ..., b_B] (2B + 1 values)":
+            _bisect_cuts_only,
     })
 
 
@@ -360,6 +383,20 @@ def _no_leading_zero(prev, nxt):
     return chain_offsets(prev, nxt)[1:]
 
 
+def _chain_mean_over_overlaps(prev, nxt):
+    prev = np.asarray(prev, dtype=np.float64)
+    nxt = np.asarray(nxt, dtype=np.float64)
+    steps = (prev - nxt).mean(axis=0)
+    return np.concatenate([np.zeros((1,) + prev.shape[2:]), np.cumsum(steps, axis=0)])
+
+
+def _chain_cumsum_flat(prev, nxt):
+    prev = np.asarray(prev, dtype=np.float64)
+    nxt = np.asarray(nxt, dtype=np.float64)
+    steps = (prev - nxt).mean(axis=1)
+    return np.concatenate([np.zeros((1,) + prev.shape[2:]), np.cumsum(steps).reshape(steps.shape)])
+
+
 exercises.register(
     "chain_offsets", chain_offsets, _inputs_chain, atol=1e-9,
     hints={
@@ -367,6 +404,10 @@ exercises.register(
         "not each overlap's difference on its own": _not_chained,
         "the offset moves network k onto network k-1: mean(F_{k-1} - F_k), not F_k - F_{k-1}": _next_minus_prev,
         "network 0 keeps offset 0: return K + 1 offsets, the first one zero": _no_leading_zero,
+        "average over the S samples, axis 1 of [K, S, H, W], not over the K overlaps (axis 0)":
+            _chain_mean_over_overlaps,
+        "np.cumsum without axis= runs over the flattened array (across pixels): use np.cumsum(steps, axis=0)":
+            _chain_cumsum_flat,
     })
 
 

@@ -49,6 +49,11 @@ def _split_size_unpacked_wh(index, sensor_size):
     return index // (H * W), (index // W) % H, index % W
 
 
+def _split_x_first(index, sensor_size):
+    b, y, x = split_index(index, sensor_size)
+    return x, y, b
+
+
 exercises.register(
     "split_index", split_index, _inputs_split,
     hints={
@@ -58,7 +63,17 @@ exercises.register(
             _split_by_height,
         "sensor_size is (H, W), height first: unpack it as `H, W = sensor_size`":
             _split_size_unpacked_wh,
+        "return (b, y, x), in that order: the bin first, the column last":
+            _split_x_first,
     })
+
+def _tikhonov_magnitude(dF_dx, dF_dy):
+    return torch.mean(torch.sqrt(dF_dx ** 2 + dF_dy ** 2))
+
+
+def _tikhonov_stacked_mean(dF_dx, dF_dy):
+    return torch.mean(torch.stack([dF_dx, dF_dy]) ** 2)
+
 
 exercises.register(
     "tikhonov_autograd", tikhonov_autograd, _inputs_tikhonov, rtol=1e-5, atol=1e-7,
@@ -71,4 +86,9 @@ exercises.register(
             lambda dF_dx, dF_dy: torch.mean(dF_dx ** 2),
         "square each gradient, not their sum: (dF/dx)^2 + (dF/dy)^2":
             lambda dF_dx, dF_dy: torch.mean((dF_dx + dF_dy) ** 2),
+        "Eq. 9 is the squared gradient, dF/dx^2 + dF/dy^2, without a square root (that is the gradient's "
+        "magnitude)":
+            _tikhonov_magnitude,
+        "the mean over the stacked [2, M] tensor divides by 2M: average dF/dx^2 + dF/dy^2 over the M pixels":
+            _tikhonov_stacked_mean,
     })

@@ -78,6 +78,16 @@ def _state_transposed(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return highpass_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start).T
 
 
+def _final_decay_from_last_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """Every pixel decayed to t_end from the stream's last event, not from its own."""
+    state = _no_final_decay(t, x, y, p, sensor_size, C, alpha, t_end, t_start)
+    return state * np.exp(-alpha * (t_end - (t[-1] if len(t) else t_start)))
+
+
+def _alpha_times_two_pi(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    return highpass_per_event(t, x, y, p, sensor_size, C, 2 * math.pi * alpha, t_end, t_start)
+
+
 exercises.register(
     "highpass_per_event", highpass_per_event, _inputs_highpass, rtol=1e-6, atol=1e-10,
     hints={
@@ -89,6 +99,11 @@ exercises.register(
         "decay the old state first, then add C * p (the new event has not decayed yet)": _decay_after_adding,
         "after each event, set that pixel's t_last to the event's time: the next decay runs from the pixel's "
         "previous event, not from t_start": _last_time_not_updated,
+        "decay each pixel to t_end from its own last event, exp(-alpha (t_end - t_last[y, x])), not from the "
+        "stream's last event t[-1]":
+            _final_decay_from_last_event,
+        "alpha is already in rad/s: decay by exp(-alpha dt), without another factor 2 pi":
+            _alpha_times_two_pi,
     })
 
 

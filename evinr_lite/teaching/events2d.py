@@ -100,6 +100,25 @@ def _esim_from_sample(L_a, L_b, t_a, t_b, ref, C):
     return esim_interval(L_a, L_b, t_a, t_b, L_a, C)
 
 
+def _esim_off_polarity_zero(L_a, L_b, t_a, t_b, ref, C):
+    times, p, new_ref = esim_interval(L_a, L_b, t_a, t_b, ref, C)
+    return times, np.maximum(p, 0).astype(np.int8), new_ref
+
+
+def _esim_levels_sorted(L_a, L_b, t_a, t_b, ref, C):
+    times, p, new_ref = esim_interval(L_a, L_b, t_a, t_b, ref, C)
+    return times[::-1] if len(p) and p[0] < 0 else times, p, new_ref
+
+
+def _esim_line_from_ref(L_a, L_b, t_a, t_b, ref, C):
+    d = L_b - ref
+    p = 1 if d > 0 else -1
+    n = int(np.floor(abs(d) / C))
+    levels = ref + p * C * np.arange(1, n + 1)
+    times = t_a + (levels - ref) / (L_b - ref) * (t_b - t_a) if n else np.zeros(0)
+    return times.astype(np.float64), np.full(n, p, dtype=np.int8), float(ref + p * n * C)
+
+
 exercises.register(
     "esim_interval", esim_interval, _inputs_esim,
     hints={
@@ -113,6 +132,14 @@ exercises.register(
         "a level that L reaches exactly fires too: the number of levels crossed is floor(|L_b - ref| / C), "
         "so L_b == ref + 2C gives 2 events":
             _esim_strict,
+        "an OFF event has polarity -1, not 0: polarities are +1 (ON) and -1 (OFF)":
+            _esim_off_polarity_zero,
+        "return the events in time order: on the way down the levels are ref - C, ref - 2C, ... (sorting them "
+        "ascending reverses the OFF events)":
+            _esim_levels_sorted,
+        "the straight line runs from (t_a, L_a) to (t_b, L_b): t = t_a + (level - L_a) / (L_b - L_a) (t_b - "
+        "t_a), measured from L_a, not from ref":
+            _esim_line_from_ref,
     })
 
 
@@ -223,6 +250,14 @@ def _frames_no_first_edge(events, boundaries, C):
     return events_to_frames_fixed(events.take(events.t != b[0]), b, C)
 
 
+def _frames_histogramdd(events, boundaries, C):
+    """np.histogramdd: bins [b_i, b_{i+1}), only the last closed."""
+    H, W = events.sensor_size
+    counts, _ = np.histogramdd((events.t, events.y, events.x), weights=events.p,
+                               bins=(np.asarray(boundaries, np.float64), np.arange(H + 1), np.arange(W + 1)))
+    return (C * counts).astype(np.float32)
+
+
 exercises.register(
     "events_to_frames_fixed", events_to_frames_fixed, _inputs_frames,
     hints={
@@ -246,6 +281,9 @@ exercises.register(
         "events before b_0 or after b_B belong to no bin: drop them (keep 0 <= bin < B), do not clip them "
         "into the first or last bin":
             _frames_clipped,
+        "np.histogramdd's (and np.histogram's) bins are [b_i, b_{i+1}), only the last closed: an event "
+        "exactly on an inner edge belongs to the bin that ends there, (b_i, b_{i+1}]":
+            _frames_histogramdd,
     })
 
 

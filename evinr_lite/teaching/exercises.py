@@ -223,8 +223,13 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
                 return p
         return None
     if isinstance(expected, dict):
-        if not isinstance(got, dict) or set(got) != set(expected):
+        if not isinstance(got, dict):
             return _Problem(f"returned {type(got).__name__}{at}, expected a dict with keys {sorted(expected)}")
+        if set(got) != set(expected):
+            missing = sorted(set(expected) - set(got), key=str)
+            extra = sorted(set(got) - set(expected), key=str)
+            return _Problem(f"returned a dict{at} with the wrong keys: missing {missing}, not expected {extra}; "
+                            "use the input's keys unchanged (the same spelling and case)")
         for k in expected:
             p = _compare(got[k], expected[k], rtol, atol, f"{where}[{k!r}]")
             if p is not None:
@@ -255,12 +260,19 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
         if g.dtype == object or g.dtype.kind not in "biufc":
             return _Problem(f"returned {type(got).__name__} of dtype {g.dtype}{at}, expected numbers")
         if g.shape != e.shape:
-            return _Problem(f"wrong shape{at}: got {g.shape}, expected {e.shape}")
+            return _Problem(f"wrong shape{at}: got {g.shape}, expected {e.shape}" + _shape_note(g, e))
         if _kind(g) != _kind(e):
-            return _Problem(f"wrong dtype{at}: got {_kind(g)} ({g.dtype}), expected {_kind(e)} ({e.dtype})")
+            return _Problem(f"wrong dtype{at}: got {_kind(g)} ({g.dtype}), expected {_kind(e)} ({e.dtype})"
+                            + _dtype_note(g, e))
         close = np.isclose(g, e, rtol=rtol, atol=atol, equal_nan=True)
         if np.all(close):
             return None
+        if g.dtype.kind == "u" and np.any(e < 0):
+            return _Problem(f"wrong values{at}: an unsigned dtype ({g.dtype}) cannot hold the negative values "
+                            "expected (-1 wraps round to the largest value): use a signed integer dtype (np.int64)")
+        if g.dtype == np.float16 and e.dtype != np.float16:
+            return _Problem(f"wrong values{at}: the result is float16 (half precision, about 3 significant "
+                            "digits), too coarse for these values: compute and return float64 (or float32)")
         bad = np.flatnonzero(~close.ravel())
         diff = np.abs(g.astype(np.float64) - e.astype(np.float64)).ravel()
         diff = np.where(np.isnan(diff), np.inf, diff)
@@ -276,6 +288,31 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
     if got != expected:
         return _Problem(f"got {got!r}{at}, expected {expected!r}", values=True)
     return None
+
+
+def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
+    """A word on a wrong shape that names a common cause: a transposed result, indices for a mask, an array
+    holding one number where a number is expected."""
+    if e.ndim >= 2 and g.ndim == e.ndim and g.shape[:-2] == e.shape[:-2] and g.shape[-2:] == e.shape[-2:][::-1]:
+        return ("; the last two axes are swapped: a transposed result, or (H, W) read as (W, H) (sensor_size and "
+                "images are rows first: `H, W = sensor_size`, `np.zeros((H, W))`, `a[y, x]`)")
+    if e.dtype == bool and g.dtype.kind in "iu" and g.size <= e.size:
+        return ("; that looks like the indices of the True entries (np.flatnonzero, np.where, np.argwhere): "
+                "return the boolean mask itself, one entry per element")
+    if e.ndim == 0 and g.size == 1:
+        return ("; that is an array holding one number where the number itself is expected: take it out "
+                "(`x[0]`, `x.squeeze()`, or `float(x)` for a numpy result), e.g. np.linalg.lstsq returns an array")
+    return ""
+
+
+def _dtype_note(g: np.ndarray, e: np.ndarray) -> str:
+    """A word on a wrong dtype that names a common cause."""
+    if e.dtype == bool and g.dtype.kind in "iuf":
+        return ": return the comparison itself (a boolean mask), without .astype(int) or multiplying by 1"
+    if e.dtype.kind in "iu" and g.dtype.kind == "f":
+        return (": `/` (and np.trunc, np.floor, np.round) give floats: use integer division `//` "
+                "(torch.div(..., rounding_mode='floor')), or convert with .astype(np.int64) after rounding")
+    return ""
 
 
 def _generic_hint(got, expected, indexed: bool = False) -> str | None:
@@ -302,7 +339,8 @@ def _generic_hint(got, expected, indexed: bool = False) -> str | None:
     # one number (or one non-zero entry) is always some factor of another: say so only when several agree
     if nz.sum() >= 2 and np.all(np.abs(g[~nz]) <= tol):
         ratios = g[nz] / e[nz]
-        if np.ptp(ratios) <= 1e-6 * max(1.0, abs(ratios[0])) and abs(ratios[0] - 1) > 1e-6:
+        if np.ptp(ratios) <= 1e-6 * max(1.0, abs(ratios[0])) and abs(ratios[0] - 1) > 1e-6 \
+                and abs(ratios[0]) > 1e-12:         # a factor 0 is a result of zeros, not a scaling
             return f"off by a constant factor: got {ratios[0]:.4g} x the expected values"
     if g.size > 1:
         d = g - e

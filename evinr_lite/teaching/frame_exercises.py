@@ -74,6 +74,10 @@ def _inputs_sine(rng):
         cases.append(dict(h=torch.rand(T, d_in, generator=g) * 2 - 1, dh_dt=torch.randn(T, d_in, generator=g),
                           weight=(torch.rand(d_in, d_out, generator=g) * 2 - 1) / d_in,
                           bias=torch.rand(d_out, generator=g) - 0.5, omega=omega))
+    # the layer is trained through its derivative (Eq. 5 uses dF/dt): both outputs must stay differentiable
+    # with respect to the weights, so a detached or rebuilt derivative fails
+    cases[-1]["weight"].requires_grad_(True)
+    cases[-1]["bias"].requires_grad_(True)
     return cases
 
 
@@ -85,6 +89,11 @@ def _inputs_boundary(rng):
         E = torch.randint(-3, 4, (B, H, W), generator=g).float() * 0.2
         cases.append(dict(F_boundaries=F, event_frames=E))
     return cases
+
+
+def _sine_derivative_of_h(h, dh_dt, weight, bias, omega):
+    z = omega * (h @ weight + bias)
+    return torch.sin(z), torch.cos(z) * (omega * (h @ weight))
 
 
 exercises.register(
@@ -101,7 +110,17 @@ exercises.register(
         "omega multiplies the bias too: z = omega * (h @ W + b)":
             lambda h, dh_dt, weight, bias, omega: (torch.sin(omega * (h @ weight) + bias),
                                                    torch.cos(omega * (h @ weight) + bias) * omega * (dh_dt @ weight)),
+        "the chain rule: dz/dt = omega * (dh/dt @ W) uses dh_dt, not h":
+            _sine_derivative_of_h,
     })
+
+def _boundary_loss_sum_of_bin_means(F_boundaries, event_frames):
+    return torch.mean((event_frames - (F_boundaries[1:] - F_boundaries[:-1])) ** 2, dim=(-2, -1)).sum()
+
+
+def _boundary_loss_last_bin_dropped(F_boundaries, event_frames):
+    return torch.mean((event_frames[:-1] - (F_boundaries[1:-1] - F_boundaries[:-2])) ** 2)
+
 
 exercises.register(
     "temporal_loss_boundary", temporal_loss_boundary, _inputs_boundary,
@@ -115,6 +134,11 @@ exercises.register(
         "bin i's change is F(b_{i+1}) - F(b_i), from its own start (F_boundaries[1:] - F_boundaries[:-1]), "
         "not from the first boundary F(b_0)":
             lambda F_boundaries, event_frames: torch.mean((event_frames - (F_boundaries[1:] - F_boundaries[:1])) ** 2),
+        "one mean over bins and pixels together (torch.mean of all the squares), not a sum of per-bin means":
+            _boundary_loss_sum_of_bin_means,
+        "use all B bins: F_boundaries[1:] - F_boundaries[:-1] has B changes, one per event frame (the last "
+        "bin is left out)":
+            _boundary_loss_last_bin_dropped,
     })
 
 
@@ -172,6 +196,15 @@ def _tv_pooled(F):
     return torch.cat([dx.abs().flatten(), dy.abs().flatten()]).mean()
 
 
+def _tonemap_power_of_denominator(L, gamma):
+    I = np.exp(np.asarray(L, dtype=np.float64))
+    return I / (I + 1.0) ** gamma
+
+
+def _tonemap_exp_minus(L, gamma):
+    return reinhard_tonemap(-np.asarray(L, dtype=np.float64), gamma)
+
+
 exercises.register(
     "reinhard_tonemap", reinhard_tonemap, _inputs_tonemap,
     hints={
@@ -181,7 +214,22 @@ exercises.register(
             _tonemap_without_exp,
         "do not forget the exponent gamma":
             lambda L, gamma: reinhard_tonemap(L, 1.0),
+        "brackets: (I / (I + 1)) ** gamma; I / (I + 1) ** gamma raises only the denominator":
+            _tonemap_power_of_denominator,
+        "I = exp(L), not exp(-L): a brighter pixel (larger L) must display brighter":
+            _tonemap_exp_minus,
     })
+
+def _tv_first_axes(F):
+    """F[:, 1:] and F[1:]: the first two axes, right only for a single image [H, W]."""
+    return (F[:, 1:] - F[:, :-1]).abs().mean() + (F[1:] - F[:-1]).abs().mean()
+
+
+def _tv_isotropic(F):
+    dx = F[..., :-1, 1:] - F[..., :-1, :-1]
+    dy = F[..., 1:, :-1] - F[..., :-1, :-1]
+    return torch.sqrt(dx ** 2 + dy ** 2).mean()
+
 
 exercises.register(
     "total_variation", total_variation, _inputs_tv, rtol=1e-5, atol=1e-7,
@@ -194,6 +242,11 @@ exercises.register(
             lambda F: (F[..., :, 1:] - F[..., :, :-1]).abs().mean(),
         "average each direction over its own differences and add the two means":
             _tv_pooled,
+        "F may have leading dimensions ([T, H, W]): index the last two axes, F[..., :, 1:] and F[..., 1:, :] "
+        "(F[:, 1:] differences along axis 1, which is H there)":
+            _tv_first_axes,
+        "the anisotropic total variation averages |dF/dx| and |dF/dy| separately, not sqrt(dF/dx^2 + dF/dy^2)":
+            _tv_isotropic,
     })
 
 
@@ -236,6 +289,19 @@ def _logit(s):
     return np.log(s / (1.0 - s))
 
 
+def _anchor_mean_along_axis(L, gamma, display_mean):
+    """The mean along the first axis (one per column) where the mean of all of L is one number."""
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    return L + (np.log(s / (1.0 - s)) - L.mean(axis=0))
+
+
+def _anchor_median(L, gamma, display_mean):
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    return L + (np.log(s / (1.0 - s)) - np.median(L))
+
+
 exercises.register(
     "anchor", anchor, _inputs_anchor, rtol=1e-6, atol=1e-9,
     hints={
@@ -247,6 +313,11 @@ exercises.register(
             _anchor_level_wrong(lambda gamma, m: np.log(m ** (1.0 / gamma))),
         "shift so that the *mean* lands on the level: add (level - mean(L)), not the level alone":
             lambda L, gamma, display_mean: np.asarray(L, dtype=np.float64) + _logit(display_mean ** (1.0 / gamma)),
+        "the mean is over all of L, one number (L.mean()): a mean along an axis (L.mean(axis=0)) shifts every "
+        "column by its own amount":
+            _anchor_mean_along_axis,
+        "shift so that the *mean* of L lands on the level (L.mean()), not the median":
+            _anchor_median,
     })
 
 

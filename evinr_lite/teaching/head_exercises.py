@@ -97,6 +97,12 @@ def _gradient_step(A, E, ridge):
     return A.T @ E
 
 
+def _head_ridge_everywhere(A, E, ridge):
+    """`A.T @ A + ridge`: ridge added to every entry, not to the diagonal."""
+    A = np.asarray(A, dtype=np.float64)
+    return np.linalg.solve(A.T @ A + ridge, A.T @ np.asarray(E, dtype=np.float64))
+
+
 exercises.register(
     "head_closed_form", head_closed_form, _inputs, rtol=1e-6, atol=1e-9,
     hints={
@@ -108,4 +114,6 @@ exercises.register(
             _drops_empty_bins,
         "A^T E is only the right-hand side: solve (A^T A + ridge I) W = A^T E (np.linalg.solve)":
             _gradient_step,
+        "`A.T @ A + ridge` adds ridge to every entry: add ridge * np.eye(d), to the diagonal only":
+            _head_ridge_everywhere,
     })

@@ -217,6 +217,13 @@ def _inputs_loss(rng):
     return cases
 
 
+def _integrate_no_leading_zero(t_events, p_events, C, t_query):
+    """csum[n - 1] without a leading 0: a query before the first event reads csum[-1], the total."""
+    csum = np.cumsum(np.asarray(p_events, dtype=np.float64))
+    n = np.searchsorted(np.asarray(t_events, np.float64), np.asarray(t_query, np.float64), side="right")
+    return C * csum[n - 1]
+
+
 exercises.register(
     "integrate_events_1d", integrate_events_1d, _inputs_integrate,
     hints={
@@ -227,7 +234,15 @@ exercises.register(
         "an event exactly at a query time counts (t_i <= t_q): use side=\"right\" in np.searchsorted, "
         "or `<=` rather than `<`":
             _integrate_strict,
+        "a query before the first event counts no event, but csum[n - 1] with n = 0 reads csum[-1], the "
+        "total: prepend a 0 (np.concatenate([[0.0], np.cumsum(p)])) and read csum[n]":
+            _integrate_no_leading_zero,
     })
+
+def _rate_first_window_length(t_events, p_events, C, boundaries):
+    b = np.asarray(boundaries, dtype=np.float64)
+    return window_sums(t_events, p_events, C, b) / (b[1] - b[0])
+
 
 exercises.register(
     "event_rate_derivative", event_rate_derivative, _inputs_rate,
@@ -260,7 +275,22 @@ exercises.register(
         "events before b_0 belong to no window: drop them (t >= b_0) before np.maximum(index, 0), which "
         "would put them in the first window":
             _rate_early_in_first,
+        "divide each window's sum by its own length, np.diff(boundaries), not the first window's length (b[1] "
+        "- b[0]): the windows differ in length":
+            _rate_first_window_length,
     })
+
+def _loss_rates(dF_dt, delta_L, durations):
+    return torch.mean((delta_L / durations - dF_dt) ** 2)
+
+
+def _loss_root(dF_dt, delta_L, durations):
+    return torch.sqrt(torch.mean((delta_L - dF_dt * durations) ** 2))
+
+
+def _loss_durations_on_events(dF_dt, delta_L, durations):
+    return torch.mean((delta_L * durations - dF_dt) ** 2)
+
 
 exercises.register(
     "temporal_loss", temporal_loss, _inputs_loss,
@@ -273,6 +303,13 @@ exercises.register(
             lambda dF_dt, delta_L, durations: torch.mean((delta_L - dF_dt) ** 2),
         "Eq. 6 squares the difference; an absolute value gives a different loss":
             lambda dF_dt, delta_L, durations: torch.mean(torch.abs(delta_L - dF_dt * durations)),
+        "Eq. 5 compares changes: multiply dF/dt by the window length (delta_L - dF_dt * durations); dividing "
+        "delta_L by it compares rates and weighs the windows differently":
+            _loss_rates,
+        "Eq. 6 is the mean of the squares, without a square root (that is the RMS error)":
+            _loss_root,
+        "multiply dF/dt by the window length, not delta_L: delta_L is already a change over the window":
+            _loss_durations_on_events,
     })
 
 

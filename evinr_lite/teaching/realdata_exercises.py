@@ -84,6 +84,14 @@ def _rate_bins_from_zero(t, bin_s):
     return (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
 
 
+def _rate_bins_rounded_down(t, bin_s):
+    """B = int((t[-1] - t0) / bin_s): the events of the last, partial bin are clipped into the one before."""
+    t = np.asarray(t, dtype=np.float64)
+    n_bins = max(int((t[-1] - t[0]) / bin_s), 1)
+    k = np.clip(np.ceil((t - t[0]) / bin_s).astype(np.int64) - 1, 0, n_bins - 1)
+    return t[0] + (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
+
+
 exercises.register(
     "event_rate", event_rate, _inputs_rate,
     hints={"divide the counts by the bin width to get events per second":
@@ -96,7 +104,9 @@ exercises.register(
            _rate_edges_to_later_bin,
            "count the bins from the first event t0 = t[0] (edges t0 + k bin_s), not from time 0: a recording's "
            "clock rarely starts at 0":
-           _rate_bins_from_zero})
+           _rate_bins_from_zero,
+           "B = ceil((t[-1] - t0) / bin_s) bins: int() rounds down and drops the last, partial bin":
+           _rate_bins_rounded_down})
 
 
 def _inputs_threshold(rng):
@@ -115,6 +125,10 @@ def _mean_of_ratios(log_changes, net_counts):
     return float(np.mean(d[keep] / n[keep]))
 
 
+def _threshold_ratio_of_sums(log_changes, net_counts):
+    return float(np.sum(log_changes) / np.sum(net_counts))
+
+
 exercises.register(
     "estimate_contrast_threshold", estimate_contrast_threshold, _inputs_threshold, rtol=1e-6,
     hints={
@@ -131,6 +145,9 @@ exercises.register(
         "intercept (np.polyfit(n, ΔL, 1))":
             lambda log_changes, net_counts: float(np.polyfit(np.asarray(net_counts, float),
                                                              np.asarray(log_changes, float), 1)[0]),
+        "sum(ΔL) / sum(n) lets rising and falling pixels cancel: the least-squares slope is sum(ΔL n) / "
+        "sum(n^2)":
+            _threshold_ratio_of_sums,
     })
 
 
@@ -192,6 +209,22 @@ def _offset_float_divided(first_frame, L_t0, eps: float = FRAME_EPS):
     return np.log(np.asarray(first_frame, np.float64) / 255.0 + eps) - np.asarray(L_t0, np.float64)
 
 
+def _offset_default_eps(first_frame, L_t0, eps=FRAME_EPS):
+    """The module's FRAME_EPS used whatever ``eps`` the caller passes."""
+    return anchor_first_offset(first_frame, L_t0)
+
+
+def _offset_over_256(first_frame, L_t0, eps=FRAME_EPS):
+    a = np.asarray(first_frame)
+    return anchor_first_offset(a / 256.0 if a.dtype == np.uint8 else a, L_t0, eps)
+
+
+def _offset_log10(first_frame, L_t0, eps=FRAME_EPS):
+    a = np.asarray(first_frame)
+    intensity = a / 255.0 if a.dtype == np.uint8 else np.clip(np.asarray(a, np.float64), 0.0, 1.0)
+    return np.log10(intensity + eps) - np.asarray(L_t0, np.float64)
+
+
 exercises.register(
     "anchor_first_offset", anchor_first_offset, _inputs_anchor, rtol=1e-6, atol=1e-9,
     hints={
@@ -204,4 +237,10 @@ exercises.register(
             _offset_mean_only,
         "divide by 255 only a uint8 frame (first_frame.dtype == np.uint8): a float frame is already in [0, 1]":
             _offset_float_divided,
+        "use the `eps` argument the caller passes, not the FRAME_EPS default":
+            _offset_default_eps,
+        "a uint8 frame's largest value is 255: divide by 255, not 256":
+            _offset_over_256,
+        "log intensities are natural logs (np.log), not base 10 (np.log10)":
+            _offset_log10,
     })

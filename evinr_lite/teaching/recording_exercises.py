@@ -162,7 +162,8 @@ def event_count_windows(n_events: int, max_events: int) -> np.ndarray:
 
 
 def _inputs_windows(rng):
-    return [dict(n_events=10, max_events=3), dict(n_events=12, max_events=4), dict(n_events=7, max_events=100),
+    # 122 events in 14 windows: k * N / w computed in floating point truncates 61 to 60 (np.linspace)
+    return [dict(n_events=122, max_events=9), dict(n_events=12, max_events=4), dict(n_events=7, max_events=100),
             dict(n_events=int(rng.integers(5000, 9000)), max_events=1000), dict(n_events=1, max_events=1)]
 
 
@@ -183,6 +184,12 @@ def _compare_windows(got, expected) -> str | None:
     return None
 
 
+def _windows_float_positions(n_events, max_events):
+    """np.linspace: k * N / w in floating point, truncated (60.999... -> 60)."""
+    w = max(1, math.ceil(n_events / max_events))
+    return np.linspace(0, n_events, w + 1).astype(np.int64)
+
+
 exercises.register(
     "event_count_windows", event_count_windows, _inputs_windows, compare=_compare_windows,
     hints={
@@ -192,6 +199,9 @@ exercises.register(
         "the windows should be as equal as possible (idx[k] = floor(k N / w)), not max_events each with a "
         "short remainder":
             lambda n_events, max_events: np.append(np.arange(0, n_events, max_events, dtype=np.int64), n_events),
+        "k * N / w in floating point can land just below a whole number (60.9999... becomes 60): compute "
+        "idx[k] = (k * N) // w in integers":
+            _windows_float_positions,
     })
 
 
@@ -228,9 +238,11 @@ def _inputs_filter(rng):
     y = np.array([1, 1, 5, 5, 1, 9, 10, 3, 3, 0, 0, 12, 13])
     order = np.argsort(t, kind="stable")
     cases.append(dict(t=t[order], x=x[order], y=y[order], dt=0.25))
-    # an event just after the window closes (1/1024 s past dt), one just inside, and a neighbour that comes later
-    t = np.array([0.0, 0.125 + 2 ** -10, 0.5, 0.625, 0.75])
-    cases.append(dict(t=t, x=np.array([4, 5, 0, 1, 2]), y=np.array([4, 4, 0, 1, 2]), dt=0.125))
+    # an event just after the window closes (1/1024 s past dt), one just inside, and a neighbour that comes later;
+    # the first and the last event stored are each kept only by a neighbour with the same timestamp (a loop
+    # that skips the first event, or never looks at the last one as a neighbour, fails)
+    t = np.array([0.0, 0.0, 0.125 + 2 ** -10, 0.5, 0.625, 0.75, 0.875, 0.875])
+    cases.append(dict(t=t, x=np.array([3, 4, 5, 0, 1, 2, 8, 9]), y=np.array([4, 4, 4, 0, 1, 2, 8, 8]), dt=0.125))
     # random small streams with whole-microsecond timestamps (ties happen)
     for n, size, span, dt in ((60, 6, 0.01, 0.002), (120, 10, 0.05, 0.004)):
         t = np.sort(np.round(rng.uniform(0, span, n), 4))
@@ -285,6 +297,33 @@ def _filter_four_neighbours(t, x, y, dt):
     return np.any((manhattan == 1) & (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
 
 
+def _filter_any_over_events(t, x, y, dt):
+    """np.any over axis 0: whether event j supports some event, not whether event i has a supporter."""
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    in_time = (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt)
+    return np.any((cheb == 1) & in_time, axis=0)
+
+
+def _filter_loop_off_by_one(t, x, y, dt, first=0, last=0):
+    n = len(t)
+    keep = np.zeros(n, dtype=bool)
+    for i in range(first, n):
+        for j in range(n - last):
+            if max(abs(x[j] - x[i]), abs(y[j] - y[i])) == 1 and t[j] <= t[i] <= t[j] + dt:
+                keep[i] = True
+    return keep
+
+
+def _filter_last_event_never_a_neighbour(t, x, y, dt):
+    return _filter_loop_off_by_one(t, x, y, dt, last=1)
+
+
+def _filter_first_event_never_kept(t, x, y, dt):
+    return _filter_loop_off_by_one(t, x, y, dt, first=1)
+
+
 exercises.register(
     "background_activity_filter", background_activity_filter, _inputs_filter,
     hints={
@@ -297,6 +336,14 @@ exercises.register(
         "the 8 neighbours include the diagonals: max(|dx|, |dy|) == 1, not |dx| + |dy| == 1": _filter_four_neighbours,
         "only earlier neighbours count (t_j <= t_i): the filter decides when event i arrives, before any later "
         "event exists, so |t_i - t_j| <= dt is too wide": _filter_later_neighbours,
+        "one answer per event i: np.any(..., axis=1) over the candidates j in row i (axis=0 asks whether "
+        "event j supports some other event)":
+            _filter_any_over_events,
+        "every event can be a neighbour, the last one too: loop j over range(len(t)), not range(len(t) - 1)":
+            _filter_last_event_never_a_neighbour,
+        "every event gets an answer, the first one too (a neighbour with the same timestamp keeps it): loop i "
+        "over range(len(t)), not range(1, len(t))":
+            _filter_first_event_never_kept,
     })
 
 
