@@ -1,7 +1,7 @@
 """The command line, the demo and the reconstruct job (they never import viz or teaching)."""
-from .cli import main   # light: the command's guard starts before anything heavy is imported
-
-_HOME = {"run_demo": "demo", "run_reconstruct": "recon_job", "RunOptions": "options", "run_batch": "batch"}
+# every name is imported on first use, the command line's too: importing the package never imports cli, so
+# `python -m evinr_lite.apps.cli` runs it without runpy's warning about a module imported twice
+_HOME = {"main": "cli", "run_demo": "demo", "run_reconstruct": "recon_job", "RunOptions": "options", "run_batch": "batch"}
 
 
 def __getattr__(name):
