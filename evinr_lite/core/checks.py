@@ -14,10 +14,59 @@ import numbers
 import numpy as np
 
 from .events import EventDataError
-from .guard import InputError
+from .guard import InputError, host_array
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
-           "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number"]
+           "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
+           "host_array", "check_seconds_precision", "check_reach", "image_stack"]
+
+
+SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
+
+
+def check_seconds_precision(arr, name: str) -> None:
+    """Refuse times ``arr`` (seconds, as given: before any cast to float64) stored as float16, or as float32
+    where float32's step at their largest magnitude is coarser than the events' microsecond (from 16 s on):
+    the times asked for are then not the times meant, and no cast afterwards brings the digits back."""
+    arr = np.asarray(arr)
+    if arr.dtype.kind != "f" or arr.dtype.itemsize >= 8 or arr.size == 0:
+        return
+    finite = arr[np.isfinite(arr)]
+    top = float(np.max(np.abs(finite))) if finite.size else 0.0
+    step = float(np.spacing(arr.dtype.type(top)))
+    if arr.dtype.itemsize < 4 or step > SECONDS_STEP:
+        raise EventDataError(f"{name}= are {arr.dtype} seconds, which keep about {np.finfo(arr.dtype).precision} "
+                             f"digits: at {top:g} s their step is {step:.3g} s, coarser than the events' microseconds, "
+                             f"so the times used are not the times meant; make them float64 where they are made "
+                             f"(np.linspace and np.arange give float64; torch: dtype=torch.float64)")
+
+
+def check_reach(lo: float, hi: float, events_t, t_origin: float, name: str) -> None:
+    """Refuse a span [lo, hi] (seconds, the events' span widened to the query times, or the one given) longer
+    than :data:`~evinr_lite.core.events.MAX_SPAN_S` when the events' own span is not: times in microseconds,
+    or on the absolute clock, given as seconds on the events' (relative) clock."""
+    from .events import MAX_SPAN_S
+
+    first, last = (float(events_t[0]), float(events_t[-1])) if len(events_t) else (lo, lo)
+    if hi - lo > MAX_SPAN_S and last - first <= MAX_SPAN_S:
+        raise EventDataError(f"{name} reach [{lo:.6g}, {hi:.6g}] s but the events cover [{first:.6g}, {last:.6g}] s "
+                             f"(relative to t_origin = {t_origin:.6g} s): a span of {hi - lo:,.6g} s, which no "
+                             f"recording has; give seconds on the events' clock: divide microseconds by 1e6 (ns by "
+                             f"1e9), and subtract events.t_origin from absolute times")
+
+
+def image_stack(a, name: str) -> np.ndarray:
+    """Grey images [F, H, W] from [F, H, W] or [F, H, W, 1] (a trailing channel of one, as image readers give);
+    colour [F, H, W, 3] and other shapes are refused naming the fix. Values are not checked here."""
+    a = np.asarray(host_array(a))
+    if a.ndim == 4 and a.shape[-1] == 1:
+        return a[..., 0]
+    if a.ndim != 3:
+        fix = ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else
+               "; colour images: make them grey first (e.g. frames.mean(axis=-1), or to_grey_uint8)"
+               if a.ndim == 4 and a.shape[-1] in (3, 4) else "")
+        raise EventDataError(f"{name} must be a stack [F, H, W] (or [F, H, W, 1]), got shape {a.shape}{fix}")
+    return a
 
 # (expected class name, given class name) -> how to turn the one into the other
 TypeFix = {
@@ -61,10 +110,11 @@ def seconds_array(value, name: str, *, allow_empty: bool = False) -> np.ndarray:
 
     Refused: text, objects and booleans (not seconds), arrays of 2 or more dimensions (a column [Q, 1] is not
     taken as Q times: pass ``np.ravel(times)``), NaN or inf, and no times at all (unless ``allow_empty``)."""
-    arr = np.asarray(value) if not isinstance(value, (str, bytes)) else np.asarray([value])
+    arr = np.asarray(host_array(value)) if not isinstance(value, (str, bytes)) else np.asarray([value])
     if arr.dtype.kind not in "iuf" or arr.dtype == bool:
         raise EventDataError(f"{name}= must be seconds (a number, a list or a 1-D array of numbers), got "
                              f"{_short(value)}")
+    check_seconds_precision(arr, name)
     arr = np.atleast_1d(arr.astype(np.float64))
     if arr.size == 0 and not allow_empty:
         raise EventDataError(f"{name}= is empty (shape {arr.shape}); pass a non-empty 1-D array: at least one time in "
@@ -117,15 +167,19 @@ def whole_number(value, name: str, *, lo: int | None = None, hi: int | None = No
 
 
 def is_real_number(value) -> bool:
-    """A real number: an int or a float, numpy's too (not a bool, not text, not an array)."""
-    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    """A real number: an int or a float, numpy's too, or a 0-d numeric array or tensor holding one (what
+    ``t.max()`` gives); not a bool, not text, not an array of several values."""
+    if isinstance(value, numbers.Real):
+        return not isinstance(value, (bool, np.bool_))
+    value = host_array(value)
+    return isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"
 
 
 def real_number(value, name: str, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,
                 hint: str = "") -> float:
     """``value`` as a float when it is a finite number in [lo, hi] (``lo_open``: (lo, hi]); else an InputError."""
     ok = is_real_number(value)
-    v = float(value) if ok else math.nan
+    v = float(host_array(value)) if ok else math.nan
     if not ok or not math.isfinite(v) or (lo is not None and (v <= lo if lo_open else v < lo)) or \
             (hi is not None and v > hi):
         span = _range(lo, hi, lo_open)
@@ -172,7 +226,11 @@ def check_image_values(images, name: str = "images", *, clipped: bool = False) -
                                  f"{scale}")
         return images
     if images.dtype.kind in "iu":
-        raise EventDataError(f"{name} are {images.dtype} integers; pass uint8 (0..255) or float in [0, 1]")
+        top = int(images.max()) if images.size else 0
+        scale = ("; for float divide by their full scale (e.g. frames / 65535.0 for 16-bit images)" if top > 255
+                 else "; if they are 0..255, .astype(np.uint8)")
+        raise EventDataError(f"{name} are {images.dtype} integers (up to {top}); pass uint8 (0..255) or float in "
+                             f"[0, 1]{scale}")
     raise EventDataError(f"{name} must be uint8 (0..255) or float in [0, 1], got dtype {images.dtype}")
 
 

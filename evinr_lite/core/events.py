@@ -21,7 +21,7 @@ import numpy as np
 
 import math
 
-from .guard import InputError   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
+from .guard import InputError, host_array   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
            "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S",
@@ -247,6 +247,10 @@ def check_sensor_size(sensor_size) -> tuple[int, int]:
                              f"{sensor_size!r}") from None
     if H <= 0 or W <= 0:
         raise EventDataError(f"sensor_size must be (H, W) with positive sizes; got {(H, W)}")
+    if H > MAX_SENSOR_SIDE or W > MAX_SENSOR_SIDE:   # a typo or a wrong field: each image would be gigabytes
+        raise EventDataError(f"sensor_size (H, W) = {(H, W)} is larger than any event camera (at most "
+                             f"{MAX_SENSOR_SIDE} pixels per side); check the size: (H, W) = (rows, columns), e.g. "
+                             f"(480, 640)")
     return H, W
 
 
@@ -277,11 +281,11 @@ class Events:
     polarity_encoding: str = field(default="auto", repr=False)
 
     def __post_init__(self):
-        H, W = check_sensor_size(self.sensor_size)
-        t = np.asarray(self.t)
-        x = np.asarray(self.x)
-        y = np.asarray(self.y)
-        arrays = {"t": t, "x": x, "y": y, "p": np.asarray(self.p)}
+        H, W = check_sensor_size(host_array(self.sensor_size))
+        t = np.asarray(host_array(self.t))   # torch tensors too (on any device, requiring grad or not)
+        x = np.asarray(host_array(self.x))
+        y = np.asarray(host_array(self.y))
+        arrays = {"t": t, "x": x, "y": y, "p": np.asarray(host_array(self.p))}
         for name, a in arrays.items():
             if a.ndim != 1:
                 raise EventDataError(f"events.{name} must be a 1-D array, got shape {a.shape}")
@@ -355,6 +359,7 @@ class Events:
         """
         if time_unit not in TIME_UNITS:
             raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
+        t, x, y, p = (host_array(a) for a in (t, x, y, p))
         t = np.asarray(t)
         if time_unit != "s":
             t, shift = relative_seconds(t, time_unit)
@@ -367,7 +372,7 @@ class Events:
     @classmethod
     def from_array(cls, array, sensor_size, *, columns: str = "txyp", **kwargs) -> "Events":
         """Build events from an [N, 4] array whose columns are named by ``columns`` (e.g. 'txyp', 'xytp')."""
-        a = np.asarray(array)
+        a = np.asarray(host_array(array))
         if a.ndim != 2 or a.shape[1] != 4:
             raise EventDataError(
                 f"an event array must have shape [N, 4] with columns {tuple(columns)}; got shape {a.shape}"

@@ -26,8 +26,19 @@ import sys
 import threading
 from contextlib import contextmanager
 
-__all__ = ["InputError", "Interrupted", "TERMINATION_SIGNALS", "termination_signals", "signals_deferred", "run_guarded",
-           "protect_streams", "check_cwd", "EXIT_OK", "EXIT_ERROR", "EXIT_INTERNAL"]
+__all__ = ["InputError", "host_array", "Interrupted", "TERMINATION_SIGNALS", "termination_signals", "signals_deferred",
+           "run_guarded", "protect_streams", "check_cwd", "EXIT_OK", "EXIT_ERROR", "EXIT_INTERNAL"]
+
+
+def host_array(value):
+    """``value`` with a torch tensor (on any device, requiring grad or not) made a numpy array of the same values
+    (``tensor.detach().cpu().numpy()``); anything else as it is. Called where arrays enter the API, so that
+    ``np.asarray`` never meets a tensor that requires grad ("Can't call numpy() on Tensor that requires grad")
+    or sits on a GPU; torch is not imported here."""
+    if type(value).__module__.startswith("torch") and hasattr(value, "detach") and hasattr(value, "cpu"):
+        return value.detach().cpu().numpy()
+    return value
+
 
 EXIT_OK, EXIT_ERROR, EXIT_INTERNAL = 0, 2, 1
 TERMINATION_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name))

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from skimage.metrics import structural_similarity
 
-from ..core.checks import check_image_values
+from ..core.checks import check_image_values, host_array, image_stack
 from ..core.events import EventDataError
 from ..core.frames import to_uint8
 
@@ -56,8 +56,11 @@ def protocol_description(equalization: str = "none") -> str:
 
 def _image(a, name: str) -> np.ndarray:
     """An image as float64: uint8 divided by 255 (as :func:`equalize` reads it), floats as they are; NaN, inf,
-    text and empty images are refused (a metric of them would be NaN or meaningless)."""
-    a = np.asarray(a)
+    text and empty images are refused (a metric of them would be NaN or meaningless). [H, W, 1] (a trailing
+    channel of one, as image readers give) is the grey image [H, W]."""
+    a = np.asarray(host_array(a))
+    if a.ndim == 3 and a.shape[-1] == 1:
+        a = a[..., 0]
     if a.dtype.kind not in "uif" or a.dtype == bool:
         raise EventDataError(f"{name} must be an image of numbers (uint8 0..255 or float in [0, 1]), got dtype {a.dtype}")
     if a.size == 0:
@@ -155,6 +158,7 @@ def score_pairs(pred, gt, equalization: str = "none") -> tuple[np.ndarray, np.nd
         (pred_eq, gt_eq, mse, ssim): the equalised stacks float64 [F, H, W] in [0, 1], and the
         per-frame scores float64 [F].
     """
+    pred, gt = image_stack(pred, "predicted frames"), image_stack(gt, "ground-truth frames")   # [F, H, W(, 1)]
     if len(pred) == 0 or len(pred) != len(gt):
         raise EventDataError(f"need one or more matched frame pairs, got {len(pred)} predictions and {len(gt)} "
                          "ground-truth frames; pass stacks [F, H, W] of the same length F >= 1")
@@ -181,7 +185,7 @@ def score_frames(pred, gt, equalization: str = "none") -> dict:
     Returns:
         {"mse": float, "ssim": float, "n_frames": int, "protocol": str}.
     """
-    pred, gt = np.asarray(pred), np.asarray(gt)
+    pred, gt = image_stack(pred, "predicted frames"), image_stack(gt, "ground-truth frames")   # [F, H, W(, 1)]
     if pred.shape != gt.shape or pred.ndim != 3:
         raise EventDataError(f"expected two [F, H, W] stacks of the same shape, got {pred.shape} and {gt.shape}")
     _, _, m, s = score_pairs(pred, gt, equalization)

@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from ..core.checks import check_image_values, real_number, require, seconds_array, whole_number
+from ..core.checks import check_image_values, image_stack, real_number, require, seconds_array, whole_number
 from ..core.events import EventDataError, Events
 from ..method.baselines import BASELINE_PARAMS, BASELINES, reconstruct_baseline
 from .metrics import EQUALIZATIONS, SCORE_PROTOCOLS, protocol_description, score_pairs
@@ -91,12 +91,11 @@ def _as_float_frames(frames) -> np.ndarray:
 
     if isinstance(frames, Frames):
         frames = frames.images
-    a = np.asarray(frames)
-    if a.ndim != 3:
-        raise EventDataError(f"frames must be a stack [F, H, W], got shape {a.shape}" +
-                             ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else ""))
+    a = image_stack(frames, "frames")   # [F, H, W] or [F, H, W, 1]; torch tensors too
     if a.dtype.kind not in "uif" or a.dtype == bool:
         raise EventDataError(f"frames must be uint8 (0..255) or float in [0, 1], got dtype {a.dtype}")
+    if a.dtype.kind in "iu" and a.dtype != np.uint8:
+        check_image_values(a, "frames")   # refused naming the dtype and the scale, not as "floats in [0, 65535]"
     return a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else a.astype(np.float64, copy=False)
 
 

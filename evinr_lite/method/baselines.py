@@ -28,7 +28,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, choice, optional_seconds, real_number, require
+from ..core.checks import (ArgumentTypeError, check_reach, check_seconds_precision, choice, host_array, optional_seconds,
+                           real_number, require)
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from .anchor import frame_log, linear_frames
@@ -57,9 +58,11 @@ def _rate(value, name: str) -> float:
 
 
 def _query(t_query) -> np.ndarray:
+    t_query = host_array(t_query)
     if isinstance(t_query, (str, bytes)) or np.asarray(t_query).dtype.kind not in "iuf":
         raise EventDataError(f"query times must be seconds (a number, a list or a 1-D array of numbers), got "
                              f"{t_query!r:.60}")
+    check_seconds_precision(t_query, "query_times")
     tq = np.asarray(t_query, dtype=np.float64)
     if tq.ndim > 1 or tq.size == 0 or not np.all(np.isfinite(tq)):
         raise EventDataError(f"query times must be a finite scalar or a non-empty 1-D array of seconds, got shape {tq.shape}")
@@ -413,6 +416,7 @@ def reconstruct_baseline(events: Events, query_times, method: str = "integration
     first, last = (events.t[0], events.t[-1]) if len(events) else (q.min(), q.max())
     lo = min(first, q.min()) if t_start is None else float(t_start)
     hi = max(last, q.max()) if t_end is None else float(t_end)
+    check_reach(lo, hi, events.t, events.t_origin, "query_times= (or t_start, t_end)")
     if method == "integration":
         def fn(t):
             return integrate_events(events, t, C=C, L0=params.get("L0"))

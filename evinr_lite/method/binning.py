@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.checks import host_array
 from ..core.events import EventDataError, Events
 
 __all__ = ["EventFrames", "fixed_duration_boundaries", "equal_count_boundaries", "events_to_frames",
@@ -27,6 +28,9 @@ def as_thresholds(C, name: str = "C") -> tuple[float, float]:
     Raises:
         EventDataError naming ``name`` when C is not a positive finite number or a pair of them.
     """
+    C = host_array(C)
+    if isinstance(C, np.ndarray) and C.ndim == 0 and C.dtype.kind in "iuf":   # np.array(0.2), t.max(): a number
+        C = C.item()
     if isinstance(C, (str, bytes, bool, np.bool_)):
         values = None
     elif np.ndim(C) == 0:

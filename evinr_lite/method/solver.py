@@ -43,7 +43,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..core.checks import check_result_frames, optional_seconds, require, seconds_array, whole_number
+from ..core.checks import (check_reach, check_result_frames, check_seconds_precision, host_array, optional_seconds,
+                           require, seconds_array, whole_number)
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from .anchor import fit_anchor, frames_in_window, linear_frames
@@ -98,6 +99,9 @@ class Reconstruction:
         """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W].
         ``chunk``: frames computed at once (a whole number >= 1)."""
         chunk = whole_number(chunk, "chunk", lo=1)
+        times = host_array(times)
+        if not isinstance(times, (str, bytes)) and np.asarray(times).dtype.kind == "f":
+            check_seconds_precision(times, "times")
         try:
             t = np.atleast_1d(np.asarray(times, np.float64))
         except (TypeError, ValueError):
@@ -258,6 +262,7 @@ def _checked_span(events: Events, query_times, t_start, t_end):
         raise EventDataError(f"need at least 2 events to reconstruct, got {len(events)}; choose a longer window")
     t_start = min(events.t[0], q.min()) if t_start is None else t_start
     t_end = max(events.t[-1], q.max()) if t_end is None else t_end
+    check_reach(t_start, t_end, events.t, events.t_origin, "query_times= (or t_start, t_end)")
     if q.min() < t_start or q.max() > t_end:
         raise EventDataError(f"query times span [{q.min()}, {q.max()}] s, outside [t_start, t_end] = "
                              f"[{t_start}, {t_end}] s; widen the span or drop those times")

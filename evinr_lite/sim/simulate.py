@@ -46,8 +46,8 @@ from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
-from ..core.checks import is_real_number
-from ..core.events import EventDataError, Events
+from ..core.checks import check_seconds_precision, host_array, is_real_number
+from ..core.events import MAX_SPAN_S, EventDataError, Events
 
 __all__ = ["simulate_events_1d", "pixel_events", "add_background_noise", "add_hot_pixels", "add_light_noise", "simulate_video", "simulate_scene", "sample_thresholds",
            "MIN_THRESHOLD_FRACTION", "MAX_PX_PER_SAMPLE"]
@@ -72,6 +72,9 @@ def _as_rng(seed) -> np.random.Generator:
 
 
 def _check_times(t) -> np.ndarray:
+    t = host_array(t)
+    if not isinstance(t, (str, bytes)) and np.asarray(t).dtype.kind == "f":
+        check_seconds_precision(t, "t (sample times)")
     t = np.asarray(t, dtype=np.float64)
     if t.ndim != 1 or t.size < 2:
         raise EventDataError(f"sample times t must be a 1-D array of at least 2 times (seconds), got shape {t.shape}")
@@ -79,12 +82,16 @@ def _check_times(t) -> np.ndarray:
         raise EventDataError("sample times t contain NaN or inf; pass finite seconds")
     if np.any(np.diff(t) <= 0):
         raise EventDataError("sample times t must be strictly increasing (seconds); sort them and drop duplicates")
+    if t[-1] - t[0] > MAX_SPAN_S:   # the events' plausibility rule (check_time_span): not seconds
+        raise EventDataError(f"sample times t span {t[-1] - t[0]:,.6g} s ({(t[-1] - t[0]) / 3600:,.3g} hours), longer "
+                             f"than any event recording; t is in seconds: divide microseconds by 1e6 (ns by 1e9)")
     return t
 
 
 def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
     C_pos = C if C_pos is None else C_pos
     C_neg = C if C_neg is None else C_neg
+    C_pos, C_neg = host_array(C_pos), host_array(C_neg)   # a 0-d array or tensor is a number
     for name, value in (("C_pos", C_pos), ("C_neg", C_neg)):
         if not (is_real_number(value) and np.isfinite(value) and value > 0):
             pair = " (for two thresholds pass C_pos= and C_neg=)" if isinstance(value, (tuple, list)) else ""
@@ -99,6 +106,7 @@ def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
 
 def _check_nonnegative(**values) -> None:
     for name, value in values.items():
+        value = host_array(value)
         if not (is_real_number(value) and np.isfinite(value) and value >= 0):
             raise EventDataError(f"{name} must be a finite number >= 0, got {value!r}")
 
@@ -248,7 +256,7 @@ def _eval_at(L: Callable, s: np.ndarray, pix: np.ndarray, n_pixels: int) -> np.n
     chunk = max(1, _REFINE_CHUNK // n_pixels)
     for i in range(0, s.size, chunk):
         si = s[i:i + chunk]
-        v = np.asarray(L(si), dtype=np.float64).reshape(si.size, n_pixels)
+        v = np.asarray(host_array(L(si)), dtype=np.float64).reshape(si.size, n_pixels)
         out[i:i + chunk] = v[np.arange(si.size), pix[i:i + chunk]]
     return out
 
@@ -354,7 +362,7 @@ def simulate_events_1d(L, t, C=0.2, *, C_pos=None, C_neg=None, threshold_sigma=0
         times in [t[0], t[-1]]. The reference level starts at L(t[0]) per pixel.
     """
     t = _check_times(t)
-    samples = np.asarray(L(t) if callable(L) else L, dtype=np.float64)
+    samples = np.asarray(host_array(L(t) if callable(L) else L), dtype=np.float64)
     if samples.ndim == 1:
         samples = samples[:, None]
     if samples.ndim != 2 or samples.shape[0] != t.size:
@@ -393,7 +401,7 @@ def pixel_events(events, pixel: int = 0) -> tuple[np.ndarray, np.ndarray]:
 
 def _check_video(log_frames, t) -> tuple[np.ndarray, np.ndarray]:
     t = _check_times(t)
-    log_frames = np.asarray(log_frames)
+    log_frames = np.asarray(host_array(log_frames))
     if log_frames.ndim != 3 or log_frames.shape[0] != t.size:
         raise EventDataError(
             f"log_frames must have shape [T, H, W] with T = len(t) = {t.size}, got {log_frames.shape}")
@@ -411,6 +419,7 @@ def _video_events(t, frames: Iterable[np.ndarray], sensor_size, C, C_pos, C_neg,
                   refractory, noise_rate, seed, threshold_drift=0.0) -> Events:
     C_pos, C_neg = _check_thresholds(C, C_pos, C_neg)
     _check_nonnegative(threshold_sigma=threshold_sigma, refractory=refractory, noise_rate=noise_rate)
+    threshold_sigma, refractory, noise_rate = (float(host_array(v)) for v in (threshold_sigma, refractory, noise_rate))
     if not (is_real_number(threshold_drift) and np.isfinite(threshold_drift)):
         raise EventDataError(f"threshold_drift must be a finite relative change, got {threshold_drift!r}")
     H, W = sensor_size
@@ -476,12 +485,14 @@ def simulate_scene(scene, t_start=0.0, t_end=None, *, sample_rate=None, C=0.2, *
     t_end = scene.duration if t_end is None else t_end
     if not (is_real_number(t_start) and is_real_number(t_end)):
         raise EventDataError(f"t_start and t_end must be seconds (numbers), got {t_start!r} and {t_end!r}")
+    t_start, t_end = float(host_array(t_start)), float(host_array(t_end))   # 0-d arrays and tensors too
     if not (np.isfinite(t_start) and np.isfinite(t_end) and t_end > t_start):
         raise EventDataError(f"time range [{t_start}, {t_end}] s is empty or reversed; t_end must exceed t_start")
     if sample_rate is None:
         sample_rate = max(100.0, float(scene.max_speed) / MAX_PX_PER_SAMPLE)
     if not (is_real_number(sample_rate) and np.isfinite(sample_rate) and sample_rate > 0):
         raise EventDataError(f"sample_rate must be a positive number of samples per second, got {sample_rate!r}")
+    sample_rate = float(host_array(sample_rate))
     if sample_rate > MAX_SAMPLE_RATE:
         raise EventDataError(f"sample_rate={sample_rate!r} samples per second is finer than the 1 us timestamps of event "
                              f"cameras and would render {sample_rate * (t_end - t_start):,.0f} frames; use at most "
