@@ -18,7 +18,7 @@ import numpy as np
 
 from evinr_lite.core.events import EventDataError
 from evinr_lite.core.frames import to_grey_uint8
-from evinr_lite.io.text import NS, parse_event_block, parse_frame_list
+from evinr_lite.io.text import NS, blank_leading_comments, parse_event_block, parse_frame_list
 
 from .canonical import CanonicalWriter
 from .errors import ConversionError
@@ -223,6 +223,8 @@ def convert_ijrr(path, out, *, sensor_size=None, C: float = 1.0, eval_window=Non
             with src.open(events_member) as fh:
                 for block in _blocks(fh, BLOCK_BYTES):
                     bar.update(len(block))
+                    if first:   # `#` / `%` notes on top, as evinr-lite's own reader skips them
+                        block, _ = blank_leading_comments(block)
                     parsed, header, origin_ns, n_lines, time_unit = _parse_block(block, origin_ns, line_base, src,
                                                                                  first, time_unit)
                     if first and header is not None:

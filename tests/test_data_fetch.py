@@ -144,10 +144,10 @@ def png_bytes(image) -> bytes:
     return buf.getvalue()
 
 
-def make_ijrr_zip(path, ev, frames, nested=False, bad_line=None):
+def make_ijrr_zip(path, ev, frames, nested=False, bad_line=None, notes=()):
     images, fns = frames
     pre = "seq/" if nested else ""
-    lines = [f"{ns_text(t)} {x} {y} {p}" for t, x, y, p in zip(ev["ns"], ev["x"], ev["y"], ev["p"])]
+    lines = list(notes) + [f"{ns_text(t)} {x} {y} {p}" for t, x, y, p in zip(ev["ns"], ev["x"], ev["y"], ev["p"])]
     if bad_line is not None:
         lines[bad_line] = "1468941032.5 12 oops 1"
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
@@ -288,6 +288,18 @@ def test_get_ijrr_downloads_converts_and_caches(server, cache, ijrr, small_senso
     requests_before = len(server.log)
     assert data_fetch.get("ijrr", "slider_depth", url=server.url + "/davis/slider_depth.zip", progress=False) == path
     assert len(server.log) == requests_before                 # cached: no new request
+
+
+def test_ijrr_events_txt_with_comment_lines_on_top_converts_as_evinr_lite_reads_it(tmp_path, cache, small_sensor,
+                                                                                   monkeypatch):
+    """`#` / `%` notes above the events: evinr-lite's reader skips them, so the converter does too (it refused them
+    as "found 5 columns"), also when the first parse block holds only part of the events."""
+    monkeypatch.setattr("data_fetch.convert_ijrr.BLOCK_BYTES", 300)
+    ev, frames = make_events(300, seed=4), make_frames(2)
+    z = make_ijrr_zip(tmp_path / "slider_depth.zip", ev, frames, notes=("# recorded 2016-07-19", "% t x y p"))
+    rec = read_canonical(data_fetch.convert(z, tmp_path / "a.h5", progress=False))
+    check_events(rec, ev)
+    check_frames(rec, frames)
 
 
 def test_ijrr_nested_zip_and_folder_give_the_same_file(tmp_path, cache, small_sensor):

@@ -26,8 +26,8 @@ import numpy as np
 
 from ..core.events import LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit
 
-__all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "parse_frame_list",
-           "line_blocks", "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
+__all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "blank_leading_comments",
+           "parse_frame_list", "line_blocks", "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
 
 NS = 10**9              # nanoseconds per second
 NS_PER_UNIT = {"s": NS, "ms": 10**6, "us": 10**3, "ns": 1}   # nanoseconds per unit of a timestamp token
@@ -442,7 +442,7 @@ def read_text_bytes(path, what: str = "file") -> bytes:
     return data
 
 
-def _blank_leading_comments(data: bytes) -> tuple[bytes | bytearray, list[int]]:
+def blank_leading_comments(data: bytes) -> tuple[bytes | bytearray, list[int]]:
     """(``data`` with the comment lines (`#` or `%` first) before the first event blanked (same length: byte
     offsets and line numbers kept), as a tool or a hand writes a note or the columns' names on top; the
     1-based numbers of those lines)."""
@@ -482,7 +482,7 @@ def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "au
     path = Path(path)
     comments = []
     if data is None:
-        data, comments = _blank_leading_comments(read_text_bytes(path, "event file"))
+        data, comments = blank_leading_comments(read_text_bytes(path, "event file"))
     everything = np.frombuffer(data, dtype=np.uint8)
     parts, header, line_base, t_last = [], None, 0, -np.inf
     for lo, hi in line_blocks(data, CHUNK_BYTES):
