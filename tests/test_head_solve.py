@@ -237,11 +237,56 @@ def test_the_second_order_head_is_the_optimum_of_the_laplacian_penalty(lam):
         penalty_spectrum(mu, cx, cy, 3)
 
 
+def test_the_banded_head_is_the_optimum_of_its_spectral_penalty():
+    """spatial_order="banded": the solve minimises |A W - E|^2 + sum_t f_t^T C^T diag(w) C f_t, with C the orthonormal
+    2-D DCT-II written out as a matrix on a 12 x 16 sensor and w = mu up to mu_ref, mu^3 / mu_ref^2 beyond; its
+    gradient vanishes at the solved head, and not at the order-2 head. The spectrum is continuous at mu_ref."""
+    import scipy.fft
+
+    from evinr_lite.method.head_solve import ORDER_REFERENCE, _weights, penalty_spectrum
+
+    lam = 0.1
+    model, bins = _setup("difference")
+    H, W = 12, 16
+    B = bins.frames.shape[1]
+    with torch.no_grad():
+        h, _ = model.features(bins.boundaries, dtype=torch.float64)
+    h = h[0].detach()
+    A, hc = h[1:] - h[:-1], h - h.mean(dim=0, keepdim=True)
+    cx, cy = _weights(B, B + 1, (H, W), lam)
+    mu = laplacian_eigenvalues((H, W), cx, cy)
+    w = penalty_spectrum(mu, cx, cy, "banded").ravel()
+    C = scipy.fft.dctn(np.eye(H * W).reshape(H * W, H, W), type=2, norm="ortho", axes=(1, 2)).reshape(H * W, H * W).T
+    Pen = torch.tensor(C.T @ np.diag(w) @ C)
+    E = bins.frames[0].reshape(B, H * W).double()
+
+    def grad(Wt):
+        Wt = Wt.clone().requires_grad_(True)
+        F = hc @ Wt
+        J = ((A @ Wt - E) ** 2).sum() + (F * (F @ Pen)).sum()
+        J.backward()
+        return Wt.grad.norm().item()
+
+    solve_head(model, bins.boundaries, bins.frames, "difference", "tikhonov", lam, order="banded")
+    banded = model.head_weight.detach()[0].double().clone()
+    solve_head(model, bins.boundaries, bins.frames, "difference", "tikhonov", lam, order=2)
+    second = model.head_weight.detach()[0].double().clone()
+    scale = grad(torch.zeros_like(banded))
+    assert grad(banded) < 1e-4 * scale
+    assert grad(second) > 1e-2 * scale
+    ref = (cx + cy) * (2 - 2 * np.cos(np.pi * ORDER_REFERENCE))
+    below, above = mu[mu <= ref], mu[mu > ref]
+    np.testing.assert_allclose(penalty_spectrum(below, cx, cy, "banded"), below)
+    assert np.all(penalty_spectrum(above, cx, cy, "banded") > above)
+    assert penalty_spectrum(np.array([ref * (1 + 1e-9)]), cx, cy, "banded")[0] == pytest.approx(ref, rel=1e-6)
+
+
 def test_spatial_order_is_checked_and_the_papers_recipes_keep_order_one():
     from evinr_lite import EventDataError
 
     assert EvINRConfig().spatial_order == 2
     assert EvINRConfig.paper().spatial_order == EvINRConfig.v0_1().spatial_order == 1
-    for bad in (0, 3, 1.5, True, "2"):
+    assert EvINRConfig(spatial_order="banded").spatial_order == "banded"
+    for bad in (0, 3, 1.5, True, "2", "band"):
         with pytest.raises(EventDataError, match="spatial_order"):
             EvINRConfig(spatial_order=bad)

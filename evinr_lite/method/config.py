@@ -223,7 +223,9 @@ class EvINRConfig:
         spatial_order: the Tikhonov regularizer's order in the closed-form head (``head_solve``): 1, the
             gradient's energy |D F|^2 (the paper's Eq. 9, what Adam's loss uses); 2 (the kit's), the
             Laplacian's energy |D^T D F|^2, equal to order 1 at a wavelength of 8 px, so lam keeps its
-            meaning there: coarser structure is smoothed less, finer more
+            meaning there: coarser structure is smoothed less, finer more; "banded": order 1 for structure
+            coarser than 8 px and a third-order roll-off (mu^3 / mu_ref^2) for finer, a candidate measured
+            in docs/defaults.md ("The spatial prior's order"), not the default
             (:func:`~evinr_lite.method.head_solve.penalty_spectrum`). Adam's loss stays first-order.
     Network (SIREN):
         hidden_features, hidden_layers: width and depth (paper: 512, 3).
@@ -331,7 +333,7 @@ class EvINRConfig:
     temporal_loss: str = "difference"
     regularizer: str = "tikhonov"
     lam: float | str = "auto"
-    spatial_order: int = 2
+    spatial_order: int | str = 2
     hidden_features: int = 128
     hidden_layers: int = 3
     omega_0: float = 30.0
@@ -373,9 +375,9 @@ class EvINRConfig:
         for name, allowed in choices.items():
             if getattr(self, name) not in allowed:
                 raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
-        if isinstance(self.spatial_order, bool) or self.spatial_order not in (1, 2):
-            raise EventDataError(f"spatial_order must be 1 (the gradient's energy) or 2 (the Laplacian's), got "
-                                 f"{self.spatial_order!r}")
+        if isinstance(self.spatial_order, bool) or self.spatial_order not in (1, 2, "banded"):
+            raise EventDataError(f"spatial_order must be 1 (the gradient's energy), 2 (the Laplacian's) or 'banded' "
+                                 f"(order 1 coarser than 8 px, a third-order roll-off finer), got {self.spatial_order!r}")
         if self.head_solve and self.regularizer == "tv":
             raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
                                  "pass head_solve=False to train the head with Adam")

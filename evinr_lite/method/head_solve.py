@@ -38,17 +38,23 @@ __all__ = ["solve_head", "laplacian_eigenvalues", "penalty_spectrum"]
 ORDER_REFERENCE = 0.25
 
 
-def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int = 1) -> np.ndarray:
+def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int | str = 1) -> np.ndarray:
     """The spatial penalty's weight per DCT frequency, from the weighted Laplacian's eigenvalues ``mu``
     (:func:`laplacian_eigenvalues` with ``cx``, ``cy``): order 1, mu itself (the gradient's energy,
     |D f|^2); order 2, mu^2 / mu_ref (the Laplacian's energy, |D^T D f|^2, scaled to equal order 1 at
-    ``ORDER_REFERENCE`` of Nyquist): less smoothing of the coarser structure, more of the finer."""
+    ``ORDER_REFERENCE`` of Nyquist): less smoothing of the coarser structure, more of the finer;
+    "banded", mu up to mu_ref and mu^3 / mu_ref^2 beyond (the gradient's energy for structure coarser than
+    the reference wavelength, a third-order roll-off for finer structure; continuous at mu_ref)."""
     if order == 1:
         return mu
-    if order != 2:
-        raise ValueError(f"order must be 1 (the gradient) or 2 (the Laplacian), got {order!r}")
+    if order not in (2, "banded"):
+        raise ValueError(f"order must be 1 (the gradient), 2 (the Laplacian) or 'banded', got {order!r}")
     ref = (cx + cy) * (2 - 2 * np.cos(np.pi * ORDER_REFERENCE))
-    return mu * mu / ref if ref > 0 else mu
+    if ref <= 0:
+        return mu
+    if order == 2:
+        return mu * mu / ref
+    return np.where(mu <= ref, mu, mu * (mu / ref) ** 2)
 
 
 def laplacian_eigenvalues(sensor_size, cx: float = 1.0, cy: float = 1.0) -> np.ndarray:
@@ -112,7 +118,7 @@ def _solve_frequencies(X: np.ndarray, M: np.ndarray, E_hat: np.ndarray, V: np.nd
 
 @torch.no_grad()
 def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temporal_loss: str = "difference",
-               regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7, order: int = 1) -> dict:
+               regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7, order: int | str = 1) -> dict:
     """Set ``model.head_weight`` and ``model.head_bias`` to the loss's optimum for its hidden layers.
 
     Args:
@@ -123,8 +129,9 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
         lam: the regularizer's weight, as in the training loss.
         ridge: relative ridge added to both Gram matrices (numerical safety; 1e-7 of their trace / d).
         order: the Tikhonov regularizer's order: 1, the training loss's |D F|^2 (what Adam minimises);
-            2, the Laplacian's |D^T D F|^2 at the same weight at a wavelength of 8 px
-            (:func:`penalty_spectrum`; ``EvINRConfig.spatial_order``).
+            2, the Laplacian's |D^T D F|^2 at the same weight at a wavelength of 8 px; "banded", order 1
+            coarser than 8 px and a third-order roll-off finer (:func:`penalty_spectrum`;
+            ``EvINRConfig.spatial_order``).
 
     Memory: the solution is written in place in float32 (in the head's own storage on a CPU), the
     DCTs a few rows and the frequencies a few columns at a time in float64; beyond the model and the
