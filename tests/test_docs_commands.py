@@ -2,7 +2,8 @@
 ``python -m data_fetch`` command in the README, docs/*.md and benchmarks/README.md names a real subcommand
 and only options it has (checked against the parsers, nothing run); every ``python benchmarks/X.py`` /
 ``python tools/X.py`` script exists and defines the flags shown; batch.md's list of suffixes is the one
-batch uses. Reads text and builds two argparse parsers: well under a second."""
+batch uses, and reliability.md's the settings a batch's resume compares. Reads text and builds two
+argparse parsers: about a second."""
 from __future__ import annotations
 
 import argparse
@@ -93,6 +94,14 @@ def test_batch_md_lists_the_suffixes_batch_reads():
     listed = re.search(r"files ending\s+in `([^`]+)`", text)
     assert listed, "docs/batch.md no longer lists the suffixes of a folder's recordings"
     assert sorted(listed.group(1).split()) == sorted(RECORDING_SUFFIXES)
+
+
+def test_reliability_md_lists_the_settings_a_batch_resume_compares():
+    from evinr_lite.apps.batch import RESULT_SETTINGS
+    text = (ROOT / "docs" / "reliability.md").read_text(encoding="utf-8")
+    listed = re.search(r"the result settings \(((?:`\w+`,?\s*)+)\)", text)
+    assert listed, "docs/reliability.md no longer lists the result settings a rerun compares"
+    assert re.findall(r"`(\w+)`", listed.group(1)) == list(RESULT_SETTINGS)
 
 
 def test_the_checker_catches_a_wrong_option():
