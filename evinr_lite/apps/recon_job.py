@@ -137,7 +137,7 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
     ``options``): sensor_size, C ("auto" fits C+ and C- from the APS frames, recorded in run.json
     as "C_fit"; None: the file's, else DEFAULT_C), fps / at, t_start / t_end, time_unit, device,
     recipe / n_iters / seed, anchor (APS frames as anchors, not scored; run.json's "anchor" says
-    which), denoise (run.json's settings["denoise"] is the report), colour (one EvINR per channel
+    which), denoise (run.json's "denoise" is the report), colour (one EvINR per channel
     of the colour filter, frames at (H/2, W/2)), video, progress.
 
     Every check that can fail runs before training: the options, the output folder (checked,
