@@ -220,3 +220,19 @@ def test_guard_an_hqf_sensor_given_that_differs_from_sensor_resolution_is_refuse
     path = _hqf(tmp_path / "e.h5")
     _both_commands_refuse(capsys, monkeypatch, tmp_path, path, ["--sensor", f"{H + 2}x{W}"],
                           rf"sensor is \(H, W\) = \({H}, {W}\).*but sensor size \({H + 2}, {W}\) was given")
+
+
+def test_an_option_the_format_does_not_take_is_refused_naming_the_ones_it_takes(tmp_path):
+    """ev.read_recording(ijrr_folder, camera="right") raised a bare TypeError from the reader's call; now the
+    refusal names the option, MVSEC as the format that takes camera=, and the reader's own options. A misspelt
+    option is refused the same way, and the options a format takes still work."""
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    t, x, y, on = _reference()
+    (folder / "events.txt").write_text("".join(f"{a:.6f} {b} {c} {d}\n" for a, b, c, d in zip(t, x, y, on)))
+    with pytest.raises(EventDataError, match=r"takes no option 'camera' \(camera= is for MVSEC.*takes t_origin, "
+                                             r"sensor_size, time_unit"):
+        read_recording(folder, camera="right", sensor_size=(H, W))
+    with pytest.raises(EventDataError, match="takes no option 'sensor_sise'"):
+        read_recording(folder, sensor_sise=(H, W))
+    assert len(read_recording(folder, sensor_size=(H, W)).events) == len(t)

@@ -194,7 +194,24 @@ def read_recording(path, **options) -> Recording:
     ``t_end=`` for the formats that read only a window). ``meta["format"]`` names the format read.
     """
     fmt = get_format(detect_format(path))
+    check_options(fmt, options, path)
     return fmt.reader(Path(path), **options)
+
+
+def check_options(fmt, options: dict, path) -> None:
+    """Refuse keyword options that ``fmt``'s reader does not take (e.g. ``camera=`` for an IJRR folder), naming the
+    ones it does, before anything is read (a reader called with them raised a bare TypeError)."""
+    import inspect
+
+    params = inspect.signature(fmt.reader).parameters
+    if any(p.kind is p.VAR_KEYWORD for p in params.values()):
+        return
+    taken = [n for n, p in list(params.items())[1:] if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD)]  # [0]: the path
+    unknown = sorted(set(options) - set(taken))
+    if unknown:
+        hint = " (camera= is for MVSEC's stereo files)" if "camera" in unknown else ""
+        raise EventDataError(f"{path}: {fmt.description} takes no option {', '.join(map(repr, unknown))}{hint}; "
+                             f"its reader takes {', '.join(taken) or 'no options'}")
 
 
 def read_events(path, **options) -> Events:
