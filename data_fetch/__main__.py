@@ -119,7 +119,7 @@ def _cmd_info(args) -> int:
     size = i.get("sensor_size")
     try:
         H, W = (int(v) for v in size)
-        sensor = f"{W}x{H}"
+        sensor = f"{W}x{H} (W x H, as datasheets write it)"
     except (TypeError, ValueError):
         sensor = "?"
     print(f"{args.file}\n  {i.get('dataset') or '?'} / {i.get('sequence') or '?'}: {i.get('source') or ''}")
