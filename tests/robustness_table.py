@@ -1,7 +1,8 @@
-"""The bad-input case table (issues 13 and 25): each case class with its count and its outcomes.
+"""The bad-input case table (issues 13 and 25, and the later rounds): each case class with its count and outcomes.
 
     python tests/robustness_table.py            every file below; exit status 1 unless the four counts are 0
     python tests/robustness_table.py --round3   only issue 25's classes (its test files)
+    python tests/robustness_table.py --later    only the later rounds (bad files 4 and 5, API arguments, fuzzed readers)
 
 One pytest case is one row of the table. A passing case ended as it must (a clear error naming the
 problem, or the correct result, and nothing left behind). A failing one is counted by what its failure
@@ -12,6 +13,7 @@ the input, an existing output or a user's file changed (data loss); else a silen
 The verdict line asks for 0 data loss, 0 tracebacks, 0 internal errors on bad input and 0 silent wrong
 results (leftovers and skips are shown too).
 """
+import argparse
 import re
 import sys
 from collections import Counter, defaultdict
@@ -23,9 +25,17 @@ HERE = Path(__file__).resolve().parent
 ROUND2 = ["test_robustness.py", "test_robustness_more.py", "test_signals.py"]
 ROUND3 = ["test_batch_ownership.py", "test_api_checks.py", "test_signals_edges.py", "test_robustness_round3.py",
           "test_io_reliability.py", "test_options.py"]
+LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_api_bad_inputs.py", "test_api_round6.py",
+         "test_fuzz_readers.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
+    # ---- later rounds: one class per file -------------------------------------------------------
+    ("bad files, round 4 (one instant, 0/1 events, absurd sizes, NaN frames)", "test_robustness_round4.py", r"test_"),
+    ("exports and odd files, round 5 (spreadsheets, compressed, npz, options)", "test_robustness_round5.py", r"test_"),
+    ("Python API arguments (bad inputs)", "test_api_bad_inputs.py", r"test_"),
+    ("Python API arguments, round 6 (tensors, 0-d, float32 and us times)", "test_api_round6.py", r"test_"),
+    ("fuzzed readers (every format, damaged bytes)", "test_fuzz_readers.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"
@@ -121,8 +131,12 @@ class Tally:
 
 
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    files = ROUND3 if "--round3" in argv else ROUND2 + ROUND3
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    which = p.add_mutually_exclusive_group()
+    which.add_argument("--round3", action="store_true", help="only issue 25's test files")
+    which.add_argument("--later", action="store_true", help="only the later rounds' test files")
+    args = p.parse_args(sys.argv[1:] if argv is None else argv)
+    files = ROUND3 if args.round3 else LATER if args.later else ROUND2 + ROUND3 + LATER
     files = [f for f in files if (HERE / f).exists()]
     tally = Tally()
     # -n 0: in this process, so the tally plugin sees every report (the suite itself runs on workers)
