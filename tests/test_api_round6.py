@@ -176,3 +176,13 @@ def test_colour_and_16_bit_stacks_are_refused_naming_the_fix(stacks):
         scoring.score_sequence(pred, t, np.repeat(gt[..., None], 3, -1), t, lpips_model=False)
     with pytest.raises(InputError, match=r"uint16 integers .*frames / 65535\.0"):
         scoring.score_sequence(pred, t, (gt * 65535).astype(np.uint16), t, lpips_model=False)
+
+
+def test_ragged_query_times_are_refused_as_not_seconds(events):
+    """A ragged list of times is no array: Reconstruction.at and reconstruct refuse it as not seconds, never with
+    numpy's "inhomogeneous shape" ValueError (the float32 check added in this round must not call np.asarray first)."""
+    rec = ev.reconstruct(events, [0.1], ev.EvINRConfig(C=0.2, **FAST))
+    with pytest.raises(InputError, match="must be seconds"):
+        rec.at([[0.1], [0.2, 0.3]])
+    with pytest.raises(InputError, match="must be seconds"):
+        ev.reconstruct(events, [[0.1], [0.2, 0.3]], ev.EvINRConfig(C=0.2, **FAST))

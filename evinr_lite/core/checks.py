@@ -27,8 +27,12 @@ SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coars
 def check_seconds_precision(arr, name: str) -> None:
     """Refuse times ``arr`` (seconds, as given: before any cast to float64) stored as float16, or as float32
     where float32's step at their largest magnitude is coarser than the events' microsecond (from 16 s on):
-    the times asked for are then not the times meant, and no cast afterwards brings the digits back."""
-    arr = np.asarray(arr)
+    the times asked for are then not the times meant, and no cast afterwards brings the digits back. Anything
+    that is no array of floats (text, a ragged list) passes: the caller's own checks refuse it with their message."""
+    try:
+        arr = np.asarray(host_array(arr))
+    except (TypeError, ValueError):
+        return
     if arr.dtype.kind != "f" or arr.dtype.itemsize >= 8 or arr.size == 0:
         return
     finite = arr[np.isfinite(arr)]
@@ -110,7 +114,10 @@ def seconds_array(value, name: str, *, allow_empty: bool = False) -> np.ndarray:
 
     Refused: text, objects and booleans (not seconds), arrays of 2 or more dimensions (a column [Q, 1] is not
     taken as Q times: pass ``np.ravel(times)``), NaN or inf, and no times at all (unless ``allow_empty``)."""
-    arr = np.asarray(host_array(value)) if not isinstance(value, (str, bytes)) else np.asarray([value])
+    try:
+        arr = np.asarray(host_array(value)) if not isinstance(value, (str, bytes)) else np.asarray([value])
+    except (TypeError, ValueError):   # a ragged list ([[0.1], [0.2, 0.3]]): no array of times
+        arr = np.asarray([None])
     if arr.dtype.kind not in "iuf" or arr.dtype == bool:
         raise EventDataError(f"{name}= must be seconds (a number, a list or a 1-D array of numbers), got "
                              f"{_short(value)}")

@@ -100,8 +100,7 @@ class Reconstruction:
         ``chunk``: frames computed at once (a whole number >= 1)."""
         chunk = whole_number(chunk, "chunk", lo=1)
         times = host_array(times)
-        if not isinstance(times, (str, bytes)) and np.asarray(times).dtype.kind == "f":
-            check_seconds_precision(times, "times")
+        check_seconds_precision(times, "times")
         try:
             t = np.atleast_1d(np.asarray(times, np.float64))
         except (TypeError, ValueError):

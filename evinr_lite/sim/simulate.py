@@ -73,8 +73,7 @@ def _as_rng(seed) -> np.random.Generator:
 
 def _check_times(t) -> np.ndarray:
     t = host_array(t)
-    if not isinstance(t, (str, bytes)) and np.asarray(t).dtype.kind == "f":
-        check_seconds_precision(t, "t (sample times)")
+    check_seconds_precision(t, "t (sample times)")
     t = np.asarray(t, dtype=np.float64)
     if t.ndim != 1 or t.size < 2:
         raise EventDataError(f"sample times t must be a 1-D array of at least 2 times (seconds), got shape {t.shape}")
