@@ -284,9 +284,9 @@ def test_the_banded_head_is_the_optimum_of_its_spectral_penalty():
 def test_spatial_order_is_checked_and_the_papers_recipes_keep_order_one():
     from evinr_lite import EventDataError
 
-    assert EvINRConfig().spatial_order == 2
+    assert EvINRConfig().spatial_order == "banded"
     assert EvINRConfig.paper().spatial_order == EvINRConfig.v0_1().spatial_order == 1
-    assert EvINRConfig(spatial_order="banded").spatial_order == "banded"
+    assert EvINRConfig(spatial_order=2).spatial_order == 2
     for bad in (0, 3, 1.5, True, "2", "band"):
         with pytest.raises(EventDataError, match="spatial_order"):
             EvINRConfig(spatial_order=bad)
