@@ -21,7 +21,7 @@ import numpy as np
 
 import math
 
-from .guard import InputError, host_array   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
+from .guard import InputError, dense_array, host_array   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
            "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S",
@@ -282,10 +282,9 @@ class Events:
 
     def __post_init__(self):
         H, W = check_sensor_size(host_array(self.sensor_size))
-        t = np.asarray(host_array(self.t))   # torch tensors too (on any device, requiring grad or not)
-        x = np.asarray(host_array(self.x))
-        y = np.asarray(host_array(self.y))
-        arrays = {"t": t, "x": x, "y": y, "p": np.asarray(host_array(self.p))}
+        # torch tensors too (on any device, requiring grad or not); a ragged nest is refused by name
+        t, x, y, p = (dense_array(getattr(self, k), f"Events.{k}", error=EventDataError) for k in "txyp")
+        arrays = {"t": t, "x": x, "y": y, "p": p}
         for name, a in arrays.items():
             if a.ndim != 1:
                 raise EventDataError(f"events.{name} must be a 1-D array, got shape {a.shape}")

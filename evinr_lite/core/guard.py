@@ -26,7 +26,7 @@ import sys
 import threading
 from contextlib import contextmanager
 
-__all__ = ["InputError", "host_array", "Interrupted", "TERMINATION_SIGNALS", "termination_signals", "signals_deferred",
+__all__ = ["InputError", "host_array", "dense_array", "Interrupted", "TERMINATION_SIGNALS", "termination_signals", "signals_deferred",
            "run_guarded", "protect_streams", "check_cwd", "EXIT_OK", "EXIT_ERROR", "EXIT_INTERNAL"]
 
 
@@ -38,6 +38,28 @@ def host_array(value):
     if type(value).__module__.startswith("torch") and hasattr(value, "detach") and hasattr(value, "cpu"):
         return value.detach().cpu().numpy()
     return value
+
+
+def dense_array(value, name: str, dtype=None, error: type[Exception] | None = None,
+                want: str = "one flat list or 1-D array (np.concatenate the pieces)"):
+    """``np.asarray(host_array(value), dtype)``, with a ragged nest (``[[0.1], [0.2, 0.3]]``: rows of
+    different lengths, which numpy refuses with "setting an array element with a sequence") or values that
+    are not numbers where ``dtype`` asks for them refused as ``error`` (default :class:`InputError`) naming
+    ``name`` and the fix (``want``: what to give instead), instead of numpy's bare ValueError. numpy is
+    imported on first use."""
+    import numpy as np
+
+    error = InputError if error is None else error
+    value = host_array(value)
+    try:
+        return np.asarray(value, dtype=dtype)
+    except (TypeError, ValueError) as err:
+        text = " ".join(repr(value).split())
+        text = text if len(text) <= 60 else f"{type(value).__name__} {text[:50]}..."
+        if "inhomogeneous" in str(err) or "sequence" in str(err):
+            raise error(f"{name} is ragged (its parts have different lengths or shapes: {text}), so it is no "
+                        f"array; give {want}") from None
+        raise error(f"{name} must be numbers, got {text} ({err})") from None
 
 
 EXIT_OK, EXIT_ERROR, EXIT_INTERNAL = 0, 2, 1

@@ -31,6 +31,7 @@ import numpy as np
 from ..core.checks import (ArgumentTypeError, check_reach, check_seconds_precision, choice, host_array, optional_seconds,
                            real_number, require)
 from ..core.events import EventDataError, Events
+from ..core.guard import dense_array
 from ..core.frames import Frames
 from .anchor import frame_log, linear_frames
 from .binning import as_thresholds
@@ -59,7 +60,7 @@ def _rate(value, name: str) -> float:
 
 def _query(t_query) -> np.ndarray:
     t_query = host_array(t_query)
-    if isinstance(t_query, (str, bytes)) or np.asarray(t_query).dtype.kind not in "iuf":
+    if isinstance(t_query, (str, bytes)) or dense_array(t_query, "query times", error=EventDataError).dtype.kind not in "iuf":
         raise EventDataError(f"query times must be seconds (a number, a list or a 1-D array of numbers), got "
                              f"{t_query!r:.60}")
     check_seconds_precision(t_query, "query_times")

@@ -12,6 +12,7 @@ import numpy as np
 
 from .binning import as_thresholds, events_to_frames
 from ..core.checks import check_seconds_precision, host_array
+from ..core.guard import dense_array
 from ..core.events import EventDataError, Events
 
 __all__ = ["integrate_events"]
@@ -43,7 +44,7 @@ def integrate_events(events: Events, t_query, C=1.0, L0=None) -> np.ndarray:
     H, W = events.sensor_size
     t_query = host_array(t_query)
     check_seconds_precision(t_query, "t_query")
-    tq = np.asarray(t_query, dtype=np.float64)
+    tq = dense_array(t_query, "t_query", np.float64, EventDataError)
     if tq.ndim > 1 or tq.size == 0 or not np.all(np.isfinite(tq)):
         raise EventDataError(f"t_query must be a finite scalar or a non-empty 1-D array of seconds, got shape {tq.shape}")
     C_pos, C_neg = as_thresholds(C)

@@ -47,6 +47,7 @@ from typing import Callable, Iterable, Iterator
 import numpy as np
 
 from ..core.checks import check_seconds_precision, host_array, is_real_number
+from ..core.guard import dense_array
 from ..core.events import MAX_SPAN_S, EventDataError, Events
 
 __all__ = ["simulate_events_1d", "pixel_events", "add_background_noise", "add_hot_pixels", "add_light_noise", "simulate_video", "simulate_scene", "sample_thresholds",
@@ -74,7 +75,7 @@ def _as_rng(seed) -> np.random.Generator:
 def _check_times(t) -> np.ndarray:
     t = host_array(t)
     check_seconds_precision(t, "t (sample times)")
-    t = np.asarray(t, dtype=np.float64)
+    t = dense_array(t, "t (sample times)", np.float64, EventDataError)
     if t.ndim != 1 or t.size < 2:
         raise EventDataError(f"sample times t must be a 1-D array of at least 2 times (seconds), got shape {t.shape}")
     if not np.all(np.isfinite(t)):
@@ -361,7 +362,8 @@ def simulate_events_1d(L, t, C=0.2, *, C_pos=None, C_neg=None, threshold_sigma=0
         times in [t[0], t[-1]]. The reference level starts at L(t[0]) per pixel.
     """
     t = _check_times(t)
-    samples = np.asarray(host_array(L(t) if callable(L) else L), dtype=np.float64)
+    samples = dense_array(L(t) if callable(L) else L, "L(t)" if callable(L) else "L", np.float64, EventDataError,
+                          want="one value per time [T] or [T, P] for P pixels")
     if samples.ndim == 1:
         samples = samples[:, None]
     if samples.ndim != 2 or samples.shape[0] != t.size:
@@ -400,7 +402,8 @@ def pixel_events(events, pixel: int = 0) -> tuple[np.ndarray, np.ndarray]:
 
 def _check_video(log_frames, t) -> tuple[np.ndarray, np.ndarray]:
     t = _check_times(t)
-    log_frames = np.asarray(host_array(log_frames))
+    log_frames = dense_array(log_frames, "log_frames", error=EventDataError,
+                             want="frames of one shape, stacked [T, H, W] (np.stack(frames))")
     if log_frames.ndim != 3 or log_frames.shape[0] != t.size:
         raise EventDataError(
             f"log_frames must have shape [T, H, W] with T = len(t) = {t.size}, got {log_frames.shape}")
