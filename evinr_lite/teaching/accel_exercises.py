@@ -190,6 +190,19 @@ def _bisect_np_median(t_events, boundaries):
     return np.array(out)
 
 
+def _bisect_sparse_at_edge(t_events, boundaries):
+    out = bisect_equal_count(t_events, boundaries)
+    t, b = np.asarray(t_events, dtype=np.float64), np.asarray(boundaries, dtype=np.float64)
+    for i, (lo, hi) in enumerate(zip(b[:-1], b[1:])):
+        if np.count_nonzero(((t > lo) | ((i == 0) & (t == lo))) & (t <= hi)) < 2:
+            out[2 * i + 1] = lo
+    return out
+
+
+def _bisect_closed_both(t_events, boundaries):
+    return _median_cuts(t_events, boundaries, lambda t, i, lo, hi: (t >= lo) & (t <= hi))
+
+
 def _bisect_cuts_only(t_events, boundaries):
     return bisect_equal_count(t_events, boundaries)[1::2]
 
@@ -214,6 +227,11 @@ exercises.register(
             _bisect_np_median,
         "return the old edges too, the cuts between them: [b_0, cut_0, b_1, cut_1, ..., b_B] (2B + 1 values)":
             _bisect_cuts_only,
+        "a bin with fewer than 2 events is cut at its time mid-point (lo + hi) / 2, not at its first edge":
+            _bisect_sparse_at_edge,
+        "bins are (b_i, b_{i+1}], open on the left: with both ends closed an event exactly on an inner edge "
+        "counts in two bins":
+            _bisect_closed_both,
     })
 
 
@@ -276,10 +294,12 @@ def _inputs_crossfade(rng):
     from ..method.solver import split_windows
 
     cases = []
-    for span, tau, overlap in ((3.0, 1.2, 0.3), (6.0, 2.2, 0.5), (2.0, 1.1, 0.1)):
-        w = split_windows(0.0, span, tau, overlap)
+    # the first sequence starts at 1.5 s, not 0: windows and times are absolute (a version that builds the
+    # windows from 0, or shifts the caller's windows in place, fails)
+    for start, span, tau, overlap in ((1.5, 3.0, 1.2, 0.3), (0.0, 6.0, 2.2, 0.5), (0.0, 2.0, 1.1, 0.1)):
+        w = split_windows(start, start + span, tau, overlap)
         edges = np.concatenate([w.ravel(), 0.5 * (w[1:, 0] + w[:-1, 1])])
-        t = np.sort(np.concatenate([edges, rng.uniform(0.0, span, 9)]))
+        t = np.sort(np.concatenate([edges, rng.uniform(start, start + span, 9)]))
         cases.append(dict(windows=w, times=t))
     cases.append(dict(windows=np.array([[0.0, 1.0]]), times=np.array([0.0, 0.3, 1.0])))
     return cases
@@ -312,6 +332,16 @@ def _not_normalised(windows, times):
     return ((t >= windows[:, :1]) & (t <= windows[:, 1:])).astype(np.float64)
 
 
+def _windows_from_zero(windows, times):
+    """The windows rebuilt from their length and step as if the sequence started at 0 (k * step, k * step + tau)."""
+    windows = np.asarray(windows, dtype=np.float64)
+    if len(windows) == 1:
+        return np.ones((1, len(np.asarray(times))))
+    tau, step = windows[0, 1] - windows[0, 0], windows[1, 0] - windows[0, 0]
+    lo = step * np.arange(len(windows))
+    return crossfade_weights(np.stack([lo, lo + tau], axis=1), times)
+
+
 exercises.register(
     "crossfade_weights", crossfade_weights, _inputs_crossfade, atol=1e-5,
     hints={
@@ -319,6 +349,8 @@ exercises.register(
         "the first window must not fade in at the start of the sequence, nor the last fade out at its end "
         "(there is no neighbour to hand over to)": _fades_at_both_ends,
         "every window covering t has weight 1: the weights of each time must sum to 1": _not_normalised,
+        "read each window's start and end from `windows` (absolute times): the sequence need not start at 0":
+            _windows_from_zero,
     })
 
 
@@ -390,6 +422,22 @@ def _chain_mean_over_overlaps(prev, nxt):
     return np.concatenate([np.zeros((1,) + prev.shape[2:]), np.cumsum(steps, axis=0)])
 
 
+def _chain_median(prev, nxt):
+    steps = np.median(np.asarray(prev, dtype=np.float64) - np.asarray(nxt, dtype=np.float64), axis=1)
+    return np.concatenate([np.zeros((1,) + np.shape(prev)[2:]), np.cumsum(steps, axis=0)])
+
+
+def _chain_first_sample(prev, nxt):
+    return chain_offsets(np.asarray(prev)[:, :1], np.asarray(nxt)[:, :1])
+
+
+def _chain_last_left_at_zero(prev, nxt):
+    out = chain_offsets(prev, nxt)
+    if len(out) > 1:
+        out[-1] = 0.0
+    return out
+
+
 def _chain_cumsum_flat(prev, nxt):
     prev = np.asarray(prev, dtype=np.float64)
     nxt = np.asarray(nxt, dtype=np.float64)
@@ -408,6 +456,13 @@ exercises.register(
             _chain_mean_over_overlaps,
         "np.cumsum without axis= runs over the flattened array (across pixels): use np.cumsum(steps, axis=0)":
             _chain_cumsum_flat,
+        "average the differences over the S samples with the mean, not the median":
+            _chain_median,
+        "use all S samples of each overlap (the mean over axis 1), not only the first one":
+            _chain_first_sample,
+        "every network gets an offset, the last one too: offset_k for k = 1 .. K (a loop over range(1, K + 1), "
+        "or np.cumsum over all K steps), not range(1, K)":
+            _chain_last_left_at_zero,
     })
 
 

@@ -95,6 +95,10 @@ def _channel_phase_subtracted(y, x, phase):
     return quad_bayer_channel(y, x, (-phase[0], -phase[1]))
 
 
+def _channel_phase_in_blocks(y, x, phase):
+    return ((np.asarray(y) // 2 + phase[0]) % 2 + (np.asarray(x) // 2 + phase[1]) % 2).astype(np.int64)
+
+
 def _channel_no_block_division(y, x, phase):
     return ((((np.asarray(y) + phase[0]) % 4) + ((np.asarray(x) + phase[1]) % 4)) // 2).astype(np.int64)
 
@@ -107,6 +111,10 @@ exercises.register(
         "phase is (dy, dx): the row offset first, then the column offset": _channel_phase_swapped,
         "add the phase to the coordinates: (y + dy) % 4, not (y - dy) % 4": _channel_phase_subtracted,
         "take the block row and the block column separately (each // 2) and add them": _channel_no_block_division,
+        "add the phase before dividing into blocks: ((y + dy) % 4) // 2 (the phase counts photosites, not blocks)":
+            _channel_phase_in_blocks,
+        "the colours are 0 = R, 1 = G, 2 = B: the R G G B tile starts with R at its top-left":
+            lambda y, x, phase: 2 - quad_bayer_channel(y, x, phase),
     })
 
 
@@ -138,6 +146,20 @@ def _grey_fancy_index(x, y, p, C, raw_size):
     return frame
 
 
+def _grey_floor_division(x, y, p, C, raw_size):
+    H, W = raw_size
+    frame = np.zeros((H // 4, W // 4))
+    np.add.at(frame, (np.asarray(y) // 4, np.asarray(x) // 4), C * np.asarray(p, dtype=np.float64) // 16)
+    return frame
+
+
+def _grey_histogram_bins_from_data(x, y, p, C, raw_size):
+    H, W = raw_size
+    f, _, _ = np.histogram2d(np.asarray(y) // 4, np.asarray(x) // 4, bins=(H // 4, W // 4),
+                             weights=np.asarray(p, dtype=np.float64))
+    return C * f / 16
+
+
 def _grey_rows_columns_swapped(x, y, p, C, raw_size):
     """The frame indexed [x // 4, y // 4]: the transposed frame (a sensor that is not square: an IndexError or this)."""
     return grey_event_frame(x, y, p, C, raw_size).T
@@ -152,4 +174,11 @@ exercises.register(
         "does not accumulate repeated indices): use np.add.at(frame, (y // 4, x // 4), C * p / 16)":
             _grey_fancy_index,
         "rows are y and columns are x: index the frame as [y // 4, x // 4]": _grey_rows_columns_swapped,
+        "did you forget the sign of the polarity? ON events add C / 16, OFF events subtract it":
+            lambda x, y, p, C, raw_size: grey_event_frame(x, y, np.abs(np.asarray(p)), C, raw_size),
+        "`C * p // 16` is floor division: it rounds C p / 16 down to a whole number; divide with `/`":
+            _grey_floor_division,
+        "np.histogram2d with a number of bins spreads them over the events' own range (min to max), not over the "
+        "sensor: give the edges, bins=(np.arange(H // 4 + 1), np.arange(W // 4 + 1)), or use np.add.at":
+            _grey_histogram_bins_from_data,
     })

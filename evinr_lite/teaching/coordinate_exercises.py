@@ -54,6 +54,11 @@ def _split_x_first(index, sensor_size):
     return x, y, b
 
 
+def _split_row_without_modulo(index, sensor_size):
+    H, W = sensor_size
+    return index // (H * W), index // W, index % W
+
+
 exercises.register(
     "split_index", split_index, _inputs_split,
     hints={
@@ -65,6 +70,8 @@ exercises.register(
             _split_size_unpacked_wh,
         "return (b, y, x), in that order: the bin first, the column last":
             _split_x_first,
+        "the row is (index // W) % H: without `% H`, index // W also counts the rows of the earlier bins":
+            _split_row_without_modulo,
     })
 
 def _tikhonov_magnitude(dF_dx, dF_dy):
@@ -89,6 +96,9 @@ exercises.register(
         "Eq. 9 is the squared gradient, dF/dx^2 + dF/dy^2, without a square root (that is the gradient's "
         "magnitude)":
             _tikhonov_magnitude,
-        "the mean over the stacked [2, M] tensor divides by 2M: average dF/dx^2 + dF/dy^2 over the M pixels":
+        "half the expected value: the mean over the stacked [2, M] tensor divides by 2M (and Eq. 9 has no factor "
+        "1/2): average dF/dx^2 + dF/dy^2 over the M pixels":
             _tikhonov_stacked_mean,
+        "Eq. 9 is the mean of the squares, without a square root over the mean (that is an RMS)":
+            lambda dF_dx, dF_dy: torch.sqrt(torch.mean(dF_dx ** 2 + dF_dy ** 2)),
     })

@@ -84,6 +84,30 @@ def _final_decay_from_last_event(t, x, y, p, sensor_size, C, alpha, t_end, t_sta
     return state * np.exp(-alpha * (t_end - (t[-1] if len(t) else t_start)))
 
 
+def _growth(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """exp(+alpha dt): the state grows between events instead of decaying."""
+    return highpass_per_event(t, x, y, p, sensor_size, C, -alpha, t_end, t_start)
+
+
+def _fancy_index_sum(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """The closed form sum of C p exp(-alpha (t_end - t)) per pixel, written with ``state[y, x] += ...``."""
+    state = np.zeros(sensor_size)
+    state[np.asarray(y), np.asarray(x)] += C * np.asarray(p) * np.exp(-alpha * (t_end - np.asarray(t, np.float64)))
+    return state
+
+
+def _integer_state(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """The state array made with an integer dtype (np.zeros_like(x), np.zeros(..., dtype=int)): every decayed
+    value is truncated toward 0 when stored."""
+    H, W = sensor_size
+    state = np.zeros((H, W), dtype=np.int64)
+    t_last = np.full((H, W), float(t_start))
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * state[yi, xi] + C * pi
+        t_last[yi, xi] = ti
+    return state * np.exp(-alpha * (t_end - t_last))
+
+
 def _alpha_times_two_pi(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return highpass_per_event(t, x, y, p, sensor_size, C, 2 * math.pi * alpha, t_end, t_start)
 
@@ -104,6 +128,14 @@ exercises.register(
             _final_decay_from_last_event,
         "alpha is already in rad/s: decay by exp(-alpha dt), without another factor 2 pi":
             _alpha_times_two_pi,
+        "the state decays: exp(-alpha * (t - t_last)), with the minus sign (exp(+alpha dt) grows without bound)":
+            _growth,
+        "`state[y, x] += ...` adds only one of the events that share a pixel (fancy indexing does not accumulate "
+        "repeated indices): loop over the events, or accumulate with np.add.at(state, (y, x), ...)":
+            _fancy_index_sum,
+        "the state array has an integer dtype, so every stored value is truncated: make it float "
+        "(np.zeros((H, W)), not np.zeros_like(x) or dtype=int)":
+            _integer_state,
     })
 
 
@@ -151,6 +183,12 @@ def _floor_not_trunc(L_boundaries, C):
     return render_counts(L_boundaries, C, np.floor)
 
 
+def _levels_on_a_grid(L_boundaries, C):
+    """Counts as differences of trunc((L - L(b_0)) / C): levels fixed at L(b_0) + k C, no moving reference."""
+    L = np.asarray(L_boundaries, dtype=np.float64)
+    return np.diff(np.trunc((L - L[0]) / C), axis=0).astype(np.int64)
+
+
 def _strict_threshold(L_boundaries, C):
     """The mistake of firing only once the change *exceeds* C (``> C`` instead of ``>= C``)."""
     def strict(x):
@@ -171,4 +209,7 @@ exercises.register(
             _reference_to_level,
         "move the reference after each bin (ref += n * C): a reference that stays at L(b_0) counts the same "
         "change again in every later bin": _reference_fixed,
+        "the reference moves with the events (ref += n * C after each bin), not on a fixed grid of levels L(b_0) + "
+        "k C: after a rise and a partial fall the grid fires an OFF event that the camera does not":
+            _levels_on_a_grid,
     })

@@ -119,6 +119,28 @@ def _esim_line_from_ref(L_a, L_b, t_a, t_b, ref, C):
     return times.astype(np.float64), np.full(n, p, dtype=np.int8), float(ref + p * n * C)
 
 
+def _esim_counted(L_a, L_b, t_a, t_b, ref, C, whole):
+    d = L_b - ref
+    p = 1 if d > 0 else -1
+    n = int(whole(abs(d) / C))
+    levels = ref + p * C * np.arange(1, n + 1)
+    times = t_a + (levels - L_a) / (L_b - L_a) * (t_b - t_a) if n else np.zeros(0)
+    return np.asarray(times, np.float64), np.full(n, p, dtype=np.int8), float(ref + p * n * C)
+
+
+def _esim_rounded(L_a, L_b, t_a, t_b, ref, C):
+    return _esim_counted(L_a, L_b, t_a, t_b, ref, C, np.round)
+
+
+def _esim_ceil(L_a, L_b, t_a, t_b, ref, C):
+    return _esim_counted(L_a, L_b, t_a, t_b, ref, C, np.ceil)
+
+
+def _esim_ref_always_up(L_a, L_b, t_a, t_b, ref, C):
+    times, p, _ = esim_interval(L_a, L_b, t_a, t_b, ref, C)
+    return times, p, float(ref + len(p) * C)
+
+
 exercises.register(
     "esim_interval", esim_interval, _inputs_esim,
     hints={
@@ -140,6 +162,14 @@ exercises.register(
         "the straight line runs from (t_a, L_a) to (t_b, L_b): t = t_a + (level - L_a) / (L_b - L_a) (t_b - "
         "t_a), measured from L_a, not from ref":
             _esim_line_from_ref,
+        "a level counts only once L reaches it: n = floor(|L_b - ref| / C), not round (a level half-way there "
+        "has not fired yet)":
+            _esim_rounded,
+        "a level counts only once L reaches it: n = floor(|L_b - ref| / C), not ceil (which counts the level "
+        "L_b is still short of)":
+            _esim_ceil,
+        "move the reference in the direction of the events: ref + p * n * C (down for OFF events), not ref + n * C":
+            _esim_ref_always_up,
     })
 
 
@@ -258,6 +288,13 @@ def _frames_histogramdd(events, boundaries, C):
     return (C * counts).astype(np.float32)
 
 
+def _frames_mean_polarity(events, boundaries, C):
+    """A wrong version (for the hint): each (bin, pixel) holds C times the mean polarity of its events."""
+    ones = Events(events.t, events.x, events.y, np.ones(len(events), np.int8), events.sensor_size)
+    n = events_to_frames_fixed(ones, boundaries, 1.0)
+    return (events_to_frames_fixed(events, boundaries, C) / np.maximum(n, 1)).astype(np.float32)
+
+
 exercises.register(
     "events_to_frames_fixed", events_to_frames_fixed, _inputs_frames,
     hints={
@@ -284,6 +321,11 @@ exercises.register(
         "np.histogramdd's (and np.histogram's) bins are [b_i, b_{i+1}), only the last closed: an event "
         "exactly on an inner edge belongs to the bin that ends there, (b_i, b_{i+1}]":
             _frames_histogramdd,
+        "sum the polarities, do not average them: divide by nothing (a bin's value is C times the net count, "
+        "not the mean polarity of its events)":
+            _frames_mean_polarity,
+        "multiply by C once: C * sum(p), not C * C * sum(p)":
+            lambda events, boundaries, C: C * events_to_frames_fixed(events, boundaries, C),
     })
 
 
@@ -418,6 +460,35 @@ def _imbalance_of_pixel_numbers(events, pix, kind):
     return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
 
 
+def _intervals_stat(events, log=np.log, stat=np.mean, to_b=lambda r: np.tanh(r / 2), none=float("nan")):
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * W + events.x
+    order = np.argsort(pix, kind="stable")
+    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    log_dt = log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return none
+    return float(to_b(stat(log_dt[pair & on]) - stat(log_dt[pair & ~on])))
+
+
+def _intervals_log10(events):
+    return _intervals_stat(events, log=np.log10)
+
+
+def _intervals_tanh_r(events):
+    return _intervals_stat(events, to_b=np.tanh)
+
+
+def _intervals_median(events):
+    return _intervals_stat(events, stat=np.median)
+
+
+def _intervals_zero_not_nan(events):
+    return _intervals_stat(events, none=0.0)
+
+
 def _intervals_log_ratio(events):
     """A wrong version (for the hint): r itself, log(C+ / C-), instead of b."""
     return float(2 * np.arctanh(interval_imbalance(events)))
@@ -448,6 +519,16 @@ exercises.register(
         "sort with np.argsort(pix, kind=\"stable\"): the default sort need not keep each pixel's events in "
         "time order, so consecutive events of a pixel are paired out of order":
             _intervals_unstable_sort,
+        "log intervals are natural logs (np.log): with np.log10 r is log10(C+ / C-), 2.3 times too small":
+            _intervals_log10,
+        "b = tanh(r / 2), with the half: (C+ - C-) / (C+ + C-) = tanh(log(C+ / C-) / 2)":
+            _intervals_tanh_r,
+        "average the log intervals with the mean, not the median (the mean of the logs is the log of the "
+        "geometric mean, which estimates log C+ - log C-)":
+            _intervals_median,
+        "with no ON pair or no OFF pair there is nothing to compare: return NaN (float('nan')), not 0 (0 would "
+        "claim a balanced sensor)":
+            _intervals_zero_not_nan,
     })
 
 

@@ -273,6 +273,10 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
         if g.dtype == np.float16 and e.dtype != np.float16:
             return _Problem(f"wrong values{at}: the result is float16 (half precision, about 3 significant "
                             "digits), too coarse for these values: compute and return float64 (or float32)")
+        if g.dtype == np.float32 and e.dtype == np.float64 and np.allclose(g, e, rtol=1e-3, atol=1e-6 + atol):
+            return _Problem(f"wrong values{at}: the result is float32 (about 7 significant digits) and differs from "
+                            f"the expected float64 values in the last digits, beyond this exercise's tolerance "
+                            f"(rtol {rtol:g}): compute in float64 (np.asarray(..., dtype=np.float64))")
         bad = np.flatnonzero(~close.ravel())
         diff = np.abs(g.astype(np.float64) - e.astype(np.float64)).ravel()
         diff = np.where(np.isnan(diff), np.inf, diff)
@@ -299,6 +303,9 @@ def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
     if e.dtype == bool and g.dtype.kind in "iu" and g.size <= e.size:
         return ("; that looks like the indices of the True entries (np.flatnonzero, np.where, np.argwhere): "
                 "return the boolean mask itself, one entry per element")
+    if e.ndim == 1 and g.ndim == 1 and abs(g.shape[0] - e.shape[0]) == 1:
+        more = "one entry too many" if g.shape[0] > e.shape[0] else "one entry too few"
+        return f"; {more}: an off-by-one (a loop's range, a slice, or a count rounded the wrong way)?"
     if e.ndim == 0 and g.size == 1:
         return ("; that is an array holding one number where the number itself is expected: take it out "
                 "(`x[0]`, `x.squeeze()`, or `float(x)` for a numpy result), e.g. np.linalg.lstsq returns an array")

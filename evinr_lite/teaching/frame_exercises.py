@@ -112,6 +112,12 @@ exercises.register(
                                                    torch.cos(omega * (h @ weight) + bias) * omega * (dh_dt @ weight)),
         "the chain rule: dz/dt = omega * (dh/dt @ W) uses dh_dt, not h":
             _sine_derivative_of_h,
+        "the bias is a constant: it has no time derivative, so dz/dt = omega * (dh/dt @ W), without + b":
+            lambda h, dh_dt, weight, bias, omega: (torch.sin(omega * (h @ weight + bias)),
+                                                   torch.cos(omega * (h @ weight + bias)) * omega * (dh_dt @ weight + bias)),
+        "omega appears once in dz/dt = omega * (dh/dt @ W): the derivative of sin(z) is cos(z), with no second omega":
+            lambda h, dh_dt, weight, bias, omega: (torch.sin(omega * (h @ weight + bias)),
+                                                   torch.cos(omega * (h @ weight + bias)) * omega ** 2 * (dh_dt @ weight)),
     })
 
 def _boundary_loss_sum_of_bin_means(F_boundaries, event_frames):
@@ -139,6 +145,12 @@ exercises.register(
         "use all B bins: F_boundaries[1:] - F_boundaries[:-1] has B changes, one per event frame (the last "
         "bin is left out)":
             _boundary_loss_last_bin_dropped,
+        "compare each event frame with the model's change over its bin, F(b_{i+1}) - F(b_i), not with the value "
+        "F(b_{i+1}) itself":
+            lambda F_boundaries, event_frames: torch.mean((event_frames - F_boundaries[1:]) ** 2),
+        "the mean is over bins and pixels, B * H * W squares: dividing the sum by B alone leaves a sum over pixels":
+            lambda F_boundaries, event_frames: torch.sum((event_frames - (F_boundaries[1:] - F_boundaries[:-1])) ** 2)
+            / event_frames.shape[0],
     })
 
 
@@ -218,11 +230,30 @@ exercises.register(
             _tonemap_power_of_denominator,
         "I = exp(L), not exp(-L): a brighter pixel (larger L) must display brighter":
             _tonemap_exp_minus,
+        "L is a natural log: I = exp(L) (np.exp), not 10 ** L":
+            lambda L, gamma: reinhard_tonemap(np.asarray(L, dtype=np.float64) * np.log(10.0), gamma),
+        "apply gamma to the ratio, (I / (I + 1)) ** gamma, not to I inside it (I ** gamma / (I ** gamma + 1))":
+            lambda L, gamma: reinhard_tonemap(gamma * np.asarray(L, dtype=np.float64), 1.0),
     })
 
 def _tv_first_axes(F):
     """F[:, 1:] and F[1:]: the first two axes, right only for a single image [H, W]."""
     return (F[:, 1:] - F[:, :-1]).abs().mean() + (F[1:] - F[:-1]).abs().mean()
+
+
+def _tv_over_pixels(F):
+    dx, dy = F[..., :, 1:] - F[..., :, :-1], F[..., 1:, :] - F[..., :-1, :]
+    return (dx.abs().sum() + dy.abs().sum()) / F.numel()
+
+
+def _tv_rolled(F):
+    return (F - torch.roll(F, 1, -1)).abs().mean() + (F - torch.roll(F, 1, -2)).abs().mean()
+
+
+def _tv_joint_crop(F):
+    dx = F[..., :-1, 1:] - F[..., :-1, :-1]
+    dy = F[..., 1:, :-1] - F[..., :-1, :-1]
+    return (dx.abs() + dy.abs()).mean()
 
 
 def _tv_isotropic(F):
@@ -247,6 +278,15 @@ exercises.register(
             _tv_first_axes,
         "the anisotropic total variation averages |dF/dx| and |dF/dy| separately, not sqrt(dF/dx^2 + dF/dy^2)":
             _tv_isotropic,
+        "average each direction over its own differences (H (W - 1) of them along x, (H - 1) W along y), not "
+        "over the H W pixels of F":
+            _tv_over_pixels,
+        "torch.roll wraps round: it also takes the difference between the last and the first column (row); use "
+        "F[..., :, 1:] - F[..., :, :-1], which has one column fewer":
+            _tv_rolled,
+        "|dF/dx| and |dF/dy| are averaged separately, each over all its differences: cropping both to "
+        "[..., :-1, :-1] leaves out the last row of dF/dx and the last column of dF/dy":
+            _tv_joint_crop,
     })
 
 
@@ -318,6 +358,10 @@ exercises.register(
             _anchor_mean_along_axis,
         "shift so that the *mean* of L lands on the level (L.mean()), not the median":
             _anchor_median,
+        "log intensities are natural logs: the level is np.log(s / (1 - s)), not np.log10":
+            _anchor_level_wrong(lambda gamma, m: np.log10(m ** (1.0 / gamma) / (1.0 - m ** (1.0 / gamma)))),
+        "the level is log(s / (1 - s)) (the logit), not log((1 - s) / s): a brighter display value needs a larger F":
+            _anchor_level_wrong(lambda gamma, m: -_logit(m ** (1.0 / gamma))),
     })
 
 
@@ -351,6 +395,11 @@ def _offset_gradients_mean(frames):
 def _offset_gradients_swapped_axes(frames):
     F = np.asarray(frames, dtype=np.float64)
     return -np.median(np.diff(F, axis=1), axis=0), -np.median(np.diff(F, axis=2), axis=0)
+
+
+def _offset_gradients_of_median_frame(frames):
+    m = np.median(np.asarray(frames, dtype=np.float64), axis=0)
+    return -np.diff(m, axis=1), -np.diff(m, axis=0)
 
 
 def _offset_gradients_no_sign(frames):
@@ -389,6 +438,9 @@ exercises.register(
             _offset_gradients_mean,
         AXES_HINT: _offset_gradients_swapped_axes,
         "the offset cancels the median gradient: return minus the median": _offset_gradients_no_sign,
+        "take the median of the frames' differences (np.median(np.diff(F, axis=2), axis=0)), not the differences "
+        "of the median frame: the two differ wherever an edge moves":
+            _offset_gradients_of_median_frame,
     })
 
 

@@ -113,17 +113,24 @@ def _sorted_events(rng, n, t0=0.0, t1=1.0):
 
 def _inputs_integrate(rng):
     cases = []
-    for n, q, C in ((5, 6, 0.2), (12, 7, 0.5), (40, 9, 0.25)):
-        t, p = _sorted_events(rng, n)
-        tq = np.sort(np.concatenate([[-0.1, 1.1], rng.uniform(0, 1, q - 2)]))
-        if n == 40:
-            tq = tq[rng.permutation(q)]         # query times in any order (a sweep that assumes them sorted fails)
-        cases.append(dict(t_events=t, p_events=p, C=C, t_query=tq))
+    t, p = _sorted_events(rng, 40)
+    tq = np.sort(np.concatenate([[-0.1, 1.1], rng.uniform(0, 1, 7)]))
+    tq = tq[rng.permutation(9)]                 # query times in any order (a sweep that assumes them sorted fails)
+    cases.append(dict(t_events=t, p_events=p, C=0.25, t_query=tq))
+    # 150 ON events on an absolute clock (t ~ 1000 s): the running sum passes 127, which int8 polarities summed
+    # as int8 wrap round (a loop `s = 0; s += p[i]` stays int8 in NumPy 2, so does an int8 buffer); and four
+    # queries sit 10 us before an event, which float32 timestamps (spacing 61 us at 1000 s) cannot tell apart
+    t = 1000.0 + np.sort(rng.uniform(0, 1, 150))
+    tq = np.sort(np.concatenate([[999.9, 1001.1], t[[10, 40, 80, 120]] - 1e-5, [t[130]]]))
+    cases.append(dict(t_events=t, p_events=np.ones(150, np.int8), C=0.5, t_query=tq))
     # the boundary rule t_i <= t_q: queries exactly at event times (and at a repeated time) count
     # the event, so side="left" or a strict `<` fails here
     t = np.array([0.1, 0.25, 0.25, 0.5, 0.8])
     p = np.array([1, 1, 1, -1, 1], dtype=np.int8)
     cases.append(dict(t_events=t, p_events=p, C=0.2, t_query=np.array([0.0, 0.1, 0.25, 0.3, 0.5, 0.8, 1.0])))
+    # last, a pixel that never fired: no events at all (every query reads 0; csum[n - 1] or t_events[0] raises)
+    cases.append(dict(t_events=np.zeros(0), p_events=np.zeros(0, np.int8), C=0.2,
+                      t_query=np.array([-0.1, 0.0, 0.3, 0.5, 0.9, 1.1])))
     return cases
 
 
@@ -224,6 +231,30 @@ def _integrate_no_leading_zero(t_events, p_events, C, t_query):
     return C * csum[n - 1]
 
 
+def _integrate_int8_sum(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): the running sum kept in the polarities' int8 (a loop `s += p[i]`)."""
+    p = np.asarray(p_events)
+    csum = np.concatenate([np.zeros(1, p.dtype), np.cumsum(p, dtype=p.dtype)])
+    return C * csum[np.searchsorted(np.asarray(t_events, np.float64), np.asarray(t_query, np.float64), side="right")]
+
+
+def _integrate_float32_times(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): times compared in float32."""
+    return integrate_events_1d(np.asarray(t_events, np.float32), p_events, C, np.asarray(t_query, np.float32))
+
+
+def _integrate_on_only(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): only the ON events counted (p > 0), OFF events ignored."""
+    return integrate_events_1d(t_events, (np.asarray(p_events) > 0).astype(np.float64), C, t_query)
+
+
+def _integrate_first_event_lost(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): the running sum starts at the second event (np.cumsum(p[1:]))."""
+    p = np.asarray(p_events, dtype=np.float64).copy()
+    p[:1] = 0.0
+    return integrate_events_1d(t_events, p, C, t_query)
+
+
 exercises.register(
     "integrate_events_1d", integrate_events_1d, _inputs_integrate,
     hints={
@@ -237,7 +268,38 @@ exercises.register(
         "a query before the first event counts no event, but csum[n - 1] with n = 0 reads csum[-1], the "
         "total: prepend a 0 (np.concatenate([[0.0], np.cumsum(p)])) and read csum[n]":
             _integrate_no_leading_zero,
+        "the running sum overflowed: int8 polarities summed as int8 wrap round past 127 (a loop `s = 0; s += "
+        "p[i]` stays int8 in NumPy 2, and so does an int8 buffer); sum in float64 (s = 0.0, or "
+        "np.cumsum(np.asarray(p, dtype=np.float64)))":
+            _integrate_int8_sum,
+        "timestamps must stay float64: in float32 a time near 1000 s is rounded to 61 us, so a query 10 us "
+        "before an event counts it":
+            _integrate_float32_times,
+        "OFF events count too: add C for every ON event and subtract C for every OFF event (sum p, not the "
+        "number of ON events)":
+            _integrate_on_only,
+        "the first event is lost: the running sum must include event 0 (np.cumsum(p), then a leading 0 for "
+        "'no event yet'), not start at p[1]":
+            _integrate_first_event_lost,
+        "multiply by C once: C * sum(p), not C * C * sum(p)":
+            lambda t_events, p_events, C, t_query: C * integrate_events_1d(t_events, p_events, C, t_query),
     })
+
+def _rate_per_event(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): each window's sum divided by its number of events, not its length."""
+    b = np.asarray(boundaries, dtype=np.float64)
+    t = np.asarray(t_events, dtype=np.float64)
+    idx, inside = _window_index(t, b)
+    n = np.bincount(idx, minlength=b.size - 1)
+    return window_sums(t, p_events, C, b) / np.maximum(n, 1)
+
+
+def _rate_closed_both(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): windows [b_k, b_{k+1}] closed at both ends (an edge event counted twice)."""
+    t, b = np.asarray(t_events, float), np.asarray(boundaries, float)
+    p = np.asarray(p_events, float)
+    return C * np.array([p[(t >= lo) & (t <= hi)].sum() for lo, hi in zip(b[:-1], b[1:])]) / np.diff(b)
+
 
 def _rate_first_window_length(t_events, p_events, C, boundaries):
     b = np.asarray(boundaries, dtype=np.float64)
@@ -278,6 +340,18 @@ exercises.register(
         "divide each window's sum by its own length, np.diff(boundaries), not the first window's length (b[1] "
         "- b[0]): the windows differ in length":
             _rate_first_window_length,
+        "divide by the window's length in seconds (b_{k+1} - b_k), not by the number of events in it: Eq. 4 is "
+        "a rate per second":
+            _rate_per_event,
+        "divide each window's sum by its own length, not by the whole span b_B - b_0":
+            lambda t_events, p_events, C, boundaries: window_sums(t_events, p_events, C, boundaries)
+            / (float(np.asarray(boundaries, dtype=np.float64)[-1]) - float(np.asarray(boundaries, dtype=np.float64)[0])),
+        "divide by the window length t2 - t1, do not multiply by it":
+            lambda t_events, p_events, C, boundaries: window_sums(t_events, p_events, C, boundaries)
+            * np.diff(np.asarray(boundaries, dtype=np.float64)),
+        "windows are (b_k, b_{k+1}], open on the left: with both ends closed, [b_k, b_{k+1}], an event exactly on "
+        "an inner edge counts in two windows":
+            _rate_closed_both,
     })
 
 def _loss_rates(dF_dt, delta_L, durations):
@@ -310,6 +384,10 @@ exercises.register(
             _loss_root,
         "multiply dF/dt by the window length, not delta_L: delta_L is already a change over the window":
             _loss_durations_on_events,
+        "the mean over B windows divides by B, not B - 1 (that is a sample variance's correction)":
+            lambda dF_dt, delta_L, durations: torch.sum((delta_L - dF_dt * durations) ** 2) / (delta_L.numel() - 1),
+        "square each window's difference, then average: torch.mean(d ** 2), not torch.mean(d) ** 2 (the brackets)":
+            lambda dF_dt, delta_L, durations: torch.mean(delta_L - dF_dt * durations) ** 2,
     })
 
 

@@ -106,7 +106,10 @@ exercises.register(
            "clock rarely starts at 0":
            _rate_bins_from_zero,
            "B = ceil((t[-1] - t0) / bin_s) bins: int() rounds down and drops the last, partial bin":
-           _rate_bins_rounded_down})
+           _rate_bins_rounded_down,
+           "a rate is events per second: divide each bin's count by the bin width bin_s, not by the number of "
+           "events (that is the fraction of the events in each bin)":
+           lambda t, bin_s: (event_rate(t, bin_s)[0], event_rate(t, bin_s)[1] * bin_s / len(t))})
 
 
 def _inputs_threshold(rng):
@@ -148,6 +151,12 @@ exercises.register(
         "sum(ΔL) / sum(n) lets rising and falling pixels cancel: the least-squares slope is sum(ΔL n) / "
         "sum(n^2)":
             _threshold_ratio_of_sums,
+        "divide by sum(n^2), not sum(|n|): the least-squares slope of ΔL ≈ C n is sum(ΔL n) / sum(n^2)":
+            lambda log_changes, net_counts: float(np.sum(np.asarray(log_changes, float) * net_counts)
+                                                  / np.sum(np.abs(np.asarray(net_counts, float)))),
+        "divide by sum(n^2), not by the number of pixels: sum(ΔL n) / M is a covariance, not the slope":
+            lambda log_changes, net_counts: float(np.sum(np.asarray(log_changes, float) * net_counts)
+                                                  / len(np.asarray(net_counts))),
     })
 
 
@@ -219,6 +228,17 @@ def _offset_over_256(first_frame, L_t0, eps=FRAME_EPS):
     return anchor_first_offset(a / 256.0 if a.dtype == np.uint8 else a, L_t0, eps)
 
 
+def _offset_log1p(first_frame, L_t0, eps=FRAME_EPS):
+    return anchor_first_offset(first_frame, L_t0, 1.0)
+
+
+def _offset_floor_division(first_frame, L_t0, eps=FRAME_EPS):
+    a = np.asarray(first_frame)
+    if a.dtype != np.uint8:
+        return anchor_first_offset(a, L_t0, eps)
+    return np.log((a // 255).astype(np.float64) + eps) - np.asarray(L_t0, np.float64)
+
+
 def _offset_log10(first_frame, L_t0, eps=FRAME_EPS):
     a = np.asarray(first_frame)
     intensity = a / 255.0 if a.dtype == np.uint8 else np.clip(np.asarray(a, np.float64), 0.0, 1.0)
@@ -243,4 +263,8 @@ exercises.register(
             _offset_over_256,
         "log intensities are natural logs (np.log), not base 10 (np.log10)":
             _offset_log10,
+        "np.log1p(I) is log(1 + I): the offset needs log(I0 + eps) with the small `eps`, not 1":
+            _offset_log1p,
+        "`first_frame // 255` is integer division (0 for every pixel but the saturated ones): divide with `/`":
+            _offset_floor_division,
     })

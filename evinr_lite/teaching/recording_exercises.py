@@ -86,11 +86,14 @@ def _inputs_hot(rng):
     counts.ravel()[rng.choice(54, 3, replace=False)] = (150, 400, 31)
     x, y = _events_from_counts(counts, rng)
     cases.append(dict(x=x, y=y, sensor_size=(6, 9), factor=10.0))
-    # the median is 1 (most firing pixels fired once); 4 = 4 x 1 is on the threshold, 5 above it
+    # an even number of firing pixels (8), counts 1 1 2 2 | 4 9 11 20: the median is (2 + 4) / 2 = 3 (np.median
+    # averages the two middle values), so with factor 3 the threshold is 9: 9 is on it (not hot), 11 and 20 are
+    # hot. The upper middle value (sorted[n // 2] = 4) flags only 20, the lower one (2) flags 9 too
     counts = np.zeros((5, 3), np.int64)
-    counts[0, 0], counts[1, 1], counts[2, 2], counts[3, 0], counts[4, 1], counts[4, 2] = 1, 1, 1, 4, 5, 1
+    for (r, c), n in {(0, 0): 1, (1, 1): 2, (2, 2): 1, (3, 0): 4, (4, 1): 9, (4, 2): 2, (0, 2): 11, (2, 0): 20}.items():
+        counts[r, c] = n
     x, y = _events_from_counts(counts, rng)
-    cases.append(dict(x=x, y=y, sensor_size=(5, 3), factor=4.0))
+    cases.append(dict(x=x, y=y, sensor_size=(5, 3), factor=3.0))
     return cases
 
 
@@ -126,6 +129,20 @@ def _hot_fancy_index(x, y, sensor_size, factor=10.0):
     return counts > factor * np.median(counts[counts > 0])
 
 
+def _hot_upper_middle(x, y, sensor_size, factor=10.0):
+    """The 'median' read as the middle element of the sorted counts, sorted[n // 2]: the upper of the two middle
+    values when n is even."""
+    counts = _pixel_counts(x, y, sensor_size)
+    nz = np.sort(counts[counts > 0])
+    return counts > factor * nz[len(nz) // 2]
+
+
+def _hot_distinct_counts(x, y, sensor_size, factor=10.0):
+    """The median of the distinct counts (np.unique), not of the pixels' counts."""
+    counts = _pixel_counts(x, y, sensor_size)
+    return counts > factor * np.median(np.unique(counts[counts > 0]))
+
+
 def _hot_rows_columns_swapped(x, y, sensor_size, factor=10.0):
     """Counts indexed [x, y]: the transposed map (on a sensor that is not square, an IndexError or this)."""
     return hot_pixel_mask(x, y, sensor_size, factor).T
@@ -142,6 +159,12 @@ exercises.register(
         "repeated indices): use np.add.at(counts, (y, x), 1) or np.bincount(y * W + x, minlength=H * W)":
             _hot_fancy_index,
         "rows are y and columns are x: count into counts[y, x]": _hot_rows_columns_swapped,
+        "the median of an even number of counts is the mean of the two middle values (np.median): sorted[n // 2] "
+        "is only the upper one": _hot_upper_middle,
+        "a pixel above the threshold is missed: compare count > factor * np.median(counts[counts > 0]), the "
+        "median of one count per firing pixel; not of the distinct values (np.unique), nor of the pixels that "
+        "fired more than once, and not `count // median > factor` (integer division rounds the ratio down)":
+            _hot_distinct_counts,
         "use the `factor` argument, not a fixed 10 (its default)": _hot_factor_ignored,
     })
 
@@ -190,6 +213,12 @@ def _windows_float_positions(n_events, max_events):
     return np.linspace(0, n_events, w + 1).astype(np.int64)
 
 
+def _windows_array_split(n_events, max_events):
+    w = max(1, math.ceil(n_events / max_events))
+    sizes = [len(a) for a in np.array_split(np.arange(n_events), w)]
+    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+
+
 exercises.register(
     "event_count_windows", event_count_windows, _inputs_windows, compare=_compare_windows,
     hints={
@@ -202,6 +231,12 @@ exercises.register(
         "k * N / w in floating point can land just below a whole number (60.9999... becomes 60): compute "
         "idx[k] = (k * N) // w in integers":
             _windows_float_positions,
+        "idx[k] = floor(k N / w) puts the longer windows last; np.array_split puts them first: build the indices "
+        "from the docstring's rule, (np.arange(w + 1) * N) // w":
+            _windows_array_split,
+        "idx[k] = floor(k N / w) rounds down: np.round moves some edges up by one":
+            lambda n_events, max_events: np.round(np.arange(max(1, math.ceil(n_events / max_events)) + 1) * n_events
+                                                  / max(1, math.ceil(n_events / max_events))).astype(np.int64),
     })
 
 
@@ -306,6 +341,20 @@ def _filter_any_over_events(t, x, y, dt):
     return np.any((cheb == 1) & in_time, axis=0)
 
 
+def _filter_manhattan_two(t, x, y, dt):
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    m = np.abs(x[:, None] - x[None, :]) + np.abs(y[:, None] - y[None, :])
+    return np.any((m >= 1) & (m <= 2) & (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
+
+
+def _filter_unsigned_coordinates(t, x, y, dt):
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x).astype(np.uint8), np.asarray(y).astype(np.uint8)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    return np.any((cheb == 1) & (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
+
+
 def _filter_loop_off_by_one(t, x, y, dt, first=0, last=0):
     n = len(t)
     keep = np.zeros(n, dtype=bool)
@@ -344,6 +393,12 @@ exercises.register(
         "every event gets an answer, the first one too (a neighbour with the same timestamp keeps it): loop i "
         "over range(len(t)), not range(1, len(t))":
             _filter_first_event_never_kept,
+        "the 8 neighbours are the pixels with max(|dx|, |dy|) == 1: |dx| + |dy| <= 2 also takes pixels two "
+        "columns (or rows) away":
+            _filter_manhattan_two,
+        "unsigned coordinates (uint8, uint16) wrap round when subtracted (1 - 2 = 255): convert x and y to a "
+        "signed integer (np.int64) before taking |x_j - x_i|":
+            _filter_unsigned_coordinates,
     })
 
 

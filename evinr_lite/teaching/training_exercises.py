@@ -112,6 +112,36 @@ def _no_durations(model, optimizer, event_frames, centers, durations, lam):
     return frame_train_step(model, optimizer, event_frames, centers, torch.ones_like(durations), lam)
 
 
+def _lam_on_temporal(model, optimizer, event_frames, centers, durations, lam):
+    F, dF_dt = model.forward_with_derivative(centers)
+    temporal = temporal_loss_derivative(dF_dt, event_frames, durations)
+    reg = tikhonov(F)
+    optimizer.zero_grad()
+    (lam * temporal + reg).backward()
+    optimizer.step()
+    return (lam * temporal + reg).detach(), temporal.detach(), reg.detach()
+
+
+def _losses_after_step(model, optimizer, event_frames, centers, durations, lam):
+    frame_train_step(model, optimizer, event_frames, centers, durations, lam)
+    with torch.enable_grad():
+        F, dF_dt = model.forward_with_derivative(centers)
+    temporal = temporal_loss_derivative(dF_dt, event_frames, durations)
+    reg = tikhonov(F)
+    return (temporal + lam * reg).detach(), temporal.detach(), reg.detach()
+
+
+def _regularizer_on_derivative(model, optimizer, event_frames, centers, durations, lam):
+    F, dF_dt = model.forward_with_derivative(centers)
+    temporal = temporal_loss_derivative(dF_dt, event_frames, durations)
+    reg = tikhonov(dF_dt)
+    loss = temporal + lam * reg
+    optimizer.zero_grad()
+    loss.backward()
+    optimizer.step()
+    return loss.detach(), temporal.detach(), reg.detach()
+
+
 def _only_temporal(model, optimizer, event_frames, centers, durations, lam):
     return frame_train_step(model, optimizer, event_frames, centers, durations, 0.0)
 
@@ -122,7 +152,8 @@ exercises.register(
         "call optimizer.zero_grad() before loss.backward(): otherwise the new gradients are added to the "
         "ones left from the previous step":
             _no_zero_grad,
-        "the parameters did not change: call optimizer.step() after loss.backward()":
+        "the parameters did not change: call optimizer.step() after loss.backward(), and no "
+        "optimizer.zero_grad() between the two (it wipes the gradients the step needs)":
             _no_step,
         "weight the Tikhonov term by lam (loss = temporal + lam * regularizer)":
             _no_lam,
@@ -130,4 +161,11 @@ exercises.register(
             _no_durations,
         "the loss is temporal + lam * Tikhonov: the regularizer is missing":
             _only_temporal,
+        "lam weights the regularizer, not the temporal term: loss = temporal + lam * tikhonov(F)":
+            _lam_on_temporal,
+        "return the losses computed for this step, before optimizer.step(): evaluating them again after the "
+        "step reports the next step's losses":
+            _losses_after_step,
+        "Tikhonov (Eq. 9) regularizes the spatial differences of F, the log intensity, not of dF/dt":
+            _regularizer_on_derivative,
     })
