@@ -554,7 +554,9 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
     """
     from filelock import FileLock, Timeout
 
-    out_dir = Path(out_dir)
+    from ..io.output import given_output_path
+
+    out_dir = given_output_path(out_dir)   # "" is refused, not taken as the current folder
     # every option checked, once; a batch writes no video unless asked
     options = RunOptions.of(options, **fields) if options is not None else RunOptions(**{"video": False, **fields})
     options.check_batch()

@@ -22,6 +22,7 @@ from ..core.events import TIME_UNITS, EventDataError
 from ..method.anchor import ANCHOR_MODES
 from ..core.recording import Recording
 from ..io.formats.mvsec import CAMERAS
+from ..io.text import MAX_CLOCK_S
 from ..method.config import EvINRConfig
 from ..method.memory import check_times_memory
 from ..method.recipes import RECIPES, contrast_option, recipe_config
@@ -224,6 +225,11 @@ class RunOptions:
             raise EventDataError(f"fps= must be a positive number of frames per second, got {self.fps}")
         checked.update(fps=_finite("fps=", self.fps), t_start=_finite("t_start=", self.t_start),
                        t_end=_finite("t_end=", self.t_end))
+        for name in ("t_start", "t_end"):   # 1e308 would overflow the frame count (an internal error), not be refused
+            if checked[name] is not None and abs(checked[name]) > MAX_CLOCK_S:
+                raise EventDataError(f"{name}={getattr(self, name)!r} s is beyond any recording's clock (over "
+                                     f"{MAX_CLOCK_S:.3g} s, 285 million years); give seconds on the recording's clock, "
+                                     "as `evinr-lite info` prints its span (or leave it out: the whole recording)")
         if self.t_start is not None and self.t_end is not None and not self.t_end > self.t_start:
             raise EventDataError(f"time window [{self.t_start}, {self.t_end}) is empty or reversed; t_end= must "
                                  "exceed t_start=")

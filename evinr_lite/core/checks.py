@@ -14,7 +14,7 @@ import numbers
 import numpy as np
 
 from .events import EventDataError
-from .guard import InputError, host_array
+from .guard import InputError, check_unmasked, host_array
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
@@ -114,6 +114,7 @@ def seconds_array(value, name: str, *, allow_empty: bool = False) -> np.ndarray:
 
     Refused: text, objects and booleans (not seconds), arrays of 2 or more dimensions (a column [Q, 1] is not
     taken as Q times: pass ``np.ravel(times)``), NaN or inf, and no times at all (unless ``allow_empty``)."""
+    check_unmasked(value, name + "=", EventDataError)   # np.asarray would use the values under the mask as times
     try:
         arr = np.asarray(host_array(value)) if not isinstance(value, (str, bytes)) else np.asarray([value])
     except (TypeError, ValueError):   # a ragged list ([[0.1], [0.2, 0.3]]): no array of times

@@ -291,8 +291,13 @@ class Events:
         n = {name: a.shape[0] for name, a in arrays.items()}
         if len(set(n.values())) != 1:
             raise EventDataError(f"t, x, y, p must have the same length, got {n}")
+        if t.dtype.kind in "mM":   # numpy's datetime64 / timedelta64: a clock, not seconds
+            raise EventDataError(f"timestamps must be numbers (seconds), got dtype {t.dtype}; convert them to float64 "
+                                 "seconds, e.g. (t - t[0]) / np.timedelta64(1, 's')")
         if t.dtype.kind not in "fiu":
-            raise EventDataError(f"timestamps must be numbers (seconds), got dtype {t.dtype}")
+            raise EventDataError(f"timestamps must be numbers (seconds), got dtype {t.dtype}" +
+                                 ("; if they are numbers kept as objects, convert them: np.asarray(t, dtype=np.float64)"
+                                  if t.dtype == object else ""))
         if t.dtype == np.float32 or t.dtype == np.float16:
             raise EventDataError(
                 "timestamps are float32/float16, which loses microseconds (and whole seconds on absolute "
@@ -320,7 +325,9 @@ class Events:
                 if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
                     raise EventDataError(f"{name} coordinates must be whole pixel indices; found non-integer values")
             elif a.dtype.kind not in "iu":
-                raise EventDataError(f"{name} coordinates must be integers, got dtype {a.dtype}")
+                raise EventDataError(f"{name} coordinates must be integers, got dtype {a.dtype}" +
+                                     (f"; if they are whole numbers kept as objects, convert them: np.asarray({name}, "
+                                      "dtype=np.int64)" if a.dtype == object else ""))
             if a.size and (a.min() < 0 or a.max() >= size):
                 swapped = (x.size and y.size and x.min() >= 0 and y.min() >= 0 and x.max() < H and y.max() < W
                            and H != W)
@@ -359,13 +366,18 @@ class Events:
         if time_unit not in TIME_UNITS:
             raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
         t, x, y, p = (host_array(a) for a in (t, x, y, p))
-        t = np.asarray(t)
+        t = dense_array(t, "Events.t", error=EventDataError)   # a ragged nest: named, not numpy's ValueError
         if time_unit != "s":
             t, shift = relative_seconds(t, time_unit)
             t_origin = t_origin + shift
-        if sort:
+        if sort:   # the columns' shapes are checked first: indexing would raise numpy's IndexError on a mismatch
+            x, y, p = (dense_array(a, f"Events.{k}", error=EventDataError) for a, k in ((x, "x"), (y, "y"), (p, "p")))
+            shapes = {k: np.shape(a) for k, a in zip("txyp", (t, x, y, p))}
+            if any(len(shape) != 1 for shape in shapes.values()) or len({shape[0] for shape in shapes.values()}) != 1:
+                raise EventDataError(f"t, x, y, p must be 1-D arrays of the same length [N] to be sorted, got shapes "
+                                     f"{shapes}; give one value per event in each (np.ravel a column [N, 1])")
             order = np.argsort(t, kind="stable")
-            t, x, y, p = (np.asarray(a)[order] for a in (t, x, y, p))
+            t, x, y, p = (a[order] for a in (t, x, y, p))
         return cls(t, x, y, p, sensor_size, t_origin=t_origin, polarity_encoding=polarity)
 
     @classmethod

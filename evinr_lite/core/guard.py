@@ -26,7 +26,7 @@ import sys
 import threading
 from contextlib import contextmanager
 
-__all__ = ["InputError", "host_array", "dense_array", "Interrupted", "TERMINATION_SIGNALS", "termination_signals", "signals_deferred",
+__all__ = ["InputError", "host_array", "dense_array", "check_unmasked", "Interrupted", "TERMINATION_SIGNALS", "termination_signals", "signals_deferred",
            "run_guarded", "protect_streams", "check_cwd", "EXIT_OK", "EXIT_ERROR", "EXIT_INTERNAL"]
 
 
@@ -45,14 +45,21 @@ def dense_array(value, name: str, dtype=None, error: type[Exception] | None = No
     """``np.asarray(host_array(value), dtype)``, with a ragged nest (``[[0.1], [0.2, 0.3]]``: rows of
     different lengths, which numpy refuses with "setting an array element with a sequence") or values that
     are not numbers where ``dtype`` asks for them refused as ``error`` (default :class:`InputError`) naming
-    ``name`` and the fix (``want``: what to give instead), instead of numpy's bare ValueError. numpy is
+    ``name`` and the fix (``want``: what to give instead), instead of numpy's bare ValueError. Also refused
+    by name: a generator, iterator or set (numpy makes a 0-d object array of it), a masked array with masked
+    entries (:func:`check_unmasked`) and a Python integer beyond int64 (numpy keeps it as an object). numpy is
     imported on first use."""
     import numpy as np
 
     error = InputError if error is None else error
     value = host_array(value)
+    if isinstance(value, (set, frozenset)) or (hasattr(value, "__next__") and hasattr(value, "__iter__")):
+        raise error(f"{name} is a {type(value).__name__}, which numpy takes as one object, not as values"
+                    + ("; a set has no order either" if isinstance(value, (set, frozenset)) else "")
+                    + f": give {want} (list(...) of it)")
+    check_unmasked(value, name, error)
     try:
-        return np.asarray(value, dtype=dtype)
+        arr = np.asarray(value, dtype=dtype)
     except (TypeError, ValueError) as err:
         text = " ".join(repr(value).split())
         text = text if len(text) <= 60 else f"{type(value).__name__} {text[:50]}..."
@@ -60,6 +67,36 @@ def dense_array(value, name: str, dtype=None, error: type[Exception] | None = No
             raise error(f"{name} is ragged (its parts have different lengths or shapes: {text}), so it is no "
                         f"array; give {want}") from None
         raise error(f"{name} must be numbers, got {text} ({err})") from None
+    return _object_integers(arr, name, error) if arr.dtype == object and arr.ndim else arr
+
+
+def check_unmasked(value, name: str, error: type[Exception] | None = None) -> None:
+    """Refuse (``error``, default :class:`InputError`) a numpy masked array with masked entries: ``np.asarray``
+    drops the mask and would use the values under it as if they were data (netCDF4, ``np.genfromtxt(...,
+    usemask=True)`` and ``np.ma`` give such arrays). A masked array with nothing masked passes."""
+    import numpy as np
+
+    if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
+        masked = int(np.ma.count_masked(value))
+        raise (error or InputError)(
+            f"{name} is a masked array with {masked} of its {np.size(value)} values masked; the values under the "
+            f"mask are no data: drop those entries (a.compressed(), with the same entries of the other columns) or "
+            f"fill them (a.filled(value)) first")
+
+
+def _object_integers(arr, name: str, error):
+    """``arr`` (an object array [...]) as it is, after refusing (``error``) by name and index a Python integer
+    beyond int64 among plain numbers: numpy keeps such a list as objects, which callers would call "not
+    numbers" or "not integers" when the value is an integer, only too large for any clock or sensor."""
+    import numbers
+
+    flat = arr.ravel().tolist()
+    if all(isinstance(v, (numbers.Integral, float)) and not isinstance(v, bool) for v in flat):
+        for i, v in enumerate(flat):
+            if isinstance(v, numbers.Integral) and not -2**63 <= v < 2**63:
+                raise error(f"{name}[{i}] = {v} does not fit a 64-bit integer: no timestamp, pixel index or "
+                            "polarity is that large, so the value is damaged; repair or drop it")
+    return arr
 
 
 EXIT_OK, EXIT_ERROR, EXIT_INTERNAL = 0, 2, 1

@@ -38,7 +38,7 @@ from PIL import Image
 from ..core.events import InputError
 from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, termination_signals  # re-exported
 
-__all__ = ["atomic_output_dir", "CloseOrAbort", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
+__all__ = ["atomic_output_dir", "given_output_path", "CloseOrAbort", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
            "termination_signals", "signals_deferred", "save_png", "PngWriter", "save_json", "first_existing", "check_writable",
            "TERMINATION_SIGNALS", "PARTIAL_MARKER", "mark_partial", "remove_stale_partials", "remove_lock_file",
            "resolve_path"]
@@ -101,6 +101,15 @@ def _inside(a: Path, b: Path) -> bool:
     return a == b or b in a.parents
 
 
+def given_output_path(out_dir) -> Path:
+    """``out_dir`` as a Path (``~`` expanded); an empty or blank name is an OutputError, not the current folder
+    (``Path("")`` is ".") nor a folder named by spaces."""
+    if isinstance(out_dir, (str, bytes)) and not out_dir.strip():
+        raise OutputError(f"out_dir={out_dir!r} is empty or blank (an empty path would be the current folder); pass "
+                          "the folder to write, e.g. out_dir=rec")
+    return Path(out_dir).expanduser()
+
+
 def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:
     """Every check of an output folder that can be made before any work; returns its absolute path.
 
@@ -111,7 +120,7 @@ def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:
     Raises:
         OutputError naming the problem and the fix.
     """
-    given = Path(out_dir).expanduser()
+    given = given_output_path(out_dir)
     out = Path(os.path.abspath(given))
     if out == out.parent or not out.name:
         raise OutputError(f"out_dir={str(given)!r} is the root of the file system; choose a folder to create, e.g. out_dir=rec")
@@ -213,7 +222,7 @@ class OutputDir:
     """
 
     def __init__(self, out_dir, *, overwrite: bool = False, inputs=(), log=None, command: str = ""):
-        self.given = Path(out_dir).expanduser()
+        self.given = given_output_path(out_dir)
         self.overwrite = overwrite
         self.inputs = tuple(inputs)
         self.log = log or (lambda message: None)

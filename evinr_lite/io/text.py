@@ -264,6 +264,43 @@ def _plain_integers(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> bo
         _parse_digits(buf, starts + signed, ends) is not None
 
 
+_DASHES = ("\u2212", "\u2013", "\u2014", "\u2010", "\u2011", "\ufe63", "\uff0d")   # minus, en/em dash, hyphens
+_POLARITY_WORDS = ("on", "off", "+", "-", "pos", "neg", "positive", "negative")
+_SIZE_LINE = re.compile(r"^\d+\s*[x\u00d7,;:/]\s*\d+$", re.IGNORECASE)   # `640x480`, `640,480`: a mistyped `W H`
+_QUOTED_THOUSANDS = re.compile(r'"\s*[+-]?\d{1,3}(,\d{3})+(\.\d*)?\s*"')   # "3,305": a spreadsheet's 1,000s
+
+
+def _token_hint(token: str, column: str, layout: TextLayout) -> str:
+    """The fix for a value that does not parse, when its text shows the usual cause ('' when it does not):
+    a Unicode minus or dash, a decimal comma or a trailing separator in a space-separated file, a polarity
+    written as a word or a bare sign."""
+    if any(d in token for d in _DASHES):
+        return ("; it holds a Unicode minus sign or dash, not the ASCII '-' a number needs (a word processor or "
+                "a copy from a web page puts it there): replace it with '-' (e.g. `sed 's/\u2212/-/g'`)")
+    if column == "p" and token.strip().lower() in _POLARITY_WORDS:
+        return ("; write the polarity as a number: 1 (or +1, or True) for ON / positive events, 0 (or -1, or "
+                "False) for OFF / negative ones")
+    if not layout.separators and re.fullmatch(r"[+-]?\d+,\d+", token):
+        return ("; it has a decimal comma: write a decimal point (0.5), or name the file .csv with `;` between "
+                "the values, a spreadsheet's layout, whose reader takes decimal commas")
+    if not layout.separators and token[-1:] in ",;" and token[:-1]:
+        return (f"; {token[-1]!r} follows the value, but a `t x y p` text file separates its values with spaces "
+                "only: remove the separators, or name the file .csv")
+    return ""
+
+
+def _count_hint(text: str, first: bool, layout: TextLayout) -> str:
+    """The fix for a line with the wrong number of values, when its text shows the usual cause ('' else)."""
+    if first and layout.size_line and _SIZE_LINE.match(text):
+        return ("; if it gives the sensor size, the `W H` line is the width and the height separated by a space "
+                "(e.g. `640 480`)")
+    if b'"' in layout.separators and _QUOTED_THOUSANDS.search(text):
+        return ("; a quoted value holds commas as thousands separators (\"3,305\"): save the file again with the "
+                "numbers written plainly (3305; in a spreadsheet, format the cells as numbers without the 1000 "
+                "separator)")
+    return ""
+
+
 def _line_text(buf: np.ndarray, newlines: np.ndarray, line: int) -> str:
     """Line `line` (0-based) of buf, for error messages."""
     lo = int(newlines[line - 1]) + 1 if line > 0 else 0
@@ -342,6 +379,10 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     def row_line(row):  # 0-based line (in this block) of event row `row`
         return int(np.searchsorted(newlines, starts[row, 0]))
 
+    def token_hint(row, c, column):  # the fix for token `row` of column `c` (t, x, y, p: 0..3) that did not parse
+        text = bytes(buf[starts[row, c]:ends[row, c]]).decode("utf-8", "replace")
+        return _token_hint(text, column, layout)
+
     header = None
     if first and counts.any():  # an rpg_e2vid header `W H` may open the file
         line = int(np.flatnonzero(counts)[0])
@@ -353,7 +394,9 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     if bad.size:
         i = int(bad[0])
         hint = " (a `W H` header is allowed only as the first line)" if counts[i] == 2 else ""
-        fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}{names_hint(i)}")
+        opens = first and i == int(np.flatnonzero(counts)[0])
+        fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}{names_hint(i)}"
+                f"{_count_hint(_line_text(buf, newlines, i), opens, layout)}")
     empty = np.zeros(0, dtype=np.int64)
     if time_unit not in TIME_UNITS and time_unit != "auto":
         raise EventDataError(f"unknown time_unit={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
@@ -371,7 +414,7 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         t = _parse_time(buf, starts[:, 0], ends[:, 0], origin_ns, time_unit)
     except _BadToken as err:
         fail(row_line(err.row), f"the timestamp is not a number; expected {layout.columns}"
-             f"{names_hint(row_line(err.row))}")
+             f"{names_hint(row_line(err.row)) or token_hint(err.row, 0, 't')}")
     xyp = []
     for c, name in ((1, "x"), (2, "y"), (3, "p")):
         try:
@@ -379,7 +422,8 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         except _BadToken as err:
             words = _parse_bool(buf, starts[:, c], ends[:, c]) if name == "p" else None
             if words is None:   # a polarity column of True / False (pandas' bool column) is 1 / 0
-                fail(row_line(err.row), f"{name} is not a number; expected {layout.columns}")
+                fail(row_line(err.row), f"{name} is not a number; expected {layout.columns}"
+                     f"{token_hint(err.row, c, name)}")
             xyp.append(words)
     x, y, p = xyp
 
@@ -413,7 +457,8 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
 def read_text_bytes(path, what: str = "file") -> bytes:
     """The bytes of a text file, refusing (EventDataError naming the file) what is not one: a missing
     path, a folder, a FIFO / pipe / device (reading would block or never end), an empty file, an
-    unreadable one, UTF-16/32 text. A UTF-8 byte-order mark is dropped."""
+    unreadable one, UTF-16/32 text. A UTF-8 byte-order mark is dropped; a file whose lines end in CR
+    alone (classic Mac OS, Excel for Mac's "CSV (Macintosh)") gets LF line ends (same length)."""
     import stat
 
     path = Path(path)
@@ -439,6 +484,8 @@ def read_text_bytes(path, what: str = "file") -> bytes:
     if data.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in data[:4096]:
         raise EventDataError(f"{path}: UTF-16/32 or binary content, not plain text; save it as plain UTF-8 (ASCII) "
                              f"text with lines {EVENT_COLUMNS}")
+    if b"\n" not in data and b"\r" in data.rstrip(b"\r"):   # old Mac line ends (Excel for Mac's "CSV (Macintosh)")
+        data = data.replace(b"\r", b"\n")                    # same length: byte offsets and line numbers kept
     return data
 
 

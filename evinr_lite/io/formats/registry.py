@@ -7,6 +7,7 @@ here by walking the package); detection, :func:`read_recording`, :data:`SUPPORTE
 """
 from __future__ import annotations
 
+import errno
 import importlib
 import os
 import pkgutil
@@ -92,6 +93,15 @@ def _checked_path(path) -> Path:
     if isinstance(path, (str, bytes)) and not path.strip():   # Path("") is ".", the current folder
         raise EventDataError("the recording's path is empty; pass the file or folder to read")
     path = Path(path)
+    if not path.exists() and path.is_symlink():   # a link that leads nowhere is no missing file: say which it is
+        try:
+            os.stat(path)
+        except OSError as err:
+            if err.errno == errno.ELOOP:
+                raise EventDataError(f"{path} goes through a loop of symbolic links, so it leads to no file; fix or "
+                                     "remove the link, or pass the recording itself") from None
+        raise EventDataError(f"{path} is a symbolic link to {os.readlink(path)}, which does not exist (moved or "
+                             "deleted?); point the link at the recording again, or pass the recording itself")
     if not path.exists():
         raise EventDataError(f"no such file or folder: {path}; check the path")
     try:
