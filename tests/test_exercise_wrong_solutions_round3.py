@@ -221,13 +221,19 @@ def test_events_outside_the_windows_do_not_cancel():
     assert ok
 
 
-def test_the_counts_the_notebooks_quote_are_unchanged():
-    """Each notebook says "✓ NAME: matches the reference on N inputs"; cases were changed, never added."""
+def quoted_counts() -> dict:
+    """{check name: N} from every notebook's "✓ NAME: matches the reference on N inputs"."""
     quoted = {}
     for path in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")):
         text = "".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"])
         for name, n in re.findall(r"✓ (\w+): matches the reference on (\d+) input", text):
             quoted[name] = int(n)
+    return quoted
+
+
+def test_the_counts_the_notebooks_quote_are_unchanged():
+    """Each notebook says "✓ NAME: matches the reference on N inputs"; cases were changed, never added."""
+    quoted = quoted_counts()
     for name in ("events_to_frames_fixed", "bisect_equal_count", "event_rate_derivative", "interval_imbalance",
                  "anchor_first_offset", "highpass_per_event", "render_event_counts", "temporal_loss_boundary"):
         assert name in quoted, name

@@ -23,22 +23,19 @@ failed clearly, and correct alternatives (a loop with a float sum, np.digitize, 
 least-squares solve, the high-pass filter's closed form by np.add.at, sigmoid by tanh, the push-through inverse,
 np.percentile) that must pass.
 """
-import json
-import re
-from pathlib import Path
-
-import pytest
-
-from test_exercise_wrong_solutions_round3 import _report   # the check's verdict and its printed report
-
-ROOT = Path(__file__).resolve().parents[1]
 
 import math
+
 import numpy as np
+import pytest
 import torch
+
 from evinr_lite.core.events import Events
-from evinr_lite.teaching import exercises
 from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
+from evinr_lite.teaching import exercises
+from test_exercise_wrong_solutions_round3 import _report, quoted_counts   # the check's verdict and its report; the notebooks' counts
+
+
 def R(n): return exercises.reference(n)
 
 # ---- integrate_events_1d
@@ -828,11 +825,7 @@ def test_the_cases_hold_the_edge_cases_the_holes_need():
 
 def test_the_counts_the_notebooks_quote_are_unchanged():
     """Each notebook says "✓ NAME: matches the reference on N inputs"; cases were changed, never added."""
-    quoted = {}
-    for path in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")):
-        text = "".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"])
-        for name, n in re.findall(r"✓ (\w+): matches the reference on (\d+) input", text):
-            quoted[name] = int(n)
+    quoted = quoted_counts()
     for name in ("integrate_events_1d", "hot_pixel_mask", "crossfade_weights"):
         assert len(exercises.get(name).cases()) == quoted[name], name
 
