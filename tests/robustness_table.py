@@ -25,16 +25,18 @@ HERE = Path(__file__).resolve().parent
 ROUND2 = ["test_robustness.py", "test_robustness_more.py", "test_signals.py"]
 ROUND3 = ["test_batch_ownership.py", "test_api_checks.py", "test_signals_edges.py", "test_robustness_round3.py",
           "test_io_reliability.py", "test_options.py"]
-LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_api_bad_inputs.py", "test_api_round6.py",
-         "test_fuzz_readers.py"]
+LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustness_round6.py", "test_api_bad_inputs.py",
+         "test_api_round6.py", "test_ragged_inputs.py", "test_fuzz_readers.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
     # ---- later rounds: one class per file -------------------------------------------------------
     ("bad files, round 4 (one instant, 0/1 events, absurd sizes, NaN frames)", "test_robustness_round4.py", r"test_"),
     ("exports and odd files, round 5 (spreadsheets, compressed, npz, options)", "test_robustness_round5.py", r"test_"),
+    ("text quirks, links, clocks and containers, round 6", "test_robustness_round6.py", r"test_"),
     ("Python API arguments (bad inputs)", "test_api_bad_inputs.py", r"test_"),
     ("Python API arguments, round 6 (tensors, 0-d, float32 and us times)", "test_api_round6.py", r"test_"),
+    ("ragged nests as times, samples, frames or columns", "test_ragged_inputs.py", r"test_"),
     ("fuzzed readers (every format, damaged bytes)", "test_fuzz_readers.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
