@@ -60,11 +60,12 @@ def _rate(value, name: str) -> float:
 
 def _query(t_query) -> np.ndarray:
     t_query = host_array(t_query)
-    if isinstance(t_query, (str, bytes)) or dense_array(t_query, "query times", error=EventDataError).dtype.kind not in "iuf":
+    arr = None if isinstance(t_query, (str, bytes)) else dense_array(t_query, "query times", error=EventDataError)
+    if arr is None or arr.dtype.kind not in "iuf":
         raise EventDataError(f"query times must be seconds (a number, a list or a 1-D array of numbers), got "
                              f"{t_query!r:.60}")
-    check_seconds_precision(t_query, "query_times")
-    tq = np.asarray(t_query, dtype=np.float64)
+    check_seconds_precision(arr, "query_times")
+    tq = arr.astype(np.float64)
     if tq.ndim > 1 or tq.size == 0 or not np.all(np.isfinite(tq)):
         raise EventDataError(f"query times must be a finite scalar or a non-empty 1-D array of seconds, got shape {tq.shape}")
     return tq
