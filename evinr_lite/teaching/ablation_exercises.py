@@ -84,6 +84,11 @@ def _dominated_any_over_rows(cost, quality):
     return ~dominated.any(axis=0)
 
 
+def _best_quality_only(cost, quality):
+    q = np.asarray(quality, dtype=np.float64)
+    return q == q.max()
+
+
 def _sweep(cost, quality, keep_equal):
     c, q = np.asarray(cost, dtype=np.float64), np.asarray(quality, dtype=np.float64)
     keep, best = np.zeros(len(c), dtype=bool), -np.inf
@@ -109,9 +114,12 @@ exercises.register(
            "dominates too: 'strictly better in both' is too strict": _strict_in_both,
            "lower cost is better: j dominates i when cost[j] <= cost[i]": _cost_reversed,
            "dominated[i, j] says j dominates i: variant i is on the front when no j does, any over axis 1 "
-           "(axis 0 asks whether i dominates some other variant)": _dominated_any_over_rows,
+           "(axis 0 asks whether i dominates some other variant; so does calling it with cost and quality swapped: "
+           "cost comes first, and lower cost is better)": _dominated_any_over_rows,
            "a sweep in order of cost that keeps a variant only when its quality beats the best so far drops a "
            "variant tied with a kept one in both cost and quality: ties in both are on the front": _sweep_strict,
            "a sweep that keeps a variant whenever its quality is >= the best so far keeps one that costs more for "
            "the same quality (it is dominated): keep it only when it is strictly better, or tied in both with the "
-           "last kept one": _sweep_ties_kept})
+           "last kept one": _sweep_ties_kept,
+           "the front holds every variant that no other one dominates (cheaper ones with lower quality too), not "
+           "only the best quality": _best_quality_only})

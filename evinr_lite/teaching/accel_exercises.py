@@ -207,6 +207,11 @@ def _bisect_cuts_only(t_events, boundaries):
     return bisect_equal_count(t_events, boundaries)[1::2]
 
 
+def _bisect_edges_then_cuts(t_events, boundaries):
+    out = bisect_equal_count(t_events, boundaries)
+    return np.concatenate([out[0::2], out[1::2]])
+
+
 exercises.register(
     "bisect_equal_count", bisect_equal_count, _inputs_bisect,
     hints={
@@ -232,6 +237,9 @@ exercises.register(
         "bins are (b_i, b_{i+1}], open on the left: with both ends closed an event exactly on an inner edge "
         "counts in two bins":
             _bisect_closed_both,
+        "interleave the edges and the cuts, [b_0, cut_0, b_1, cut_1, ..., b_B] (in time order), not all the edges "
+        "followed by all the cuts (np.concatenate([b, cuts])); out[0::2] = b, out[1::2] = cuts":
+            _bisect_edges_then_cuts,
     })
 
 

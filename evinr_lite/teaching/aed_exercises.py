@@ -160,6 +160,25 @@ def _grey_histogram_bins_from_data(x, y, p, C, raw_size):
     return C * f / 16
 
 
+def _grey_mean_per_pixel(x, y, p, C, raw_size):
+    """Each grey pixel's events averaged instead of summed."""
+    H, W = raw_size
+    n = np.zeros((H // 4, W // 4))
+    np.add.at(n, (np.asarray(y) // 4, np.asarray(x) // 4), 1.0)
+    return grey_event_frame(x, y, p, C, raw_size) / np.maximum(n, 1)
+
+
+def _grey_unsigned_polarity(x, y, p, C, raw_size):
+    return grey_event_frame(x, y, np.asarray(p).astype(np.uint8).astype(np.float64), C, raw_size)
+
+
+def _grey_size_from_events(x, y, p, C, raw_size):
+    """The frame sized by the largest event coordinates (y.max() // 4 + 1, x.max() // 4 + 1), not by raw_size."""
+    frame = np.zeros((int(np.max(y)) // 4 + 1, int(np.max(x)) // 4 + 1))
+    np.add.at(frame, (np.asarray(y) // 4, np.asarray(x) // 4), C * np.asarray(p, dtype=np.float64) / 16)
+    return frame
+
+
 def _grey_rows_columns_swapped(x, y, p, C, raw_size):
     """The frame indexed [x // 4, y // 4]: the transposed frame (a sensor that is not square: an IndexError or this)."""
     return grey_event_frame(x, y, p, C, raw_size).T
@@ -181,4 +200,13 @@ exercises.register(
         "np.histogram2d with a number of bins spreads them over the events' own range (min to max), not over the "
         "sensor: give the edges, bins=(np.arange(H // 4 + 1), np.arange(W // 4 + 1)), or use np.add.at":
             _grey_histogram_bins_from_data,
+        "sum the events of each grey pixel (C p / 16 each), do not average them: the net count is what changes "
+        "the log intensity":
+            _grey_mean_per_pixel,
+        "p is signed (+1 / -1): converted to an unsigned dtype (np.uint8) -1 becomes 255; keep it signed or make it "
+        "float":
+            _grey_unsigned_polarity,
+        "the frame's size comes from raw_size, (H // 4, W // 4), not from the largest event coordinates: the "
+        "last rows or columns may have no event":
+            _grey_size_from_events,
     })

@@ -23,12 +23,14 @@ __all__: list[str] = []
 
 def _inputs_highpass(rng):
     cases = []
-    # C and t_end differ between cases too: a version that fixes either to one value fails
-    for n, (H, W), alpha, C, t_end in ((12, (2, 3), 2 * math.pi, 0.2, 1.2), (40, (3, 4), 5.0, 0.35, 1.5),
-                                       (25, (1, 5), 0.0, 0.15, 1.0)):
+    # C and t_end differ between cases too: a version that fixes either to one value fails. The first sensor is
+    # one row and one column larger than the events reach (pixels that never fired): a state sized from the
+    # events (y.max() + 1, x.max() + 1) comes out too small
+    for n, (H, W), alpha, C, t_end, extra in ((12, (2, 3), 2 * math.pi, 0.2, 1.2, 1), (40, (3, 4), 5.0, 0.35, 1.5, 0),
+                                              (25, (1, 5), 0.0, 0.15, 1.0, 0)):
         t = np.sort(rng.uniform(0.0, 1.0, n))
         cases.append(dict(t=t, x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=rng.choice([-1, 1], n),
-                          sensor_size=(H, W), C=C, alpha=alpha, t_end=t_end))
+                          sensor_size=(H + extra, W + extra), C=C, alpha=alpha, t_end=t_end))
     return cases
 
 
@@ -112,6 +114,10 @@ def _alpha_times_two_pi(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return highpass_per_event(t, x, y, p, sensor_size, C, 2 * math.pi * alpha, t_end, t_start)
 
 
+def _alpha_over_two_pi(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    return highpass_per_event(t, x, y, p, sensor_size, C, alpha / (2 * math.pi), t_end, t_start)
+
+
 exercises.register(
     "highpass_per_event", highpass_per_event, _inputs_highpass, rtol=1e-6, atol=1e-10,
     hints={
@@ -128,6 +134,9 @@ exercises.register(
             _final_decay_from_last_event,
         "alpha is already in rad/s: decay by exp(-alpha dt), without another factor 2 pi":
             _alpha_times_two_pi,
+        "alpha is already in rad/s: decay by exp(-alpha dt), without dividing by 2 pi (that would make it a "
+        "frequency in Hz)":
+            _alpha_over_two_pi,
         "the state decays: exp(-alpha * (t - t_last)), with the minus sign (exp(+alpha dt) grows without bound)":
             _growth,
         "`state[y, x] += ...` adds only one of the events that share a pixel (fancy indexing does not accumulate "

@@ -136,6 +136,15 @@ def _esim_ceil(L_a, L_b, t_a, t_b, ref, C):
     return _esim_counted(L_a, L_b, t_a, t_b, ref, C, np.ceil)
 
 
+def _esim_half_levels(L_a, L_b, t_a, t_b, ref, C):
+    """A wrong version (for the hint): the events timed at the half-way levels ref + (k - 1/2) C."""
+    times, p, new_ref = esim_interval(L_a, L_b, t_a, t_b, ref, C)
+    if not len(p):
+        return times, p, new_ref
+    levels = ref + p[0] * C * (np.arange(1, len(p) + 1) - 0.5)
+    return t_a + (levels - L_a) / (L_b - L_a) * (t_b - t_a), p, new_ref
+
+
 def _esim_ref_always_up(L_a, L_b, t_a, t_b, ref, C):
     times, p, _ = esim_interval(L_a, L_b, t_a, t_b, ref, C)
     return times, p, float(ref + len(p) * C)
@@ -170,6 +179,9 @@ exercises.register(
             _esim_ceil,
         "move the reference in the direction of the events: ref + p * n * C (down for OFF events), not ref + n * C":
             _esim_ref_always_up,
+        "an event fires when L reaches the level ref + k C itself (k = 1, 2, ...), not half-way between two levels: "
+        "levels = ref + p * C * np.arange(1, n + 1)":
+            _esim_half_levels,
     })
 
 
@@ -215,6 +227,9 @@ def _inputs_frames(rng):
                 np.array([1, -1, 1, 1, -1, 1, 1, -1]), (2, 3))
     cases.append(dict(events=ev, boundaries=np.array([0.0, 0.25, 0.5]), C=0.5))
     ev = _random_events(rng, 300, (5, 7))
+    # on a 6 x 8 sensor whose last row and last column never fire: frames sized from the events (y.max() + 1,
+    # x.max() + 1) come out too small
+    ev = Events(ev.t, ev.x, ev.y, ev.p, (6, 8))
     # bins that start at b_0 = 0.125, not at 0, with one event exactly there: bin 0 takes it (`t == b_0`, not
     # `t == 0`). 0.125 is exact in float32 too, so times and edges held in float32 still meet on it
     t = ev.t.copy()
@@ -295,6 +310,13 @@ def _frames_mean_polarity(events, boundaries, C):
     return (events_to_frames_fixed(events, boundaries, C) / np.maximum(n, 1)).astype(np.float32)
 
 
+def _frames_normalised_per_frame(events, boundaries, C):
+    """A wrong version (for the hint): every frame divided by its largest |value| (a display step)."""
+    f = events_to_frames_fixed(events, boundaries, C)
+    m = np.abs(f).max(axis=(1, 2), keepdims=True)
+    return (f / np.where(m > 0, m, 1)).astype(np.float32)
+
+
 exercises.register(
     "events_to_frames_fixed", events_to_frames_fixed, _inputs_frames,
     hints={
@@ -326,6 +348,9 @@ exercises.register(
             _frames_mean_polarity,
         "multiply by C once: C * sum(p), not C * C * sum(p)":
             lambda events, boundaries, C: C * events_to_frames_fixed(events, boundaries, C),
+        "do not normalise the frames (each by its largest value): a frame holds C times the net count, in log "
+        "units, the same scale in every bin (scaling is for display only)":
+            _frames_normalised_per_frame,
     })
 
 
@@ -489,6 +514,23 @@ def _intervals_zero_not_nan(events):
     return _intervals_stat(events, none=0.0)
 
 
+def _intervals_per_pixel_means(events):
+    """A wrong version (for the hint): each pixel's mean log interval first, then the mean over pixels."""
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * W + events.x
+    order = np.argsort(pix, kind="stable")
+    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on, px = p[1:] > 0, pix[1:]
+    means = []
+    for sel in (pair & on, pair & ~on):
+        if not sel.any():
+            return float("nan")
+        means.append(np.mean([log_dt[sel & (px == k)].mean() for k in np.unique(px[sel])]))
+    return float(np.tanh((means[0] - means[1]) / 2))
+
+
 def _intervals_log_ratio(events):
     """A wrong version (for the hint): r itself, log(C+ / C-), instead of b."""
     return float(2 * np.arctanh(interval_imbalance(events)))
@@ -529,6 +571,9 @@ exercises.register(
         "with no ON pair or no OFF pair there is nothing to compare: return NaN (float('nan')), not 0 (0 would "
         "claim a balanced sensor)":
             _intervals_zero_not_nan,
+        "pool the intervals of all pixels: one mean over every ON pair and one over every OFF pair, not a mean of "
+        "per-pixel means (a pixel with one pair would weigh as much as one with a hundred)":
+            _intervals_per_pixel_means,
     })
 
 

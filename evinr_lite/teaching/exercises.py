@@ -190,6 +190,8 @@ def _describe_value(v) -> str:
         return f"{v.dtype}{list(v.shape)}" if v.size > 4 else np.array2string(v, precision=3)
     if isinstance(v, (list, tuple)) and len(v) > 4:
         return f"{type(v).__name__} of {len(v)}"
+    if isinstance(v, dict) and len(repr(v)) > 60:          # a table of rows: its repr would fill the headline
+        return f"dict of {len(v)} items ({', '.join(repr(k) for k in list(v)[:4])}{', ...' if len(v) > 4 else ''})"
     return _fmt(v) if isinstance(v, (int, float, np.number)) else repr(v)
 
 
@@ -306,9 +308,19 @@ def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
     if e.ndim == 1 and g.ndim == 1 and abs(g.shape[0] - e.shape[0]) == 1:
         more = "one entry too many" if g.shape[0] > e.shape[0] else "one entry too few"
         return f"; {more}: an off-by-one (a loop's range, a slice, or a count rounded the wrong way)?"
+    if e.ndim >= 3 and g.ndim == e.ndim and g.shape[1:] == e.shape[1:] and abs(g.shape[0] - e.shape[0]) == 1:
+        more = "one entry too many" if g.shape[0] > e.shape[0] else "one entry too few"
+        return (f"; {more} along the first axis: an off-by-one (a loop's range, a slice, np.diff's `prepend=` "
+                "that keeps the length: B + 1 boundaries make B bins)?")
     if e.ndim == 0 and g.size == 1:
         return ("; that is an array holding one number where the number itself is expected: take it out "
                 "(`x[0]`, `x.squeeze()`, or `float(x)` for a numpy result), e.g. np.linalg.lstsq returns an array")
+    if e.ndim == 0 and g.size > 1:
+        return (f"; one number is expected, not {g.size}: reduce over every entry (np.mean(x) or torch.mean(x) "
+                "without `axis=` / `dim=`), and return that number alone")
+    if g.size == e.size and g.size > 1 and tuple(d for d in g.shape if d != 1) == tuple(d for d in e.shape if d != 1):
+        return ("; the same number of entries with an extra or missing axis of length 1 (a column (N, 1) for a "
+                "1-D (N,), say): drop `[:, None]` / `reshape(-1, 1)` / `keepdims=True`, or `.ravel()` the result")
     return ""
 
 
@@ -318,7 +330,11 @@ def _dtype_note(g: np.ndarray, e: np.ndarray) -> str:
         return ": return the comparison itself (a boolean mask), without .astype(int) or multiplying by 1"
     if e.dtype.kind in "iu" and g.dtype.kind == "f":
         return (": `/` (and np.trunc, np.floor, np.round) give floats: use integer division `//` "
-                "(torch.div(..., rounding_mode='floor')), or convert with .astype(np.int64) after rounding")
+                "(torch.div(..., rounding_mode='floor')), or convert with .astype(np.int64) after rounding; an "
+                "array made without a dtype (np.zeros(n), np.full(n, p)) is float too: give dtype=")
+    if e.dtype.kind == "f" and g.dtype.kind in "iu":
+        return (": the values were made whole numbers: no .astype(int) or int(...) on the result, and no integer "
+                "array to fill (np.zeros(..., dtype=int), or np.zeros_like of an integer input such as x or p)")
     return ""
 
 
@@ -340,15 +356,23 @@ def _generic_hint(got, expected, indexed: bool = False) -> str | None:
                 "of zero or of a negative number?")
     scale = max(np.abs(e).max(), 1e-12)
     tol = 1e-6 * scale
+    if _to_numpy(got).dtype == bool and _to_numpy(expected).dtype == bool and g.size > 1 and np.all(g != e):
+        return "the mask is inverted everywhere: True where False is expected and the other way round (`~` once too often?)"
     if np.all(np.abs(g + e) <= tol) and np.any(np.abs(e) > tol):
         return "the sign is flipped everywhere"
+    with np.errstate(all="ignore"):
+        if np.all(np.abs(e) < 700) and np.allclose(g, np.exp(e), rtol=1e-6, atol=1e-9):
+            return ("the result is np.exp of the expected values: the quantity is a log intensity (or a change of "
+                    "one), so no np.exp (exp(L) is the linear intensity)")
+        if np.all(e > 0) and np.allclose(g, np.log(e), rtol=1e-6, atol=1e-9):
+            return "the result is np.log of the expected values: no np.log on this quantity (it is not a log yet)"
     nz = np.abs(e) > tol
     # one number (or one non-zero entry) is always some factor of another: say so only when several agree
     if nz.sum() >= 2 and np.all(np.abs(g[~nz]) <= tol):
         ratios = g[nz] / e[nz]
         if np.ptp(ratios) <= 1e-6 * max(1.0, abs(ratios[0])) and abs(ratios[0] - 1) > 1e-6 \
                 and abs(ratios[0]) > 1e-12:         # a factor 0 is a result of zeros, not a scaling
-            return f"off by a constant factor: got {ratios[0]:.4g} x the expected values"
+            return f"off by a constant factor: got {ratios[0]:.4g} x the expected values" + _unit_note(ratios[0])
     if g.size > 1:
         d = g - e
         if np.ptp(d) <= tol and abs(d[0]) > tol:
@@ -365,6 +389,15 @@ def _generic_hint(got, expected, indexed: bool = False) -> str | None:
                 "`a[idx] += v` adds only once for a repeated index; accumulate with `np.add.at(a, idx, v)` "
                 "(or `np.bincount(idx, weights=v)`, or `index_put_(..., accumulate=True)` in torch)")
     return None
+
+
+def _unit_note(ratio: float) -> str:
+    """A word on a factor that is a power of 1000: a unit conversion."""
+    k = np.log10(abs(ratio)) / 3 if ratio else 0.0
+    if ratio > 0 and abs(k - round(k)) < 1e-6 and round(k) != 0:
+        return (" (a power of 1000: a unit conversion? the kit's times are seconds throughout, rates per second: "
+                "no milliseconds or microseconds)")
+    return ""
 
 
 def _axes_hint(g: np.ndarray, e: np.ndarray, tol: float) -> str | None:
@@ -548,6 +581,204 @@ def _in_place_message(changed: list[str]) -> str:
             "stay as it was, so compute a new array (`x = x + ...`) or work on a copy (`np.array(x, dtype=float)`)")
 
 
+
+# ---- mistakes seen only across inputs: state kept between calls, a notebook variable for an argument ------
+
+_MUTABLE = (list, dict, set, bytearray, np.ndarray)
+
+
+def _mutable_defaults(fn: Callable) -> dict[str, Any]:
+    """Copies of ``fn``'s default argument values that can change in place (lists, dicts, sets, arrays)."""
+    out: dict[str, Any] = {}
+    try:
+        params = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return out
+    for p in params:
+        if isinstance(p.default, _MUTABLE):
+            try:
+                out[p.name] = copy.deepcopy(p.default)
+            except Exception:
+                continue
+    return out
+
+
+def _same_value(a, b) -> bool:
+    try:
+        if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+            return _same_array(a, b)
+        return bool(a == b)
+    except Exception:
+        return True          # cannot tell: say nothing
+
+
+def _mutable_default_hint(fn: Callable, before: dict[str, Any]) -> str | None:
+    """A mutable default argument that changed (or holds data) during the check."""
+    try:
+        now = {p.name: p.default for p in inspect.signature(fn).parameters.values()}
+    except (TypeError, ValueError):
+        now = {}
+    for name, old in before.items():
+        value = now.get(name)
+        if not _same_value(old, value) or (isinstance(value, (list, dict, set)) and len(value) > 0):
+            return (f"the default value of `{name}` is created once, when the function is defined, and shared by "
+                    f"every call: what one call puts in it is still there in the next (it holds data now). Use "
+                    f"`{name}=None` and create a fresh one inside the function")
+    return None
+
+
+def _state_hint(fn: Callable, before: dict[str, Any], ex: Exercise, args, kwargs, got) -> str | None:
+    """A mutable default argument that changed (or holds data) during the check, or a second call on the same
+    input that gives another result: the function keeps state from one call to the next."""
+    hint = _mutable_default_hint(fn, before)
+    if hint is not None or ex.observe is not None:
+        return hint
+    try:
+        again = _run(fn, args, kwargs, ex.observe)
+        if _compare(again, got, ex.rtol, ex.atol) is not None:
+            return ("called again on the same input, your function returns another result: it keeps state between "
+                    "calls (a notebook variable it changes, a mutable default argument, or unseeded randomness); "
+                    "compute everything from the arguments, starting afresh in each call")
+    except Exception:
+        return None
+    return None
+
+
+def _stale_elsewhere(ex: Exercise, cases: list, k: int, subset: tuple, fn_outputs) -> bool:
+    """On every other input (but #1) where the learner is wrong, its output is also the reference's with the
+    arguments ``subset`` taken from input #1: a coincidence on one input (a phase (0, 0) both times) says nothing."""
+    kw0 = cases[0][1]
+    for j, (a, kw) in enumerate(cases):
+        if j in (0, k):
+            continue
+        try:
+            g = fn_outputs(j)
+            if _compare(g, _run(ex.reference, a, kw), ex.rtol, ex.atol) is None:
+                continue
+            if _compare(g, _run(ex.reference, (), dict(kw, **{name: kw0[name] for name in subset})),
+                        ex.rtol, ex.atol) is not None:
+                return False
+        except Exception:
+            return False
+    return True
+
+
+def _stale_argument_hint(ex: Exercise, fn: Callable, cases: list, k: int, got, expected) -> str | None:
+    """The learner's output on input ``k`` equals the reference's with one or two arguments taken from input #1
+    (and so on every other input where it is wrong): the function reads a notebook variable (or a value fixed in
+    the code) in place of those arguments."""
+    if k == 0 or ex.observe is not None:
+        return None
+    memo: dict = {}
+
+    def fn_outputs(j):
+        if j not in memo:
+            memo[j] = _run(fn, *cases[j])
+        return memo[j]
+
+    (args0, kw0), (args, kw) = cases[0], cases[k]
+    if args or args0:
+        return None
+    names = [name for name in kw if name in kw0 and not _same_value(kw[name], kw0[name])]
+    subsets = [(a,) for a in names] + [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
+    for subset in subsets[:45]:
+        trial = dict(kw, **{name: kw0[name] for name in subset})
+        try:
+            w = _run(ex.reference, (), trial)
+            if _compare(w, expected, ex.rtol, ex.atol) is None or _compare(got, w, ex.rtol, ex.atol) is not None:
+                continue
+        except Exception:
+            continue
+        if not _stale_elsewhere(ex, cases, k, subset, fn_outputs):
+            continue
+        which = ", ".join(f"`{name}`" for name in subset)
+        return (f"this is the right result for input #1's {which}, not for this input's: the function uses a "
+                f"notebook variable (a global such as the first example's data) or a value fixed in the code in "
+                f"place of its argument{'s' if len(subset) > 1 else ''} {which}; use the arguments it is given")
+    return None
+
+
+def _fixed_size_hint(ex: Exercise, cases: list, k: int, got, expected) -> str | None:
+    """A result shaped like input #1's expected result (all of it, or the sizes that differ): a size fixed in the
+    code, or read from a notebook variable, instead of from the arguments."""
+    if k == 0:
+        return None
+    try:
+        g, e = _to_numpy(got), _to_numpy(expected)
+        if g.dtype == object or g.shape == e.shape or g.ndim != e.ndim or g.ndim == 0:
+            return None
+        e0 = _to_numpy(_run(ex.reference, *cases[0], ex.observe))
+    except Exception:
+        return None
+    if e0.ndim != g.ndim or e0.shape == e.shape:
+        return None
+    if all(gd == ed or gd == fd for gd, ed, fd in zip(g.shape, e.shape, e0.shape)):
+        return (f"the result's shape {g.shape} has input #1's sizes (its result is {e0.shape}), not this input's "
+                f"{e.shape}: a size fixed in the code (np.zeros(3), `H, W = 4, 4`) or taken from a notebook "
+                "variable; read the sizes from the arguments (len(...), .shape, sensor_size)")
+    return None
+
+
+def _size_from_events_hint(args, kwargs, got, expected) -> str | None:
+    """An image smaller than the sensor (the last rows or columns missing) where an input gives the sensor's
+    size: the size was read off the largest event coordinates."""
+    if not any(isinstance(v, tuple) and len(v) == 2 and all(isinstance(a, (int, np.integer)) for a in v)
+               or getattr(v, "sensor_size", None) is not None for v in (*args, *kwargs.values())):
+        return None
+    try:
+        g, e = _to_numpy(got), _to_numpy(expected)
+    except Exception:
+        return None
+    if g.ndim < 2 or g.ndim != e.ndim or g.shape[:-2] != e.shape[:-2] or g.shape == e.shape:
+        return None
+    if all(a <= b for a, b in zip(g.shape[-2:], e.shape[-2:])):
+        return ("the image is smaller than the sensor: its size is sensor_size (H, W = sensor_size), not the largest "
+                "event coordinates plus one (y.max() + 1, x.max() + 1): pixels that never fired are part of it too")
+    return None
+
+
+def _swapped_pair_hint(ex: Exercise, got, expected) -> str | None:
+    """A pair of outputs returned in the other order."""
+    if not (isinstance(expected, (tuple, list)) and len(expected) == 2 and isinstance(got, (tuple, list))
+            and len(got) == 2):
+        return None
+    try:
+        if _compare(got[::-1], expected, ex.rtol, ex.atol) is None or (
+                ex.compare is not None and ex.compare(tuple(got[::-1]), expected) is None):
+            return "the two outputs are swapped: return them in the order the docstring gives"
+    except Exception:
+        return None
+    return None
+
+
+def _scalar_factor_hint(ex: Exercise, fn: Callable, cases: list, k: int, got, expected) -> str | None:
+    """One number off by the same factor on every input (a weight such as lam, a 1/2, a sum for a mean)."""
+    if ex.observe is not None:
+        return None
+    try:
+        g, e = float(_to_numpy(got)), float(_to_numpy(expected))
+        if not (np.isfinite(g) and np.isfinite(e)) or e == 0 or g == 0:
+            return None
+        ratio = g / e
+        seen = 0
+        for j, (a, kw) in enumerate(cases):
+            if j == k:
+                continue
+            ej = float(_to_numpy(_run(ex.reference, a, kw)))
+            if ej == 0:
+                continue
+            if abs(float(_to_numpy(_run(fn, a, kw))) / ej - ratio) > 1e-5 * max(1.0, abs(ratio)):
+                return None
+            seen += 1
+    except Exception:
+        return None
+    if seen == 0:
+        return None
+    return (f"off by a constant factor: got {ratio:.4g} x the expected value on every input (a weight such as "
+            f"lam or 1/2 that does not belong here, a sum where a mean is expected, or the other way round?)"
+            + _unit_note(ratio))
+
+
 def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
     """(passed, headline, detail lines) without printing."""
     if not callable(fn):
@@ -557,6 +788,7 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
     except Exception as err:  # a bug in the exercise itself, not the learner's
         return False, f"could not build the test inputs ({type(err).__name__}: {err})", []
     n = len(cases)
+    defaults = _mutable_defaults(fn)
     for k, (args, kwargs) in enumerate(cases):
         where = f"input #{k + 1} of {n} ({_describe_case(args, kwargs)})"
         after: list = []
@@ -575,6 +807,9 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                 details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
                                "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
                                "`np.zeros((H, W))`, `frame[y, x]`")
+            state = _mutable_default_hint(fn, defaults) if k > 0 else None
+            if state:
+                details.append(f"hint: {state}")
             return False, f"raised {type(err).__name__} on {where}", details
         expected = _run(ex.reference, args, kwargs, ex.observe)
         if ex.compare is not None:
@@ -604,6 +839,18 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                     break
             except Exception:
                 continue
+        # mistakes that show only across inputs: state kept from an earlier call, a notebook variable or a
+        # fixed size in place of an argument; and a pair returned in the other order
+        if hint is None:
+            hint = _swapped_pair_hint(ex, got, expected)
+        if hint is None and k > 0:
+            hint = _state_hint(fn, defaults, ex, args, kwargs, got)
+        if hint is None:
+            hint = _stale_argument_hint(ex, fn, cases, k, got, expected)
+        if hint is None:
+            hint = _size_from_events_hint(args, kwargs, got, expected)
+        if hint is None:
+            hint = _fixed_size_hint(ex, cases, k, got, expected)
         if problem.values:
             if hint is None:
                 hint = _wrong_axes_hint(ex, args, kwargs, got, expected)
@@ -612,11 +859,28 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                 hint = _generic_hint(got, expected, indexed=indexed)
                 if hint is None and isinstance(expected, (tuple, list, dict)):
                     hint = _generic_hint(*_differing_leaf(got, expected, ex.rtol, ex.atol), indexed=indexed)
+            if hint is None:
+                hint = _scalar_factor_hint(ex, fn, cases, k, got, expected)
         if hint:
             details.append(f"hint: {hint}")
         if changed:
             details.append("also: " + _in_place_message(changed))
         return False, f"does not match the reference on {where}", details
+    # the same input once more (the last one, right after its first run): a function that keeps state between
+    # calls (a notebook variable it changes, a mutable default argument) gives another result the second time
+    if n and ex.observe is None:
+        args, kwargs = cases[-1]
+        try:
+            again = _run(fn, args, kwargs)
+            problem = _compare(again, _run(ex.reference, args, kwargs), ex.rtol, ex.atol) if ex.compare is None \
+                else (None if ex.compare(again, _run(ex.reference, args, kwargs)) is None else _Problem("", True))
+        except Exception as err:
+            problem = _Problem(f"{type(err).__name__}: {err}")
+        if problem is not None:
+            return False, f"gives another result when input #{n} of {n} is run a second time", [
+                "every input matched once, but a second call on the same input does not: your function keeps "
+                "state between calls (a notebook variable it changes, a mutable default argument such as "
+                "`state={}`, or unseeded randomness); compute everything from the arguments, afresh in each call"]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
 
 

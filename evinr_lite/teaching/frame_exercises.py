@@ -217,6 +217,11 @@ def _tonemap_exp_minus(L, gamma):
     return reinhard_tonemap(-np.asarray(L, dtype=np.float64), gamma)
 
 
+def _tonemap_min_max(L, gamma):
+    g = reinhard_tonemap(L, gamma)
+    return (g - g.min()) / (g.max() - g.min())
+
+
 exercises.register(
     "reinhard_tonemap", reinhard_tonemap, _inputs_tonemap,
     hints={
@@ -234,6 +239,9 @@ exercises.register(
             lambda L, gamma: reinhard_tonemap(np.asarray(L, dtype=np.float64) * np.log(10.0), gamma),
         "apply gamma to the ratio, (I / (I + 1)) ** gamma, not to I inside it (I ** gamma / (I ** gamma + 1))":
             lambda L, gamma: reinhard_tonemap(gamma * np.asarray(L, dtype=np.float64), 1.0),
+        "do not stretch the result to [0, 1] (min-max normalising): Eq. 12 already maps into (0, 1), and a "
+        "stretch makes each image's display depend on its own darkest and brightest pixels":
+            _tonemap_min_max,
     })
 
 def _tv_first_axes(F):
@@ -254,6 +262,18 @@ def _tv_joint_crop(F):
     dx = F[..., :-1, 1:] - F[..., :-1, :-1]
     dy = F[..., 1:, :-1] - F[..., :-1, :-1]
     return (dx.abs() + dy.abs()).mean()
+
+
+def _tv_sum_over_images(F):
+    """Each image's total variation, summed over the leading dimensions instead of averaged."""
+    dx = (F[..., :, 1:] - F[..., :, :-1]).abs().mean(dim=(-2, -1))
+    dy = (F[..., 1:, :] - F[..., :-1, :]).abs().mean(dim=(-2, -1))
+    return (dx + dy).sum()
+
+
+def _tv_root_mean_square(F):
+    dx, dy = F[..., :, 1:] - F[..., :, :-1], F[..., 1:, :] - F[..., :-1, :]
+    return torch.sqrt((dx ** 2).mean()) + torch.sqrt((dy ** 2).mean())
 
 
 def _tv_isotropic(F):
@@ -287,6 +307,12 @@ exercises.register(
         "|dF/dx| and |dF/dy| are averaged separately, each over all its differences: cropping both to "
         "[..., :-1, :-1] leaves out the last row of dF/dx and the last column of dF/dy":
             _tv_joint_crop,
+        "average over the leading dimensions too (every image of [T, H, W]): the mean of all differences, not the "
+        "sum of the images' total variations":
+            _tv_sum_over_images,
+        "the mean of |d| (absolute values), not the square root of the mean of d ** 2 (an RMS, the root of "
+        "Tikhonov)":
+            _tv_root_mean_square,
     })
 
 
@@ -336,6 +362,26 @@ def _anchor_mean_along_axis(L, gamma, display_mean):
     return L + (np.log(s / (1.0 - s)) - L.mean(axis=0))
 
 
+def _anchor_per_frame(L, gamma, display_mean):
+    """Each image of L shifted by its own mean (the mean over the last two axes) instead of one shift for all."""
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    return L + (np.log(s / (1.0 - s)) - (L.mean(axis=(-2, -1), keepdims=True) if L.ndim >= 2 else L.mean()))
+
+
+def _anchor_last_axis(L, gamma, display_mean):
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    return L + (np.log(s / (1.0 - s)) - L.mean(axis=-1, keepdims=True))
+
+
+def _anchor_standardised(L, gamma, display_mean):
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    sd = L.std()
+    return (L - L.mean()) / (sd if sd > 0 else 1.0) + np.log(s / (1.0 - s))
+
+
 def _anchor_median(L, gamma, display_mean):
     L = np.asarray(L, dtype=np.float64)
     s = display_mean ** (1.0 / gamma)
@@ -362,6 +408,15 @@ exercises.register(
             _anchor_level_wrong(lambda gamma, m: np.log10(m ** (1.0 / gamma) / (1.0 - m ** (1.0 / gamma)))),
         "the level is log(s / (1 - s)) (the logit), not log((1 - s) / s): a brighter display value needs a larger F":
             _anchor_level_wrong(lambda gamma, m: -_logit(m ** (1.0 / gamma))),
+        "one shift for all of L, the mean over every entry: a mean per image (over the last two axes) shifts each "
+        "frame by its own amount and removes the brightness changes between frames":
+            _anchor_per_frame,
+        "the mean is over all of L, one number (L.mean()): a mean along the last axis (L.mean(axis=-1)) shifts "
+        "every row by its own amount":
+            _anchor_last_axis,
+        "only shift L (add one constant); do not rescale it: dividing by its standard deviation changes the "
+        "contrast the events measured":
+            _anchor_standardised,
     })
 
 
@@ -400,6 +455,19 @@ def _offset_gradients_swapped_axes(frames):
 def _offset_gradients_of_median_frame(frames):
     m = np.median(np.asarray(frames, dtype=np.float64), axis=0)
     return -np.diff(m, axis=1), -np.diff(m, axis=0)
+
+
+def _offset_gradients_upper_middle(frames):
+    """The median read as the middle entry of the sorted differences, sorted[K // 2]."""
+    F = np.asarray(frames, dtype=np.float64)
+    K = F.shape[0]
+    return -np.sort(np.diff(F, axis=2), axis=0)[K // 2], -np.sort(np.diff(F, axis=1), axis=0)[K // 2]
+
+
+def _offset_gradients_prepended(frames):
+    F = np.asarray(frames, dtype=np.float64)
+    return (-np.median(np.diff(F, axis=2, prepend=F[:, :, :1]), axis=0),
+            -np.median(np.diff(F, axis=1, prepend=F[:, :1, :]), axis=0))
 
 
 def _offset_gradients_no_sign(frames):
@@ -441,6 +509,12 @@ exercises.register(
         "take the median of the frames' differences (np.median(np.diff(F, axis=2), axis=0)), not the differences "
         "of the median frame: the two differ wherever an edge moves":
             _offset_gradients_of_median_frame,
+        "the median of an even number of frames is the mean of the two middle values (np.median): sorted[K // 2] "
+        "is only the upper one":
+            _offset_gradients_upper_middle,
+        "gx has W - 1 columns (one per pair of neighbours), gy H - 1 rows: np.diff without `prepend=`, which adds "
+        "a difference of 0 at the border":
+            _offset_gradients_prepended,
     })
 
 

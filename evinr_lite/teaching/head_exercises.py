@@ -103,6 +103,11 @@ def _head_ridge_everywhere(A, E, ridge):
     return np.linalg.solve(A.T @ A + ridge, A.T @ np.asarray(E, dtype=np.float64))
 
 
+def _ridge_over_bins(A, E, ridge):
+    """The ridge divided by the number of bins (a mean-squared loss's normal equations)."""
+    return head_closed_form(A, E, ridge / np.asarray(A).shape[0])
+
+
 exercises.register(
     "head_closed_form", head_closed_form, _inputs, rtol=1e-6, atol=1e-9,
     hints={
@@ -116,4 +121,7 @@ exercises.register(
             _gradient_step,
         "`A.T @ A + ridge` adds ridge to every entry: add ridge * np.eye(d), to the diagonal only":
             _head_ridge_everywhere,
+        "the loss is a sum of squares, |A W - E|^2 + ridge |W|^2: add ridge itself to A^T A, not ridge / B (that "
+        "is the normal equations of a mean over bins)":
+            _ridge_over_bins,
     })

@@ -301,6 +301,26 @@ def _rate_closed_both(t_events, p_events, C, boundaries):
     return C * np.array([p[(t >= lo) & (t <= hi)].sum() for lo, hi in zip(b[:-1], b[1:])]) / np.diff(b)
 
 
+def _rate_nearest_centre(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): each event given to the window whose centre is nearest (off by half a
+    window where the windows differ in length)."""
+    b, t = np.asarray(boundaries, float), np.asarray(t_events, float)
+    centres = 0.5 * (b[1:] + b[:-1])
+    keep = (t >= b[0]) & (t <= b[-1])
+    i = np.argmin(np.abs(t[keep, None] - centres[None, :]), axis=1)
+    return C * np.bincount(i, weights=np.asarray(p_events, float)[keep], minlength=centres.size) / np.diff(b)
+
+
+def _rate_cumsum_no_leading_zero(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): differences of csum[n] read at the edges, csum without its leading 0, so an
+    edge before every event reads csum[-1], the total."""
+    b, t = np.asarray(boundaries, float), np.asarray(t_events, float)
+    csum = np.cumsum(np.asarray(p_events, float))
+    n = np.searchsorted(t, b, side="right") - 1
+    n[0] = np.searchsorted(t, b[0], side="left") - 1
+    return C * np.diff(csum[n]) / np.diff(b)
+
+
 def _rate_first_window_length(t_events, p_events, C, boundaries):
     b = np.asarray(boundaries, dtype=np.float64)
     return window_sums(t_events, p_events, C, b) / (b[1] - b[0])
@@ -352,6 +372,12 @@ exercises.register(
         "windows are (b_k, b_{k+1}], open on the left: with both ends closed, [b_k, b_{k+1}], an event exactly on "
         "an inner edge counts in two windows":
             _rate_closed_both,
+        "an event belongs to the window whose edges hold it, b_k < t <= b_{k+1}, not to the window whose centre is "
+        "nearest: where the windows differ in length the centres' half-way points are not the edges":
+            _rate_nearest_centre,
+        "an edge before the first event has a running sum of 0, but csum[n] with n = -1 reads csum[-1], the total: "
+        "prepend a 0 (np.concatenate([[0.0], np.cumsum(p)])) before taking differences at the edges":
+            _rate_cumsum_no_leading_zero,
     })
 
 def _loss_rates(dF_dt, delta_L, durations):
@@ -388,6 +414,9 @@ exercises.register(
             lambda dF_dt, delta_L, durations: torch.sum((delta_L - dF_dt * durations) ** 2) / (delta_L.numel() - 1),
         "square each window's difference, then average: torch.mean(d ** 2), not torch.mean(d) ** 2 (the brackets)":
             lambda dF_dt, delta_L, durations: torch.mean(delta_L - dF_dt * durations) ** 2,
+        "the model's change over a window is +dF/dt * (t2 - t1), the same sign as the events' delta_L: the "
+        "residual is delta_L - dF_dt * durations, not delta_L + dF_dt * durations":
+            lambda dF_dt, delta_L, durations: torch.mean((delta_L + dF_dt * durations) ** 2),
     })
 
 

@@ -105,6 +105,16 @@ def _path_integral(gx, gy):
     return g - g.mean()
 
 
+def _path_integral_rows_first(gx, gy):
+    """Cumulative sums along the first row, then down every column: the other path, exact only for a gradient."""
+    gx, gy = np.asarray(gx, dtype=np.float64), np.asarray(gy, dtype=np.float64)
+    H, W = gx.shape[0], gy.shape[1]
+    g = np.zeros((H, W))
+    g[0, 1:] = np.cumsum(gx[0])
+    g[1:, :] = g[:1, :] + np.cumsum(gy, axis=0)
+    return g - g.mean()
+
+
 exercises.register(
     "integrate_gradients", integrate_gradients, _inputs, rtol=1e-6, atol=1e-8,
     hints={
@@ -113,4 +123,7 @@ exercises.register(
         "a path integral (cumulative sums along one path) is exact only for a true gradient; least squares "
         "uses every difference: solve D^T D g = D^T b (with the zero-mean condition)":
             _path_integral,
+        "cumulative sums along the first row and then down the columns are a path integral too: exact only for a "
+        "true gradient; least squares uses every difference (D^T D g = D^T b, then the zero mean)":
+            _path_integral_rows_first,
     })

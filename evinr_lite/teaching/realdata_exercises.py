@@ -98,6 +98,8 @@ exercises.register(
            lambda t, bin_s: (event_rate(t, bin_s)[0], event_rate(t, bin_s)[1] * bin_s),
            "return the bin centres, not the left edges":
            lambda t, bin_s: (event_rate(t, bin_s)[0] - bin_s / 2, event_rate(t, bin_s)[1]),
+           "return the bin centres t0 + (k + 1/2) bin_s, not the right edges t0 + (k + 1) bin_s":
+           lambda t, bin_s: (event_rate(t, bin_s)[0] + bin_s / 2, event_rate(t, bin_s)[1]),
            "an event exactly on a bin edge t0 + k bin_s belongs to bin k - 1 (bins are (b_k, b_{k+1}], the "
            "library's rule; bin 0 also holds t0): use ceil((t - t0) / bin_s) - 1 clipped at 0, or "
            "searchsorted(edges, t, side='left') - 1, not floor or side='right'":
@@ -132,6 +134,16 @@ def _threshold_ratio_of_sums(log_changes, net_counts):
     return float(np.sum(log_changes) / np.sum(net_counts))
 
 
+def _threshold_rms_ratio(log_changes, net_counts):
+    d, n = np.asarray(log_changes, float), np.asarray(net_counts, float)
+    return float(np.sqrt(np.sum(d * d) / np.sum(n * n)))
+
+
+def _threshold_of_magnitudes(log_changes, net_counts):
+    d, n = np.abs(np.asarray(log_changes, float)), np.abs(np.asarray(net_counts, float))
+    return float(np.sum(d * n) / np.sum(n * n))
+
+
 exercises.register(
     "estimate_contrast_threshold", estimate_contrast_threshold, _inputs_threshold, rtol=1e-6,
     hints={
@@ -157,6 +169,11 @@ exercises.register(
         "divide by sum(n^2), not by the number of pixels: sum(ΔL n) / M is a covariance, not the slope":
             lambda log_changes, net_counts: float(np.sum(np.asarray(log_changes, float) * net_counts)
                                                   / len(np.asarray(net_counts))),
+        "the least-squares slope is sum(ΔL n) / sum(n^2), not sqrt(sum(ΔL^2) / sum(n^2)) (a ratio of RMS values, "
+        "which noise in ΔL inflates)":
+            _threshold_rms_ratio,
+        "keep the signs: a fit on |ΔL| and |n| lets a pixel whose ΔL has the wrong sign (noise) count as agreeing":
+            _threshold_of_magnitudes,
     })
 
 
@@ -239,6 +256,20 @@ def _offset_floor_division(first_frame, L_t0, eps=FRAME_EPS):
     return np.log((a // 255).astype(np.float64) + eps) - np.asarray(L_t0, np.float64)
 
 
+def _offset_clipped_before_scaling(first_frame, L_t0, eps=FRAME_EPS):
+    """np.clip(frame, 0, 1) on a uint8 frame before dividing by 255: every lit pixel becomes 1 / 255."""
+    a = np.asarray(first_frame)
+    clipped = np.clip(a, 0, 1)
+    intensity = clipped / 255.0 if a.dtype == np.uint8 else np.asarray(clipped, np.float64)
+    return np.log(intensity + eps) - np.asarray(L_t0, np.float64)
+
+
+def _offset_exp_of_network(first_frame, L_t0, eps=FRAME_EPS):
+    a = np.asarray(first_frame)
+    intensity = a / 255.0 if a.dtype == np.uint8 else np.clip(np.asarray(a, np.float64), 0.0, 1.0)
+    return np.log(intensity + eps) - np.exp(np.asarray(L_t0, np.float64))
+
+
 def _offset_log10(first_frame, L_t0, eps=FRAME_EPS):
     a = np.asarray(first_frame)
     intensity = a / 255.0 if a.dtype == np.uint8 else np.clip(np.asarray(a, np.float64), 0.0, 1.0)
@@ -267,4 +298,9 @@ exercises.register(
             _offset_log1p,
         "`first_frame // 255` is integer division (0 for every pixel but the saturated ones): divide with `/`":
             _offset_floor_division,
+        "clip to [0, 1] after dividing a uint8 frame by 255, not before: np.clip(frame, 0, 1) on 0..255 turns "
+        "every lit pixel into 1 (then 1 / 255)":
+            _offset_clipped_before_scaling,
+        "L_t0 is already a log intensity: subtract it as it is, g = log(I0 + eps) - L_t0 (no np.exp)":
+            _offset_exp_of_network,
     })

@@ -88,12 +88,13 @@ def _inputs_hot(rng):
     cases.append(dict(x=x, y=y, sensor_size=(6, 9), factor=10.0))
     # an even number of firing pixels (8), counts 1 1 2 2 | 4 9 11 20: the median is (2 + 4) / 2 = 3 (np.median
     # averages the two middle values), so with factor 3 the threshold is 9: 9 is on it (not hot), 11 and 20 are
-    # hot. The upper middle value (sorted[n // 2] = 4) flags only 20, the lower one (2) flags 9 too
-    counts = np.zeros((5, 3), np.int64)
+    # hot. The upper middle value (sorted[n // 2] = 4) flags only 20, the lower one (2) flags 9 too. The sensor is
+    # 6 x 4 and its last row and column never fire: a mask sized from the events (y.max() + 1) is too small
+    counts = np.zeros((6, 4), np.int64)
     for (r, c), n in {(0, 0): 1, (1, 1): 2, (2, 2): 1, (3, 0): 4, (4, 1): 9, (4, 2): 2, (0, 2): 11, (2, 0): 20}.items():
         counts[r, c] = n
     x, y = _events_from_counts(counts, rng)
-    cases.append(dict(x=x, y=y, sensor_size=(5, 3), factor=3.0))
+    cases.append(dict(x=x, y=y, sensor_size=(6, 4), factor=3.0))
     return cases
 
 
@@ -143,6 +144,11 @@ def _hot_distinct_counts(x, y, sensor_size, factor=10.0):
     return counts > factor * np.median(np.unique(counts[counts > 0]))
 
 
+def _hot_median_per_column(x, y, sensor_size, factor=10.0):
+    counts = _pixel_counts(x, y, sensor_size)
+    return counts > factor * np.median(counts, axis=0)
+
+
 def _hot_rows_columns_swapped(x, y, sensor_size, factor=10.0):
     """Counts indexed [x, y]: the transposed map (on a sensor that is not square, an IndexError or this)."""
     return hot_pixel_mask(x, y, sensor_size, factor).T
@@ -166,6 +172,9 @@ exercises.register(
         "fired more than once, and not `count // median > factor` (integer division rounds the ratio down)":
             _hot_distinct_counts,
         "use the `factor` argument, not a fixed 10 (its default)": _hot_factor_ignored,
+        "one typical count for the whole sensor, np.median(counts[counts > 0]): a median along an axis (one per "
+        "column) compares each pixel with its own column only":
+            _hot_median_per_column,
     })
 
 
@@ -219,6 +228,17 @@ def _windows_array_split(n_events, max_events):
     return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
 
 
+def _windows_float_step(n_events, max_events):
+    """k * (N / w) in floating point, truncated: the step N / w is rounded first, so some k * step fall short."""
+    w = max(1, math.ceil(n_events / max_events))
+    return (np.arange(w + 1) * (n_events / w)).astype(np.int64)
+
+
+def _windows_ceil_size(n_events, max_events):
+    w = max(1, math.ceil(n_events / max_events))
+    return np.minimum(np.arange(w + 1) * math.ceil(n_events / w), n_events).astype(np.int64)
+
+
 exercises.register(
     "event_count_windows", event_count_windows, _inputs_windows, compare=_compare_windows,
     hints={
@@ -237,6 +257,12 @@ exercises.register(
         "idx[k] = floor(k N / w) rounds down: np.round moves some edges up by one":
             lambda n_events, max_events: np.round(np.arange(max(1, math.ceil(n_events / max_events)) + 1) * n_events
                                                   / max(1, math.ceil(n_events / max_events))).astype(np.int64),
+        "k * (N / w) in floating point falls just short of a whole number for some k (N / w is rounded first): "
+        "compute idx[k] = (k * N) // w in integers":
+            _windows_float_step,
+        "windows of ceil(N / w) events each leave a short last window: idx[k] = floor(k N / w) spreads the "
+        "remainder so that the sizes differ by at most one":
+            _windows_ceil_size,
     })
 
 
@@ -355,6 +381,14 @@ def _filter_unsigned_coordinates(t, x, y, dt):
     return np.any((cheb == 1) & (t[None, :] <= t[:, None]) & (t[:, None] <= t[None, :] + dt), axis=1)
 
 
+def _filter_dt_in_microseconds(t, x, y, dt):
+    return background_activity_filter(t, x, y, dt * 1e-6)
+
+
+def _filter_dt_in_milliseconds(t, x, y, dt):
+    return background_activity_filter(t, x, y, dt * 1e3)
+
+
 def _filter_loop_off_by_one(t, x, y, dt, first=0, last=0):
     n = len(t)
     keep = np.zeros(n, dtype=bool)
@@ -399,6 +433,12 @@ exercises.register(
         "unsigned coordinates (uint8, uint16) wrap round when subtracted (1 - 2 = 255): convert x and y to a "
         "signed integer (np.int64) before taking |x_j - x_i|":
             _filter_unsigned_coordinates,
+        "dt is in seconds, like t: use it as it is (dt * 1e-6 reads it as microseconds and shrinks the window "
+        "a million times)":
+            _filter_dt_in_microseconds,
+        "dt is in seconds, like t: use it as it is (dt * 1e3 reads it as milliseconds and makes the window a "
+        "thousand times longer)":
+            _filter_dt_in_milliseconds,
     })
 
 

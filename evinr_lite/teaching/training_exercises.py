@@ -142,6 +142,16 @@ def _regularizer_on_derivative(model, optimizer, event_frames, centers, duration
     return loss.detach(), temporal.detach(), reg.detach()
 
 
+def _minus_regularizer(model, optimizer, event_frames, centers, durations, lam):
+    return frame_train_step(model, optimizer, event_frames, centers, durations, -lam)
+
+
+def _two_steps(model, optimizer, event_frames, centers, durations, lam):
+    out = frame_train_step(model, optimizer, event_frames, centers, durations, lam)
+    optimizer.step()
+    return out
+
+
 def _only_temporal(model, optimizer, event_frames, centers, durations, lam):
     return frame_train_step(model, optimizer, event_frames, centers, durations, 0.0)
 
@@ -168,4 +178,8 @@ exercises.register(
             _losses_after_step,
         "Tikhonov (Eq. 9) regularizes the spatial differences of F, the log intensity, not of dF/dt":
             _regularizer_on_derivative,
+        "the regularizer is added: loss = temporal + lam * regularizer (a minus rewards rough frames)":
+            _minus_regularizer,
+        "one call makes one optimizer.step(): a second step moves the parameters again with the same gradients":
+            _two_steps,
     })
