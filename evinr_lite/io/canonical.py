@@ -717,13 +717,6 @@ class CanonicalWriter(CloseOrAbort):
             self.abort()
             raise self.error(f"no events were found for {self.out.name}; the raw file holds no events "
                                   "(wrong topic or an empty/damaged file)")
-        if self.n >= 2 and self.t_first == self.t_last:   # a file of one instant: nothing could be reconstructed
-            self.abort()
-            raise self.error(f"all {self.n:,} events have the same timestamp ({self.t_first!r} s), so "
-                             f"{self.out.name} would span no time and nothing could be reconstructed from it; the raw "
-                             "timestamps are damaged, or read in the wrong unit (decimal seconds read as 'us' or 'ns' "
-                             "collapse to one instant): give the unit they are written in (--time-unit, time_unit=), "
-                             "or leave it out")
         idx = np.concatenate(self.index) if self.index else np.zeros(0)
         dset = self.f.create_dataset("events/t_index", data=idx, dtype=np.float64)
         dset.attrs["stride"] = CHUNK_EVENTS
