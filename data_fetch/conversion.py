@@ -184,6 +184,11 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
         raise DataFetchError(f"the output {out} already exists; it is left as it is: choose another --out or pass "
                              "--overwrite (overwrite=True) to replace it")
     check_writable_folder(out.parent, "output folder")
+    topics_given = [flag for flag, value in (("--event-topic (event_topic=)", event_topic),
+                                             ("--image-topic (image_topic=)", image_topic)) if value]
+    if topics_given and ds is not None and ds.method == "manual":
+        raise DataFetchError(f"{raw}: {' and '.join(topics_given)} {'pick' if len(topics_given) > 1 else 'picks'} the topics of a ROS bag, but this is a "
+                             f"{ds.name} sequence folder, which has none; leave {'them' if len(topics_given) > 1 else 'it'} out")
     if ds is not None and ds.method == "manual":   # AED: a sequence folder placed by hand (layout: convert_aed.py)
         from .convert_aed import convert_aed
 
@@ -205,6 +210,9 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
         raise DataFetchError(f"{raw}: a {kind} recording stores its time unit itself; leave --time-unit out")
     if cfa not in (_UNSET, None) and kind not in ("bag", "bag2", "bag-zip"):
         raise DataFetchError(f"{raw}: cfa= applies to ROS bags (CED) only, not a {kind} recording; leave it out")
+    if topics_given and kind not in ("bag", "bag2", "bag-zip"):   # else silently ignored: the user expects them used
+        raise DataFetchError(f"{raw}: {' and '.join(topics_given)} {'pick' if len(topics_given) > 1 else 'picks'} the topics of a ROS bag, but this is a {kind} "
+                             f"recording, which has none; leave {'them' if len(topics_given) > 1 else 'it'} out")
     if kind == "ijrr":
         from .convert_ijrr import convert_ijrr
 

@@ -52,7 +52,7 @@ def _mvsec(f, path, writer_args, sensor_size, side, progress):
     if sensor_size is None:
         if not has_frames:
             raise ConversionError(f"{path}: no frames to take the sensor size from; pass sensor_size=(H, W) "
-                                  "(260, 346 for MVSEC's DAVIS346)")
+                                  "(--sensor-size 260 346 for MVSEC's DAVIS346)")
         sensor_size = f[img_key].shape[1:3]
     origin = auto_origin(float(ev[0, 2]))
     polarity = PolarityMapper(f"{path}: {key}")
@@ -87,7 +87,8 @@ def _hqf(f, path, writer_args, sensor_size, progress, time_unit=None):
                                   "was expected; pass the right sensor size")
         sensor_size = file_size
     if sensor_size is None:
-        raise ConversionError(f"{path}: no root attribute sensor_resolution; pass sensor_size=(H, W)")
+        raise ConversionError(f"{path}: no root attribute sensor_resolution; pass sensor_size=(H, W) "
+                              "(--sensor-size H W)")
     xs, ys, ts, ps = (f[f"events/{k}"] for k in ("xs", "ys", "ts", "ps"))
     n = ts.shape[0]
     if any(d.shape != (n,) for d in (xs, ys, ps)):

@@ -67,6 +67,25 @@ def labelled_grid(rows, row_labels, column_labels, *, title: str = "") -> np.nda
     return np.asarray(canvas)
 
 
+def _check_demo_memory(sensor_size, duration, n_frames, cfg, *, fraction: float = 0.8) -> None:
+    """Refuse (EventDataError, before anything is simulated) a demo whose reconstruction (the solver's estimate,
+    :func:`~evinr_lite.method.memory.estimate_memory`) and ground-truth frames would not fit in ``fraction`` of
+    the free memory, naming the demo's own settings (its command has no --start/--end or --fps/--at)."""
+    from ..core.events import EventDataError, check_sensor_size
+    from ..method.memory import available_bytes, estimate_memory
+
+    H, W = check_sensor_size(sensor_size)
+    n_frames = int(n_frames)
+    est = estimate_memory((H, W), 0.0, float(duration), 0, n_frames, cfg)["total"]
+    est += 4.0 * n_frames * H * W * 8   # the scene's true frames, shown and scored (float64 copies)
+    free = available_bytes("cpu")
+    if est > fraction * free:
+        raise EventDataError(f"the demo at {H}x{W} pixels with {n_frames:,} frames over {duration:g} s needs about "
+                             f"{est / 2**30:,.1f} GiB of memory but about {free / 2**30:,.1f} GiB is free; choose a "
+                             "smaller --size, fewer --frames or a shorter --duration (run_demo's sensor_size, n_frames "
+                             "and duration; the defaults: --size 120x160 --frames 8 --duration 2)")
+
+
 def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 160), duration: float = 2.0,
              C: float = 0.2, n_frames: int = 8, seed: int = 0, overwrite: bool = False,
              config: EvINRConfig | None = None, log=print) -> dict:
@@ -80,6 +99,7 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
     """
     t0 = time.perf_counter()
     cfg = config or EvINRConfig(C=C, seed=seed)
+    _check_demo_memory(sensor_size, duration, n_frames, cfg)   # before the scene and its frames are allocated
     sc = make_scene(scene, sensor_size=sensor_size, duration=duration)
     events = simulate_scene(sc, 0.0, duration, C=C, seed=seed)
     H, W = sc.sensor_size

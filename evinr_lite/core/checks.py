@@ -14,7 +14,7 @@ import numbers
 import numpy as np
 
 from .events import EventDataError
-from .guard import InputError, check_unmasked, host_array
+from .guard import InputError, check_unmasked, dense_array, host_array
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
@@ -61,8 +61,10 @@ def check_reach(lo: float, hi: float, events_t, t_origin: float, name: str) -> N
 
 def image_stack(a, name: str) -> np.ndarray:
     """Grey images [F, H, W] from [F, H, W] or [F, H, W, 1] (a trailing channel of one, as image readers give);
-    colour [F, H, W, 3] and other shapes are refused naming the fix. Values are not checked here."""
-    a = np.asarray(host_array(a))
+    colour [F, H, W, 3] and other shapes are refused naming the fix, and so are images of different sizes (a
+    ragged list). Values are not checked here."""
+    a = dense_array(a, name, error=EventDataError, want="images of one size [H, W] each (crop or resize them to "
+                                                       "one size first)")
     if a.ndim == 4 and a.shape[-1] == 1:
         return a[..., 0]
     if a.ndim != 3:

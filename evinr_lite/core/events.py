@@ -254,6 +254,29 @@ def check_sensor_size(sensor_size) -> tuple[int, int]:
     return H, W
 
 
+def _checked_take_index(index, n: int) -> np.ndarray:
+    """``Events.take``'s index as a boolean mask of length ``n`` or non-decreasing integers in [0, n)."""
+    a = np.asarray(index)
+    if a.dtype == bool:
+        if a.shape != (n,):
+            raise EventDataError(f"take: a boolean mask must have one value per event, shape ({n},), got shape "
+                                 f"{a.shape}; build it from the events' own columns (e.g. events.p > 0)")
+        return a
+    if a.ndim == 1 and a.size == 0:   # [] (numpy makes it float64): no event
+        return a.astype(np.int64)
+    if a.ndim != 1 or a.dtype.kind not in "iu":
+        raise EventDataError(f"take: index must be a slice, a boolean mask of shape ({n},) or 1-D whole-number "
+                             f"indices, got {a.dtype} of shape {a.shape}"
+                             + ("; convert whole numbers with index.astype(np.int64)" if a.dtype.kind == "f" else ""))
+    if a.size and (a.min() < 0 or a.max() >= n):
+        raise EventDataError(f"take: indices span [{a.min()}, {a.max()}] but there are {n} events (indices 0 .. "
+                             f"{n - 1}); drop the indices outside")
+    if a.size > 1 and np.any(np.diff(a) < 0):
+        raise EventDataError("take: the indices are not in increasing order, which would put the events out of "
+                             "time order; sort them first (np.sort(index))")
+    return a
+
+
 @dataclass(frozen=True, eq=False)
 class Events:
     """A stream of N events on a sensor of ``sensor_size = (H, W)`` pixels.
@@ -331,12 +354,18 @@ class Events:
             if a.size and (a.min() < 0 or a.max() >= size):
                 swapped = (x.size and y.size and x.min() >= 0 and y.min() >= 0 and x.max() < H and y.max() < W
                            and H != W)
+                # 1 .. W and 1 .. H: counted from 1 (MATLAB, Julia, R), one past the sensor at the far edge
+                one_based = (not swapped and x.size and y.size and x.min() >= 1 and y.min() >= 1 and x.max() <= W
+                             and y.max() <= H and y.dtype.kind in "iuf" and x.dtype.kind in "iuf")
                 raise EventDataError(
                     f"{name} ({axis}) coordinates span [{a.min()}, {a.max()}] but sensor_size (H, W) = "
                     f"{(H, W)} allows [0, {size - 1}]; check the sensor size (it is (H, W), rows first) "
                     "and that x is the column and y the row"
                     + (f"; the events fit ({W}, {H}), the size given the other way round (on the command line "
                        f"--sensor {W}x{H}, or correct the size the file records)" if swapped else "")
+                    + ("; no coordinate is 0 and they reach the sensor's far edge: they count pixels from 1 (as "
+                       "MATLAB, Julia and R index), so subtract 1 from x and y (pixels count from 0 here)"
+                       if one_based else "")
                 )
         p = normalize_polarity(arrays["p"], self.polarity_encoding)
         object.__setattr__(self, "t", t)
@@ -402,9 +431,15 @@ class Events:
     @classmethod
     def concatenate(cls, parts: list["Events"], sort: bool = True) -> "Events":
         """Merge event streams on the same sensor and clock (sorted by time, stable)."""
+        if isinstance(parts, Events):
+            raise EventDataError("concatenate takes a list of Events, got one Events; pass them in a list: "
+                                 "Events.concatenate([a, b])")
+        if isinstance(parts, (str, bytes, dict)) or not hasattr(parts, "__iter__"):
+            raise EventDataError(f"concatenate takes a list of Events, got a {type(parts).__name__}; pass them in a "
+                                 "list: Events.concatenate([a, b])")
+        parts = list(parts)
         if not parts:
             raise EventDataError("nothing to concatenate: pass at least one Events")
-        parts = list(parts)
         for i, e in enumerate(parts):
             if not isinstance(e, Events):
                 raise EventDataError(f"concatenate: parts[{i}] is a {type(e).__name__}, not Events; pass a list of "
@@ -432,7 +467,12 @@ class Events:
         return float(self.t[-1] - self.t[0]) if len(self) > 1 else 0.0
 
     def take(self, index) -> "Events":
-        """Events selected by a slice, boolean mask or sorted integer index (no re-validation of values)."""
+        """Events selected by a slice, boolean mask or sorted integer index (no re-validation of values).
+
+        The index itself is checked (EventDataError): a mask of another length, indices that are not whole
+        numbers, out of range or not in increasing order (the events must stay sorted by time)."""
+        if not isinstance(index, slice):
+            index = _checked_take_index(index, len(self))
         new = object.__new__(Events)
         for k in "txyp":
             object.__setattr__(new, k, getattr(self, k)[index])

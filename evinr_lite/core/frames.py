@@ -7,6 +7,7 @@ import numpy as np
 
 from .checks import check_image_values
 from .events import EventDataError, InputError, check_t_origin
+from .guard import dense_array
 
 __all__ = ["Frames", "in_window", "to_grey_uint8", "to_uint8", "GREY_WEIGHTS"]
 
@@ -30,7 +31,8 @@ class Frames:
     t_origin: float = 0.0
 
     def __post_init__(self):
-        images = np.asarray(self.images)
+        images = dense_array(self.images, "Frames.images", error=EventDataError,
+                             want="images of one size [H, W] each (crop or resize them to one size first)")
         if images.ndim == 4 and images.shape[-1] == 1:
             images = images[..., 0]
         if images.dtype != np.uint8 and images.dtype.kind != "f":
@@ -41,7 +43,8 @@ class Frames:
             check_image_values(images, "frame images")
         except InputError as err:
             raise EventDataError(str(err)) from None
-        t = np.asarray(self.t, dtype=np.float64)
+        t = dense_array(self.t, "Frames.t", np.float64, error=EventDataError,
+                        want="one timestamp (seconds) per frame, a 1-D list or array")
         if t.shape != (images.shape[0],):
             raise EventDataError(f"{images.shape[0]} frames but {t.shape[0] if t.ndim == 1 else t.shape} timestamps")
         if not np.all(np.isfinite(t)):

@@ -86,12 +86,12 @@ def resolve_lpips(lpips_model=None):
     return _LPIPS_CACHE[key], ""
 
 
-def _as_float_frames(frames) -> np.ndarray:
+def _as_float_frames(frames, name: str = "frames") -> np.ndarray:
     from ..core.frames import Frames
 
     if isinstance(frames, Frames):
         frames = frames.images
-    a = image_stack(frames, "frames")   # [F, H, W] or [F, H, W, 1]; torch tensors too
+    a = image_stack(frames, name)   # [F, H, W] or [F, H, W, 1]; torch tensors too
     if a.dtype.kind not in "uif" or a.dtype == bool:
         raise EventDataError(f"frames must be uint8 (0..255) or float in [0, 1], got dtype {a.dtype}")
     if a.dtype.kind in "iu" and a.dtype != np.uint8:
@@ -119,8 +119,8 @@ def score_sequence(pred_frames, pred_times, gt_frames, gt_times, equalization: s
     Raises:
         ValueError: no GT frame has a prediction within ``tol`` (the message says how to fix it).
     """
-    pred = _as_float_frames(pred_frames)
-    gt = _as_float_frames(gt_frames)
+    pred = _as_float_frames(pred_frames, "pred_frames")
+    gt = _as_float_frames(gt_frames, "gt_frames")
     pt, gtt = seconds_array(pred_times, "pred_times"), seconds_array(gt_times, "gt_times")
     if len(pt) != len(pred) or len(gtt) != len(gt):
         raise EventDataError(f"{len(pred)} predictions with {len(pt)} times, {len(gt)} GT frames with {len(gtt)} times; "

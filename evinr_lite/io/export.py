@@ -40,10 +40,33 @@ def _stack_uint8(frames) -> np.ndarray:
     return to_uint8(frames)
 
 
+def _output_file(path, suffix: str, what: str) -> Path:
+    """``path`` as a Path, checked before anything is encoded: a file name ending in ``suffix`` (the writers pick
+    the format by it), in a folder that exists, and not a folder itself; else EventDataError naming the fix."""
+    if not isinstance(path, (str, Path)) and not hasattr(path, "__fspath__"):
+        raise EventDataError(f"{what}: path must be a file name (str or Path), got {type(path).__name__}")
+    path = Path(path)
+    if path.is_dir():
+        raise EventDataError(f"{what}: {path} is a folder; pass a file name in it, e.g. {path / ('frames' + suffix)}")
+    if path.suffix.lower() != suffix:
+        raise EventDataError(f"{what}: {path} does not end in {suffix} (the file's format follows its name); name it "
+                             f"{path.with_name(path.name + suffix) if not path.suffix else path.with_suffix(suffix)}")
+    if not path.parent.is_dir():
+        raise EventDataError(f"{what}: the folder {path.parent} does not exist (or is a file); create it first "
+                             f"(Path({str(path.parent)!r}).mkdir(parents=True)) or write elsewhere")
+    return path
+
+
 def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
     """Write frames [F, H, W] or [F, H, W, 3] as ``folder/<prefix>00000.png``, ... (8-bit grey or RGB).
     Returns the paths."""
     folder = Path(folder)
+    if not isinstance(prefix, str) or "/" in prefix or "\\" in prefix or "\0" in prefix:
+        raise EventDataError(f"prefix must be the start of a file name, without a folder ('/'), got {prefix!r}; "
+                             "put the folder in folder= (e.g. save_frames_png('out/frames', frames, prefix='f_'))")
+    if folder.exists() and not folder.is_dir():
+        raise EventDataError(f"{folder} is a file, not a folder; pass the folder to write the PNGs into (a new one "
+                             "is created)")
     folder.mkdir(parents=True, exist_ok=True)
     paths = []
     with PngWriter() as png:          # encoded on the kit's threads; the same bytes as save_png in turn
@@ -62,6 +85,7 @@ def save_gif(path, frames, fps: float) -> Path:
     """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (to the GIF's 10 ms
     resolution, at most 50 per second), looping."""
     _check_fps(fps)
+    path = _output_file(path, ".gif", "save_gif")
     images = [Image.fromarray(img) for img in _stack_uint8(frames)]
     delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
     images[0].save(path, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
@@ -77,6 +101,7 @@ def save_mp4(path, frames, fps: float) -> Path:
     import cv2
 
     _check_fps(fps)
+    path = _output_file(path, ".mp4", "save_mp4")
     frames = _stack_uint8(frames)
     colour = frames.ndim == 4
     F, H, W = frames.shape[:3]

@@ -107,6 +107,10 @@ def given_output_path(out_dir) -> Path:
     if isinstance(out_dir, (str, bytes)) and not out_dir.strip():
         raise OutputError(f"out_dir={out_dir!r} is empty or blank (an empty path would be the current folder); pass "
                           "the folder to write, e.g. out_dir=rec")
+    name = os.fspath(out_dir) if isinstance(out_dir, (str, bytes, os.PathLike)) else ""
+    if (b"\0" if isinstance(name, bytes) else "\0") in name:   # no file name holds one: os calls raise a bare ValueError
+        raise OutputError(f"out_dir={name!r} holds a NUL character (\\x00), which no file name can; "
+                          "pass the folder's name without it")
     return Path(out_dir).expanduser()
 
 

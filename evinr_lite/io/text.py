@@ -270,6 +270,14 @@ _SIZE_LINE = re.compile(r"^\d+\s*[x\u00d7,;:/]\s*\d+$", re.IGNORECASE)   # `640x
 _QUOTED_THOUSANDS = re.compile(r'"\s*[+-]?\d{1,3}(,\d{3})+(\.\d*)?\s*"')   # "3,305": a spreadsheet's 1,000s
 
 
+def _names_the_columns(words) -> bool:
+    """Whether ``words`` name the four columns of an event file (a time, x, y and a polarity, units allowed:
+    `t_us`, `time [s]`), as a names line does."""
+    roots = {re.split(r"[_\[(]", w.lower(), maxsplit=1)[0] for w in words}
+    return (len(words) == 4 and {"x", "y"} <= roots and bool(roots & {"t", "ts", "time", "timestamp", "timestamps"})
+            and bool(roots & {"p", "pol", "polarity", "polarities"}))
+
+
 def _token_hint(token: str, column: str, layout: TextLayout) -> str:
     """The fix for a value that does not parse, when its text shows the usual cause ('' when it does not):
     a Unicode minus or dash, a decimal comma or a trailing separator in a space-separated file, a polarity
@@ -367,11 +375,16 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         raise EventDataError(f"{source}, line {line_base + line + 1}: {problem} "
                              f"(line reads {_line_text(buf, newlines, line)!r})")
 
-    def names_hint(line):  # a first line of column names in a `t x y p` file: say what it is and the ways out
-        if not (first and layout.size_line and line == int(np.flatnonzero(counts)[0])):
-            return ""
+    def names_hint(line):  # a line of column names: say what it is and the ways out
         words = re.split(r"[\s,;]+", _line_text(buf, newlines, line).strip("\ufeff \t\"'"))
         if not all(_WORD.match(w) for w in words):
+            return ""
+        if not (first and line == int(np.flatnonzero(counts)[0])):   # after the events began: files joined
+            if not _names_the_columns(words):   # a damaged line of words is not a names line
+                return ""
+            return ("; it names the columns again, as where two exports were joined into one file (`cat a.csv "
+                    "b.csv`): delete that line, or read the files one by one and join them with Events.concatenate")
+        if not layout.size_line:
             return ""
         return ("; it names the columns, but a `t x y p` text file holds only numbers: start that line with `#` "
                 "(a comment), or name the file .csv, whose reader takes a first line naming the columns in any order")
@@ -393,8 +406,10 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     bad = np.flatnonzero((counts != 0) & (counts != 4))
     if bad.size:
         i = int(bad[0])
-        hint = " (a `W H` header is allowed only as the first line)" if counts[i] == 2 else ""
         opens = first and i == int(np.flatnonzero(counts)[0])
+        hint = "" if counts[i] != 2 else (
+            " (a `W H` first line gives the sensor size as two whole numbers: the width and the height, e.g. "
+            "`640 480`)" if opens and layout.size_line else " (a `W H` header is allowed only as the first line)")
         fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}{names_hint(i)}"
                 f"{_count_hint(_line_text(buf, newlines, i), opens, layout)}")
     empty = np.zeros(0, dtype=np.int64)
@@ -457,8 +472,9 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
 def read_text_bytes(path, what: str = "file") -> bytes:
     """The bytes of a text file, refusing (EventDataError naming the file) what is not one: a missing
     path, a folder, a FIFO / pipe / device (reading would block or never end), an empty file, an
-    unreadable one, UTF-16/32 text. A UTF-8 byte-order mark is dropped; a file whose lines end in CR
-    alone (classic Mac OS, Excel for Mac's "CSV (Macintosh)") gets LF line ends (same length)."""
+    unreadable one, UTF-16/32 text, one whose end is zero bytes (a cut-off copy). A UTF-8 byte-order mark and
+    DOS's end-of-file mark (a last Ctrl-Z) are dropped; a file whose lines end in CR alone (classic Mac OS,
+    Excel for Mac's "CSV (Macintosh)") gets LF line ends (same length)."""
     import stat
 
     path = Path(path)
@@ -479,8 +495,17 @@ def read_text_bytes(path, what: str = "file") -> bytes:
     if not data.strip():
         raise EventDataError(f"{path} is empty; expected lines {EVENT_COLUMNS}" if what == "event file"
                              else f"{path} is empty")
-    if data.startswith(b"\xef\xbb\xbf"):
-        data = data[3:]
+    bom = 3 if data.startswith(b"\xef\xbb\xbf") else 0
+    data = data[bom:]
+    text = data.rstrip(b"\x00")
+    if len(text) < len(data) and text.strip() and b"\x00" not in text:   # zero-filled tail: a cut-off copy
+        lines = text.count(b"\n") + (not text.endswith(b"\n"))
+        raise EventDataError(f"{path} ends in {len(data) - len(text):,} zero bytes (NUL) after line {lines:,}: the file "
+                             "was not written completely (a copy or a recording cut off by a crash or a full disk "
+                             "leaves its end zero-filled); copy it again, or keep the lines before the zeros "
+                             f"(`truncate -s {bom + len(text)} {path}`) if they are all there is")
+    if data.endswith(b"\x1a"):   # DOS's end-of-file mark (Ctrl-Z), as old Windows tools append it: not data
+        data = data[:-1] + b" "
     if data.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in data[:4096]:
         raise EventDataError(f"{path}: UTF-16/32 or binary content, not plain text; save it as plain UTF-8 (ASCII) "
                              f"text with lines {EVENT_COLUMNS}")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -406,7 +406,15 @@ class EvINRConfig:
         def number(name, value, *, integer=False):
             if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or (
                     integer and not float(value).is_integer()) or not math.isfinite(value):
-                raise EventDataError(f"{name} must be a finite {'whole ' if integer else ''}number, got {value!r}")
+                hint = ""
+                if isinstance(value, str):   # '0.5' read from a file, a form or the command line
+                    try:
+                        number_ = float(value)
+                        number_ = int(number_) if integer and number_.is_integer() else number_
+                        hint = f"; pass the number itself ({name}={number_!r}), not text"
+                    except ValueError:
+                        pass
+                raise EventDataError(f"{name} must be a finite {'whole ' if integer else ''}number, got {value!r}{hint}")
             return int(value) if integer else float(value)
 
         if isinstance(self.C, (tuple, list, np.ndarray)):   # (c_pos, c_neg), checked by the one parser of C
@@ -431,7 +439,12 @@ class EvINRConfig:
             setattr(self, name, int(getattr(self, name)))
         if isinstance(self.lam, str):
             if self.lam != "auto":
-                raise EventDataError(f"lam must be a number >= 0 or 'auto' (chosen from the events), got {self.lam!r}")
+                try:
+                    hint = f"; pass the number itself (lam={float(self.lam)!r}), not text"
+                except ValueError:
+                    hint = ""
+                raise EventDataError(f"lam must be a number >= 0 or 'auto' (chosen from the events), got "
+                                     f"{self.lam!r}{hint}")
         elif not number("lam", self.lam) >= 0:
             raise EventDataError(f"lam must be zero or positive (or 'auto'), got {self.lam}")
         if not 0 < number("lr_decay", self.lr_decay) <= 1:
@@ -478,6 +491,20 @@ class EvINRConfig:
                 warnings.warn(f"c2f_iters {late} are not inside the run of n_iters={self.n_iters} iterations: those "
                               f"bisections never happen, so the final bins are coarser than bin_duration; pass {fix}",
                               stacklevel=3)
+        object.__setattr__(self, "_checked", True)
+
+    def __setattr__(self, name, value):
+        """A field changed after construction (``cfg.tau = 2.0``) is checked as on construction: the whole
+        config is built again with the new value (the same checks, the same messages), so a bad value is
+        refused where it is set, not deep inside a run."""
+        if self.__dict__.get("_checked") and name in _FIELDS:
+            import warnings
+
+            with warnings.catch_warnings():
+                if name not in ("n_iters", "c2f_iters", "coarse_to_fine"):   # their warning concerns this change
+                    warnings.simplefilter("ignore")
+                value = getattr(replace(self, **{name: value}), name)
+        object.__setattr__(self, name, value)
 
     @classmethod
     def paper(cls, **overrides) -> "EvINRConfig":
@@ -537,3 +564,6 @@ class EvINRConfig:
     def n_bisections(self) -> int:
         """How many times the bins are halved during training."""
         return len(self.c2f_iters) if self.coarse_to_fine else 0
+
+
+_FIELDS = frozenset(f.name for f in fields(EvINRConfig))

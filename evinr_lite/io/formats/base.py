@@ -88,12 +88,28 @@ def existing(path, kind: str = "file") -> Path:
     return path
 
 
+def _holds_objects(path: Path) -> bool:
+    """Whether the .npy file's header (read without loading anything) declares a dtype that holds Python objects."""
+    try:
+        with open(path, "rb") as f:
+            version = np.lib.format.read_magic(f)
+            header = (np.lib.format.read_array_header_1_0 if version == (1, 0) else
+                      np.lib.format.read_array_header_2_0)(f)
+        return header[2].hasobject
+    except Exception:   # a damaged header: the caller's message says so
+        return False
+
+
 def load_npy(path: Path, *, mmap: bool = False):
     """np.load of one plain array (memory-mapped when ``mmap``), every failure an EventDataError naming the file."""
     try:   # memory-mapped first: a damaged header that claims more data than the file holds fails, not allocates
         array = np.load(path, allow_pickle=False, mmap_mode="r")
         return array if mmap or not isinstance(array, np.memmap) else np.array(array)
     except Exception as err:   # numpy raises ValueError, SyntaxError, TokenError, OSError, ... on a damaged header
+        if _holds_objects(path):   # a whole file, saved with allow_pickle: not damaged, but never unpickled here
+            raise EventDataError(f"{path}: not a readable numeric .npy array: it holds Python objects (dtype object, "
+                                 "saved with allow_pickle), which are not loaded (unpickling can run any code); save "
+                                 "the numbers themselves: np.save(path, np.asarray(a, dtype=np.float64))") from None
         raise EventDataError(f"{path}: not a readable numeric .npy array ({type(err).__name__}: {err}); the file is "
                              "damaged or incomplete, or not saved with np.save(path, array)") from None
 
