@@ -290,3 +290,66 @@ def test_spatial_order_is_checked_and_the_papers_recipes_keep_order_one():
     for bad in (0, 3, 1.5, True, "2", "band"):
         with pytest.raises(EventDataError, match="spatial_order"):
             EvINRConfig(spatial_order=bad)
+
+
+@pytest.mark.parametrize("alpha", [0.25, 1.0])
+def test_the_head_with_a_time_order_is_the_optimum_of_its_penalty(alpha):
+    """time_order=alpha: the solve minimises |A W - E|^2 + tr(W^T P W M), with M the weighted grid Laplacian (order 1)
+    and P the weighted geometric mean of the frames' Gram G = H_c^T H_c and the changes' Gram S = A^T A,
+    G^1/2 (G^-1/2 S G^-1/2)^alpha G^1/2 / ref^alpha, ref = tr S / tr G, written out here with scipy's matrix powers
+    (alpha = 0 would be sum_t |D f_t|^2, the frames' roughness). Its gradient vanishes at the solved head and not at
+    the head of time_order 0; at alpha = 1 the head is the least-squares fit shrunk by 1 / (1 + mu / ref) at each
+    spatial frequency."""
+    import scipy.linalg
+
+    from evinr_lite.method.head_solve import _weights
+
+    lam = 0.05
+    model, bins = _setup("difference")
+    H, W = 12, 16
+    B = bins.frames.shape[1]
+    with torch.no_grad():
+        h, _ = model.features(bins.boundaries, dtype=torch.float64)
+    h = h[0].detach().numpy()
+    A, hc = h[1:] - h[:-1], h - h.mean(axis=0, keepdims=True)
+    d = A.shape[1]
+    S, G = A.T @ A, hc.T @ hc
+    S, G = S + 1e-7 * np.trace(S) / d * np.eye(d), G + 1e-7 * np.trace(G) / d * np.eye(d)   # the solve's ridge
+    Gh = np.real(scipy.linalg.sqrtm(G))
+    Gih = np.linalg.inv(Gh)
+    P = Gh @ np.real(scipy.linalg.fractional_matrix_power(Gih @ S @ Gih, alpha)) @ Gh / (np.trace(S) / np.trace(G)) ** alpha
+    cx, cy = _weights(B, B + 1, (H, W), lam)
+    M = cx * np.kron(np.eye(H), _differences(W)).T @ np.kron(np.eye(H), _differences(W)) + \
+        cy * np.kron(_differences(H), np.eye(W)).T @ np.kron(_differences(H), np.eye(W))
+    E = bins.frames[0].reshape(B, H * W).double().numpy()
+    At, Pt, Mt, Et = (torch.tensor(x) for x in (A, P, M, E))
+
+    def grad(Wt):
+        Wt = Wt.clone().requires_grad_(True)
+        J = ((At @ Wt - Et) ** 2).sum() + (Wt * (Pt @ Wt @ Mt)).sum()
+        J.backward()
+        return Wt.grad.norm().item()
+
+    solve_head(model, bins.boundaries, bins.frames, "difference", "tikhonov", lam, order=1, time_order=alpha)
+    tilted = model.head_weight.detach()[0].double().clone()
+    solve_head(model, bins.boundaries, bins.frames, "difference", "tikhonov", lam, order=1)
+    frames_only = model.head_weight.detach()[0].double().clone()
+    scale = grad(torch.zeros_like(tilted))
+    assert grad(tilted) < 1e-4 * scale
+    assert grad(frames_only) > 1e-2 * scale
+    if alpha == 1.0:   # the per-bin changes' roughness: a uniform shrinkage of the least-squares fit per frequency
+        fit = np.linalg.solve(S, A.T @ E)                                      # [d, P]
+        C = scipy.fft.dctn(np.eye(H * W).reshape(H * W, H, W), norm="ortho", axes=(1, 2)).reshape(H * W, H * W).T
+        mu = laplacian_eigenvalues((H, W), cx, cy).ravel()
+        expected = (fit @ C.T / (1 + mu / (np.trace(S) / np.trace(G)))) @ C
+        np.testing.assert_allclose(tilted.numpy(), expected, atol=1e-4 * np.abs(expected).max())
+
+
+def test_prior_time_order_is_checked_and_the_papers_recipes_keep_the_frames_penalty():
+    from evinr_lite import EventDataError
+
+    assert EvINRConfig().prior_time_order == 0.25
+    assert EvINRConfig.paper().prior_time_order == EvINRConfig.v0_1().prior_time_order == 0.0
+    for bad in (-0.1, 1.5, float("nan"), True, "0.25"):
+        with pytest.raises(EventDataError, match="prior_time_order"):
+            EvINRConfig(prior_time_order=bad)

@@ -106,6 +106,14 @@ class EvINRConfig:
       chunk 0.376 -> 0.376 (SSIM 0.453 -> 0.458, MSE 0.0671 -> 0.0655), held out 0.555 -> 0.559, stress
       0.613 -> 0.619, fresh seeds 11-15 +0.002 / +0.006 / +0.002 / +0.010 / +0.007, long_pan_20s 0.676 ->
       0.683, long_ijrr_60s 0.722 -> 0.719; the same time (docs/defaults.md, "The spatial prior's order").
+    - prior_time_order=0.25 (2026-12-07, tenth session): the spatial prior weighs each temporal mode of the
+      features by (Lambda_i / Lambda_ref)^0.25, Lambda_i the mode's change per bin against its spread:
+      slow changes are shrunk less, fast ones (the changes' quantization noise) more. Kit-only means,
+      0 -> 0.25 (CLAHE-SSIM / SSIM / MSE): zoo 0.665 / 0.720 / 0.0338 -> 0.669 / 0.722 / 0.0339, real chunk
+      0.376 / 0.458 / 0.0655 -> 0.378 / 0.460 / 0.0654, held out 0.559 -> 0.565, stress 0.619 -> 0.624,
+      fresh seeds 11 and 16 (16 drawn this session) 0.592 -> 0.597 and 0.667 -> 0.672,
+      long_pan_20s 0.683 -> 0.687, long_ijrr_60s 0.719 -> 0.733; the same time (docs/defaults.md, "The spatial
+      prior's order in time").
     - lam="auto" instead of 0.05 (0.01 before issue 21): with the exact head, less smoothing wins where
       much texture passes each pixel, and more where little does (quick zoo, fixed lam, CLAHE-SSIM
       mean: 0.293 at lam 1, 0.403 at 0.2, 0.482 at 0.05, 0.528 at 0.01). The Tikhonov term damps the
@@ -234,6 +242,12 @@ class EvINRConfig:
             for structure coarser than 8 px and a third-order roll-off (mu^3 / mu_ref^2) for finer,
             continuous at 8 px (:func:`~evinr_lite.method.head_solve.penalty_spectrum`; measured in
             docs/defaults.md, "The spatial prior's order"). Adam's loss stays first-order.
+        prior_time_order: alpha in [0, 1], the closed-form head's spatial prior's order in time: the
+            penalty of each temporal mode of the features is weighted by (its change per bin against its
+            spread, relative to the features' mean)^alpha. 0 penalises the frames' roughness (the paper's,
+            what Adam's loss uses), 1 the per-bin changes'; the kit's 0.25 shrinks slow changes less and
+            fast ones (quantization noise) more (:mod:`~evinr_lite.method.head_solve`; docs/defaults.md,
+            "The spatial prior's order in time").
     Network (SIREN):
         hidden_features, hidden_layers: width and depth (paper: 512, 3).
         omega_0: frequency factor of the hidden layers (SIREN's default 30).
@@ -341,6 +355,7 @@ class EvINRConfig:
     regularizer: str = "tikhonov"
     lam: float | str = "auto"
     spatial_order: int | str = "banded"
+    prior_time_order: float = 0.25
     hidden_features: int = 128
     hidden_layers: int = 3
     omega_0: float = 30.0
@@ -447,6 +462,10 @@ class EvINRConfig:
                                      f"{self.lam!r}{hint}")
         elif not number("lam", self.lam) >= 0:
             raise EventDataError(f"lam must be zero or positive (or 'auto'), got {self.lam}")
+        if not 0 <= number("prior_time_order", self.prior_time_order) <= 1:
+            raise EventDataError(f"prior_time_order must be within [0, 1] (0: the frames' roughness, the paper's; 1: the "
+                                 f"per-bin changes'; the kit's 0.25), got {self.prior_time_order!r}")
+        self.prior_time_order = float(self.prior_time_order)
         if not 0 < number("lr_decay", self.lr_decay) <= 1:
             raise EventDataError(f"lr_decay must be in (0, 1], got {self.lr_decay}")
         if not 0 < number("display_mean", self.display_mean) < 1:
@@ -517,7 +536,8 @@ class EvINRConfig:
                       "omega_0": 30.0, "first_omega_0": None, "first_omega_per_s": None, "n_iters": 300, "lr": 1e-4, "lr_decay": 0.95,
                       "lr_decay_every": 10, "head_lr_scale": 1.0, "coarse_to_fine": True, "c2f_iters": (100, 200),
                       "tau": 5.0, "overlap": 0.5, "tonemap": "reinhard", "gamma": 0.6, "display_mean": DISPLAY_MEANS["reinhard"], "head_solve": False, "offset_solve": "none", "offset_coarse_px": None,
-                      "balance": "none", "hot_pixels": "keep", "background": "keep", "spatial_order": 1, **overrides})
+                      "balance": "none", "hot_pixels": "keep", "background": "keep", "spatial_order": 1,
+                      "prior_time_order": 0.0, **overrides})
 
     @classmethod
     def v0_1(cls, **overrides) -> "EvINRConfig":

@@ -20,6 +20,19 @@ eigendecomposition A^T A V = H_c^T H_c V Lambda (V^T H_c^T H_c V = I) solves all
 w = V (Lambda + lam' mu)^-1 V^T A^T e. The DCT over pixels commutes with A^T over bins, so the
 right-hand side is (V^T A^T) DCT(E): B frame transforms and a d x B product instead of d transforms
 and a d x d one. Cost: O(d^3 + (B + d) P log P + B d P + d^2 P).
+
+**The prior's order in time** (``time_order``, alpha). Each eigenvector v_i is a temporal mode of the
+features with Lambda_i = |A v_i|^2 / |H_c v_i|^2, its change per bin against its spread over the window:
+small for slow modes, large for fast ones. The penalty above weighs every mode alike (the frames' own
+roughness), so a slow change, which the per-bin differences see only as small steps, is shrunk by
+Lambda_i / (Lambda_i + lam' mu) much more than a fast one of the same size. The data term treats each
+bin's error as independent, so the integrated error of a slow change would grow like a random walk; the
+staircase of a pixel's events never strays more than one threshold from its log intensity, which is
+bounded. With alpha > 0 the penalty of mode i is weighted by (Lambda_i / Lambda_ref)^alpha, Lambda_ref =
+tr(A^T A) / tr(H_c^T H_c) (the features' mean ratio, so lam keeps its scale): the spatial roughness of a
+fractional time derivative of order alpha of the frames (alpha = 0, the frames, the paper's; alpha = 1,
+the per-bin changes). The solve is the same, with lam' mu_p replaced by lam' mu_p (Lambda_i /
+Lambda_ref)^alpha in each mode's denominator.
 """
 from __future__ import annotations
 
@@ -94,8 +107,9 @@ def _dct_rows(X: np.ndarray, sensor_size, inverse: bool = False) -> None:
 
 
 def _solve_frequencies(X: np.ndarray, M: np.ndarray, E_hat: np.ndarray, V: np.ndarray, lam_: np.ndarray,
-                       mu: np.ndarray, eps_s: float = 0.0) -> float:
-    """X [d, P] float32 <- V (Lambda + mu_p)^-1 M E_hat[:, p] for every spatial frequency p, with
+                       mu: np.ndarray, eps_s: float = 0.0, mode_weight: np.ndarray | None = None) -> float:
+    """X [d, P] float32 <- V (Lambda + mu_p)^-1 M E_hat[:, p] for every spatial frequency p (with
+    ``mode_weight`` w [d]: V (Lambda + w mu_p)^-1 M E_hat[:, p], the penalty of mode i weighted by w_i), with
     M = V^T A^T [d, B] and E_hat [B, P] the DCT of the event frames: the same as V (Lambda + mu)^-1 V^T
     DCT(A^T E), at B/d of the cost (the DCT over pixels commutes with A^T over bins). Float64 over
     chunks of columns (V can be large where G is ill-conditioned), stored as float32. Returns the
@@ -107,7 +121,7 @@ def _solve_frequencies(X: np.ndarray, M: np.ndarray, E_hat: np.ndarray, V: np.nd
         c1 = min(P, c0 + cols)
         Ec = E_hat[:, c0:c1].astype(np.float64)
         m = M @ Ec
-        Y = m / (lam_[:, None] + mu[None, c0:c1])
+        Y = m / (lam_[:, None] + (mu[None, c0:c1] if mode_weight is None else mode_weight[:, None] * mu[None, c0:c1]))
         Xc = V @ Y
         # |A x - e|^2 per column from the eigenbasis: x = V y, V^T (S + eps_s I) V = Lambda, V^T A^T e = m:
         # x^T S x - 2 x^T A^T e + |e|^2 = sum y (lam y - 2 m) - eps_s |x|^2 + |e|^2
@@ -118,7 +132,8 @@ def _solve_frequencies(X: np.ndarray, M: np.ndarray, E_hat: np.ndarray, V: np.nd
 
 @torch.no_grad()
 def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temporal_loss: str = "difference",
-               regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7, order: int | str = 1) -> dict:
+               regularizer: str = "tikhonov", lam: float = 0.05, ridge: float = 1e-7, order: int | str = 1,
+               time_order: float = 0.0) -> dict:
     """Set ``model.head_weight`` and ``model.head_bias`` to the loss's optimum for its hidden layers.
 
     Args:
@@ -132,6 +147,8 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
             2, the Laplacian's |D^T D F|^2 at the same weight at a wavelength of 8 px; "banded", order 1
             coarser than 8 px and a third-order roll-off finer (:func:`penalty_spectrum`;
             ``EvINRConfig.spatial_order``).
+        time_order: alpha in [0, 1], the prior's order in time (the module's docstring): 0, the frames'
+            roughness (the training loss's); 0.25, the kit's (``EvINRConfig.prior_time_order``).
 
     Memory: the solution is written in place in float32 (in the head's own storage on a CPU), the
     DCTs a few rows and the frequencies a few columns at a time in float64; beyond the model and the
@@ -184,10 +201,14 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
         eps_s = ridge * max(np.trace(S) / d, 1e-30)
         eps_g = ridge * max(np.trace(G) / d, 1e-30)
         lam_, V = scipy.linalg.eigh(S + eps_s * np.eye(d), G + eps_g * np.eye(d))   # S V = G V diag(lam_)
+        weight = None
+        if time_order:   # each temporal mode's penalty weighted by (Lambda_i / Lambda_ref)^alpha
+            ref = (np.trace(S) + d * eps_s) / (np.trace(G) + d * eps_g)
+            weight = (np.maximum(lam_, 0.0) / ref) ** time_order
         E_hat = E[n].float().cpu().numpy().copy()                        # [B, P]: the event frames' DCT
         _dct_rows(E_hat, (H, W))
         # DCT(W) at every frequency, and the temporal loss |A W - E|^2 (= |A DCT(W) - DCT(E)|^2)
-        total += _solve_frequencies(weights[n], V.T @ A64[n].T, E_hat, V, lam_, mu, eps_s)
+        total += _solve_frequencies(weights[n], V.T @ A64[n].T, E_hat, V, lam_, mu, eps_s, weight)
         del E_hat
         _dct_rows(weights[n], (H, W), inverse=True)                     # W
     if not in_place:

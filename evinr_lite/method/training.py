@@ -178,7 +178,7 @@ def train_frame_inr(events: Events, windows: np.ndarray, cfg: EvINRConfig, log=N
     bar.close()
     if cfg.head_solve:   # the output layer's exact optimum for the (trained or initial) hidden layers
         solved = solve_head(model, bins.boundaries, bins.frames, cfg.temporal_loss, regularizer, cfg.lam,
-                            order=cfg.spatial_order)
+                            order=cfg.spatial_order, time_order=cfg.prior_time_order)
         history["head_solve_s"] = solved["seconds"]
         history["temporal_after_solve"] = solved["temporal"]
     history["final_bins"] = int(bins.frames.shape[1])
