@@ -142,7 +142,7 @@ def test_a_npy_of_python_objects_is_named_not_called_damaged(capsys, tmp_path):
     (np.ones(3, bool), r"take: a boolean mask must have one value per event, shape \(400,\), got shape \(3,\)"),
     (np.array([0.0, 2.0]), r"take: index must be .*got float64.*index\.astype\(np\.int64\)"),
     (np.array([5, 400]), r"take: indices span \[5, 400\] but there are 400 events"),
-    (np.array([7, 3]), r"take: the indices are not in increasing order.*np\.sort\(index\)"),
+    (np.array([7, 3]), r"take: the indices put the events out of time order.*np\.sort\(index\)"),
 ], ids=["mask of another length", "float indices", "out of range", "unsorted"])
 def test_events_take_checks_its_index(events, index, pattern):
     with pytest.raises(EventDataError, match=pattern):

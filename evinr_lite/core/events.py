@@ -254,8 +254,9 @@ def check_sensor_size(sensor_size) -> tuple[int, int]:
     return H, W
 
 
-def _checked_take_index(index, n: int) -> np.ndarray:
-    """``Events.take``'s index as a boolean mask of length ``n`` or non-decreasing integers in [0, n)."""
+def _checked_take_index(index, n: int, t=None) -> np.ndarray:
+    """``Events.take``'s index as a boolean mask of length ``n`` or integers in [0, n) that keep the times ``t``
+    (float64 [n], s) in order: events with the same timestamp may come in any order."""
     a = np.asarray(index)
     if a.dtype == bool:
         if a.shape != (n,):
@@ -271,9 +272,10 @@ def _checked_take_index(index, n: int) -> np.ndarray:
     if a.size and (a.min() < 0 or a.max() >= n):
         raise EventDataError(f"take: indices span [{a.min()}, {a.max()}] but there are {n} events (indices 0 .. "
                              f"{n - 1}); drop the indices outside")
-    if a.size > 1 and np.any(np.diff(a) < 0):
-        raise EventDataError("take: the indices are not in increasing order, which would put the events out of "
-                             "time order; sort them first (np.sort(index))")
+    if a.size > 1 and np.any(np.diff(a) < 0) and (t is None or np.any(np.diff(t[a]) < 0)):
+        raise EventDataError("take: the indices put the events out of time order (a later event's index before an "
+                             "earlier one's); sort them first (np.sort(index)); events with the same timestamp may "
+                             "come in any order")
     return a
 
 
@@ -470,9 +472,10 @@ class Events:
         """Events selected by a slice, boolean mask or sorted integer index (no re-validation of values).
 
         The index itself is checked (EventDataError): a mask of another length, indices that are not whole
-        numbers, out of range or not in increasing order (the events must stay sorted by time)."""
+        numbers, out of range or that put the events out of time order (the events must stay sorted by time;
+        events with the same timestamp may be taken in any order)."""
         if not isinstance(index, slice):
-            index = _checked_take_index(index, len(self))
+            index = _checked_take_index(index, len(self), self.t)
         new = object.__new__(Events)
         for k in "txyp":
             object.__setattr__(new, k, getattr(self, k)[index])

@@ -8,6 +8,8 @@ Times are seconds; C is in log units per event.
 """
 from __future__ import annotations
 
+import functools
+
 import math
 import re
 from dataclasses import dataclass, fields, replace
@@ -510,13 +512,12 @@ class EvINRConfig:
                 warnings.warn(f"c2f_iters {late} are not inside the run of n_iters={self.n_iters} iterations: those "
                               f"bisections never happen, so the final bins are coarser than bin_duration; pass {fix}",
                               stacklevel=3)
-        object.__setattr__(self, "_checked", True)
 
     def __setattr__(self, name, value):
         """A field changed after construction (``cfg.tau = 2.0``) is checked as on construction: the whole
         config is built again with the new value (the same checks, the same messages), so a bad value is
         refused where it is set, not deep inside a run."""
-        if self.__dict__.get("_checked") and name in _FIELDS:
+        if name in _FIELDS and id(self) not in _BUILDING:
             import warnings
 
             with warnings.catch_warnings():
@@ -587,3 +588,20 @@ class EvINRConfig:
 
 
 _FIELDS = frozenset(f.name for f in fields(EvINRConfig))
+# configs being constructed (by id, while their __init__ and __post_init__ run): their fields are set freely there,
+# and checked by __post_init__; kept outside the instance so that cfg.__dict__ holds the fields alone
+_BUILDING: set = set()
+
+
+def _marking_construction(init):
+    @functools.wraps(init)
+    def wrapped(self, *args, **kwargs):
+        _BUILDING.add(id(self))
+        try:
+            init(self, *args, **kwargs)
+        finally:
+            _BUILDING.discard(id(self))
+    return wrapped
+
+
+EvINRConfig.__init__ = _marking_construction(EvINRConfig.__init__)
