@@ -114,7 +114,7 @@ class EvINRConfig:
       0 -> 0.25 (CLAHE-SSIM / SSIM / MSE): zoo 0.665 / 0.720 / 0.0338 -> 0.669 / 0.722 / 0.0339, real chunk
       0.376 / 0.458 / 0.0655 -> 0.378 / 0.460 / 0.0654, held out 0.559 -> 0.565, stress 0.619 -> 0.624,
       fresh seeds 11 and 16 (16 drawn this session) 0.592 -> 0.597 and 0.667 -> 0.672,
-      long_pan_20s 0.683 -> 0.687, long_ijrr_60s 0.719 -> 0.733; the same time (docs/defaults.md, "The spatial
+      long_pan_20s 0.683 -> 0.686, long_ijrr_60s 0.719 -> 0.733; the same time (docs/defaults.md, "The spatial
       prior's order in time").
     - lam="auto" instead of 0.05 (0.01 before issue 21): with the exact head, less smoothing wins where
       much texture passes each pixel, and more where little does (quick zoo, fixed lam, CLAHE-SSIM
