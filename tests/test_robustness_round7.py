@@ -31,7 +31,7 @@ import pytest
 from evinr_lite import EventDataError, Events, EvINRConfig, Frames, read_recording
 from evinr_lite.apps.cli import main
 
-from test_robustness import H, W, _events, assert_clear_error, run, tree
+from test_robustness import H, W, _events, assert_clear_error, df, run, tree  # noqa: F401 (df: a fixture)
 from test_robustness_round4 import FAST, SENSOR, _both_commands_refuse, _hqf
 
 
@@ -259,19 +259,6 @@ def test_an_out_holding_a_nul_character_is_refused(capsys, tmp_path, command):
     argv = {"reconstruct": ["reconstruct", path, "--out", out, *FAST], "demo": ["demo", "--out", out],
             "batch": ["batch", path, "--out", out]}[command]
     assert_clear_error(capsys, argv, r"--out '.*a\\x00b' holds a NUL character", root=tmp_path)
-
-
-@pytest.fixture
-def df(capsys, tmp_path, monkeypatch):
-    from data_fetch.__main__ import main as df_main
-
-    monkeypatch.setenv("EVINR_DATA", str(tmp_path / "cache"))
-
-    def call(*argv):
-        code = df_main([str(a) for a in argv])
-        out, err = capsys.readouterr()
-        return code, out, err
-    return call
 
 
 @pytest.fixture(scope="module")

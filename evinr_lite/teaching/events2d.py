@@ -420,13 +420,19 @@ def _intervals_unsorted(events):
     return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
 
 
-def _intervals_no_floor(events):
-    """A wrong version (for the hint): log(0) for two events with the same timestamp."""
+def _by_pixel(events):
+    """(pix, t, p, pair) for the wrong versions below: the events sorted by pixel (time order kept within one),
+    and pair [N - 1], True where two consecutive events share a pixel and a polarity."""
     H, W = events.sensor_size
     pix = events.y.astype(np.int64) * W + events.x
     order = np.argsort(pix, kind="stable")
     pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
-    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    return pix, t, p, (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+
+
+def _intervals_no_floor(events):
+    """A wrong version (for the hint): log(0) for two events with the same timestamp."""
+    pix, t, p, pair = _by_pixel(events)
     with np.errstate(divide="ignore", invalid="ignore"):
         log_dt = np.log(np.diff(t))
         on = p[1:] > 0
@@ -449,11 +455,7 @@ def _intervals_per_polarity(events):
 
 def _intervals_of_means(events):
     """A wrong version (for the hint): the log of the ratio of the mean intervals."""
-    H, W = events.sensor_size
-    pix = events.y.astype(np.int64) * W + events.x
-    order = np.argsort(pix, kind="stable")
-    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
-    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    pix, t, p, pair = _by_pixel(events)
     dt = np.maximum(np.diff(t), MIN_INTERVAL)
     on = p[1:] > 0
     return float(np.tanh(np.log(dt[pair & on].mean() / dt[pair & ~on].mean()) / 2))
@@ -486,11 +488,7 @@ def _imbalance_of_pixel_numbers(events, pix, kind):
 
 
 def _intervals_stat(events, log=np.log, stat=np.mean, to_b=lambda r: np.tanh(r / 2), none=float("nan")):
-    H, W = events.sensor_size
-    pix = events.y.astype(np.int64) * W + events.x
-    order = np.argsort(pix, kind="stable")
-    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
-    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    pix, t, p, pair = _by_pixel(events)
     log_dt = log(np.maximum(np.diff(t), MIN_INTERVAL))
     on = p[1:] > 0
     if not (pair & on).any() or not (pair & ~on).any():
@@ -516,11 +514,7 @@ def _intervals_zero_not_nan(events):
 
 def _intervals_per_pixel_means(events):
     """A wrong version (for the hint): each pixel's mean log interval first, then the mean over pixels."""
-    H, W = events.sensor_size
-    pix = events.y.astype(np.int64) * W + events.x
-    order = np.argsort(pix, kind="stable")
-    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
-    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    pix, t, p, pair = _by_pixel(events)
     log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
     on, px = p[1:] > 0, pix[1:]
     means = []
