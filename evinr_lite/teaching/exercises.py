@@ -1005,6 +1005,14 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                     break
             except Exception:
                 continue
+        # mistakes that show only across inputs: state kept from an earlier call, a notebook variable or a
+        # fixed size in place of an argument; and a pair returned in the other order
+        if hint is None:
+            hint = _swapped_pair_hint(ex, got, expected)
+        if hint is None:
+            hint = _state_hint(fn, defaults, ex, args, kwargs, got, first=k == 0)
+        if hint is None:
+            hint = _stale_argument_hint(ex, fn, cases, k, got, expected)
         # mistakes any exercise can show (polarities read as 0/1, a clip to [0, 1], a rounded result), recognised
         # the same way from wrong versions made from the reference
         if hint is None and ex.observe is None:
@@ -1018,14 +1026,6 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                         break
                 except Exception:
                     continue
-        # mistakes that show only across inputs: state kept from an earlier call, a notebook variable or a
-        # fixed size in place of an argument; and a pair returned in the other order
-        if hint is None:
-            hint = _swapped_pair_hint(ex, got, expected)
-        if hint is None:
-            hint = _state_hint(fn, defaults, ex, args, kwargs, got, first=k == 0)
-        if hint is None:
-            hint = _stale_argument_hint(ex, fn, cases, k, got, expected)
         if hint is None:
             hint = _size_from_events_hint(args, kwargs, got, expected)
         if hint is None:
