@@ -107,8 +107,10 @@ def _inputs_bisect(rng):
     # Bin (1.25, 2.25] holds 1.75 and three events at 2.25: its cut between events 1 and 2 would land on the
     # edge 2.25, so the bin is cut at its time mid-point instead. The times start at 0.25, not 0 (exact in
     # binary, so the equalities hold): bin 0's closed left edge is t == b_0, and its 5 events (an odd count)
-    # put the cut elsewhere when the event at b_0 is left out (`t == 0` in place of `t == b_0`)
-    cases.append(dict(t_events=np.array([0.0, 0.2, 0.6, 1.0, 1.0, 1.5, 2.0, 2.0, 2.0, 2.5, 2.9, 3.0]) + 0.25,
+    # put the cut elsewhere when the event at b_0 is left out (`t == 0` in place of `t == b_0`). The last bin
+    # (2.25, 3.25] holds 2.75, 3.0, 3.15 and one event exactly at its end b_B = 3.25: 4 events cut at 3.075; a
+    # last bin open at its end (t < b_B) leaves 3 and cuts at 2.875
+    cases.append(dict(t_events=np.array([0.0, 0.2, 0.6, 1.0, 1.0, 1.5, 2.0, 2.0, 2.0, 2.5, 2.75, 2.9, 3.0]) + 0.25,
                       boundaries=np.array([0.0, 1.0, 2.0, 3.0]) + 0.25))
     return cases
 
@@ -212,6 +214,13 @@ def _bisect_edges_then_cuts(t_events, boundaries):
     return np.concatenate([out[0::2], out[1::2]])
 
 
+def _last_bin_open(t_events, boundaries):
+    """The last bin open at its end: an event exactly at b_B left out."""
+    t = np.asarray(t_events, dtype=np.float64)
+    b = np.asarray(boundaries, dtype=np.float64)
+    return bisect_equal_count(t[t < b[-1]], b)
+
+
 exercises.register(
     "bisect_equal_count", bisect_equal_count, _inputs_bisect,
     hints={
@@ -240,6 +249,8 @@ exercises.register(
         "interleave the edges and the cuts, [b_0, cut_0, b_1, cut_1, ..., b_B] (in time order), not all the edges "
         "followed by all the cuts (np.concatenate([b, cuts])); out[0::2] = b, out[1::2] = cuts":
             _bisect_edges_then_cuts,
+        "an event exactly at the last edge b_B belongs to the last bin (b_{B-1}, b_B]: the bins are closed at their "
+        "end, the last one too (no strict t < b_B)": _last_bin_open,
     })
 
 

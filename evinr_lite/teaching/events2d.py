@@ -317,6 +317,13 @@ def _frames_normalised_per_frame(events, boundaries, C):
     return (f / np.where(m > 0, m, 1)).astype(np.float32)
 
 
+def _frames_last_edge_open(events, boundaries, C):
+    """The last bin open at its end: an event exactly at b_B dropped."""
+    keep = events.t < np.asarray(boundaries, dtype=np.float64)[-1]
+    return events_to_frames_fixed(Events(events.t[keep], events.x[keep], events.y[keep], events.p[keep],
+                                         events.sensor_size), boundaries, C)
+
+
 exercises.register(
     "events_to_frames_fixed", events_to_frames_fixed, _inputs_frames,
     hints={
@@ -351,6 +358,8 @@ exercises.register(
         "do not normalise the frames (each by its largest value): a frame holds C times the net count, in log "
         "units, the same scale in every bin (scaling is for display only)":
             _frames_normalised_per_frame,
+        "an event exactly at the last edge b_B belongs to the last bin (b_{B-1}, b_B]: keep it (only the events "
+        "after b_B are dropped, no strict t < b_B)": _frames_last_edge_open,
     })
 
 

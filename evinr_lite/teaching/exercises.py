@@ -180,6 +180,14 @@ def _fmt(v) -> str:
     return str(v)
 
 
+def _fmt_pair(a, b) -> tuple[str, str]:
+    """Two numbers formatted so that they read differently when they differ (4 digits, more when needed)."""
+    fa, fb = _fmt(a), _fmt(b)
+    if fa == fb and isinstance(a, (float, np.floating)) and isinstance(b, (float, np.floating)) and a != b:
+        return f"{float(a):.12g}", f"{float(b):.12g}"
+    return fa, fb
+
+
 def _describe_value(v) -> str:
     if not isinstance(v, (np.ndarray, np.generic, int, float, str, bool, list, tuple, dict)) and not _is_tensor(v) \
             and v is not None and ("\n" in repr(v) or len(repr(v)) > 60):
@@ -284,12 +292,13 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
         diff = np.where(np.isnan(diff), np.inf, diff)
         worst = int(bad[np.argmax(diff[bad])])
         if e.ndim == 0:
-            return _Problem(f"wrong value{at}: got {_fmt(g.item())}, expected {_fmt(e.item())}", values=True)
+            gs, es = _fmt_pair(g.item(), e.item())
+            return _Problem(f"wrong value{at}: got {gs}, expected {es}", values=True)
         idx = np.unravel_index(worst, e.shape)
         idx_s = str(idx[0]) if len(idx) == 1 else str(tuple(int(i) for i in idx))
-        return _Problem(
-            f"wrong values{at}: {bad.size} of {e.size} differ; at index {idx_s}: got {_fmt(g.ravel()[worst])}, "
-            f"expected {_fmt(e.ravel()[worst])}", values=True)
+        gs, es = _fmt_pair(g.ravel()[worst], e.ravel()[worst])
+        return _Problem(f"wrong values{at}: {bad.size} of {e.size} differ; at index {idx_s}: got {gs}, expected {es}",
+                        values=True)
     # anything else: plain equality
     if got != expected:
         return _Problem(f"got {got!r}{at}, expected {expected!r}", values=True)
@@ -561,24 +570,57 @@ def _same_array(a, b) -> bool:
         return True          # cannot tell: say nothing
 
 
+def _same_contents(a, b) -> bool:
+    """``a`` and ``b`` hold the same keys, items and values (dicts, lists and tuples compared recursively, arrays
+    entry by entry); an object that cannot be compared counts as the same (say nothing)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same_contents(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return type(a) is type(b) and len(a) == len(b) and all(_same_contents(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray) or _is_tensor(a) or isinstance(b, np.ndarray) or _is_tensor(b):
+        return _same_array(a, b)
+    if isinstance(a, (bool, int, float, complex, str, bytes, np.generic, type(None))):
+        try:
+            return type(a) is type(b) and (bool(a == b) or bool(a != a and b != b))
+        except Exception:
+            return True
+    return True
+
+
 def _changed_inputs(before: tuple[tuple, dict], after: tuple[tuple, dict]) -> list[str]:
-    """Names of the array inputs (or array fields of an input) that the call changed in place."""
+    """Names of the array inputs (or array fields of an input), and of the dict and list inputs (a key added,
+    removed or changed, an item appended, the list sorted), that the call changed in place."""
     (args0, kwargs0), (args1, kwargs1) = before, after
     pairs = [(f"argument {k + 1}", a, b) for k, (a, b) in enumerate(zip(args0, args1))]
     pairs += [(name, kwargs0[name], kwargs1[name]) for name in kwargs0 if name in kwargs1]
     changed = []
     for name, v0, v1 in pairs:
+        if isinstance(v0, (dict, list)):
+            if not _same_contents(v0, v1):
+                changed.append(name)
+            continue
         for (field_name, a0), (_, a1) in zip(_arrays_of(v0), _arrays_of(v1)):
             if not _same_array(a0, a1):
                 changed.append(f"{name}{field_name}")
     return changed
 
 
-def _in_place_message(changed: list[str]) -> str:
+def _in_place_message(changed: list[str], containers: tuple = ()) -> str:
     names = ", ".join(f"`{n}`" for n in changed)
+    if containers and set(changed) <= set(containers):
+        return (f"changed its input {names} in place (a key added, changed or removed: `row[key] = ...`, "
+                "`row.pop(key)`, `del row[key]`; or a list appended to or sorted): the caller's table must stay "
+                "as it was, so build a new dict (`{name: ... for name, row in table.items()}`) or work on "
+                "`copy.deepcopy(...)` of it")
     return (f"changed its input {names} in place (`x += ...`, `x[...] = ...`, `np.exp(x, out=x)`; "
             "`np.asarray(x, dtype=...)` is x itself when the dtype already matches): the caller's data must "
             "stay as it was, so compute a new array (`x = x + ...`) or work on a copy (`np.array(x, dtype=float)`)")
+
+
+def _container_names(args: tuple, kwargs: dict) -> tuple:
+    """The names `_changed_inputs` gives the dict and list inputs."""
+    return tuple([f"argument {k + 1}" for k, a in enumerate(args) if isinstance(a, (dict, list))]
+                 + [name for name, v in kwargs.items() if isinstance(v, (dict, list))])
 
 
 
@@ -627,18 +669,22 @@ def _mutable_default_hint(fn: Callable, before: dict[str, Any]) -> str | None:
     return None
 
 
-def _state_hint(fn: Callable, before: dict[str, Any], ex: Exercise, args, kwargs, got) -> str | None:
+def _state_hint(fn: Callable, before: dict[str, Any], ex: Exercise, args, kwargs, got,
+                first: bool = False) -> str | None:
     """A mutable default argument that changed (or holds data) during the check, or a second call on the same
-    input that gives another result: the function keeps state from one call to the next."""
-    hint = _mutable_default_hint(fn, before)
+    input that gives another result: the function keeps state between calls, or draws unseeded random numbers.
+    ``first``: the failing input is the first one, where a default cannot hold an earlier call's data yet."""
+    hint = None if first else _mutable_default_hint(fn, before)
     if hint is not None or ex.observe is not None:
         return hint
     try:
         again = _run(fn, args, kwargs, ex.observe)
         if _compare(again, got, ex.rtol, ex.atol) is not None:
             return ("called again on the same input, your function returns another result: it keeps state between "
-                    "calls (a notebook variable it changes, a mutable default argument, or unseeded randomness); "
-                    "compute everything from the arguments, starting afresh in each call")
+                    "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "
+                    "from the global generator (np.random.choice, np.random.randn, torch.randn without a seed of "
+                    "its own); compute everything from the arguments, starting afresh in each call, with no "
+                    "randomness (nothing here asks for a random sample)")
     except Exception:
         return None
     return None
@@ -653,9 +699,9 @@ def _stale_elsewhere(ex: Exercise, cases: list, k: int, subset: tuple, fn_output
             continue
         try:
             g = fn_outputs(j)
-            if _compare(g, _run(ex.reference, a, kw), ex.rtol, ex.atol) is None:
+            if _compare(g, _run(ex.reference, a, kw, ex.observe), ex.rtol, ex.atol) is None:
                 continue
-            if _compare(g, _run(ex.reference, (), dict(kw, **{name: kw0[name] for name in subset})),
+            if _compare(g, _run(ex.reference, (), dict(kw, **{name: kw0[name] for name in subset}), ex.observe),
                         ex.rtol, ex.atol) is not None:
                 return False
         except Exception:
@@ -667,24 +713,27 @@ def _stale_argument_hint(ex: Exercise, fn: Callable, cases: list, k: int, got, e
     """The learner's output on input ``k`` equals the reference's with one or two arguments taken from input #1
     (and so on every other input where it is wrong): the function reads a notebook variable (or a value fixed in
     the code) in place of those arguments."""
-    if k == 0 or ex.observe is not None:
+    if k == 0:
         return None
     memo: dict = {}
 
     def fn_outputs(j):
         if j not in memo:
-            memo[j] = _run(fn, *cases[j])
+            memo[j] = _run(fn, *cases[j], ex.observe)
         return memo[j]
 
     (args0, kw0), (args, kw) = cases[0], cases[k]
     if args or args0:
         return None
     names = [name for name in kw if name in kw0 and not _same_value(kw[name], kw0[name])]
+    if ex.observe is not None:       # a model and its optimiser belong together: try the plain numbers alone
+        names = [name for name in names
+                 if isinstance(kw[name], (int, float, np.number)) and not isinstance(kw[name], bool)]
     subsets = [(a,) for a in names] + [(a, b) for i, a in enumerate(names) for b in names[i + 1:]]
     for subset in subsets[:45]:
         trial = dict(kw, **{name: kw0[name] for name in subset})
         try:
-            w = _run(ex.reference, (), trial)
+            w = _run(ex.reference, (), trial, ex.observe)
             if _compare(w, expected, ex.rtol, ex.atol) is None or _compare(got, w, ex.rtol, ex.atol) is not None:
                 continue
         except Exception:
@@ -779,6 +828,123 @@ def _scalar_factor_hint(ex: Exercise, fn: Callable, cases: list, k: int, got, ex
             + _unit_note(ratio))
 
 
+_POLARITY_NAMES = ("p", "p_events", "polarity", "polarities")
+
+
+def _is_pm1(v) -> bool:
+    """An integer numpy array of polarities -1 and +1 (with at least one -1)."""
+    return isinstance(v, np.ndarray) and v.dtype.kind == "i" and v.size > 0 and bool(np.all(np.abs(v) == 1)) \
+        and bool(np.any(v < 0))
+
+
+def _with_polarities(kwargs: dict, f: Callable) -> dict | None:
+    """``kwargs`` with ``f`` applied to every -1/+1 polarity input (an argument named p or p_events, or the ``p``
+    of events); None when there is none."""
+    out, found = {}, False
+    for name, v in kwargs.items():
+        if name in _POLARITY_NAMES and _is_pm1(v):
+            out[name], found = f(v), True
+        elif getattr(v, "sensor_size", None) is not None and _is_pm1(getattr(v, "p", None)):
+            ev = copy.copy(v)
+            object.__setattr__(ev, "p", f(v.p))        # events hold -1/+1 alone: set the field past the check
+            out[name], found = ev, True
+        else:
+            out[name] = v
+    return out if found else None
+
+
+def _outside_unit(v) -> bool:
+    try:
+        a = _to_numpy(v)
+        return a.dtype.kind == "f" and a.size > 0 and bool(np.any((a < 0) | (a > 1)))
+    except Exception:
+        return False
+
+
+def _clip_unit(v):
+    return v.clamp(0.0, 1.0) if _is_tensor(v) else np.clip(v, 0.0, 1.0)
+
+
+def _clipped_inputs(kwargs: dict, only: str | None = None) -> dict | None:
+    """``kwargs`` with the float array (or tensor) input ``only`` (or, without it, every one) clipped to [0, 1];
+    None when no such input holds values outside [0, 1]."""
+    found = {name for name, v in kwargs.items() if (isinstance(v, np.ndarray) or _is_tensor(v)) and _outside_unit(v)
+             and only in (None, name)}
+    return {name: _clip_unit(v) if name in found else v for name, v in kwargs.items()} if found else None
+
+
+def _map_numbers(v, f: Callable):
+    """``f`` applied to every array, tensor or float inside ``v`` (tuples, lists and dicts kept)."""
+    if isinstance(v, dict):
+        return {k: _map_numbers(x, f) for k, x in v.items()}
+    if isinstance(v, (tuple, list)):
+        return type(v)(_map_numbers(x, f) for x in v)
+    if isinstance(v, (np.ndarray, float, np.floating)) or _is_tensor(v):
+        return f(v)
+    return v
+
+
+def _round_to(d: int) -> Callable:
+    def f(v):
+        if _is_tensor(v):
+            return _torch_round(v, d) if v.is_floating_point() else v
+        if isinstance(v, np.ndarray) and v.dtype.kind != "f":
+            return v
+        r = np.round(v, d)
+        return float(r) if isinstance(v, float) else r
+    return f
+
+
+def _torch_round(v, d):
+    return (v * 10.0 ** d).round() / 10.0 ** d
+
+
+def _generic_mistakes(ex: Exercise) -> list[tuple[str, Callable]]:
+    """Wrong versions made from the reference, for mistakes that any exercise can show: -1/+1 polarities treated
+    as 0/1 (or OFF events dropped), an input or the result clipped to [0, 1], a result rounded for display."""
+    ref = ex.reference
+
+    def on_inputs(change):
+        def wrong(*args, **kwargs):
+            changed = change(kwargs)
+            if args or changed is None:
+                raise ValueError("not applicable")
+            return ref(**changed)
+        return wrong
+
+    def on_output(change):
+        def wrong(*args, **kwargs):
+            return change(ref(*args, **kwargs))
+        return wrong
+
+    out = [
+        ("the polarities are already -1 and +1 here: `2 * p - 1` (the conversion for polarities stored as 0 and 1) "
+         "turns an OFF event's -1 into -3; use p as it is (np.where(p > 0, 1, -1) works for either encoding)",
+         on_inputs(lambda kw: _with_polarities(kw, lambda p: 2 * p - 1))),
+        ("the OFF events count as 0: the polarities are -1 and +1 and an OFF event subtracts; weights such as "
+         "`p > 0`, `p == 1` or `(p + 1) // 2` (a 0/1 encoding) drop them: use p itself",
+         on_inputs(lambda kw: _with_polarities(kw, lambda p: (p > 0).astype(p.dtype)))),
+    ]
+    try:
+        params = list(inspect.signature(ref).parameters)
+    except (TypeError, ValueError):
+        params = []
+    for only in [None] + params:            # every array input clipped, or one of them
+        what = "an input was" if only is None else f"`{only}` was"
+        out.append((f"{what} clipped to [0, 1] (np.clip, torch.clamp) before use: nothing here asks for that "
+                    "(only a display image lives in [0, 1]); use the values as they are",
+                    on_inputs(lambda kw, only=only: _clipped_inputs(kw, only))))
+    out += [
+        ("the result is clipped to [0, 1] (np.clip, torch.clamp): nothing here asks for that (only a display "
+         "image lives in [0, 1]); return the values unclipped",
+         on_output(lambda v: _map_numbers(v, lambda a: _clip_unit(a) if _outside_unit(a) else a))),
+    ]
+    for d in range(7):
+        out.append((f"the values are rounded to {d} decimal{'s' if d != 1 else ''}: return them as computed "
+                    "(round only where you print them)", on_output(lambda v, d=d: _map_numbers(v, _round_to(d)))))
+    return out
+
+
 def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
     """(passed, headline, detail lines) without printing."""
     if not callable(fn):
@@ -825,7 +991,7 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         if problem is None and not changed:
             continue
         if problem is None:
-            return False, f"changed its input on {where}", [_in_place_message(changed)]
+            return False, f"changed its input on {where}", [_in_place_message(changed, _container_names(args, kwargs))]
         details = [problem.message]
         hint = None
         # a known mistake is recognised by its output, whatever the first difference is (a wrong
@@ -843,10 +1009,23 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         # fixed size in place of an argument; and a pair returned in the other order
         if hint is None:
             hint = _swapped_pair_hint(ex, got, expected)
-        if hint is None and k > 0:
-            hint = _state_hint(fn, defaults, ex, args, kwargs, got)
+        if hint is None:
+            hint = _state_hint(fn, defaults, ex, args, kwargs, got, first=k == 0)
         if hint is None:
             hint = _stale_argument_hint(ex, fn, cases, k, got, expected)
+        # mistakes any exercise can show (polarities read as 0/1, a clip to [0, 1], a rounded result), recognised
+        # the same way from wrong versions made from the reference
+        if hint is None and ex.observe is None:
+            for message, wrong in _generic_mistakes(ex):
+                try:
+                    w = _run(wrong, args, kwargs)
+                    if _compare(w, expected, ex.rtol, ex.atol) is not None \
+                            and _compare(got, w, ex.rtol, ex.atol) is None \
+                            and _same_mistake_elsewhere(ex, fn, wrong, cases, k):
+                        hint = message
+                        break
+                except Exception:
+                    continue
         if hint is None:
             hint = _size_from_events_hint(args, kwargs, got, expected)
         if hint is None:
@@ -864,7 +1043,7 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         if hint:
             details.append(f"hint: {hint}")
         if changed:
-            details.append("also: " + _in_place_message(changed))
+            details.append("also: " + _in_place_message(changed, _container_names(args, kwargs)))
         return False, f"does not match the reference on {where}", details
     # the same input once more (the last one, right after its first run): a function that keeps state between
     # calls (a notebook variable it changes, a mutable default argument) gives another result the second time

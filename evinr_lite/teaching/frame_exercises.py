@@ -499,6 +499,13 @@ def _compare_offset_gradients(got, expected):
     return None
 
 
+def _offset_gradients_lower(frames):
+    """The lower of the two middle values for an even K."""
+    F = np.asarray(frames, dtype=np.float64)
+    return (-np.quantile(np.diff(F, axis=2), 0.5, axis=0, method="lower"),
+            -np.quantile(np.diff(F, axis=1), 0.5, axis=0, method="lower"))
+
+
 exercises.register(
     "offset_gradients", offset_gradients, _inputs_offset_gradients, compare=_compare_offset_gradients,
     hints={
@@ -515,6 +522,8 @@ exercises.register(
         "gx has W - 1 columns (one per pair of neighbours), gy H - 1 rows: np.diff without `prepend=`, which adds "
         "a difference of 0 at the border":
             _offset_gradients_prepended,
+        "the median of an even number K of differences is the mean of the two middle ones: np.median, not the "
+        "lower middle value (sorted[(K - 1) // 2], np.quantile(..., method='lower'))": _offset_gradients_lower,
     })
 
 

@@ -378,6 +378,11 @@ exercises.register(
         "an edge before the first event has a running sum of 0, but csum[n] with n = -1 reads csum[-1], the total: "
         "prepend a 0 (np.concatenate([[0.0], np.cumsum(p)])) before taking differences at the edges":
             _rate_cumsum_no_leading_zero,
+        "an event exactly at the last edge b_B belongs to the last window (b_{B-1}, b_B]: no strict t < b_B at the "
+        "end (only the events after b_B are left out)":
+            lambda t_events, p_events, C, boundaries: event_rate_derivative(
+                np.asarray(t_events)[np.asarray(t_events) < boundaries[-1]],
+                np.asarray(p_events)[np.asarray(t_events) < boundaries[-1]], C, boundaries),
     })
 
 def _loss_rates(dF_dt, delta_L, durations):

@@ -174,6 +174,11 @@ exercises.register(
             _threshold_rms_ratio,
         "keep the signs: a fit on |ΔL| and |n| lets a pixel whose ΔL has the wrong sign (noise) count as agreeing":
             _threshold_of_magnitudes,
+        "C is the least-squares slope sum(ΔL n) / sum(n^2) over all pixels, not the median of the per-pixel ratios "
+        "ΔL / n (each pixel weighs as much as its n^2 in least squares)":
+            lambda log_changes, net_counts: float(np.median(
+                np.asarray(log_changes, float)[np.asarray(net_counts) != 0]
+                / np.asarray(net_counts, float)[np.asarray(net_counts) != 0])),
     })
 
 

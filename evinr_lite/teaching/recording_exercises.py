@@ -407,6 +407,15 @@ def _filter_first_event_never_kept(t, x, y, dt):
     return _filter_loop_off_by_one(t, x, y, dt, first=1)
 
 
+def _filter_time_difference(t, x, y, dt):
+    """The window's end compared as a difference, t_i - t_j <= dt."""
+    t = np.asarray(t, np.float64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    gap = t[:, None] - t[None, :]
+    return np.any((cheb == 1) & (gap >= 0) & (gap <= dt), axis=1)
+
+
 exercises.register(
     "background_activity_filter", background_activity_filter, _inputs_filter,
     hints={
@@ -439,6 +448,8 @@ exercises.register(
         "dt is in seconds, like t: use it as it is (dt * 1e3 reads it as milliseconds and makes the window a "
         "thousand times longer)":
             _filter_dt_in_milliseconds,
+        "compare t_i <= t_j + dt as written: t_i - t_j <= dt rounds differently in floating point, and an event "
+        "exactly dt after its neighbour can fall out of the window": _filter_time_difference,
     })
 
 
