@@ -174,7 +174,7 @@ def test_keep_background_turns_off_the_kit_filter_from_the_command_line(monkeypa
     assert main(["reconstruct", "rec", "--out", str(tmp_path / "o"), "--keep-background", "--quiet"]) == 0
     o = seen["options"]
     assert o.keep_background and o.config(0.2).background == "keep"
-    assert RunOptions().config(0.2).background == "filter" and not RunOptions().keep_background
+    assert RunOptions().config(0.2).background == "auto" and not RunOptions().keep_background
     assert build_parser().parse_args(["batch", "a", "--out", "o", "--keep-background"]).keep_background
     settings = json.loads(json.dumps(o.to_dict(BATCH_FIELDS)))
     assert RunOptions.from_settings(settings).keep_background is True   # a batch's settings carry it

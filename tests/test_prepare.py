@@ -31,12 +31,15 @@ def _key(ev: Events):
 
 def test_the_default_filters_background_and_the_paper_keeps_it(noisy):
     ev, _ = noisy
-    kept, _ = prepare_events(ev, EvINRConfig(C=0.225))
+    kept, used = prepare_events(ev, EvINRConfig(C=0.225, background="filter"))
     # the same events as denoise() with its defaults (hot pixels, then the two-sided same-polarity filter)
     reference, _ = denoise(ev)
     assert set(map(tuple, _key(kept).T)) <= set(map(tuple, _key(reference).T))
     assert len(kept) >= 0.99 * len(reference)       # only pixels still hot on the filtered counts may go
-    assert EvINRConfig().background == "filter"
+    assert used.background == "filter" and used.background_dt == 0.05
+    # the kit's default chooses the window from the events: this recording's background activity keeps 50 ms
+    assert EvINRConfig().background == "auto"
+    assert prepare_events(ev, EvINRConfig(C=0.225))[1].background_dt == 0.05
     assert EvINRConfig.paper().background == EvINRConfig.v0_1().background == "keep"   # the paper's recipe exactly
     assert len(prepare_events(ev, EvINRConfig.paper(C=0.225))[0]) == len(ev)
 
@@ -45,14 +48,14 @@ def test_a_run_that_denoised_first_does_not_filter_again():
     from evinr_lite.apps.options import RunOptions
 
     assert RunOptions(denoise=True).config(0.2).background == "keep"      # --denoise filtered and reported already
-    assert RunOptions().config(0.2).background == "filter"
+    assert RunOptions().config(0.2).background == "auto"
 
 
 def test_the_filter_removes_background_and_keeps_signal():
     scene = OscillatingScene("astronaut", SIZE, 6.0, path=((12.0, 4.0, 4.0, 0.0), (2.0, 3.0, 1.3, 1.0)))
     clean = simulate_scene(scene, C=0.2, seed=0)
     ev, added = add_background_noise(clean, 1.0, seed=1, t_start=0.0, t_end=6.0, return_labels=True)
-    kept, _ = prepare_events(ev, EvINRConfig(C=0.2, hot_pixels="keep"))
+    kept, _ = prepare_events(ev, EvINRConfig(C=0.2, hot_pixels="keep", background="filter"))
     kept_keys = set(map(tuple, _key(kept).T))
     is_kept = np.array([k in kept_keys for k in map(tuple, _key(ev).T)])
     assert is_kept[~added].mean() > 0.95             # signal events stay
@@ -74,10 +77,11 @@ def test_a_streamed_recording_sees_the_same_events_as_the_whole_span(noisy, tau)
     parts = [source.events(a, b) for a, b in zip(edges[:-1], edges[1:])]
     np.testing.assert_array_equal(np.concatenate([_key(p) for p in parts], axis=1), _key(whole_ev))
     # the reach matters: filtered alone, a window loses edge events whose neighbours lie beyond it
-    only_filter = EvINRConfig(C=0.225, tau=tau, hot_pixels="keep", balance="none", lam=0.01, progress=False)
+    only_filter = EvINRConfig(C=0.225, tau=tau, hot_pixels="keep", balance="none", lam=0.01, background="filter",
+                              progress=False)
     _, plain = prepare_source(MemorySource(ev), t0, t1, only_filter)
     a, b = 1.0, 1.0 + tau
-    alone, wide = filter_background(ev.slice_time(a, b, allow_empty=True)), plain.events(a, b)
+    alone, wide = filter_background(ev.slice_time(a, b, allow_empty=True), only_filter.background_dt), plain.events(a, b)
     assert set(map(tuple, _key(alone).T)) < set(map(tuple, _key(wide).T))
 
 

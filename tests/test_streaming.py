@@ -13,7 +13,7 @@ from evinr_lite import EvINRConfig, make_scene, simulate_scene
 from evinr_lite.core.events import EventDataError
 from evinr_lite.evaluation.scoring import score_sequence
 from evinr_lite.io.source import MemorySource
-from evinr_lite.method.prepare import REACH
+from evinr_lite.method.prepare import prepare_source, reach
 from evinr_lite.method.models import FrameINR
 from evinr_lite.method.solver import reconstruct
 from evinr_lite.method.streaming import StreamState, stream_reconstruct
@@ -77,10 +77,14 @@ def test_many_windows_give_the_whole_sequence_result(scene_events, tmp_path):
     np.testing.assert_allclose(frames, whole.frames, rtol=0, atol=1e-4)
     # each window read only its own events and the background filter's reach (never the whole
     # recording); before them, the two counting passes of method/prepare.prepare_source (raw counts for
-    # the hot pixels, filtered ones for the ON/OFF balance and lam) read the span in chunks of tau, and
-    # after them, on a span of at most 3 s, the static image's coarse part (method/coarse.py) reads it once more
-    assert len(source.asked) == 4 + 3 + 3 + 3
-    assert all(t1 - t0 <= cfg.tau + 2 * REACH + 1e-6 for t0, t1 in source.asked)
+    # the hot pixels, filtered ones for the ON/OFF balance and lam) read the span in chunks of tau, with the
+    # span read once in between for the filter's window (background="auto", method/background.py: a span of
+    # at most 8 s is measured whole), and after them, on a span of at most 3 s, the static image's coarse
+    # part (method/coarse.py) reads it once more
+    assert len(source.asked) == 4 + 3 + 1 + 3 + 3
+    used = prepare_source(MemorySource(events), 0.0, 3.0, cfg)[0]
+    r = reach(used.background_dt) if used.background == "filter" else 0.0
+    assert [t1 - t0 > cfg.tau + 2 * r + 1e-6 for t0, t1 in source.asked] == [False] * 3 + [True] + [False] * 10
     assert (tmp_path / "log_intensity.f32").stat().st_size == len(q) * SIZE[0] * SIZE[1] * 4   # the spill
 
 

@@ -139,8 +139,10 @@ STATIC_CAMERA_HELP = ("the camera stood still (a tripod) and things moved in fro
                       "from the frames where something moved over it, so the background an object passed over "
                       "appears (EvINRConfig(camera='static'); kit recipe, events only). Not for a moving camera")
 KEEP_BACKGROUND_HELP = ("train on every event: skip the kit recipe's background-activity filter (an event is kept "
-                        "when a neighbouring pixel fired one of the same polarity within 50 ms; EvINRConfig.background); "
-                        "for sparse recordings whose isolated events are signal. paper and v0_1 keep every event anyway")
+                        "when a neighbouring pixel fired one of the same polarity within a window the recipe chooses "
+                        "from the events' share of noise, 50-400 ms, or every event is kept on a clean recording; "
+                        "EvINRConfig.background); for sparse recordings whose isolated events are signal. paper and "
+                        "v0_1 keep every event anyway")
 SAVE_LOG_HELP = ("also write the frames' log intensity, unclipped, as float32 in log_intensity.h5 (4 bytes a pixel "
                  "a frame): the dynamic range the 8-bit PNGs clip, to tone-map again or to use as data")
 DISPLAY_MEAN_HELP = ("how bright the frames are, from 0.01 to 0.99: the level events never give. linear: the frames' "

@@ -20,6 +20,7 @@ from ..core.events import EventDataError
 from .anchor import ANCHOR_MODES
 from .balance import BALANCE_MODES, HOT_PIXEL_MODES
 from .binning import as_thresholds
+from .denoise import DEFAULT_DT
 from .offset import OFFSET_SOLVES, STATIC_REST
 from .prepare import BACKGROUND_MODES
 from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEMAPS
@@ -206,6 +207,11 @@ class EvINRConfig:
       0.569 / 0.0682, long_pan_20s 0.569 / 0.669 / 0.0352 -> 0.643 / 0.732 / 0.0307, unequal_onhot
       0.637 -> 0.784; costs chelsea_speed 0.552 -> 0.536 and ihc_warp 0.436 -> 0.412 (fast motion and
       sparse fine texture, where some signal events have no neighbour).
+    - background="auto" instead of "filter" (2026-12-07, eleventh session): the filter's window, 50 ms to
+      0.4 s or no filter, chosen from the events' own share of noise (:mod:`~evinr_lite.method.background`:
+      the share read against random probes, the window that keeps the most signal net of twice the
+      noise). A slow or sparse clean recording keeps its events (a 50 ms window dropped 10 % of a slow
+      pan's); a noisy one keeps 50 ms. Figures in docs/defaults.md, "The background filter's window".
 
     With these, on the 13 short zoo scenes at full size (``benchmarks/zoo_results.md``, 2 cores):
     kit 0.643 / 0.703 / 0.0344, integration + the same L1 offset 0.559 / 0.635 / 0.0364 (the INR:
@@ -319,11 +325,16 @@ class EvINRConfig:
             evidence (the rule before the intervals). A given pair is used as it is.
         hot_pixels: "keep" or "drop": the events of pixels firing far above the sensor's robust rate
             (:func:`evinr_lite.method.denoise.hot_pixel_mask`) are left out before training.
-        background: "keep" or "filter": background activity (isolated events with no event of the same
-            polarity at a neighbouring pixel within 50 ms before or after) is left out before training,
-            after the hot pixels and before the ON/OFF balance and lam are estimated
-            (:func:`evinr_lite.method.denoise.denoise` with its defaults; streamed windows are read with
-            the filter's reach beyond their edges, so they see the same events).
+        background: "keep", "filter" or "auto": background activity (isolated events with no event of the
+            same polarity at a neighbouring pixel within ``background_dt`` before or after) is left out
+            before training, after the hot pixels and before the ON/OFF balance and lam are estimated
+            (:func:`evinr_lite.method.denoise.correlation_filter`, two-sided, same polarity; streamed
+            windows are read with the filter's reach beyond their edges, so they see the same events).
+            "auto" (the kit's) chooses the window, or no filter, from the events' own share of noise
+            (:mod:`evinr_lite.method.background`); the returned config says which ("filter" with its
+            ``background_dt``, or "keep").
+        background_dt: seconds, the filter's window with ``background="filter"`` (50 ms: the fixed
+            default before "auto"; a slow or sparse scene loses signal events below about 1 / speed).
         anchor: APS frames as anchors (:mod:`evinr_lite.method.anchor`; pass ``frames=`` to
             :func:`reconstruct`): "none" (events only, the default), "first" (the first frame in the
             window sets the per-pixel offset) or "all" (every ``anchor_every``-th frame is a soft
@@ -382,7 +393,8 @@ class EvINRConfig:
     camera: str = "moving"
     balance: str = "events"
     hot_pixels: str = "drop"
-    background: str = "filter"
+    background: str = "auto"
+    background_dt: float = DEFAULT_DT
     anchor: str = "none"
     anchor_every: int = 2
     anchor_smoothing: float = 0.03
@@ -464,6 +476,10 @@ class EvINRConfig:
                                      f"{self.lam!r}{hint}")
         elif not number("lam", self.lam) >= 0:
             raise EventDataError(f"lam must be zero or positive (or 'auto'), got {self.lam}")
+        if not number("background_dt", self.background_dt) > 0:
+            raise EventDataError(f"background_dt must be a positive number of seconds (the filter's window, e.g. 0.05), "
+                                 f"got {self.background_dt!r}")
+        self.background_dt = float(self.background_dt)
         if not 0 <= number("prior_time_order", self.prior_time_order) <= 1:
             raise EventDataError(f"prior_time_order must be within [0, 1] (0: the frames' roughness, the paper's; 1: the "
                                  f"per-bin changes'; the kit's 0.25), got {self.prior_time_order!r}")

@@ -5,9 +5,13 @@ In this order, each judged on what the step before left (``EvINRConfig`` fields 
 1. hot pixels dropped (``hot_pixels="drop"``): pixels whose count is far above the sensor's robust
    count (:func:`~evinr_lite.method.denoise.hot_pixel_mask`);
 2. background activity filtered (``background="filter"``): events without an event of the same
-   polarity at a neighbouring pixel within ``DEFAULT_DT`` (50 ms) before or after them
-   (:func:`~evinr_lite.method.denoise.correlation_filter`, :func:`~evinr_lite.method.denoise.denoise`'s
-   defaults). Hot pixels go first: their events would otherwise keep their neighbours' noise;
+   polarity at a neighbouring pixel within ``background_dt`` (50 ms by default) before or after them
+   (:func:`~evinr_lite.method.denoise.correlation_filter`, two-sided and same polarity as
+   :func:`~evinr_lite.method.denoise.denoise`'s defaults). ``background="auto"`` (the kit's) first chooses
+   that window, or no filter, from the events' own share of noise
+   (:func:`~evinr_lite.method.background.fit_background`, measured on the spans of
+   :func:`~evinr_lite.method.background.sample_spans`) and the config says what it chose. Hot pixels go
+   first: their events would otherwise keep their neighbours' noise;
 3. the ON/OFF balance (``balance="events"``: C+ and C- from one nominal C,
    :mod:`~evinr_lite.method.balance`) and ``lam="auto"`` (:mod:`~evinr_lite.method.smoothing`),
    both from the per-pixel ON / OFF counts (and, for the balance, the intervals between events of one
@@ -17,9 +21,9 @@ In this order, each judged on what the step before left (``EvINRConfig`` fields 
 :func:`prepare_source` for a recording read window by window
 (:func:`~evinr_lite.method.streaming.stream_reconstruct`). The two see the same events: the stream
 counts the span in chunks first (two reading passes when the background is filtered: the hot
-pixels come from the raw counts, the balance from the filtered ones), and reads each window with the
-filter's reach (twice ``DEFAULT_DT``, clipped to the span) beyond its edges, so an event near an
-edge is judged on the same neighbours as in the whole span. A span no longer than one counting chunk
+pixels come from the raw counts, the balance from the filtered ones; with "auto" the sampled spans are
+read in between), and reads each window with the filter's reach (:func:`reach`, clipped to the span)
+beyond its edges, so an event near an edge is judged on the same neighbours as in the whole span. A span no longer than one counting chunk
 (``cfg.tau``) is read once and prepared in memory, as :func:`prepare_events` does, and its windows are
 slices of it.
 """
@@ -31,14 +35,31 @@ import numpy as np
 
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
-from .denoise import DEFAULT_DT, denoise_mask, hot_threshold
+from .background import fit_background, sample_spans
+from .denoise import denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
 __all__ = ["prepare_events", "prepare_source", "plan_from_counts", "drop_pixels", "filter_background",
-           "BACKGROUND_MODES", "REACH"]
+           "choose_background", "reach", "BACKGROUND_MODES"]
 
-BACKGROUND_MODES = ("keep", "filter")
-REACH = 2 * DEFAULT_DT    # s read beyond a streamed window's edges: more than the filter's DEFAULT_DT, so rounding never matters
+BACKGROUND_MODES = ("keep", "filter", "auto")
+
+
+def reach(dt: float) -> float:
+    """Seconds read beyond a streamed window's edges for a filter of window ``dt`` (s): twice it, so
+    rounding never matters."""
+    return 2 * float(dt)
+
+
+def choose_background(cfg, read, t_start: float, t_end: float, hot=None):
+    """``cfg`` with ``background="auto"`` resolved (else unchanged): ``background="filter"`` with the
+    ``background_dt`` that :func:`~evinr_lite.method.background.fit_background` chooses, or ``"keep"``.
+    ``read(a, b)``: the events over [a, b) (s); ``hot``: bool [H, W] pixels to drop first, or None."""
+    if cfg.background != "auto":
+        return cfg
+    samples = [(drop_pixels(read(a, b), hot), (qa, qb)) for a, b, qa, qb in sample_spans(t_start, t_end)]
+    fit = fit_background(samples, cfg.seed)
+    return replace(cfg, background="keep") if fit.dt is None else replace(cfg, background="filter", background_dt=fit.dt)
 
 
 def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sliced=None):
@@ -74,12 +95,12 @@ def drop_pixels(events: Events, mask) -> Events:
     return events.take(~mask[events.y, events.x])
 
 
-def filter_background(events: Events) -> Events:
-    """The events that :func:`~evinr_lite.method.denoise.denoise` keeps with its defaults and its hot-pixel
-    stage off (the correlation filter: two-sided, same polarity, ``DEFAULT_DT``)."""
+def filter_background(events: Events, dt: float) -> Events:
+    """The events that :func:`~evinr_lite.method.denoise.denoise` keeps with its hot-pixel stage off and a
+    window of ``dt`` seconds (the correlation filter: two-sided, same polarity)."""
     if len(events) == 0:
         return events
-    return events.take(denoise_mask(events, hot_pixels=False)[0])
+    return events.take(denoise_mask(events, hot_pixels=False, dt=dt)[0])
 
 
 def _hot_mask(n: np.ndarray) -> np.ndarray:
@@ -103,10 +124,14 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
     if not len(events):
         return events, cfg
     t0, t1 = (float(events.t[0]), float(events.t[-1])) if span is None else span
-    if cfg.background == "filter":                  # hot pixels first, then the filter: denoise() with its defaults
+    if cfg.background != "keep":                    # hot pixels first, then the filter (its window chosen first)
         n_in = len(events)
-        events = events.take(denoise_mask(events, hot_pixels=cfg.hot_pixels == "drop")[0])
-        _check_left(len(events), n_in)
+        first = hot_pixel_mask(events) if cfg.hot_pixels == "drop" else None
+        events = drop_pixels(events, first)
+        cfg = choose_background(cfg, lambda a, b: events.slice_time(a, b, allow_empty=True), t0, t1)
+        if cfg.background == "filter":
+            events = filter_background(events, cfg.background_dt)
+            _check_left(len(events), n_in)
     counts = PolarityCounts(tuple(events.sensor_size), slices=span_slices(t0, t1)).update(events)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap),
                                 counts.intervals, counts.sliced)
@@ -115,12 +140,13 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
 
 class _Prepared:
     """A recording source whose windows are prepared as in the whole span: hot pixels (``first``)
-    dropped, background filtered on the window read ``REACH`` beyond its edges (within the span), then
-    the pixels of ``then`` dropped. Everything else is the source's."""
+    dropped, background filtered with a window of ``dt`` seconds (None: not filtered) on the window read
+    :func:`reach` beyond its edges (within the span), then the pixels of ``then`` dropped. Everything else
+    is the source's."""
 
-    def __init__(self, source, span, first=None, background=False, then=None, held=None):
+    def __init__(self, source, span, first=None, dt=None, then=None, held=None):
         self._source, self._span = source, span
-        self._first, self._background, self._then, self._held = first, background, then, held
+        self._first, self._dt, self._then, self._held = first, dt, then, held
 
     def __getattr__(self, name):
         return getattr(self._source, name)
@@ -128,11 +154,12 @@ class _Prepared:
     def events(self, t0, t1):
         if self._held is not None:                   # a span of one counting chunk, prepared once
             return self._held.slice_time(t0, t1, allow_empty=True)
-        if not self._background:                     # hot pixels only (``first`` is set with the filter)
-            return drop_pixels(self._source.events(t0, t1), self._then)
+        if self._dt is None:                         # hot pixels only
+            return drop_pixels(drop_pixels(self._source.events(t0, t1), self._first), self._then)
         lo, hi = self._span
-        a, b = max(t0 - REACH, lo), min(t1 + REACH, np.nextafter(hi, np.inf))   # the span's end is inclusive
-        wide = filter_background(drop_pixels(self._source.events(a, max(a, b)), self._first))
+        r = reach(self._dt)
+        a, b = max(t0 - r, lo), min(t1 + r, np.nextafter(hi, np.inf))   # the span's end is inclusive
+        wide = filter_background(drop_pixels(self._source.events(a, max(a, b)), self._first), self._dt)
         inside = (wide.t >= t0) & (wide.t < t1)
         return drop_pixels(wide.take(inside), self._then)
 
@@ -171,13 +198,14 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
     """:func:`prepare_events` for a streamed recording (a hook in
     :func:`~evinr_lite.method.streaming.stream_reconstruct`): ``(cfg, source)``. The counts are read
     over [t_start, t_end] in chunks of ``chunk_s`` seconds (default ``cfg.tau``, so memory stays that
-    of one window): once, or twice with ``cfg.background == "filter"`` (raw counts for the hot
-    pixels, then the filtered events' counts). So every window is trained with the same C pair, lam
+    of one window): once, or twice when the background may be filtered (``cfg.background`` "filter" or
+    "auto"; raw counts for the hot pixels, then the filtered events' counts, with "auto" the sampled spans
+    read in between to choose the window). So every window is trained with the same C pair, lam
     and events as the whole-span solve. ``progress``: a bar for each pass over the recording."""
     if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto" and cfg.background == "keep":
         return cfg, source
     chunk_s = chunk_s or cfg.tau or (t_end - t_start)
-    span, first, filtered = (t_start, t_end), None, cfg.background == "filter"
+    span, first, filtered = (t_start, t_end), None, cfg.background != "keep"
     if filtered and t_end - t_start <= chunk_s:
         # the span is one chunk (no more than one window's events): read it once, prepare it as the
         # whole-span solve does, and hand the windows slices of it instead of reading and filtering again
@@ -189,11 +217,14 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         if cfg.hot_pixels == "drop":
             first = _hot_mask(counts.n_on + counts.n_off)
         n_in = int((counts.n_on + counts.n_off).sum())
-        counts = _counts(_Prepared(source, span, first, background=True), t_start, t_end, chunk_s,
-                         "filtering background activity" if progress else None)
-        _check_left(int((counts.n_on + counts.n_off).sum()), n_in)
+        cfg = choose_background(cfg, source.events, t_start, t_end, first)
+        dt = cfg.background_dt if cfg.background == "filter" else None
+        counts = _counts(_Prepared(source, span, first, dt=dt), t_start, t_end, chunk_s,
+                         ("filtering background activity" if dt else "counting events again") if progress else None)
+        if dt:
+            _check_left(int((counts.n_on + counts.n_off).sum()), n_in)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap),
                                 counts.intervals, counts.sliced)
-    if not filtered and not hot.any():
+    if cfg.background == "keep" and first is None and not hot.any():
         return cfg, source
-    return cfg, _Prepared(source, span, first, background=filtered, then=hot)
+    return cfg, _Prepared(source, span, first, dt=cfg.background_dt if cfg.background == "filter" else None, then=hot)
