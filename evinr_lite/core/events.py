@@ -48,7 +48,7 @@ def wrap_hint(before, after, scales=(1.0,)) -> str:
                 return (f"; they fall from {a:.0f} to {b:.0f}, across {'2**32' if bits == 32 else '2**31 to -2**31'}: a "
                         f"{'signed ' if bits == 31 else ''}32-bit counter of{unit or ' ticks'} wrapped around{every}, "
                         "so a sort would interleave its laps: unwrap the times in their own unit before anything else, "
-                        "t = t.astype(np.int64) + 2**32 * np.cumsum(np.diff(t, prepend=t[0]) < 0), and save them as "
+                        "t = t.astype(np.int64); t = t + 2**32 * np.cumsum(np.diff(t, prepend=t[0]) < 0), and save them as "
                         "64-bit numbers")
     return ""
 

@@ -116,12 +116,20 @@ def _no_such(path: Path, given) -> str:
     return f"no such file or folder: {path}; check the path"
 
 
+# the files of an IJRR or EVREAL folder: a folder holding one is a damaged recording folder, not a folder of recordings
+RECORDING_FOLDER_FILES = frozenset({"events.txt", "images.txt", "calib.txt", "groundtruth.txt", "imu.txt",
+                                    "depthmaps.txt", "metadata.json", "events_ts.npy", "events_xy.npy", "events_p.npy",
+                                    "images.npy", "images_ts.npy"})
+
+
 def _recordings_inside(folder: Path) -> list[str]:
     """The names of the recordings directly inside ``folder`` (files with a recording suffix, recording folders)."""
     found = []
     try:
         children = sorted(folder.iterdir())
     except OSError:
+        return found
+    if any(child.name in RECORDING_FOLDER_FILES for child in children):   # a recording folder that lacks a part
         return found
     for child in children:
         if child.name.startswith("."):
