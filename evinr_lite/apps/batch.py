@@ -41,7 +41,8 @@ import numpy as np
 from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
-from ..io.formats import RECORDING_SUFFIXES, detect_format, is_recording_folder, is_ros2_bag  # formats: io.formats
+from ..io.formats import (RECORDING_SUFFIXES, detect_format, is_recording_folder, is_ros2_bag,  # formats: io.formats
+                          recording_path)
 from .options import BATCH_FIELDS, RunOptions
 from .recon_job import EQUALIZATIONS, run_reconstruct
 
@@ -148,7 +149,7 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
     cache = Path(cache) if cache is not None else cache_dir()
     items = []
     for spec in inputs:
-        path = Path(spec)
+        path = recording_path(spec) if str(spec).startswith("~") else Path(spec)   # ~ as reconstruct reads it
         if path.exists():
             path = _real_path(path)
             if path.is_dir() and is_ros2_bag(path):

@@ -340,6 +340,18 @@ def check_run_options(**fields) -> RunOptions:
     return RunOptions(**fields)
 
 
+def _times_hint(times: np.ndarray, lo: float, hi: float, t_origin: float) -> str:
+    """Why times outside [lo, hi] may be so: given in ms / us / ns, or on the absolute clock (with t_origin)."""
+    for unit, scale in (("milliseconds", 1e-3), ("microseconds", 1e-6), ("nanoseconds", 1e-9)):
+        if np.all((times * scale >= lo) & (times * scale <= hi)):
+            shown = ",".join(f"{v * scale:.9g}" for v in times[:3]) + ("..." if len(times) > 3 else "")
+            return f"; they look like {unit}: the times are seconds, e.g. {shown}"
+    if t_origin and np.all((times - t_origin >= lo) & (times - t_origin <= hi)):
+        return (f"; they are on the recording's absolute clock: the times are seconds after t_origin = {t_origin!r} "
+                "(see `evinr-lite info`), so subtract it")
+    return ""
+
+
 def choose_times(rec: Recording, *, fps: float | None = None, at=None, check=None) -> tuple[np.ndarray, str]:
     """The times to reconstruct and where they come from.
 
@@ -361,7 +373,8 @@ def choose_times(rec: Recording, *, fps: float | None = None, at=None, check=Non
         outside = times[(times < lo) | (times > hi)]
         if outside.size:
             raise EventDataError(f"requested time {outside[0]} s is outside the reconstructed window "
-                                 f"[{lo:.6f}, {hi:.6f}] s; choose times inside it (or widen t_start=/t_end=)")
+                                 f"[{lo:.6f}, {hi:.6f}] s; choose times inside it (or widen t_start=/t_end=)"
+                                 + _times_hint(times, lo, hi, rec.events.t_origin))
         return times, f"{len(times)} requested times"
     if fps is None and rec.frames is not None:
         inside = rec.frames.t[(rec.frames.t >= lo) & (rec.frames.t <= hi)]

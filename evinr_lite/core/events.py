@@ -25,12 +25,43 @@ from .guard import InputError, dense_array, host_array   # the guard maps it to 
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
            "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S",
-           "MAX_SENSOR_SIDE", "fall_back_hint"]
+           "MAX_SENSOR_SIDE", "fall_back_hint", "wrap_hint"]
 
-def fall_back_hint(n_falls: int) -> str:
+WRAP_BITS = (32, 31)   # counters that wrap: unsigned 32-bit (0 .. 2**32 - 1) and signed 32-bit (to -2**31)
+
+
+def wrap_hint(before, after, scales=(1.0,)) -> str:
+    """The fix for timestamps that fall from ``before`` to ``after`` (numbers, one unit) because a 32-bit counter
+    wrapped around (uint32 microseconds every 71.6 minutes, int32 every 35.8), or "" when the fall is no such
+    wrap. ``scales``: the factors that take the values to the counter's unit (1 for a file's raw numbers; 1e3,
+    1e6, 1e9 for seconds, whose counter may have counted ms, us or ns). A sort would interleave the laps."""
+    for scale in scales:
+        a, b = float(before) * scale, float(after) * scale
+        for bits in WRAP_BITS:
+            lap = 2.0 ** 32
+            low = 0.0 if bits == 32 else -2.0 ** 31          # the counter's smallest value
+            top = low + lap                                  # one past its largest
+            # from just below the top to just above the bottom: the step over the wrap is short (under 1/1024 lap)
+            if a < top + 1 and b >= low - 1 and -1 <= b + lap - a < lap / 1024:
+                unit = {1e3: " milliseconds", 1e6: " microseconds", 1e9: " nanoseconds"}.get(scale, "")
+                every = f" (every {lap / scale / 60:,.1f} minutes)" if scale > 1 else ""
+                return (f"; they fall from {a:.0f} to {b:.0f}, across {'2**32' if bits == 32 else '2**31 to -2**31'}: a "
+                        f"{'signed ' if bits == 31 else ''}32-bit counter of{unit or ' ticks'} wrapped around{every}, "
+                        "so a sort would interleave its laps: unwrap the times in their own unit before anything else, "
+                        "t = t.astype(np.int64); t = t + 2**32 * np.cumsum(np.diff(t, prepend=t[0]) < 0), and save them as "
+                        "64-bit numbers")
+    return ""
+
+
+def fall_back_hint(n_falls: int, before=None, after=None, scales=(1.0,)) -> str:
     """What to add to an unsorted-times refusal when the times fall back exactly once (``n_falls``, the
     decreasing steps found): two recordings joined, or a clock that restarted, where a sort would
-    interleave the two parts instead of repairing them."""
+    interleave the two parts instead of repairing them. ``before`` / ``after``: the first fall's values,
+    to name a 32-bit counter that wrapped around (:func:`wrap_hint`) whatever the number of falls."""
+    if before is not None and after is not None:
+        wrapped = wrap_hint(before, after, scales)
+        if wrapped:
+            return wrapped
     if n_falls != 1:
         return ""
     return ("; they fall back only once, so if two recordings were joined or the clock restarted there, a sort would "
@@ -84,6 +115,7 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
             raise EventDataError(
                 f"polarity values {{{shown}}} are neither -1/+1 nor 0/1 "
                 "(a mix of both, or other numbers). Convert them to -1 (OFF) / +1 (ON) before loading."
+                + _two_value_hint(values)
             )
     if encoding == "pm1":
         if not np.all(np.isin(values, (-1, 1))):
@@ -99,6 +131,18 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
             )
         return np.where(p > 0, 1, -1).astype(np.int8)
     raise EventDataError(f"unknown polarity encoding {encoding!r}; use 'auto', 'pm1', '01' or 'bool'")
+
+
+def _two_value_hint(values: np.ndarray) -> str:
+    """The conversion for polarities stored as two other values: 0/255 (an 8-bit image's black and white), 1/2
+    (counted from 1, as MATLAB indexes) or any other pair (the larger taken as ON)."""
+    if values.size != 2:
+        return ""
+    lo, hi = (v.item() for v in values)
+    why = {(0, 255): "0/255 are an 8-bit image's black and white: ",
+           (1, 2): "1/2 count from 1 (as MATLAB indexes): "}.get((lo, hi), "")
+    return (f" {why[:1].upper() + why[1:] if why else ''}if {hi:g} is ON and {lo:g} OFF, convert them with "
+            f"p = np.where(p == {hi:g}, 1, -1)")
 
 
 class TimeUnitWarning(UserWarning):
@@ -279,6 +323,15 @@ def _checked_take_index(index, n: int, t=None) -> np.ndarray:
     return a
 
 
+def _narrow_integer(a: np.ndarray, size: int):
+    """np.iinfo of the integer type of coordinates ``a`` when it cannot hold every pixel index below ``size``
+    (uint8 on a sensor wider than 256), else None."""
+    if a.dtype.kind not in "iu" or a.dtype.itemsize > 2:
+        return None
+    info = np.iinfo(a.dtype)
+    return info if size - 1 > info.max else None
+
+
 @dataclass(frozen=True, eq=False)
 class Events:
     """A stream of N events on a sensor of ``sensor_size = (H, W)`` pixels.
@@ -340,10 +393,12 @@ class Events:
             dec = np.flatnonzero(np.diff(t) < 0)
             if dec.size:
                 i = int(dec[0])
+                origin = float(self.t_origin) if _is_number(self.t_origin) else 0.0   # a wrapped counter is absolute
                 raise EventDataError(
                     f"timestamps are not sorted: t[{i}] = {float(t[i])!r} > t[{i + 1}] = {float(t[i + 1])!r} "
                     f"({dec.size} decreasing steps); sort the events by time, e.g. "
-                    "Events.from_arrays(..., sort=True)" + fall_back_hint(dec.size)
+                    "Events.from_arrays(..., sort=True)"
+                    + fall_back_hint(dec.size, float(t[i]) + origin, float(t[i + 1]) + origin, scales=(1e6, 1e9, 1e3))
                 )
         for name, a, size, axis in (("x", x, W, "column, width W"), ("y", y, H, "row, height H")):
             if a.dtype.kind == "f":
@@ -353,6 +408,14 @@ class Events:
                 raise EventDataError(f"{name} coordinates must be integers, got dtype {a.dtype}" +
                                      (f"; if they are whole numbers kept as objects, convert them: np.asarray({name}, "
                                       "dtype=np.int64)" if a.dtype == object else ""))
+            narrow = _narrow_integer(a, size)   # a type too small for the sensor: values past its top wrapped
+            if narrow is not None and narrow.kind == "u" and a.size and a.max() == narrow.max:
+                raise EventDataError(
+                    f"{name} is stored as {a.dtype}, which holds only 0 .. {narrow.max}, but the sensor is {size} "
+                    f"{'columns wide' if name == 'x' else 'rows high'} and {name} reaches {narrow.max}: the "
+                    f"{'columns' if name == 'x' else 'rows'} past {narrow.max} wrapped around to 0 when the events were "
+                    f"saved, so those events sit at the wrong pixels; save {name} as uint16 or wider from the camera's "
+                    f"data (if they really stop at {narrow.max}, pass {name}.astype(np.int32))")
             if a.size and (a.min() < 0 or a.max() >= size):
                 swapped = (x.size and y.size and x.min() >= 0 and y.min() >= 0 and x.max() < H and y.max() < W
                            and H != W)
@@ -368,6 +431,9 @@ class Events:
                     + ("; no coordinate is 0 and they reach the sensor's far edge: they count pixels from 1 (as "
                        "MATLAB, Julia and R index), so subtract 1 from x and y (pixels count from 0 here)"
                        if one_based else "")
+                    + (f"; {name} is stored as {a.dtype}, which holds only {narrow.min} .. {narrow.max}: the values past "
+                       f"{narrow.max} wrapped around to negative numbers when the events were saved; save {name} as "
+                       "int16 or wider from the camera's data" if narrow is not None and a.min() < 0 else "")
                 )
         p = normalize_polarity(arrays["p"], self.polarity_encoding)
         object.__setattr__(self, "t", t)

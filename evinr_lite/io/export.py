@@ -9,6 +9,10 @@ they are given; the reconstruct job hands them the temporary folder of
 from __future__ import annotations
 
 import csv
+import os
+import re
+import shutil
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -40,15 +44,16 @@ def _stack_uint8(frames) -> np.ndarray:
     return to_uint8(frames)
 
 
-def _output_file(path, suffix: str, what: str) -> Path:
+def _output_file(path, suffix: str, what: str, *, any_suffix: bool = False) -> Path:
     """``path`` as a Path, checked before anything is encoded: a file name ending in ``suffix`` (the writers pick
-    the format by it), in a folder that exists, and not a folder itself; else EventDataError naming the fix."""
+    the format by it; ``any_suffix``: any name, ``suffix`` is only the example's), in a folder that exists, and not
+    a folder itself; else EventDataError naming the fix."""
     if not isinstance(path, (str, Path)) and not hasattr(path, "__fspath__"):
         raise EventDataError(f"{what}: path must be a file name (str or Path), got {type(path).__name__}")
-    path = Path(path)
+    path = Path(path).expanduser()
     if path.is_dir():
         raise EventDataError(f"{what}: {path} is a folder; pass a file name in it, e.g. {path / ('frames' + suffix)}")
-    if path.suffix.lower() != suffix:
+    if not any_suffix and path.suffix.lower() != suffix:
         raise EventDataError(f"{what}: {path} does not end in {suffix} (the file's format follows its name); name it "
                              f"{path.with_name(path.name + suffix) if not path.suffix else path.with_suffix(suffix)}")
     if not path.parent.is_dir():
@@ -57,28 +62,79 @@ def _output_file(path, suffix: str, what: str) -> Path:
     return path
 
 
-def save_frames_png(folder, frames, prefix: str = "frame_") -> list[Path]:
+@contextmanager
+def _written_beside(path: Path):
+    """A temporary name beside ``path`` (hidden, with the same suffix: the writers pick the format by it) to write
+    to; renamed onto ``path`` when the block ends, removed when it fails, so that ``path`` is never half-written
+    (an interrupted or failed write leaves the file that was there, or none)."""
+    tmp = path.with_name(f".{path.stem}.partial-{os.getpid()}{path.suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _frame_files(folder: Path, prefix: str) -> list[Path]:
+    """The numbered frames ``<prefix>NNNNN.png`` in ``folder`` (as save_frames_png names them)."""
+    pattern = re.compile(re.escape(prefix) + r"\d{5}\.png")
+    return sorted(p for p in folder.iterdir() if pattern.fullmatch(p.name)) if folder.is_dir() else []
+
+
+def save_frames_png(folder, frames, prefix: str = "frame_", *, overwrite: bool = False) -> list[Path]:
     """Write frames [F, H, W] or [F, H, W, 3] as ``folder/<prefix>00000.png``, ... (8-bit grey or RGB).
-    Returns the paths."""
-    folder = Path(folder)
+    Returns the paths.
+
+    A new folder is written beside and renamed into place when every frame is written (a failed write leaves
+    none). Frames named ``<prefix>NNNNN.png`` already in the folder are refused (the new ones would mix with
+    those beyond their count), unless ``overwrite``: then they are replaced, and those beyond the new count
+    removed."""
     if not isinstance(prefix, str) or "/" in prefix or "\\" in prefix or "\0" in prefix:
         raise EventDataError(f"prefix must be the start of a file name, without a folder ('/'), got {prefix!r}; "
                              "put the folder in folder= (e.g. save_frames_png('out/frames', frames, prefix='f_'))")
+    folder = Path(folder).expanduser()
     if folder.exists() and not folder.is_dir():
         raise EventDataError(f"{folder} is a file, not a folder; pass the folder to write the PNGs into (a new one "
                              "is created)")
-    folder.mkdir(parents=True, exist_ok=True)
-    paths = []
-    with PngWriter() as png:          # encoded on the kit's threads; the same bytes as save_png in turn
-        for i, img in enumerate(_stack_uint8(frames)):
-            paths.append(folder / f"{prefix}{i:05d}.png")
-            png.write(paths[-1], img)
+    images = _stack_uint8(frames)     # checked before anything is created
+    old = _frame_files(folder, prefix)
+    if old and not overwrite:
+        raise EventDataError(f"{folder} already holds {len(old)} frame(s) named {prefix}NNNNN.png ({old[0].name} "
+                             f"..); the {len(images)} new ones would mix with them: write into a new folder, or pass "
+                             "overwrite=True to replace them")
+    new_folder = not folder.exists()
+    if new_folder:
+        folder.parent.mkdir(parents=True, exist_ok=True)
+    target = folder.with_name(f".{folder.name}.partial-{os.getpid()}") if new_folder else folder
+    paths = [folder / f"{prefix}{i:05d}.png" for i in range(len(images))]
+    try:
+        target.mkdir(exist_ok=not new_folder)
+        with PngWriter() as png:          # encoded on the kit's threads; the same bytes as save_png in turn
+            for path, img in zip(paths, images):
+                png.write(target / path.name, img)
+        if new_folder:
+            os.replace(target, folder)   # a new folder: no other is there to replace
+    except BaseException:
+        if new_folder:
+            shutil.rmtree(target, ignore_errors=True)
+        raise
+    for stale in old[len(images):]:   # overwrite: the old frames beyond the new count would pass for new ones
+        stale.unlink(missing_ok=True)
     return paths
+
+
+VIDEO_FPS = (0.01, 65535.0)   # frames per second a video file can state: MPEG-4's time base (and a GIF's delay)
 
 
 def _check_fps(fps) -> None:
     if isinstance(fps, (bool, np.bool_, str, bytes)) or not (np.isscalar(fps) and np.isfinite(fps) and fps > 0):
         raise EventDataError(f"fps must be positive: a finite number of frames per second (e.g. 10), got {fps!r}")
+    lo, hi = VIDEO_FPS
+    if not lo <= fps <= hi:   # beyond them OpenCV fails (or libavcodec aborts the process), Pillow overflows
+        raise EventDataError(f"fps={fps!r} is beyond what a video file can state ({lo} to {hi:.0f} frames per "
+                             "second); it is the playback rate, not the rate the frames were reconstructed at: "
+                             "pass a rate to watch, e.g. 10 (or 30)")
 
 
 def save_gif(path, frames, fps: float) -> Path:
@@ -88,7 +144,8 @@ def save_gif(path, frames, fps: float) -> Path:
     path = _output_file(path, ".gif", "save_gif")
     images = [Image.fromarray(img) for img in _stack_uint8(frames)]
     delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
-    images[0].save(path, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
+    with _written_beside(path) as tmp:
+        images[0].save(tmp, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
     return Path(path)
 
 
@@ -108,15 +165,16 @@ def save_mp4(path, frames, fps: float) -> Path:
     frames = np.pad(frames, ((0, 0), (0, H % 2), (0, W % 2)) + (((0, 0),) if colour else ()))
     if colour:
         frames = np.ascontiguousarray(frames[..., ::-1])   # OpenCV writes BGR
-    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
-                             (frames.shape[2], frames.shape[1]), isColor=colour)
-    if not writer.isOpened():
-        raise RuntimeError(f"OpenCV could not open an MP4 writer for {path}; the GIF and PNGs are still written")
-    try:
-        for img in frames:
-            writer.write(img)
-    finally:
-        writer.release()
+    with _written_beside(path) as tmp:
+        writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
+                                 (frames.shape[2], frames.shape[1]), isColor=colour)
+        if not writer.isOpened():
+            raise RuntimeError(f"OpenCV could not open an MP4 writer for {path}; the GIF and PNGs are still written")
+        try:
+            for img in frames:
+                writer.write(img)
+        finally:
+            writer.release()
     return Path(path)
 
 
@@ -124,11 +182,12 @@ def save_timestamps(path, times, t_origin: float = 0.0) -> Path:
     """One line per frame: `index t_seconds` (relative to t_origin), with a header comment."""
     times = seconds_array(times, "times", allow_empty=True)
     t_origin = real_number(t_origin, "t_origin", hint="seconds: the absolute time of t = 0 (0 when relative)")
-    with open(path, "w") as f:
+    path = _output_file(path, ".txt", "save_timestamps", any_suffix=True)
+    with _written_beside(path) as tmp, open(tmp, "w") as f:
         f.write(f"# frame index, time in seconds relative to t_origin = {t_origin!r} s\n")
         for i, t in enumerate(times):
             f.write(f"{i} {t:.9f}\n")
-    return Path(path)
+    return path
 
 
 def save_csv(path, rows: list[dict]) -> Path:
@@ -146,11 +205,12 @@ def save_csv(path, rows: list[dict]) -> Path:
         if extra:
             raise EventDataError(f"rows[{i}] has column(s) {extra} that the first row lacks (the columns are the first "
                                  "row's keys); give every row the same keys")
-    with open(path, "w", newline="") as f:
+    path = _output_file(path, ".csv", "save_csv", any_suffix=True)
+    with _written_beside(path) as tmp, open(tmp, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
-    return Path(path)
+    return path
 
 
 # ---- the log intensity, unclipped ---------------------------------------------------------------
@@ -233,10 +293,11 @@ def save_log_intensity(path, log_intensity, times, **kw) -> Path:
     if L.ndim not in (3, 4) or L.shape[0] != len(np.atleast_1d(times)):
         raise EventDataError(f"log_intensity must be [F, H, W] or [F, H, W, 3] with one frame per time, got shape "
                              f"{L.shape} for {len(np.atleast_1d(times))} time(s)")
-    with LogIntensityWriter(path, times, L.shape[1:], **kw) as out:
+    path = _output_file(path, ".h5", "save_log_intensity", any_suffix=True)
+    with _written_beside(path) as tmp, LogIntensityWriter(tmp, times, L.shape[1:], **kw) as out:
         for i, img in enumerate(L):
             out.write(i, img)
-    return Path(path)
+    return path
 
 
 def read_log_intensity(path, frames=None) -> tuple[np.ndarray, np.ndarray, dict]:

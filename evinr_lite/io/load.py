@@ -17,7 +17,7 @@ from ..core.frames import Frames
 from ..core.recording import Recording
 from .formats.base import FileFormat, check_frame_times, same_time_message
 from .formats.registry import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,
-                               TIME_UNIT_FORMATS, detect_format, get_format)
+                               TIME_UNIT_FORMATS, detect_format, get_format, recording_path)
 from .source import MemorySource, RecordingSource
 
 __all__ = ["open_recording", "read_any", "load_recording", "describe_recording", "format_info", "reader_options",
@@ -72,6 +72,7 @@ def open_recording(path, *, sensor_size=None, time_unit: str | None = None, came
     Formats that can read a window without the rest (memory-mapped .npy, canonical, HQF, DSEC and MVSEC h5, AEDAT4
     and Prophesee packets) do so; the others (text, IJRR and EVREAL folders) are read once and sliced.
     """
+    path = recording_path(path)
     fmt = get_format(detect_format(path))
     options = {**reader_options(fmt, path, sensor_size, time_unit, camera), **options}
     if fmt.open_source is not None:
@@ -118,6 +119,7 @@ def read_any(path, *, sensor_size=None, t_start: float | None = None, t_end: flo
         EventDataError: missing file, unknown format, wrong or missing sensor size, a time unit the
             format does not allow.
     """
+    path = recording_path(path)
     fmt = get_format(detect_format(path))
     kwargs = reader_options(fmt, path, sensor_size, time_unit, camera)
     if fmt.windowed:

@@ -111,7 +111,12 @@ def given_output_path(out_dir) -> Path:
     if (b"\0" if isinstance(name, bytes) else "\0") in name:   # no file name holds one: os calls raise a bare ValueError
         raise OutputError(f"out_dir={name!r} holds a NUL character (\\x00), which no file name can; "
                           "pass the folder's name without it")
-    return Path(out_dir).expanduser()
+    try:
+        return Path(out_dir).expanduser()
+    except (RuntimeError, KeyError):   # ~someone who is no user here, or no home folder to expand ~ to
+        raise OutputError(f"out_dir={name or out_dir!r} starts with {Path(name).parts[0] if name else '~'}, which "
+                          "names no user's home folder on this machine; write the folder's full path (e.g. "
+                          "/home/me/results)") from None
 
 
 def check_output_path(out_dir, *, overwrite: bool = False, inputs=()) -> Path:

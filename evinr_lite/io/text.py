@@ -24,7 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.events import LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit
+from ..core.events import (LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit,
+                           wrap_hint)
 
 __all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "blank_leading_comments",
            "parse_frame_list", "line_blocks", "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
@@ -452,9 +453,12 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
     if t_last is not None:
         back = np.flatnonzero(np.diff(t, prepend=t_last) < 0)
         if back.size:
-            fail(row_line(back[0]), "the timestamp is earlier than the one before: the events are not "
+            k = int(back[0])
+            before, after = (t[k - 1] if k else t_last) + origin_ns / NS, t[k] + origin_ns / NS   # absolute seconds
+            fail(row_line(k), "the timestamp is earlier than the one before: the events are not "
                  f"sorted by time; {layout.sort_hint} or load the columns "
-                 "with numpy and use Events.from_arrays(..., sort=True)")
+                 "with numpy and use Events.from_arrays(..., sort=True)"
+                 + wrap_hint(before, after, scales=(round(1 / TIME_UNITS[time_unit]),)))
     for name, v in (("x", x), ("y", y)):
         if v.dtype.kind == "f":
             not_whole = np.flatnonzero(~np.isfinite(v) | (v != np.round(v)))

@@ -533,6 +533,8 @@ class EvINRConfig:
         """A field changed after construction (``cfg.tau = 2.0``) is checked as on construction: the whole
         config is built again with the new value (the same checks, the same messages), so a bad value is
         refused where it is set, not deep inside a run."""
+        if name not in _FIELDS and not name.startswith("_"):   # a misspelt field set after construction was kept
+            raise unknown_field(name, f"cfg.{name} = ... would set a new attribute that no step reads")
         if name in _FIELDS and id(self) not in _BUILDING:
             import warnings
 
@@ -609,9 +611,27 @@ _FIELDS = frozenset(f.name for f in fields(EvINRConfig))
 _BUILDING: set = set()
 
 
+class UnknownFieldError(EventDataError, TypeError, AttributeError):
+    """A name that is no field of EvINRConfig (a misspelt keyword or attribute): an EventDataError, and the
+    TypeError / AttributeError Python would have raised, so that code catching those still does."""
+
+
+def unknown_field(name: str, how: str) -> UnknownFieldError:
+    """The error for ``name``, no field of EvINRConfig, with the closest field names."""
+    import difflib
+
+    close = difflib.get_close_matches(name, sorted(_FIELDS), n=3, cutoff=0.6)
+    return UnknownFieldError(f"EvINRConfig has no field {name!r} ({how})"
+                             + (f"; did you mean {' or '.join(map(repr, close))}?" if close else
+                                "; see help(EvINRConfig) for its fields"))
+
+
 def _marking_construction(init):
     @functools.wraps(init)
     def wrapped(self, *args, **kwargs):
+        unknown = [k for k in kwargs if k not in _FIELDS]
+        if unknown:   # Python's TypeError named the word but not the field meant
+            raise unknown_field(unknown[0], "a keyword given to EvINRConfig(...)")
         _BUILDING.add(id(self))
         try:
             init(self, *args, **kwargs)

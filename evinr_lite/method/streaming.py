@@ -246,6 +246,33 @@ def _check(source, query_times, config, t_start, t_end, offset_from):
     return cfg, q, t_start, t_end
 
 
+def _check_two_events(source, t_start: float, t_end: float) -> None:
+    """Refuse, before any pass over the recording, a span [t_start, t_end] holding fewer than 2 events, as
+    :func:`~evinr_lite.method.solver.reconstruct` does (a window between two events trained networks on nothing:
+    a frame of the networks' initial noise, or lam='auto' never resolved). Read in chunks that double from 1 ms,
+    stopping at the second event: a few reads, whatever the span."""
+    first, last = source.t_span
+    if source.n_events is not None and t_start <= first and t_end >= last:   # the whole recording: no read needed
+        found = source.n_events
+    else:
+        found = _count_up_to_two(source, t_start, t_end)
+    if found < 2:
+        raise EventDataError(f"fewer than 2 events in [{t_start}, {t_end}] s; choose a window with events (the "
+                             f"recording's events cover [{first:.6f}, {last:.6f}] s)")
+
+
+def _count_up_to_two(source, t_start: float, t_end: float) -> int:
+    """The events in [t_start, t_end] (end included), counted until there are 2."""
+    found, a, step = 0, float(t_start), 1e-3
+    while a <= t_end and found < 2:
+        b = min(a + step, float(t_end))
+        found += len(source.events(a, np.nextafter(b, np.inf) if b >= t_end else b))
+        if b >= t_end:
+            break
+        a, step = b, step * 2
+    return found
+
+
 def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *, t_start: float | None = None,
                        t_end: float | None = None, offset_from: str = "span", workdir=None,
                        state: StreamState | None = None, on_state=None, progress: bool | None = None):
@@ -284,6 +311,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
 
     source = as_source(source)
     cfg, q, t_start, t_end = _check(source, query_times, config, t_start, t_end, offset_from)
+    _check_two_events(source, t_start, t_end)
     show = cfg.progress if progress is None else bool(progress)
     # hot pixels, background, ON/OFF balance, lam (method/prepare.py)
     cfg, source = prepare_source(source, t_start, t_end, cfg, progress=show)

@@ -339,7 +339,7 @@ def probe_sorted(column, source, n_probe: int = 1025, also: str = "") -> None:
         raise EventDataError(f"{source}: the timestamps are not sorted (t[{a}] = {float(values[down[0]])!r} > "
                              f"t[{b}] = {float(values[down[0] + 1])!r}), so a time window cannot be found without "
                              f"reading everything; sort the events by time and save the file again{also}"
-                             + fall_back_hint(down.size))
+                             + fall_back_hint(down.size, values[down[0]], values[down[0] + 1]))
 
 
 # ---- one clock, plausible units ------------------------------------------------------------

@@ -11,6 +11,7 @@ import errno
 import importlib
 import os
 import pkgutil
+import re
 import stat
 from pathlib import Path
 
@@ -20,7 +21,8 @@ from .base import FileFormat
 
 __all__ = ["FORMATS", "get_format", "detect_format", "read_recording", "read_events", "sniff_format",
            "SUPPORTED_FORMATS", "RECORDING_SUFFIXES", "SIZE_FREE_FORMATS", "READER_WINDOW_FORMATS",
-           "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder", "is_ros2_bag"]
+           "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder", "is_ros2_bag",
+           "recording_path"]
 
 HEAD_BYTES = 64
 _AEDAT_FIX = "AEDAT 3.1 and AEDAT4 are read: convert it with iniVation's DV software (Convert to AEDAT4) or export " \
@@ -89,10 +91,58 @@ def get_format(name: str) -> FileFormat:
         raise EventDataError(f"unknown format {name!r}; known: {', '.join(_BY_NAME)}") from None
 
 
-def _checked_path(path) -> Path:
+def recording_path(path) -> Path:
+    """The recording's path as a Path, ``~`` and ``~user`` expanded (as the output folder's are; a Python caller
+    or a quoted argument passes them as they are); an empty path or an unknown user is an EventDataError."""
     if isinstance(path, (str, bytes)) and not path.strip():   # Path("") is ".", the current folder
         raise EventDataError("the recording's path is empty; pass the file or folder to read")
-    path = Path(path)
+    if isinstance(path, bytes):
+        path = os.fsdecode(path)
+    try:
+        return Path(path).expanduser()
+    except (RuntimeError, KeyError):   # ~someone who is no user here, or no home folder to expand ~ to
+        head = Path(path).parts[0]
+        raise EventDataError(f"{path}: {head} names no user's home folder on this machine; write the folder's full "
+                             "path (e.g. /home/me/data/...)") from None
+
+
+def _no_such(path: Path, given) -> str:
+    """Why ``path`` (which does not exist) was not found, and the fix."""
+    text = os.fspath(given) if isinstance(given, (str, os.PathLike)) else str(given)
+    if re.match(r"(https?|ftp|s3|gs)://?", text):
+        text = re.sub(r"^(\w+):/(?!/)", r"\1://", text)   # Path() has made '://' into ':/'
+        return (f"{text} is a web address, not a file on this machine; download it first (for the datasets the kit "
+                "knows: `python -m data_fetch get DATASET SEQUENCE`) and pass the file")
+    return f"no such file or folder: {path}; check the path"
+
+
+# the files of an IJRR or EVREAL folder: a folder holding one is a damaged recording folder, not a folder of recordings
+RECORDING_FOLDER_FILES = frozenset({"events.txt", "images.txt", "calib.txt", "groundtruth.txt", "imu.txt",
+                                    "depthmaps.txt", "metadata.json", "events_ts.npy", "events_xy.npy", "events_p.npy",
+                                    "images.npy", "images_ts.npy"})
+
+
+def _recordings_inside(folder: Path) -> list[str]:
+    """The names of the recordings directly inside ``folder`` (files with a recording suffix, recording folders)."""
+    found = []
+    try:
+        children = sorted(folder.iterdir())
+    except OSError:
+        return found
+    if any(child.name in RECORDING_FOLDER_FILES for child in children):   # a recording folder that lacks a part
+        return found
+    for child in children:
+        if child.name.startswith("."):
+            continue
+        if child.is_file() and child.suffix.lower() in RECORDING_SUFFIXES or child.is_dir() and \
+                any(fmt.folder and fmt.sniff(child, None) for fmt in FORMATS):
+            found.append(child.name + ("/" if child.is_dir() else ""))
+    return found
+
+
+def _checked_path(path) -> Path:
+    given = path
+    path = recording_path(path)
     if not path.exists() and path.is_symlink():   # a link that leads nowhere is no missing file: say which it is
         try:
             os.stat(path)
@@ -103,7 +153,7 @@ def _checked_path(path) -> Path:
         raise EventDataError(f"{path} is a symbolic link to {os.readlink(path)}, which does not exist (moved or "
                              "deleted?); point the link at the recording again, or pass the recording itself")
     if not path.exists():
-        raise EventDataError(f"no such file or folder: {path}; check the path")
+        raise EventDataError(_no_such(path, given))
     try:
         mode = path.stat().st_mode
     except OSError as err:
@@ -132,6 +182,13 @@ def detect_format(path) -> str:
             raise EventDataError(f"{path}: a ROS2 bag, which is not read directly; convert it with `python -m data_fetch "
                                  f"convert {path}` (dvs_msgs event arrays and the APS images, or event_camera_msgs "
                                  "packets, to the canonical .h5 that evinr-lite reads)")
+        inside = _recordings_inside(path)
+        if inside:   # a folder of recordings, not a recording folder
+            shown = ", ".join(inside[:5]) + (f" and {len(inside) - 5} more" if len(inside) > 5 else "")
+            raise EventDataError(f"{path}: a folder holding {len(inside)} recording(s) ({shown}), not one recording "
+                                 f"(such as an IJRR or EVREAL folder); pass one of them, e.g. {path / inside[0]}, or "
+                                 f"give the folder to `evinr-lite batch {path} --out DIR`, which reads every recording "
+                                 "in it")
         raise EventDataError(f"{path}: folder of unknown format (no events.txt or events_ts.npy); "
                              f"supported formats: {SUPPORTED_FORMATS}")
     if path.stat().st_size == 0:
@@ -203,9 +260,10 @@ def read_recording(path, **options) -> Recording:
     ``options`` go to that format's reader (e.g. ``sensor_size=``, ``time_unit=``, ``t_start=`` /
     ``t_end=`` for the formats that read only a window). ``meta["format"]`` names the format read.
     """
+    path = recording_path(path)
     fmt = get_format(detect_format(path))
     check_options(fmt, options, path)
-    return fmt.reader(Path(path), **options)
+    return fmt.reader(path, **options)
 
 
 def check_options(fmt, options: dict, path) -> None:
