@@ -23,9 +23,9 @@ In this order, each judged on what the step before left (``EvINRConfig`` fields 
 counts the span in chunks first (two reading passes when the background is filtered: the hot
 pixels come from the raw counts, the balance from the filtered ones; with "auto" the sampled spans are
 read in between), and reads each window with the filter's reach (:func:`reach`, clipped to the span)
-beyond its edges, so an event near an edge is judged on the same neighbours as in the whole span. A span no longer than one counting chunk
-(``cfg.tau``) is read once and prepared in memory, as :func:`prepare_events` does, and its windows are
-slices of it.
+beyond its edges, so an event near an edge is judged on the same neighbours as in the whole span. A
+span no longer than one counting chunk (``cfg.tau``) is read once and prepared in memory, as
+:func:`prepare_events` does, and its windows are slices of it.
 """
 from __future__ import annotations
 
