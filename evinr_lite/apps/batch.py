@@ -32,7 +32,6 @@ import math
 import os
 import re
 import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -350,14 +349,10 @@ def summarize(rows, settings: dict | None = None) -> dict:
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    from ..io.output import written_beside
+
+    with written_beside(path) as tmp:
+        tmp.write_text(text)
 
 
 def _summary_files(summary: dict) -> dict[str, str]:

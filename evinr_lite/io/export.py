@@ -12,7 +12,6 @@ import csv
 import os
 import re
 import shutil
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +20,7 @@ from PIL import Image
 from ..core.checks import check_image_values, real_number, seconds_array
 from ..core.events import EventDataError
 from ..core.frames import Frames, to_uint8
-from .output import CloseOrAbort, PngWriter
+from .output import CloseOrAbort, PngWriter, written_beside
 
 __all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv", "LogIntensityWriter",
            "save_log_intensity", "read_log_intensity", "LOG_INTENSITY_FILE"]
@@ -60,20 +59,6 @@ def _output_file(path, suffix: str, what: str, *, any_suffix: bool = False) -> P
         raise EventDataError(f"{what}: the folder {path.parent} does not exist (or is a file); create it first "
                              f"(Path({str(path.parent)!r}).mkdir(parents=True)) or write elsewhere")
     return path
-
-
-@contextmanager
-def _written_beside(path: Path):
-    """A temporary name beside ``path`` (hidden, with the same suffix: the writers pick the format by it) to write
-    to; renamed onto ``path`` when the block ends, removed when it fails, so that ``path`` is never half-written
-    (an interrupted or failed write leaves the file that was there, or none)."""
-    tmp = path.with_name(f".{path.stem}.partial-{os.getpid()}{path.suffix}")
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def _frame_files(folder: Path, prefix: str) -> list[Path]:
@@ -144,7 +129,7 @@ def save_gif(path, frames, fps: float) -> Path:
     path = _output_file(path, ".gif", "save_gif")
     images = [Image.fromarray(img) for img in _stack_uint8(frames)]
     delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
-    with _written_beside(path) as tmp:
+    with written_beside(path) as tmp:
         images[0].save(tmp, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
     return Path(path)
 
@@ -165,7 +150,7 @@ def save_mp4(path, frames, fps: float) -> Path:
     frames = np.pad(frames, ((0, 0), (0, H % 2), (0, W % 2)) + (((0, 0),) if colour else ()))
     if colour:
         frames = np.ascontiguousarray(frames[..., ::-1])   # OpenCV writes BGR
-    with _written_beside(path) as tmp:
+    with written_beside(path) as tmp:
         writer = cv2.VideoWriter(str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), float(fps),
                                  (frames.shape[2], frames.shape[1]), isColor=colour)
         if not writer.isOpened():
@@ -183,7 +168,7 @@ def save_timestamps(path, times, t_origin: float = 0.0) -> Path:
     times = seconds_array(times, "times", allow_empty=True)
     t_origin = real_number(t_origin, "t_origin", hint="seconds: the absolute time of t = 0 (0 when relative)")
     path = _output_file(path, ".txt", "save_timestamps", any_suffix=True)
-    with _written_beside(path) as tmp, open(tmp, "w") as f:
+    with written_beside(path) as tmp, open(tmp, "w") as f:
         f.write(f"# frame index, time in seconds relative to t_origin = {t_origin!r} s\n")
         for i, t in enumerate(times):
             f.write(f"{i} {t:.9f}\n")
@@ -206,7 +191,7 @@ def save_csv(path, rows: list[dict]) -> Path:
             raise EventDataError(f"rows[{i}] has column(s) {extra} that the first row lacks (the columns are the first "
                                  "row's keys); give every row the same keys")
     path = _output_file(path, ".csv", "save_csv", any_suffix=True)
-    with _written_beside(path) as tmp, open(tmp, "w", newline="") as f:
+    with written_beside(path) as tmp, open(tmp, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
@@ -294,7 +279,7 @@ def save_log_intensity(path, log_intensity, times, **kw) -> Path:
         raise EventDataError(f"log_intensity must be [F, H, W] or [F, H, W, 3] with one frame per time, got shape "
                              f"{L.shape} for {len(np.atleast_1d(times))} time(s)")
     path = _output_file(path, ".h5", "save_log_intensity", any_suffix=True)
-    with _written_beside(path) as tmp, LogIntensityWriter(tmp, times, L.shape[1:], **kw) as out:
+    with written_beside(path) as tmp, LogIntensityWriter(tmp, times, L.shape[1:], **kw) as out:
         for i, img in enumerate(L):
             out.write(i, img)
     return path

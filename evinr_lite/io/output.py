@@ -41,7 +41,7 @@ from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, ter
 __all__ = ["atomic_output_dir", "given_output_path", "CloseOrAbort", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
            "termination_signals", "signals_deferred", "save_png", "PngWriter", "save_json", "first_existing", "check_writable",
            "TERMINATION_SIGNALS", "PARTIAL_MARKER", "mark_partial", "remove_stale_partials", "remove_lock_file",
-           "resolve_path"]
+           "resolve_path", "written_beside"]
 
 _TEMP_ROOM = len(".partial-4194304-") + 16 + 1   # bytes a temporary name adds to the folder's name
 
@@ -522,6 +522,21 @@ class PngWriter(CloseOrAbort):
         self._pool.shutdown(wait=True, cancel_futures=True)
         self._pending = []
 
+
+
+@contextmanager
+def written_beside(path):
+    """A temporary name beside ``path`` to write to (hidden, unique, with the same suffix: writers pick the
+    format by it); renamed onto ``path`` when the block ends, removed when it fails, so ``path`` is never
+    half-written (an interrupted or failed write leaves the file that was there, or none)."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.stem}.partial-{os.getpid()}-{secrets.token_hex(4)}{path.suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def save_json(path, obj) -> None:
