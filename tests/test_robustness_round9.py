@@ -19,9 +19,9 @@ between pixels were answered, a single number as a query was numpy's IndexError,
 infinite or reversed span named an inner ``slice_time`` or a "window [0.5, 5e-324)" instead of their argument.
 
 Guards: odd inputs next to these that already behave and must keep their outcome (fewer than MIN_EVENTS events,
-every event at one pixel or at isolated hot pixels, thin sensors, one polarity, spans either side of the 8 s limit, duplicate events, hot
-pixels, bad background_dt and background values, a huge window, the returned config fed back, determinism, the
-streamed path choosing as the in-memory one).
+every event at one pixel or at isolated pixels, thin sensors, one polarity, spans either side of the 8 s limit,
+duplicate events, hot pixels, bad background_dt and background values, a huge window, the returned config fed
+back, determinism, the streamed path choosing as the in-memory one).
 """
 import decimal
 

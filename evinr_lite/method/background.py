@@ -62,7 +62,8 @@ from ..core.events import EventDataError, Events
 from .denoise import DEFAULT_DT
 
 __all__ = ["GRID", "MIN_ROOM", "N_QUERY", "WHOLE_SPAN", "SLICES", "SLICE_S", "MARGIN", "MIN_EVENTS", "CROP_PX", "NOISE_COST",
-           "MAX_TILES", "BackgroundFit", "neighbour_gaps", "sample_spans", "tile_counts", "busy_spans", "fit_background"]
+           "MAX_TILES", "BackgroundFit", "neighbour_gaps", "checked_span", "sample_spans", "tile_counts", "busy_spans",
+           "fit_background"]
 
 GRID = (0.05, 0.1, 0.2, 0.4)   # s: the filter's windows tried (50 ms: the fixed default before; 0.4 s keeps ~all signal)
 MIN_ROOM = 0.1                 # a window estimates the noise share only where >= 10 % of the probes find no neighbour
@@ -167,7 +168,8 @@ def _queries(sensor_size, t, x, y, p) -> tuple:
                                  f"{a.dtype} of shape {a.shape}")
         lo = -1 if name == "p" else 0
         if a.size and not (np.all(np.isfinite(a)) and np.all(a == np.round(a)) and a.min() >= lo and a.max() <= hi):
-            what = "polarities -1, 0 or +1" if name == "p" else f"whole pixel coordinates in [0, {hi}] (the sensor is {H} x {W})"
+            what = ("polarities -1, 0 or +1" if name == "p" else
+                    f"whole pixel coordinates in [0, {hi}] (the sensor is {H} x {W})")
             raise EventDataError(f"neighbour_gaps: {name} must hold {what}, got values in [{a.min()}, {a.max()}]")
         cols[name] = a.astype(np.int64)
     sizes = {len(a) for a in (t, *cols.values())} - {1}
@@ -203,7 +205,7 @@ def _busiest_crop(samples, sensor_size) -> tuple:
     return int(i), int(i) + h, int(j), int(j) + w
 
 
-def _span(t_start, t_end, name: str) -> tuple:
+def checked_span(t_start, t_end, name: str) -> tuple:
     """(t_start, t_end) as floats: finite seconds, t_end >= t_start; else an EventDataError naming ``name``."""
     a = real_number(t_start, f"{name}: t_start", hint="seconds on the events' clock")
     b = real_number(t_end, f"{name}: t_end", hint="seconds on the events' clock")
@@ -217,7 +219,7 @@ def sample_spans(t_start: float, t_end: float) -> list:
     span when it is at most :data:`WHOLE_SPAN` long; else :data:`SLICES` slices with a :data:`SLICE_S`
     interior, centred at (i + 1/2) / SLICES of it, read :data:`MARGIN` beyond the interior. ``t_start`` and
     ``t_end``: finite seconds, t_end >= t_start."""
-    t_start, t_end = _span(t_start, t_end, "sample_spans")
+    t_start, t_end = checked_span(t_start, t_end, "sample_spans")
     if t_end - t_start <= WHOLE_SPAN:
         return [(t_start, t_end, t_start, t_end)]
     out = []
@@ -239,7 +241,7 @@ def tile_counts(t, t_start: float, t_end: float) -> np.ndarray:
     :data:`SLICE_S` seconds from t_start (the last one shorter, holding the span's end; longer tiles when the
     span would need more than :data:`MAX_TILES`). Times outside the span are not counted. Counts of the
     span's events in chunks add up to those of all of them at once (the streamed and in-memory paths)."""
-    t_start, t_end = _span(t_start, t_end, "tile_counts")
+    t_start, t_end = checked_span(t_start, t_end, "tile_counts")
     length, k = _tile(t_start, t_end)
     t = np.asarray(t, np.float64)
     t = t[(t >= t_start) & (t <= t_end)]
@@ -250,7 +252,7 @@ def busy_spans(t_start: float, t_end: float, tiles) -> list:
     """:func:`sample_spans`' form for the :data:`SLICES` tiles (of :func:`tile_counts`) that hold the most
     events, in time order (ties: the earlier tile), tiles without events left out; read :data:`MARGIN`
     beyond each. Where the evenly spread slices of a long span miss its events."""
-    t_start, t_end = _span(t_start, t_end, "busy_spans")
+    t_start, t_end = checked_span(t_start, t_end, "busy_spans")
     length, k = _tile(t_start, t_end)
     tiles = np.asarray(tiles)
     if tiles.shape != (k,):
@@ -276,7 +278,7 @@ def _samples(samples) -> list:
                 and isinstance(item[1], (list, tuple, np.ndarray)) and len(item[1]) == 2):
             raise EventDataError(f"fit_background: samples[{i}] must be (events, (query_from, query_to)); samples is "
                                  f"a list {form}")
-        a, b = _span(*item[1], f"fit_background: samples[{i}]")
+        a, b = checked_span(*item[1], f"fit_background: samples[{i}]")
         if out and tuple(item[0].sensor_size) != tuple(out[0][0].sensor_size):
             raise EventDataError(f"fit_background: samples[{i}] is of sensor {tuple(item[0].sensor_size)}, samples[0] "
                                  f"of {tuple(out[0][0].sensor_size)}: the spans of one recording share its sensor")

@@ -36,7 +36,7 @@ import numpy as np
 from ..core.checks import real_number
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
-from .background import MIN_EVENTS, _span, busy_spans, fit_background, sample_spans, tile_counts
+from .background import MIN_EVENTS, busy_spans, checked_span, fit_background, sample_spans, tile_counts
 from .denoise import DEFAULT_DT, denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
@@ -62,7 +62,7 @@ def choose_background(cfg, read, t_start: float, t_end: float, hot=None, tiles=N
     empty (every event at one instant): refused as the windows' plan refuses it."""
     if cfg.background != "auto":
         return cfg
-    t_start, t_end = _span(t_start, t_end, "choose_background")
+    t_start, t_end = checked_span(t_start, t_end, "choose_background")
     if not t_end > t_start:   # read(t, t) would be refused as an empty window, blaming a window nobody gave
         raise EventDataError(f"time span [{t_start}, {t_end}] is empty; t_end must exceed t_start")
 
@@ -144,7 +144,7 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
     if span is not None:
         if not (isinstance(span, (tuple, list, np.ndarray)) and len(span) == 2):
             raise EventDataError(f"prepare_events: span must be (t_start, t_end) in seconds, or None, got {span!r}")
-        span = _span(*span, "prepare_events")
+        span = checked_span(*span, "prepare_events")
     if not len(events):
         return events, cfg
     t0, t1 = (float(events.t[0]), float(events.t[-1])) if span is None else span
@@ -230,7 +230,7 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
     "auto"; raw counts for the hot pixels, then the filtered events' counts, with "auto" the sampled spans
     read in between to choose the window). So every window is trained with the same C pair, lam
     and events as the whole-span solve. ``progress``: a bar for each pass over the recording."""
-    t_start, t_end = _span(t_start, t_end, "prepare_source")
+    t_start, t_end = checked_span(t_start, t_end, "prepare_source")
     if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto" and cfg.background == "keep":
         return cfg, source
     chunk_s = chunk_s or cfg.tau or (t_end - t_start)
