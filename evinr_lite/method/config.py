@@ -335,6 +335,7 @@ class EvINRConfig:
             ``background_dt``, or "keep").
         background_dt: seconds, the filter's window with ``background="filter"`` (50 ms: the fixed
             default before "auto"; a slow or sparse scene loses signal events below about 1 / speed).
+            With "auto", which chooses it, another value is refused (it would not be used).
         anchor: APS frames as anchors (:mod:`evinr_lite.method.anchor`; pass ``frames=`` to
             :func:`reconstruct`): "none" (events only, the default), "first" (the first frame in the
             window sets the per-pixel offset) or "all" (every ``anchor_every``-th frame is a soft
@@ -480,6 +481,11 @@ class EvINRConfig:
             raise EventDataError(f"background_dt must be a positive number of seconds (the filter's window, e.g. 0.05), "
                                  f"got {self.background_dt!r}")
         self.background_dt = float(self.background_dt)
+        if self.background == "auto" and self.background_dt != DEFAULT_DT:   # "auto" would set it without a word
+            raise EventDataError(f"background_dt={self.background_dt!r} is the filter's window with background='filter', "
+                                 f"but background='auto' (the kit's default) chooses the window itself from the events "
+                                 f"and would not use it; pass background='filter' with background_dt="
+                                 f"{self.background_dt!r}, or leave background_dt at {DEFAULT_DT} with 'auto'")
         if not 0 <= number("prior_time_order", self.prior_time_order) <= 1:
             raise EventDataError(f"prior_time_order must be within [0, 1] (0: the frames' roughness, the paper's; 1: the "
                                  f"per-bin changes'; the kit's 0.25), got {self.prior_time_order!r}")

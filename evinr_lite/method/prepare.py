@@ -33,10 +33,11 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..core.checks import real_number
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
-from .background import fit_background, sample_spans
-from .denoise import denoise_mask, hot_pixel_mask, hot_threshold
+from .background import MIN_EVENTS, busy_spans, checked_span, fit_background, sample_spans, tile_counts
+from .denoise import DEFAULT_DT, denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
 __all__ = ["prepare_events", "prepare_source", "plan_from_counts", "drop_pixels", "filter_background",
@@ -46,19 +47,34 @@ BACKGROUND_MODES = ("keep", "filter", "auto")
 
 
 def reach(dt: float) -> float:
-    """Seconds read beyond a streamed window's edges for a filter of window ``dt`` (s): twice it, so
-    rounding never matters."""
-    return 2 * float(dt)
+    """Seconds read beyond a streamed window's edges for a filter of window ``dt`` (s, a positive finite
+    number): twice it, so rounding never matters."""
+    return 2 * real_number(dt, "reach: dt", lo=0, lo_open=True, hint="the background filter's window in seconds")
 
 
-def choose_background(cfg, read, t_start: float, t_end: float, hot=None):
+def choose_background(cfg, read, t_start: float, t_end: float, hot=None, tiles=None):
     """``cfg`` with ``background="auto"`` resolved (else unchanged): ``background="filter"`` with the
     ``background_dt`` that :func:`~evinr_lite.method.background.fit_background` chooses, or ``"keep"``.
-    ``read(a, b)``: the events over [a, b) (s); ``hot``: bool [H, W] pixels to drop first, or None."""
+    ``read(a, b)``: the events over [a, b) (s); ``hot``: bool [H, W] pixels to drop first, or None.
+    ``tiles``: the span's :func:`~evinr_lite.method.background.tile_counts` (or a function giving them),
+    for a long span whose evenly spread slices hold fewer than MIN_EVENTS events: then its busiest tiles
+    are measured (:func:`~evinr_lite.method.background.busy_spans`). The span [t_start, t_end] must not be
+    empty (every event at one instant): refused as the windows' plan refuses it."""
     if cfg.background != "auto":
         return cfg
-    samples = [(drop_pixels(read(a, b), hot), (qa, qb)) for a, b, qa, qb in sample_spans(t_start, t_end)]
-    fit = fit_background(samples, cfg.seed)
+    t_start, t_end = checked_span(t_start, t_end, "choose_background")
+    if not t_end > t_start:   # read(t, t) would be refused as an empty window, blaming a window nobody gave
+        raise EventDataError(f"time span [{t_start}, {t_end}] is empty; t_end must exceed t_start")
+
+    def measure(spans):
+        return fit_background([(drop_pixels(read(a, b), hot), (qa, qb)) for a, b, qa, qb in spans], cfg.seed)
+
+    spans = sample_spans(t_start, t_end)
+    fit = measure(spans)
+    if fit.n_events < MIN_EVENTS and len(spans) > 1 and tiles is not None:   # the slices missed the events
+        busy = busy_spans(t_start, t_end, tiles() if callable(tiles) else tiles)
+        if busy and busy != spans:
+            fit = measure(busy)
     return replace(cfg, background="keep") if fit.dt is None else replace(cfg, background="filter", background_dt=fit.dt)
 
 
@@ -108,11 +124,15 @@ def _hot_mask(n: np.ndarray) -> np.ndarray:
     return n > hot_threshold(np.rint(n))
 
 
-def _check_left(n_left: int, n_in: int):
+def _check_left(n_left: int, n_in: int, dt: float = DEFAULT_DT, sensor_size=None):
+    """Refuse what the background filter (window ``dt`` s) left of ``n_in`` events when under 2."""
     if n_left < 2:
-        raise EventDataError(f"the background filter left {n_left} of {n_in:,} events; the recording is mostly "
-                             "isolated events (noise, or a scene too sparse for a 50 ms neighbourhood). Pass "
-                             "EvINRConfig(background='keep') to train on every event")
+        why = ("a sensor of one pixel has no neighbouring pixels, so the filter drops every event" if
+               sensor_size is not None and tuple(sensor_size) == (1, 1) else
+               f"the recording is mostly isolated events (noise, or a scene too sparse for a {dt:g} s neighbourhood)")
+        raise EventDataError(f"the background filter left {n_left} of {n_in:,} events (an event is kept when a "
+                             f"neighbouring pixel fired one of its polarity within background_dt = {dt:g} s of it); "
+                             f"{why}. Pass EvINRConfig(background='keep') to train on every event")
 
 
 def prepare_events(events: Events, cfg, span: tuple | None = None):
@@ -121,17 +141,22 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
     estimated from these events (``cfg.balance == "events"``, one C given) and ``lam="auto"`` by its
     value. ``span``: (t_start, t_end) seconds reconstructed (default: the events' first and last
     time), which sets how much of it one window covers."""
+    if span is not None:
+        if not (isinstance(span, (tuple, list, np.ndarray)) and len(span) == 2):
+            raise EventDataError(f"prepare_events: span must be (t_start, t_end) in seconds, or None, got {span!r}")
+        span = checked_span(*span, "prepare_events")
     if not len(events):
         return events, cfg
     t0, t1 = (float(events.t[0]), float(events.t[-1])) if span is None else span
     if cfg.background != "keep":                    # hot pixels first, then the filter (its window chosen first)
-        n_in = len(events)
+        n_in, raw = len(events), events
         first = hot_pixel_mask(events) if cfg.hot_pixels == "drop" else None
         events = drop_pixels(events, first)
-        cfg = choose_background(cfg, lambda a, b: events.slice_time(a, b, allow_empty=True), t0, t1)
+        cfg = choose_background(cfg, lambda a, b: events.slice_time(a, b, allow_empty=True), t0, t1,
+                                tiles=lambda: tile_counts(raw.t, t0, t1))
         if cfg.background == "filter":
             events = filter_background(events, cfg.background_dt)
-            _check_left(len(events), n_in)
+            _check_left(len(events), n_in, cfg.background_dt, events.sensor_size)
     counts = PolarityCounts(tuple(events.sensor_size), slices=span_slices(t0, t1)).update(events)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap),
                                 counts.intervals, counts.sliced)
@@ -178,10 +203,11 @@ def _read_spans(source, t_start: float, t_end: float, chunk_s: float):
 
 
 def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str | None = None,
-            counts_only: bool = False) -> PolarityCounts:
+            counts_only: bool = False, tiles=None) -> PolarityCounts:
     """The per-pixel ON / OFF counts over the span, read a chunk at a time (``counts_only``: those alone,
     without the balance's intervals and slices); ``progress``: a bar's title (seconds of the recording
-    read), or None for none."""
+    read), or None for none. ``tiles``: an int64 array of the span's
+    :func:`~evinr_lite.method.background.tile_counts` to add the events to, or None."""
     from tqdm.auto import tqdm
 
     counts = PolarityCounts(tuple(source.sensor_size), slices=None if counts_only else span_slices(t_start, t_end),
@@ -190,6 +216,8 @@ def _counts(source, t_start: float, t_end: float, chunk_s: float, progress: str 
               bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s of events [{elapsed}<{remaining}]") as bar:
         for (a, b), events in _read_spans(source, t_start, t_end, chunk_s):
             counts.update(events)
+            if tiles is not None:
+                tiles += tile_counts(events.t, t_start, t_end)
             bar.update(round(b - a, 3))
     return counts
 
@@ -202,6 +230,7 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
     "auto"; raw counts for the hot pixels, then the filtered events' counts, with "auto" the sampled spans
     read in between to choose the window). So every window is trained with the same C pair, lam
     and events as the whole-span solve. ``progress``: a bar for each pass over the recording."""
+    t_start, t_end = checked_span(t_start, t_end, "prepare_source")
     if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto" and cfg.background == "keep":
         return cfg, source
     chunk_s = chunk_s or cfg.tau or (t_end - t_start)
@@ -212,17 +241,20 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         held, cfg = prepare_events(source.events(t_start, np.nextafter(t_end, np.inf)), cfg, span)
         return cfg, _Prepared(source, span, held=held)
     # with the filter, this first pass only finds the hot pixels (the balance reads the second one's counts)
-    counts = _counts(source, t_start, t_end, chunk_s, "counting events" if progress else None, counts_only=filtered)
+    # and, with "auto", counts the events on the span's tiles (where they are, for the window's statistics)
+    tiles = tile_counts([], t_start, t_end) if cfg.background == "auto" else None     # zeros, one per tile
+    counts = _counts(source, t_start, t_end, chunk_s, "counting events" if progress else None, counts_only=filtered,
+                     tiles=tiles)
     if filtered:
         if cfg.hot_pixels == "drop":
             first = _hot_mask(counts.n_on + counts.n_off)
         n_in = int((counts.n_on + counts.n_off).sum())
-        cfg = choose_background(cfg, source.events, t_start, t_end, first)
+        cfg = choose_background(cfg, source.events, t_start, t_end, first, tiles=tiles)
         dt = cfg.background_dt if cfg.background == "filter" else None
         counts = _counts(_Prepared(source, span, first, dt=dt), t_start, t_end, chunk_s,
                          ("filtering background activity" if dt else "counting events again") if progress else None)
         if dt:
-            _check_left(int((counts.n_on + counts.n_off).sum()), n_in)
+            _check_left(int((counts.n_on + counts.n_off).sum()), n_in, dt, source.sensor_size)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap),
                                 counts.intervals, counts.sliced)
     if cfg.background == "keep" and first is None and not hot.any():
