@@ -25,12 +25,15 @@ def _inputs_highpass(rng):
     cases = []
     # C and t_end differ between cases too: a version that fixes either to one value fails. The first sensor is
     # one row and one column larger than the events reach (pixels that never fired): a state sized from the
-    # events (y.max() + 1, x.max() + 1) comes out too small
-    for n, (H, W), alpha, C, t_end, extra in ((12, (2, 3), 2 * math.pi, 0.2, 1.2, 1), (40, (3, 4), 5.0, 0.35, 1.5, 0),
-                                              (25, (1, 5), 0.0, 0.15, 1.0, 0)):
-        t = np.sort(rng.uniform(0.0, 1.0, n))
+    # events (y.max() + 1, x.max() + 1) comes out too small. The second recording's clock reads 1000 s (t_start =
+    # 1000): times held in float32 (spacing 61 us there) change every decay by about alpha x 30 us
+    for n, (H, W), alpha, C, t_end, extra, t0 in ((12, (2, 3), 2 * math.pi, 0.2, 1.2, 1, 0.0),
+                                                  (40, (3, 4), 5.0, 0.35, 1.5, 0, 1000.0),
+                                                  (25, (1, 5), 0.0, 0.15, 1.0, 0, 0.0)):
+        t = t0 + np.sort(rng.uniform(0.0, 1.0, n))
         cases.append(dict(t=t, x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=rng.choice([-1, 1], n),
-                          sensor_size=(H + extra, W + extra), C=C, alpha=alpha, t_end=t_end))
+                          sensor_size=(H + extra, W + extra), C=C, alpha=alpha, t_end=t0 + t_end)
+                     | ({"t_start": t0} if t0 else {}))
     return cases
 
 
@@ -145,6 +148,10 @@ exercises.register(
         "the state array has an integer dtype, so every stored value is truncated: make it float "
         "(np.zeros((H, W)), not np.zeros_like(x) or dtype=int)":
             _integer_state,
+        "timestamps must stay float64: in float32 a time near 1000 s is rounded to a multiple of 61 us, which "
+        "changes every decay exp(-alpha (t - t_last)); keep t as it is given (np.asarray(t, dtype=np.float64))":
+            lambda t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0: highpass_per_event(
+                np.asarray(t, np.float32), x, y, p, sensor_size, C, alpha, t_end, t_start),
     })
 
 

@@ -411,7 +411,9 @@ def _inputs_intervals(rng):
     t = np.array([0.0, 0.05, 0.1, 0.25, 0.3, 0.4, 0.45, 0.9])
     cases.append(dict(events=Events(t, np.array([0, 1, 0, 1, 0, 0, 0, 0]), np.zeros(8, np.int64),
                                     np.array([1, -1, 1, -1, 1, -1, -1, 1]), (1, 2))))
-    cases.append(dict(events=_random_events(rng, 400, (3, 4))))
+    # a sensor taller than wide (H = 4 > W = 3): the pixel number x * W + y gives two pixels one number here (x = 0,
+    # y = 3 and x = 1, y = 0), as y * H + x does on the wide sensors above; x * H + y and y * W + x are both one-to-one
+    cases.append(dict(events=_random_events(rng, 400, (4, 3))))
     # ON runs only, and OFF events that never follow one another: no OFF pair, so no estimate (NaN)
     cases.append(dict(events=Events(np.array([0.0, 0.1, 0.2, 0.3, 0.5]), np.zeros(5, np.int64),
                                     np.zeros(5, np.int64), np.array([1, 1, -1, 1, 1]), (1, 1))))
@@ -476,6 +478,13 @@ def _intervals_pixel_index_h(events):
     H, W = events.sensor_size
     pix = events.y.astype(np.int64) * H + events.x
     return _imbalance_of_pixel_numbers(events, pix, "stable")
+
+
+def _intervals_pixel_index_x_w(events):
+    """A wrong version (for the hint): the pixel number x * W + y, which gives two pixels one number when H > W
+    (x = 0, y = W and x = 1, y = 0)."""
+    H, W = events.sensor_size
+    return _imbalance_of_pixel_numbers(events, events.x.astype(np.int64) * W + events.y, "stable")
 
 
 def _intervals_unstable_sort(events):
@@ -561,6 +570,9 @@ exercises.register(
         "number the pixels y * W + x, W = sensor_size[1] (the row length): y * H + x gives two pixels one "
         "number when the sensor is not square":
             _intervals_pixel_index_h,
+        "number the pixels y * W + x (the row times the row length W, plus the column): x * W + y gives two pixels "
+        "one number when the sensor is taller than wide (x * H + y, column by column, would do too)":
+            _intervals_pixel_index_x_w,
         "sort with np.argsort(pix, kind=\"stable\"): the default sort need not keep each pixel's events in "
         "time order, so consecutive events of a pixel are paired out of order":
             _intervals_unstable_sort,
