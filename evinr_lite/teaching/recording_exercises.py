@@ -258,6 +258,12 @@ def _windows_ceil_size(n_events, max_events):
     return np.minimum(np.arange(w + 1) * math.ceil(n_events / w), n_events).astype(np.int64)
 
 
+def _windows_ceil_positions(n_events, max_events):
+    """idx[k] = ceil(k N / w), rounded up."""
+    w = max(1, math.ceil(n_events / max_events))
+    return -(-(np.arange(w + 1, dtype=np.int64) * n_events) // w)
+
+
 exercises.register(
     "event_count_windows", event_count_windows, _inputs_windows, compare=_compare_windows,
     hints={
@@ -282,6 +288,9 @@ exercises.register(
         "windows of ceil(N / w) events each leave a short last window: idx[k] = floor(k N / w) spreads the "
         "remainder so that the sizes differ by at most one":
             _windows_ceil_size,
+        "idx[k] = floor(k N / w) rounds down, (k * N) // w: rounded up (-(-(k * N) // w), np.ceil) the longer "
+        "windows come first":
+            _windows_ceil_positions,
     })
 
 
