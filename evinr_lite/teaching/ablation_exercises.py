@@ -44,11 +44,19 @@ def _time_times_ssim(table):
     return {name: row["time_s"] * row["ssim"] for name, row in table.items()}
 
 
+def _products_sorted_names(table):
+    """The names sorted, the products in the table's order: zipped, each product goes to another row's name."""
+    return dict(zip(sorted(table), [row["time_s"] * row["fps"] for row in table.values()]))
+
+
 exercises.register(
     "time_fps_products", time_fps_products, _inputs_products, rtol=1e-6,
     hints={"FPS is frames per second: frames = seconds x (frames / second), multiply time_s by fps": _time_over_fps,
            "fps / time_s has units frames per second squared; the frame count is time_s * fps": _fps_over_time,
-           "use the row's 'fps' entry (the FPS column), not its quality": _time_times_ssim})
+           "use the row's 'fps' entry (the FPS column), not its quality": _time_times_ssim,
+           "the names and the products are out of step: zip(sorted(table), products) pairs each product (in the "
+           "table's order) with another row's name; build {name: row['time_s'] * row['fps'] for name, row in "
+           "table.items()}": _products_sorted_names})
 
 
 # ---- exercise 2: Pareto front ------------------------------------------------------------------
@@ -82,6 +90,16 @@ def _dominated_any_over_rows(cost, quality):
     q = np.asarray(quality, dtype=np.float64)[:, None]
     dominated = (c.T <= c) & (q.T >= q) & ((c.T < c) | (q.T > q))
     return ~dominated.any(axis=0)
+
+
+def _running_best_kept(cost, quality):
+    """In order of cost (a stable sort), keep q >= np.maximum.accumulate(q): a variant that costs more for only the
+    same quality as the best so far is kept."""
+    c, q = np.asarray(cost, dtype=np.float64), np.asarray(quality, dtype=np.float64)
+    order = np.argsort(c, kind="stable")
+    keep = np.zeros(len(c), dtype=bool)
+    keep[order] = q[order] >= np.maximum.accumulate(q[order])
+    return keep
 
 
 def _best_quality_only(cost, quality):
@@ -122,4 +140,8 @@ exercises.register(
            "the same quality (it is dominated): keep it only when it is strictly better, or tied in both with the "
            "last kept one": _sweep_ties_kept,
            "the front holds every variant that no other one dominates (cheaper ones with lower quality too), not "
-           "only the best quality": _best_quality_only})
+           "only the best quality": _best_quality_only,
+           "q >= np.maximum.accumulate(q) in order of cost keeps a variant that costs more for only the same quality "
+           "as a cheaper one (that one dominates it), and among equal costs keeps a worse one sorted before a better "
+           "one: compare with the best quality of the strictly cheaper variants, and ties only in both":
+           _running_best_kept})

@@ -361,6 +361,20 @@ def _windows_from_zero(windows, times):
     return crossfade_weights(np.stack([lo, lo + tau], axis=1), times)
 
 
+def _normalised_over_times(windows, times):
+    """The ramps divided by their sums over the times (axis 1) instead of over the windows (axis 0)."""
+    windows = np.asarray(windows, dtype=np.float64)
+    t = np.asarray(times, dtype=np.float64)
+    if len(windows) == 1:
+        return np.ones((1, len(t)))
+    overlap = windows[0, 1] - windows[1, 0]
+    fade_in = np.clip((t - windows[:, :1]) / overlap, 0.0, 1.0)
+    fade_out = np.clip((windows[:, 1:] - t) / overlap, 0.0, 1.0)
+    fade_in[0], fade_out[-1] = 1.0, 1.0
+    w = np.minimum(fade_in, fade_out)
+    return w / w.sum(axis=1, keepdims=True)
+
+
 exercises.register(
     "crossfade_weights", crossfade_weights, _inputs_crossfade, atol=1e-5,
     hints={
@@ -370,6 +384,9 @@ exercises.register(
         "every window covering t has weight 1: the weights of each time must sum to 1": _not_normalised,
         "read each window's start and end from `windows` (absolute times): the sequence need not start at 0":
             _windows_from_zero,
+        "normalise over the windows, w / w.sum(axis=0): each time's weights (a column of [N, Q]) sum to 1; "
+        "w.sum(axis=1) adds one window's weights over all the times":
+            _normalised_over_times,
     })
 
 
@@ -464,6 +481,19 @@ def _chain_cumsum_flat(prev, nxt):
     return np.concatenate([np.zeros((1,) + prev.shape[2:]), np.cumsum(steps).reshape(steps.shape)])
 
 
+def _chain_steps_before(prev, nxt):
+    """offset_k = the sum of the steps of the overlaps before k only (an exclusive running sum): one step short."""
+    out = chain_offsets(prev, nxt)
+    return np.concatenate([out[:1], out[:-1]])
+
+
+def _chain_len_divisor(prev, nxt):
+    """The sum over the samples divided by len(prev), the number of overlaps K, not the samples S."""
+    prev, nxt = np.asarray(prev, dtype=np.float64), np.asarray(nxt, dtype=np.float64)
+    steps = (prev - nxt).sum(axis=1) / max(len(prev), 1)
+    return np.concatenate([np.zeros((1,) + prev.shape[2:]), np.cumsum(steps, axis=0)])
+
+
 exercises.register(
     "chain_offsets", chain_offsets, _inputs_chain, atol=1e-9,
     hints={
@@ -482,6 +512,12 @@ exercises.register(
         "every network gets an offset, the last one too: offset_k for k = 1 .. K (a loop over range(1, K + 1), "
         "or np.cumsum over all K steps), not range(1, K)":
             _chain_last_left_at_zero,
+        "offset_k includes overlap k's own step: offset_k = offset_{k-1} + mean(F_{k-1} - F_k), so offset_1 is the "
+        "first step (np.cumsum(steps, axis=0) after the leading 0), not the sum of the steps before it":
+            _chain_steps_before,
+        "len(prev) is K, the number of overlaps (the first axis): the mean over the S samples divides by "
+        "prev.shape[1] (or use .mean(axis=1))":
+            _chain_len_divisor,
     })
 
 

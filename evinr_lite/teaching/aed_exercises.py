@@ -115,6 +115,9 @@ exercises.register(
             _channel_phase_in_blocks,
         "the colours are 0 = R, 1 = G, 2 = B: the R G G B tile starts with R at its top-left":
             lambda y, x, phase: 2 - quad_bayer_channel(y, x, phase),
+        "rows and columns count from 0: the photosite at y = 0, x = 0 sees tile entry (dy % 4, dx % 4); (y - 1 + dy) "
+        "counts them from 1 and shifts the pattern by one photosite":
+            lambda y, x, phase: quad_bayer_channel(y, x, (phase[0] - 1, phase[1] - 1)),
     })
 
 
@@ -179,6 +182,12 @@ def _grey_size_from_events(x, y, p, C, raw_size):
     return frame
 
 
+def _grey_one_per_distinct_event(x, y, p, C, raw_size):
+    """The events made a set of (y, x, p): several identical events (one photosite firing again) count once."""
+    events = np.unique(np.stack([np.asarray(y), np.asarray(x), np.asarray(p)]), axis=1)
+    return grey_event_frame(events[1], events[0], events[2], C, raw_size)
+
+
 def _grey_rows_columns_swapped(x, y, p, C, raw_size):
     """The frame indexed [x // 4, y // 4]: the transposed frame (a sensor that is not square: an IndexError or this)."""
     return grey_event_frame(x, y, p, C, raw_size).T
@@ -209,4 +218,7 @@ exercises.register(
         "the frame's size comes from raw_size, (H // 4, W // 4), not from the largest event coordinates: the "
         "last rows or columns may have no event":
             _grey_size_from_events,
+        "every event counts, repeated ones too: a set (or np.unique) of the (y, x, p) triples keeps one of several "
+        "identical events (a photosite that fired again); add up all of them with np.add.at":
+            _grey_one_per_distinct_event,
     })

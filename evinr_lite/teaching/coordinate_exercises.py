@@ -59,6 +59,12 @@ def _split_row_without_modulo(index, sensor_size):
     return index // (H * W), index // W, index % W
 
 
+def _split_bin_without_brackets(index, sensor_size):
+    """index // H * W, which Python reads as (index // H) * W."""
+    H, W = sensor_size
+    return index // H * W, (index // W) % H, index % W
+
+
 exercises.register(
     "split_index", split_index, _inputs_split,
     hints={
@@ -72,6 +78,8 @@ exercises.register(
             _split_x_first,
         "the row is (index // W) % H: without `% H`, index // W also counts the rows of the earlier bins":
             _split_row_without_modulo,
+        "brackets: `index // H * W` is (index // H) * W, from left to right; the bin is index // (H * W)":
+            _split_bin_without_brackets,
     })
 
 def _tikhonov_magnitude(dF_dx, dF_dy):
@@ -101,4 +109,7 @@ exercises.register(
             _tikhonov_stacked_mean,
         "Eq. 9 is the mean of the squares, without a square root over the mean (that is an RMS)":
             lambda dF_dx, dF_dy: torch.sqrt(torch.mean(dF_dx ** 2 + dF_dy ** 2)),
+        "torch.var subtracts the mean (and divides by M - 1): Eq. 9 is the mean of the squares themselves, "
+        "torch.mean(dF_dx ** 2 + dF_dy ** 2)":
+            lambda dF_dx, dF_dy: torch.var(dF_dx) + torch.var(dF_dy),
     })

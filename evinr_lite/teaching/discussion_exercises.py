@@ -25,12 +25,15 @@ def _inputs_highpass(rng):
     cases = []
     # C and t_end differ between cases too: a version that fixes either to one value fails. The first sensor is
     # one row and one column larger than the events reach (pixels that never fired): a state sized from the
-    # events (y.max() + 1, x.max() + 1) comes out too small
-    for n, (H, W), alpha, C, t_end, extra in ((12, (2, 3), 2 * math.pi, 0.2, 1.2, 1), (40, (3, 4), 5.0, 0.35, 1.5, 0),
-                                              (25, (1, 5), 0.0, 0.15, 1.0, 0)):
-        t = np.sort(rng.uniform(0.0, 1.0, n))
+    # events (y.max() + 1, x.max() + 1) comes out too small. The second recording's clock reads 1000 s (t_start =
+    # 1000): times held in float32 (spacing 61 us there) change every decay by about alpha x 30 us
+    for n, (H, W), alpha, C, t_end, extra, t0 in ((12, (2, 3), 2 * math.pi, 0.2, 1.2, 1, 0.0),
+                                                  (40, (3, 4), 5.0, 0.35, 1.5, 0, 1000.0),
+                                                  (25, (1, 5), 0.0, 0.15, 1.0, 0, 0.0)):
+        t = t0 + np.sort(rng.uniform(0.0, 1.0, n))
         cases.append(dict(t=t, x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=rng.choice([-1, 1], n),
-                          sensor_size=(H + extra, W + extra), C=C, alpha=alpha, t_end=t_end))
+                          sensor_size=(H + extra, W + extra), C=C, alpha=alpha, t_end=t0 + t_end)
+                     | ({"t_start": t0} if t0 else {}))
     return cases
 
 
@@ -118,6 +121,17 @@ def _alpha_over_two_pi(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return highpass_per_event(t, x, y, p, sensor_size, C, alpha / (2 * math.pi), t_end, t_start)
 
 
+def _t_last_set_first(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """t_last set to the event's time before the decay, which is then exp(0) = 1: no decay between events."""
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_last = np.full((H, W), float(t_start))
+    for ti, xi, yi, pi in zip(t, x, y, p):
+        t_last[yi, xi] = ti
+        state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * state[yi, xi] + C * pi
+    return state * np.exp(-alpha * (t_end - t_last))
+
+
 exercises.register(
     "highpass_per_event", highpass_per_event, _inputs_highpass, rtol=1e-6, atol=1e-10,
     hints={
@@ -145,6 +159,13 @@ exercises.register(
         "the state array has an integer dtype, so every stored value is truncated: make it float "
         "(np.zeros((H, W)), not np.zeros_like(x) or dtype=int)":
             _integer_state,
+        "set the pixel's t_last = t after its decay, not before: updated first, the decay exp(-alpha (t - t_last)) "
+        "is exp(0) = 1 and the state never decays between events (only at the end, to t_end)":
+            _t_last_set_first,
+        "timestamps must stay float64: in float32 a time near 1000 s is rounded to a multiple of 61 us, which "
+        "changes every decay exp(-alpha (t - t_last)); keep t as it is given (np.asarray(t, dtype=np.float64))":
+            lambda t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0: highpass_per_event(
+                np.asarray(t, np.float32), x, y, p, sensor_size, C, alpha, t_end, t_start),
     })
 
 
@@ -205,6 +226,18 @@ def _strict_threshold(L_boundaries, C):
     return render_counts(L_boundaries, C, strict)
 
 
+def _reference_by_modulo(L_boundaries, C):
+    """The reference moved to L - (L - ref) % C: numpy's % is a floor modulo, so after a fall the reference lands a
+    whole C below the last level crossed."""
+    L = np.asarray(L_boundaries, dtype=np.float64)
+    ref = L[0].copy()
+    out = np.empty((L.shape[0] - 1,) + L.shape[1:], dtype=np.int64)
+    for k in range(1, L.shape[0]):
+        out[k - 1] = np.trunc((L[k] - ref) / C)
+        ref = L[k] - (L[k] - ref) % C
+    return out
+
+
 exercises.register(
     "render_event_counts", render_event_counts, _inputs_render,
     hints={
@@ -221,4 +254,7 @@ exercises.register(
         "the reference moves with the events (ref += n * C after each bin), not on a fixed grid of levels L(b_0) + "
         "k C: after a rise and a partial fall the grid fires an OFF event that the camera does not":
             _levels_on_a_grid,
+        "move the reference by the whole steps fired, ref += n * C: L - (L - ref) % C is not the same after a fall, "
+        "since numpy's % is a floor modulo (-0.3 % 0.25 is 0.2, not -0.05)":
+            _reference_by_modulo,
     })

@@ -150,6 +150,13 @@ def _esim_ref_always_up(L_a, L_b, t_a, t_b, ref, C):
     return times, p, float(ref + len(p) * C)
 
 
+def _esim_interp_unsorted(L_a, L_b, t_a, t_b, ref, C):
+    """A wrong version (for the hint): np.interp(levels, [L_a, L_b], [t_a, t_b]), whose x-points must increase."""
+    times, p, new_ref = esim_interval(L_a, L_b, t_a, t_b, ref, C)
+    levels = ref + (p[0] if len(p) else 1) * C * np.arange(1, len(p) + 1)
+    return np.interp(levels, [L_a, L_b], [t_a, t_b]).astype(np.float64), p, new_ref
+
+
 exercises.register(
     "esim_interval", esim_interval, _inputs_esim,
     hints={
@@ -182,6 +189,10 @@ exercises.register(
         "an event fires when L reaches the level ref + k C itself (k = 1, 2, ...), not half-way between two levels: "
         "levels = ref + p * C * np.arange(1, n + 1)":
             _esim_half_levels,
+        "np.interp needs increasing x-points: on a fall (L_b < L_a) np.interp(levels, [L_a, L_b], [t_a, t_b]) "
+        "returns an end point silently; use the line t_a + (level - L_a) / (L_b - L_a) (t_b - t_a), or give "
+        "np.interp the points in increasing order":
+            _esim_interp_unsorted,
     })
 
 
@@ -411,7 +422,9 @@ def _inputs_intervals(rng):
     t = np.array([0.0, 0.05, 0.1, 0.25, 0.3, 0.4, 0.45, 0.9])
     cases.append(dict(events=Events(t, np.array([0, 1, 0, 1, 0, 0, 0, 0]), np.zeros(8, np.int64),
                                     np.array([1, -1, 1, -1, 1, -1, -1, 1]), (1, 2))))
-    cases.append(dict(events=_random_events(rng, 400, (3, 4))))
+    # a sensor taller than wide (H = 4 > W = 3): the pixel number x * W + y gives two pixels one number here (x = 0,
+    # y = 3 and x = 1, y = 0), as y * H + x does on the wide sensors above; x * H + y and y * W + x are both one-to-one
+    cases.append(dict(events=_random_events(rng, 400, (4, 3))))
     # ON runs only, and OFF events that never follow one another: no OFF pair, so no estimate (NaN)
     cases.append(dict(events=Events(np.array([0.0, 0.1, 0.2, 0.3, 0.5]), np.zeros(5, np.int64),
                                     np.zeros(5, np.int64), np.array([1, 1, -1, 1, 1]), (1, 1))))
@@ -478,6 +491,13 @@ def _intervals_pixel_index_h(events):
     return _imbalance_of_pixel_numbers(events, pix, "stable")
 
 
+def _intervals_pixel_index_x_w(events):
+    """A wrong version (for the hint): the pixel number x * W + y, which gives two pixels one number when H > W
+    (x = 0, y = W and x = 1, y = 0)."""
+    H, W = events.sensor_size
+    return _imbalance_of_pixel_numbers(events, events.x.astype(np.int64) * W + events.y, "stable")
+
+
 def _intervals_unstable_sort(events):
     """A wrong version (for the hint): np.argsort's default sort, which need not keep each pixel's events in
     time order (some intervals become negative and are floored, others are paired out of order)."""
@@ -534,6 +554,53 @@ def _intervals_per_pixel_means(events):
     return float(np.tanh((means[0] - means[1]) / 2))
 
 
+def _intervals_floor_added(events):
+    """A wrong version (for the hint): MIN_INTERVAL added to every interval instead of a floor."""
+    pix, t, p, pair = _by_pixel(events)
+    log_dt = np.log(np.diff(t) + MIN_INTERVAL)
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
+def _intervals_floor_in_ms(events):
+    """A wrong version (for the hint): the floor at a millisecond, 1e-3 s."""
+    pix, t, p, pair = _by_pixel(events)
+    log_dt = np.log(np.maximum(np.diff(t), 1e-3))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
+def _intervals_across_pixels(events):
+    """A wrong version (for the hint): sorted by pixel, but a pair only needs the same polarity (the last event of
+    one pixel pairs with the first of the next)."""
+    pix, t, p, _ = _by_pixel(events)
+    pair = p[1:] == p[:-1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
+def _intervals_lexsort_by_time(events):
+    """A wrong version (for the hint): np.lexsort((pix, t)), which sorts by its last key, the time."""
+    H, W = events.sensor_size
+    pix = events.y.astype(np.int64) * W + events.x
+    order = np.lexsort((pix, np.asarray(events.t, np.float64)))
+    pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
 def _intervals_log_ratio(events):
     """A wrong version (for the hint): r itself, log(C+ / C-), instead of b."""
     return float(2 * np.arctanh(interval_imbalance(events)))
@@ -561,6 +628,9 @@ exercises.register(
         "number the pixels y * W + x, W = sensor_size[1] (the row length): y * H + x gives two pixels one "
         "number when the sensor is not square":
             _intervals_pixel_index_h,
+        "number the pixels y * W + x (the row times the row length W, plus the column): x * W + y gives two pixels "
+        "one number when the sensor is taller than wide (x * H + y, column by column, would do too)":
+            _intervals_pixel_index_x_w,
         "sort with np.argsort(pix, kind=\"stable\"): the default sort need not keep each pixel's events in "
         "time order, so consecutive events of a pixel are paired out of order":
             _intervals_unstable_sort,
@@ -577,6 +647,18 @@ exercises.register(
         "pool the intervals of all pixels: one mean over every ON pair and one over every OFF pair, not a mean of "
         "per-pixel means (a pixel with one pair would weigh as much as one with a hundred)":
             _intervals_per_pixel_means,
+        "floor each interval at MIN_INTERVAL, np.maximum(dt, MIN_INTERVAL): adding it (dt + MIN_INTERVAL) lengthens "
+        "every interval, not only the zero ones":
+            _intervals_floor_added,
+        "MIN_INTERVAL is 1e-6 s (a microsecond, the timestamps' resolution): a floor at 1e-3 s (a millisecond) "
+        "lifts every interval shorter than that":
+            _intervals_floor_in_ms,
+        "a pair is two consecutive events of one pixel with the same polarity: after sorting by pixel, the last "
+        "event of one pixel and the first of the next are no pair (test pix[1:] == pix[:-1] too)":
+            _intervals_across_pixels,
+        "np.lexsort sorts by its last key first: np.lexsort((pix, t)) sorts by time (pixel only among equal times); "
+        "to sort by pixel with time order kept use np.lexsort((t, pix)) or np.argsort(pix, kind='stable')":
+            _intervals_lexsort_by_time,
     })
 
 

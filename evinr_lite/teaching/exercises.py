@@ -36,14 +36,16 @@ tuple of positional arguments. A hint maps a message to a *wrong version* of the
 reference (same signature) that makes the mistake: when the learner's output matches the
 wrong version's output, the message is shown. Without a matching hint, a few generic ones are
 tried: a flipped sign, a constant factor or offset, a shift by one position (``<`` versus ``<=``),
-differences along the wrong image axis (the reference run on transposed images), and a
-scatter-add that kept one contribution per repeated index (fancy-index ``+=`` for ``np.add.at``).
+differences along the wrong image axis (the reference run on transposed images), a
+scatter-add that kept one contribution per repeated index (fancy-index ``+=`` for ``np.add.at``), and
+an image shifted by one row or column towards its start (indices counted from 1, ``a[y - 1, x - 1]``).
 
 A hint is shown only when the learner's output also matches the wrong version on the other inputs
 where that mistake shows, so that one input cannot make two different mistakes look alike. Beyond the
 values, a check fails a function that changes an input array in place (even when its result is right),
 a tensor result cut off from the autograd graph where the reference's is differentiable (cases mark such
-inputs with ``requires_grad``), and a list or a tensor where the reference returns a numpy array.
+inputs with ``requires_grad``), and a list or a tensor where the reference returns a numpy array. An
+exception is reported at the learner's own line, even when numpy or torch raised it deeper down.
 
 ``use`` says "not finished" for a stub that still raises ``NotImplementedError`` and "does not
 pass the check yet" for a finished function that gives wrong results. For a function with side
@@ -53,6 +55,8 @@ from __future__ import annotations
 
 import copy
 import inspect
+import os
+import sysconfig
 import traceback
 import warnings
 from dataclasses import dataclass, field
@@ -367,7 +371,10 @@ def _generic_hint(got, expected, indexed: bool = False) -> str | None:
     tol = 1e-6 * scale
     if _to_numpy(got).dtype == bool and _to_numpy(expected).dtype == bool and g.size > 1 and np.all(g != e):
         return "the mask is inverted everywhere: True where False is expected and the other way round (`~` once too often?)"
-    if np.all(np.abs(g + e) <= tol) and np.any(np.abs(e) > tol):
+    nz = np.abs(e) > tol
+    # a single non-zero entry of an array flipped may be anything else that lands on minus it: say so only when
+    # several entries agree (a single number, a scalar result, may have its sign flipped on its own)
+    if np.all(np.abs(g + e) <= tol) and nz.sum() >= (1 if e.size == 1 else 2):
         return "the sign is flipped everywhere"
     with np.errstate(all="ignore"):
         if np.all(np.abs(e) < 700) and np.allclose(g, np.exp(e), rtol=1e-6, atol=1e-9):
@@ -375,7 +382,6 @@ def _generic_hint(got, expected, indexed: bool = False) -> str | None:
                     "one), so no np.exp (exp(L) is the linear intensity)")
         if np.all(e > 0) and np.allclose(g, np.log(e), rtol=1e-6, atol=1e-9):
             return "the result is np.log of the expected values: no np.log on this quantity (it is not a log yet)"
-    nz = np.abs(e) > tol
     # one number (or one non-zero entry) is always some factor of another: say so only when several agree
     if nz.sum() >= 2 and np.all(np.abs(g[~nz]) <= tol):
         ratios = g[nz] / e[nz]
@@ -470,6 +476,24 @@ def _wrong_axes_hint(ex: "Exercise", args: tuple, kwargs: dict, got, expected=No
     return None
 
 
+def _one_based_hint(got, expected, rtol: float, atol: float) -> str | None:
+    """An image (or a stack of images) rolled by one row and/or one column towards the start: the values of row
+    (column) 0 sit in the last one. That is indexing counted from 1, ``a[y - 1, x - 1]``: index -1 wraps round."""
+    try:
+        g, e = _to_numpy(got), _to_numpy(expected)
+        if g.dtype == object or g.shape != e.shape or e.ndim < 2 or min(e.shape[-2:]) < 2:
+            return None
+        for shift, axes, what in (((-1, -1), (-2, -1), "one row and one column"), ((-1,), (-2,), "one row"),
+                                  ((-1,), (-1,), "one column")):
+            if _compare(g, np.roll(e, shift, axis=axes), rtol, atol) is None:
+                return (f"the image is shifted by {what}, and the first one's values sit in the last one: indices "
+                        "counted from 1 (`a[y - 1, x - 1]`) put row (column) 0 at index -1, which wraps round to the "
+                        "end; numpy counts from 0, so index with y and x as they are")
+    except Exception:
+        return None
+    return None
+
+
 def _one_contribution_per_entry(g: np.ndarray, e: np.ndarray, tol: float) -> bool:
     """True when ``g`` looks like a scatter-add that kept one contribution per repeated index.
 
@@ -518,12 +542,25 @@ def _non_square(args, kwargs) -> bool:
     return False
 
 
+def _library_file(filename: str) -> bool:
+    """A file of an installed library or of Python itself (numpy, torch, the standard library), not the learner's
+    notebook or module (nor this kit, whose frames say which of its functions the learner's call broke)."""
+    path = os.path.realpath(filename)
+    return any(path.startswith(root + os.sep) for root in _LIBRARY_ROOTS)
+
+
+_LIBRARY_ROOTS = tuple(sorted({os.path.realpath(p) for key in ("stdlib", "platstdlib", "purelib", "platlib")
+                               if (p := sysconfig.get_paths().get(key))}))
+
+
 def _where_raised(err: BaseException) -> list[str]:
-    """The line of the learner's code that raised (the last frame outside this module)."""
+    """The line of the learner's code that raised: the last frame outside this module and outside the libraries it
+    called (an error raised deep inside numpy or torch is reported at the learner's line that called them)."""
     frames = [f for f in traceback.extract_tb(err.__traceback__) if f.filename != __file__]
     if not frames:
         return []
-    f = frames[-1]
+    own = [f for f in frames if not _library_file(f.filename)]
+    f = (own or frames)[-1]
     code = f": `{f.line.strip()}`" if f.line else ""
     return [f"raised in {f.name}, line {f.lineno}{code}"]
 
@@ -969,6 +1006,11 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                 names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
                 details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
                                "stub's parameter names and order")
+            if isinstance(err, RuntimeError) and "does not require grad" in str(err):
+                details.append("hint: the loss has no autograd graph to back-propagate: it was computed under "
+                               "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
+                               ".item(), .numpy()); compute it with torch operations on the model's outputs, "
+                               "with gradients on")
             if isinstance(err, IndexError) and _non_square(args, kwargs):
                 details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
                                "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
@@ -1031,6 +1073,8 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         if hint is None:
             hint = _fixed_size_hint(ex, cases, k, got, expected)
         if problem.values:
+            if hint is None:
+                hint = _one_based_hint(got, expected, ex.rtol, ex.atol)
             if hint is None:
                 hint = _wrong_axes_hint(ex, args, kwargs, got, expected)
             if hint is None:

@@ -128,6 +128,12 @@ def _boundary_loss_last_bin_dropped(F_boundaries, event_frames):
     return torch.mean((event_frames[:-1] - (F_boundaries[1:-1] - F_boundaries[:-2])) ** 2)
 
 
+def _boundary_loss_where_fired(F_boundaries, event_frames):
+    """The mean over the (bin, pixel) entries where events fired (E != 0) only."""
+    r = (event_frames - (F_boundaries[1:] - F_boundaries[:-1])) ** 2
+    return r[event_frames != 0].mean()
+
+
 exercises.register(
     "temporal_loss_boundary", temporal_loss_boundary, _inputs_boundary,
     hints={
@@ -151,6 +157,9 @@ exercises.register(
         "the mean is over bins and pixels, B * H * W squares: dividing the sum by B alone leaves a sum over pixels":
             lambda F_boundaries, event_frames: torch.sum((event_frames - (F_boundaries[1:] - F_boundaries[:-1])) ** 2)
             / event_frames.shape[0],
+        "a pixel with no events in a bin (E = 0) is a measurement too: it says the model should not change there; "
+        "average over every bin and pixel, not only where events fired (E != 0)":
+            _boundary_loss_where_fired,
     })
 
 
@@ -242,6 +251,8 @@ exercises.register(
         "do not stretch the result to [0, 1] (min-max normalising): Eq. 12 already maps into (0, 1), and a "
         "stretch makes each image's display depend on its own darkest and brightest pixels":
             _tonemap_min_max,
+        "L is a natural log: I = exp(L) (np.exp), not 2 ** L (np.exp2)":
+            lambda L, gamma: reinhard_tonemap(np.asarray(L, dtype=np.float64) * np.log(2.0), gamma),
     })
 
 def _tv_first_axes(F):
@@ -282,6 +293,11 @@ def _tv_isotropic(F):
     return torch.sqrt(dx ** 2 + dy ** 2).mean()
 
 
+def _tv_central_differences(F):
+    """torch.gradient's central differences ((F[x+1] - F[x-1]) / 2 inside, one-sided at the borders)."""
+    return torch.gradient(F, dim=-1)[0].abs().mean() + torch.gradient(F, dim=-2)[0].abs().mean()
+
+
 exercises.register(
     "total_variation", total_variation, _inputs_tv, rtol=1e-5, atol=1e-7,
     hints={
@@ -313,6 +329,9 @@ exercises.register(
         "the mean of |d| (absolute values), not the square root of the mean of d ** 2 (an RMS, the root of "
         "Tikhonov)":
             _tv_root_mean_square,
+        "torch.gradient (np.gradient) takes central differences, (F[x+1] - F[x-1]) / 2 inside and one-sided ones at "
+        "the borders: total variation uses the forward differences F[..., :, 1:] - F[..., :, :-1] (and along y)":
+            _tv_central_differences,
     })
 
 
@@ -382,6 +401,20 @@ def _anchor_standardised(L, gamma, display_mean):
     return (L - L.mean()) / (sd if sd > 0 else 1.0) + np.log(s / (1.0 - s))
 
 
+def _anchor_builtin_sum(L, gamma, display_mean):
+    """Python's built-in sum, which adds the rows of a 2-D array (one total per column), divided by L.size."""
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    return L + (np.log(s / (1.0 - s)) - sum(L) / L.size)
+
+
+def _anchor_len_divisor(L, gamma, display_mean):
+    """The sum divided by len(L), the number of rows (the first axis), not the number of entries."""
+    L = np.asarray(L, dtype=np.float64)
+    s = display_mean ** (1.0 / gamma)
+    return L + (np.log(s / (1.0 - s)) - L.sum() / len(L))
+
+
 def _anchor_median(L, gamma, display_mean):
     L = np.asarray(L, dtype=np.float64)
     s = display_mean ** (1.0 / gamma)
@@ -417,6 +450,12 @@ exercises.register(
         "only shift L (add one constant); do not rescale it: dividing by its standard deviation changes the "
         "contrast the events measured":
             _anchor_standardised,
+        "Python's built-in sum(L) adds the rows of a 2-D array (along the first axis) and gives one total per "
+        "column, so every column is shifted by its own amount: use L.mean() (or np.sum(L) / L.size), one number":
+            _anchor_builtin_sum,
+        "len(L) is the number of rows of L (its first axis), not the number of entries: divide the sum by L.size, "
+        "or use L.mean()":
+            _anchor_len_divisor,
     })
 
 
@@ -475,6 +514,12 @@ def _offset_gradients_no_sign(frames):
     return -gx, -gy
 
 
+def _offset_gradients_central(frames):
+    """np.gradient's central differences (shape [H, W]) in place of the forward differences np.diff."""
+    F = np.asarray(frames, dtype=np.float64)
+    return -np.median(np.gradient(F, axis=2), axis=0), -np.median(np.gradient(F, axis=1), axis=0)
+
+
 AXES_HINT = ("gx is the difference along x, the column axis (axis 2 of [K, H, W], shape [H, W - 1]); gy along y, "
              "the rows (axis 1, shape [H - 1, W])")
 
@@ -524,6 +569,9 @@ exercises.register(
             _offset_gradients_prepended,
         "the median of an even number K of differences is the mean of the two middle ones: np.median, not the "
         "lower middle value (sorted[(K - 1) // 2], np.quantile(..., method='lower'))": _offset_gradients_lower,
+        "np.gradient takes central differences, (F[x+1] - F[x-1]) / 2, and keeps the shape [H, W]: the gradient "
+        "field is the forward differences np.diff(F, axis=2) (shape [H, W - 1]) and np.diff(F, axis=1) ([H - 1, W])":
+            _offset_gradients_central,
     })
 
 

@@ -255,6 +255,30 @@ def _integrate_first_event_lost(t_events, p_events, C, t_query):
     return integrate_events_1d(t_events, p, C, t_query)
 
 
+def _integrate_interpolated(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): the running sum read by np.interp, a straight line between events."""
+    t = np.asarray(t_events, dtype=np.float64)
+    if t.size == 0:
+        return np.zeros(np.shape(t_query))
+    return C * np.interp(np.asarray(t_query, dtype=np.float64), t, np.cumsum(np.asarray(p_events, np.float64)), left=0.0)
+
+
+def _integrate_one_event_per_time(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): one event per timestamp (a dict keyed by time keeps the last of a tie)."""
+    d = dict(zip(np.asarray(t_events, np.float64).tolist(), np.asarray(p_events, np.float64).tolist()))
+    t, p = np.array(list(d), dtype=np.float64), np.array(list(d.values()), dtype=np.float64)
+    return integrate_events_1d(t, p, C, t_query)
+
+
+def _integrate_events_before(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): np.cumsum(p) - p, the sum of the events before each one, read at the last
+    event up to t_q (which is then left out)."""
+    p = np.asarray(p_events, dtype=np.float64)
+    n = np.searchsorted(np.asarray(t_events, np.float64), np.asarray(t_query, np.float64), side="right") - 1
+    before = np.cumsum(p) - p
+    return C * np.where(n >= 0, before[np.maximum(n, 0)] if p.size else 0.0, 0.0)
+
+
 exercises.register(
     "integrate_events_1d", integrate_events_1d, _inputs_integrate,
     hints={
@@ -283,6 +307,15 @@ exercises.register(
             _integrate_first_event_lost,
         "multiply by C once: C * sum(p), not C * C * sum(p)":
             lambda t_events, p_events, C, t_query: C * integrate_events_1d(t_events, p_events, C, t_query),
+        "the running sum is a step function: it jumps at each event and stays flat in between, but np.interp draws "
+        "straight lines between the events; count the events up to t_q (np.searchsorted(t, t_q, side='right'))":
+            _integrate_interpolated,
+        "several events can share a timestamp, and each one counts: a dict keyed by time (or np.unique(t)) keeps "
+        "only one of them; sum over the events themselves":
+            _integrate_one_event_per_time,
+        "np.cumsum(p) - p is the sum of the events *before* each one: read at the last event up to t_q it leaves "
+        "that event out; np.cumsum(p)[n - 1] (or a leading 0 and csum[n]) includes it":
+            _integrate_events_before,
     })
 
 def _rate_per_event(t_events, p_events, C, boundaries):
@@ -319,6 +352,14 @@ def _rate_cumsum_no_leading_zero(t_events, p_events, C, boundaries):
     n = np.searchsorted(t, b, side="right") - 1
     n[0] = np.searchsorted(t, b[0], side="left") - 1
     return C * np.diff(csum[n]) / np.diff(b)
+
+
+def _rate_interpolated_sums(t_events, p_events, C, boundaries):
+    """A wrong version (for the hint): the running sum read at the edges by np.interp (straight lines between
+    events) instead of counted."""
+    t, b = np.asarray(t_events, float), np.asarray(boundaries, float)
+    at = np.interp(b, t, np.cumsum(np.asarray(p_events, float)), left=0.0)
+    return C * np.diff(at) / np.diff(b)
 
 
 def _rate_first_window_length(t_events, p_events, C, boundaries):
@@ -383,6 +424,10 @@ exercises.register(
             lambda t_events, p_events, C, boundaries: event_rate_derivative(
                 np.asarray(t_events)[np.asarray(t_events) < boundaries[-1]],
                 np.asarray(p_events)[np.asarray(t_events) < boundaries[-1]], C, boundaries),
+        "the running sum of the polarities is a step function (flat between events): np.interp at the edges draws "
+        "straight lines between the events and splits an event between two windows; count the events in each "
+        "window instead":
+            _rate_interpolated_sums,
     })
 
 def _loss_rates(dF_dt, delta_L, durations):
@@ -422,6 +467,9 @@ exercises.register(
         "the model's change over a window is +dF/dt * (t2 - t1), the same sign as the events' delta_L: the "
         "residual is delta_L - dF_dt * durations, not delta_L + dF_dt * durations":
             lambda dF_dt, delta_L, durations: torch.mean((delta_L + dF_dt * durations) ** 2),
+        "durations[:, None] is a column [B, 1]: against the [B] vectors it broadcasts to a [B, B] table (every "
+        "window's dF/dt times every window's length) and the mean runs over B * B entries; keep all three as [B]":
+            lambda dF_dt, delta_L, durations: torch.mean((delta_L - dF_dt * durations[:, None]) ** 2),
     })
 
 

@@ -115,6 +115,13 @@ def _path_integral_rows_first(gx, gy):
     return g - g.mean()
 
 
+def _zeros_for_a_line(gx, gy):
+    """A single row or column answered with zeros, as if it had nothing to integrate."""
+    gx, gy = np.asarray(gx, dtype=np.float64), np.asarray(gy, dtype=np.float64)
+    H, W = gx.shape[0], gy.shape[1]
+    return np.zeros((H, W)) if H == 1 or W == 1 else integrate_gradients(gx, gy)
+
+
 exercises.register(
     "integrate_gradients", integrate_gradients, _inputs, rtol=1e-6, atol=1e-8,
     hints={
@@ -126,4 +133,7 @@ exercises.register(
         "cumulative sums along the first row and then down the columns are a path integral too: exact only for a "
         "true gradient; least squares uses every difference (D^T D g = D^T b, then the zero mean)":
             _path_integral_rows_first,
+        "a single row (or column) is an image too: its differences along the row still fix g up to the constant "
+        "(there g is the running sum of gx, shifted to mean 0); only a single pixel has nothing to integrate":
+            _zeros_for_a_line,
     })

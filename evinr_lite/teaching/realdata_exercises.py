@@ -92,6 +92,22 @@ def _rate_bins_rounded_down(t, bin_s):
     return t[0] + (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
 
 
+def _rate_firing_bins_only(t, bin_s):
+    """Only the bins that hold an event (np.unique of the bin numbers), the empty ones left out."""
+    t = np.asarray(t, dtype=np.float64)
+    k = np.maximum(np.ceil((t - t[0]) / bin_s).astype(np.int64) - 1, 0)
+    ks, counts = np.unique(k, return_counts=True)
+    return t[0] + (ks + 0.5) * bin_s, counts / bin_s
+
+
+def _rate_bins_from_one(t, bin_s):
+    """Bin numbers ceil((t - t0) / bin_s), counted from 1 (the - 1 forgotten), clipped into 0 .. B - 1."""
+    t = np.asarray(t, dtype=np.float64)
+    n_bins = max(int(np.ceil((t[-1] - t[0]) / bin_s)), 1)
+    k = np.clip(np.ceil((t - t[0]) / bin_s).astype(np.int64), 0, n_bins - 1)
+    return t[0] + (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
+
+
 exercises.register(
     "event_rate", event_rate, _inputs_rate,
     hints={"divide the counts by the bin width to get events per second":
@@ -111,7 +127,17 @@ exercises.register(
            _rate_bins_rounded_down,
            "a rate is events per second: divide each bin's count by the bin width bin_s, not by the number of "
            "events (that is the fraction of the events in each bin)":
-           lambda t, bin_s: (event_rate(t, bin_s)[0], event_rate(t, bin_s)[1] * bin_s / len(t))})
+           lambda t, bin_s: (event_rate(t, bin_s)[0], event_rate(t, bin_s)[1] * bin_s / len(t)),
+           "every bin from t0 to t[-1] is part of the result, the empty ones too (rate 0): np.unique of the bin "
+           "numbers gives only the bins that hold events; count with np.bincount(k, minlength=B)":
+           _rate_firing_bins_only,
+           "bins are numbered from 0: bin k is (t0 + k bin_s, t0 + (k + 1) bin_s], so k = ceil((t - t0) / bin_s) - 1 "
+           "(clipped at 0 for t0 itself); without the - 1 every event lands one bin late and the last bin takes "
+           "two bins' events":
+           _rate_bins_from_one,
+           "several events can share a timestamp and each one counts: np.unique(t) (or a set, or a dict keyed by "
+           "time) merges them; count the events as they are":
+           lambda t, bin_s: event_rate(np.unique(np.asarray(t, dtype=np.float64)), bin_s)})
 
 
 def _inputs_threshold(rng):
@@ -142,6 +168,12 @@ def _threshold_rms_ratio(log_changes, net_counts):
 def _threshold_of_magnitudes(log_changes, net_counts):
     d, n = np.abs(np.asarray(log_changes, float)), np.abs(np.asarray(net_counts, float))
     return float(np.sum(d * n) / np.sum(n * n))
+
+
+def _threshold_means_over_other_pixels(log_changes, net_counts):
+    """np.mean(ΔL n) over all pixels divided by np.mean(n^2) over the pixels with n != 0: two different counts."""
+    d, n = np.asarray(log_changes, float), np.asarray(net_counts, float)
+    return float(np.mean(d * n) / np.mean(n[n != 0] ** 2))
 
 
 exercises.register(
@@ -179,6 +211,9 @@ exercises.register(
             lambda log_changes, net_counts: float(np.median(
                 np.asarray(log_changes, float)[np.asarray(net_counts) != 0]
                 / np.asarray(net_counts, float)[np.asarray(net_counts) != 0])),
+        "take both sums over the same pixels: np.mean(ΔL n) over all of them divided by np.mean(n^2) over the pixels "
+        "that fired divides by two different counts; the ratio of sums, sum(ΔL n) / sum(n^2), needs no means":
+            _threshold_means_over_other_pixels,
     })
 
 
@@ -281,6 +316,26 @@ def _offset_log10(first_frame, L_t0, eps=FRAME_EPS):
     return np.log10(intensity + eps) - np.asarray(L_t0, np.float64)
 
 
+def _offset_dtype_tested_with_is(first_frame, L_t0, eps=FRAME_EPS):
+    """`first_frame.dtype is np.uint8` is always False: a uint8 frame taken as a float one (clipped to [0, 1])."""
+    a = np.asarray(first_frame)
+    return np.log(np.clip(a.astype(np.float64), 0.0, 1.0) + eps) - np.asarray(L_t0, np.float64)
+
+
+def _offset_eps_floor(first_frame, L_t0, eps=FRAME_EPS):
+    """eps as a floor, log(max(I0, eps)), not added."""
+    a = np.asarray(first_frame)
+    intensity = a / 255.0 if a.dtype == np.uint8 else np.clip(np.asarray(a, np.float64), 0.0, 1.0)
+    return np.log(np.maximum(intensity, eps)) - np.asarray(L_t0, np.float64)
+
+
+def _offset_eps_twice(first_frame, L_t0, eps=FRAME_EPS):
+    """eps added to the intensity and again inside the log."""
+    a = np.asarray(first_frame)
+    intensity = a / 255.0 if a.dtype == np.uint8 else np.clip(np.asarray(a, np.float64), 0.0, 1.0)
+    return np.log(intensity + 2 * eps) - np.asarray(L_t0, np.float64)
+
+
 exercises.register(
     "anchor_first_offset", anchor_first_offset, _inputs_anchor, rtol=1e-6, atol=1e-9,
     hints={
@@ -308,4 +363,14 @@ exercises.register(
             _offset_clipped_before_scaling,
         "L_t0 is already a log intensity: subtract it as it is, g = log(I0 + eps) - L_t0 (no np.exp)":
             _offset_exp_of_network,
+        "compare dtypes with ==, not `is`: `first_frame.dtype is np.uint8` is always False (a dtype object is not "
+        "the scalar type np.uint8), so the uint8 frame was taken as a float one; test `first_frame.dtype == "
+        "np.uint8`":
+            _offset_dtype_tested_with_is,
+        "eps is added to the intensity, log(I0 + eps): a floor (np.maximum(I0, eps), np.clip(I0, eps, 1)) keeps "
+        "the bright pixels' log(I0) without the eps, and the two differ on every pixel":
+            _offset_eps_floor,
+        "eps is added once, inside the log: log(I0 + eps) with I0 the frame in [0, 1] (no eps in I0 itself, then "
+        "another in the log)":
+            _offset_eps_twice,
     })

@@ -86,12 +86,13 @@ def _inputs_hot(rng):
     counts.ravel()[rng.choice(54, 3, replace=False)] = (150, 400, 31)
     x, y = _events_from_counts(counts, rng)
     cases.append(dict(x=x, y=y, sensor_size=(6, 9), factor=10.0))
-    # an even number of firing pixels (8), counts 1 1 2 2 | 4 9 11 20: the median is (2 + 4) / 2 = 3 (np.median
-    # averages the two middle values), so with factor 3 the threshold is 9: 9 is on it (not hot), 11 and 20 are
-    # hot. The upper middle value (sorted[n // 2] = 4) flags only 20, the lower one (2) flags 9 too. The sensor is
-    # 6 x 4 and its last row and column never fire: a mask sized from the events (y.max() + 1) is too small
+    # an even number of firing pixels (8), counts 1 1 2 2 | 5 10 11 20: the median is (2 + 5) / 2 = 3.5 (np.median
+    # averages the two middle values), so with factor 3 the threshold is 10.5: 11 and 20 are hot, 10 is not. The
+    # upper middle value (sorted[n // 2] = 5) flags only 20, the lower one (2) flags 10 too, and so does the median
+    # made a whole number (int(3.5) = 3: threshold 9). The sensor is 6 x 4 and its last row and column never fire:
+    # a mask sized from the events (y.max() + 1) is too small
     counts = np.zeros((6, 4), np.int64)
-    for (r, c), n in {(0, 0): 1, (1, 1): 2, (2, 2): 1, (3, 0): 4, (4, 1): 9, (4, 2): 2, (0, 2): 11, (2, 0): 20}.items():
+    for (r, c), n in {(0, 0): 1, (1, 1): 2, (2, 2): 1, (3, 0): 5, (4, 1): 10, (4, 2): 2, (0, 2): 11, (2, 0): 20}.items():
         counts[r, c] = n
     x, y = _events_from_counts(counts, rng)
     cases.append(dict(x=x, y=y, sensor_size=(6, 4), factor=3.0))
@@ -154,6 +155,18 @@ def _hot_rows_columns_swapped(x, y, sensor_size, factor=10.0):
     return hot_pixel_mask(x, y, sensor_size, factor).T
 
 
+def _hot_ratio_floor_division(x, y, sensor_size, factor=10.0):
+    """count // median > factor: the ratio rounded down before the comparison."""
+    counts = _pixel_counts(x, y, sensor_size)
+    return counts // np.median(counts[counts > 0]) > factor
+
+
+def _hot_whole_median(x, y, sensor_size, factor=10.0):
+    """The median made a whole number (int(np.median(...))): a median of x.5 loses its half."""
+    counts = _pixel_counts(x, y, sensor_size)
+    return counts > factor * int(np.median(counts[counts > 0]))
+
+
 exercises.register(
     "hot_pixel_mask", hot_pixel_mask, _inputs_hot,
     hints={
@@ -175,6 +188,12 @@ exercises.register(
         "one typical count for the whole sensor, np.median(counts[counts > 0]): a median along an axis (one per "
         "column) compares each pixel with its own column only":
             _hot_median_per_column,
+        "`count // median > factor`: integer division rounds the ratio down, so a pixel whose ratio lies between "
+        "factor and factor + 1 is missed; compare count > factor * median":
+            _hot_ratio_floor_division,
+        "the median of an even number of counts can end in .5: keep it as np.median gives it (no int(...), round or "
+        "`//`, which move the threshold factor x median)":
+            _hot_whole_median,
     })
 
 
@@ -239,6 +258,12 @@ def _windows_ceil_size(n_events, max_events):
     return np.minimum(np.arange(w + 1) * math.ceil(n_events / w), n_events).astype(np.int64)
 
 
+def _windows_ceil_positions(n_events, max_events):
+    """idx[k] = ceil(k N / w), rounded up."""
+    w = max(1, math.ceil(n_events / max_events))
+    return -(-(np.arange(w + 1, dtype=np.int64) * n_events) // w)
+
+
 exercises.register(
     "event_count_windows", event_count_windows, _inputs_windows, compare=_compare_windows,
     hints={
@@ -263,6 +288,9 @@ exercises.register(
         "windows of ceil(N / w) events each leave a short last window: idx[k] = floor(k N / w) spreads the "
         "remainder so that the sizes differ by at most one":
             _windows_ceil_size,
+        "idx[k] = floor(k N / w) rounds down, (k * N) // w: rounded up (-(-(k * N) // w), np.ceil) the longer "
+        "windows come first":
+            _windows_ceil_positions,
     })
 
 
@@ -307,7 +335,15 @@ def _inputs_filter(rng):
     # random small streams with whole-microsecond timestamps (ties happen)
     for n, size, span, dt in ((60, 6, 0.01, 0.002), (120, 10, 0.05, 0.004)):
         t = np.sort(np.round(rng.uniform(0, span, n), 4))
-        cases.append(dict(t=t, x=rng.integers(0, size, n), y=rng.integers(0, size, n), dt=dt))
+        x, y = rng.integers(0, size, n), rng.integers(0, size, n)
+        if dt == 0.004:
+            # two neighbours alone at pixels (20, 20) and (21, 20), exactly dt apart in decimal: 0.0197 <= 0.0157 +
+            # 0.004 holds in float64, so the later one is kept; in whole microseconds made with astype(int), which
+            # truncates, 0.0157 s is 15699 us (0.0157 * 1e6 = 15699.999...) and the pair falls apart
+            for v, column in ((0.0157, 20), (0.0197, 21)):
+                k = np.searchsorted(t, v)
+                t[k], x[k], y[k] = v, column, 20
+        cases.append(dict(t=t, x=x, y=y, dt=dt))
     return cases
 
 
@@ -416,6 +452,15 @@ def _filter_time_difference(t, x, y, dt):
     return np.any((cheb == 1) & (gap >= 0) & (gap <= dt), axis=1)
 
 
+def _filter_truncated_microseconds(t, x, y, dt):
+    """Times made whole microseconds with astype(int), which truncates (0.0157 * 1e6 = 15699.999... -> 15699)."""
+    tu = (np.asarray(t, np.float64) * 1e6).astype(np.int64)
+    du = int(dt * 1e6)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    return np.any((cheb == 1) & (tu[None, :] <= tu[:, None]) & (tu[:, None] <= tu[None, :] + du), axis=1)
+
+
 exercises.register(
     "background_activity_filter", background_activity_filter, _inputs_filter,
     hints={
@@ -450,6 +495,10 @@ exercises.register(
             _filter_dt_in_milliseconds,
         "compare t_i <= t_j + dt as written: t_i - t_j <= dt rounds differently in floating point, and an event "
         "exactly dt after its neighbour can fall out of the window": _filter_time_difference,
+        "(t * 1e6).astype(int) truncates: 0.0157 s is 15699.999... us and becomes 15699, a microsecond early, so "
+        "an event exactly dt after its neighbour falls out of the window; compare the seconds as they are (or "
+        "np.round before astype)":
+            _filter_truncated_microseconds,
     })
 
 

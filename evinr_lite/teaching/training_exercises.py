@@ -3,11 +3,11 @@
 Exercise (reference solution registered with :mod:`evinr_lite.teaching.exercises` at import):
 
 - ``frame_train_step``: F and dF/dt at the bin mid-points (Eq. 11 and 5, forward mode), the temporal
-  loss (Eq. 6) plus lambda times Tikhonov (Eq. 9), then one optimiser step. The check runs it on a
-  tiny seeded :class:`~evinr_lite.method.models.FrameINR` with an Adam optimiser whose gradients hold
-  stale values (as after an earlier step), and compares the returned losses *and* every parameter
-  after the step with the reference's, so a forgotten ``zero_grad`` or ``step`` is caught even
-  where the loss value alone looks right.
+  loss (Eq. 6) plus lambda times Tikhonov (Eq. 9), then one optimiser step. The check runs it on
+  tiny seeded :class:`~evinr_lite.method.models.FrameINR` models (one network, then two: the inputs
+  are [N, B, ...]) with an Adam optimiser whose gradients hold stale values (as after an earlier step),
+  and compares the returned losses *and* every parameter after the step with the reference's, so a
+  forgotten ``zero_grad`` or ``step`` is caught even where the loss value alone looks right.
 
 The loop in notebook 04 calls this step ``N_ITERS`` times; the learning-rate schedule stays outside it.
 """
@@ -49,20 +49,26 @@ def frame_train_step(model, optimizer, event_frames, centers, durations, lam):
 
 
 def _inputs_step(rng):
-    """Tiny seeded cases: a 3 x 4 sensor, 5 bins, an 8-wide SIREN; stale gradients in place."""
+    """Tiny seeded cases: a 3 x 4 sensor, 5 bins, an 8-wide SIREN; stale gradients in place. The first model has
+    one network (as in notebook 04), the second two (N = 2, overlapping windows): the step is written for [N, B]
+    inputs, so a version that assumes N = 1 (durations.view(-1, 1, 1), centers[0]) fails there."""
     cases = []
-    for seed, lam, lr in ((0, 0.05, 1e-3), (1, 0.5, 3e-3)):
-        model = FrameINR((3, 4), [[0.0, 1.0]], hidden_features=8, hidden_layers=1, omega_0=30.0,
+    for seed, lam, lr, windows in ((0, 0.05, 1e-3, [[0.0, 1.0]]), (1, 0.5, 3e-3, [[0.0, 0.6], [0.4, 1.0]])):
+        model = FrameINR((3, 4), windows, hidden_features=8, hidden_layers=1, omega_0=30.0,
                          first_omega_0=10.0, seed=seed)
         g = torch.Generator().manual_seed(seed)
         for p in model.parameters():                              # stale gradients, as after an earlier step
             p.grad = torch.randn(p.shape, generator=g, dtype=p.dtype)
         opt = torch.optim.Adam(model.parameters(), lr=lr)
-        edges = np.sort(rng.uniform(0.0, 1.0, 6))
-        edges[0], edges[-1] = 0.0, 1.0
-        centers = torch.as_tensor(0.5 * (edges[1:] + edges[:-1]))[None]
-        durations = torch.as_tensor(np.diff(edges), dtype=torch.float32)[None]
-        E = (torch.randint(-2, 3, (1, 5, 3, 4), generator=g) * 0.2).float()
+        edges = []
+        for lo, hi in windows:                                    # 5 bins of unequal lengths in each window
+            e = np.sort(rng.uniform(lo, hi, 6))
+            e[0], e[-1] = lo, hi
+            edges.append(e)
+        edges = np.stack(edges)
+        centers = torch.as_tensor(0.5 * (edges[:, 1:] + edges[:, :-1]))
+        durations = torch.as_tensor(np.diff(edges, axis=1), dtype=torch.float32)
+        E = (torch.randint(-2, 3, (len(windows), 5, 3, 4), generator=g) * 0.2).float()
         cases.append(dict(model=model, optimizer=opt, event_frames=E, centers=centers, durations=durations, lam=lam))
     return cases
 
