@@ -3,7 +3,7 @@ are the filter's own rule, the noise share is read from the events, and the wind
 import numpy as np
 import pytest
 
-from evinr_lite.core.events import Events
+from evinr_lite.core.events import EventDataError, Events
 from evinr_lite.io.source import MemorySource
 from evinr_lite.method import EvINRConfig
 from evinr_lite.method.background import GRID, fit_background, neighbour_gaps, sample_spans
@@ -99,3 +99,16 @@ def test_background_dt_must_be_positive_seconds():
         EvINRConfig(background_dt=0)
     with pytest.raises(EventDataError, match="pass the number itself"):
         EvINRConfig(background_dt="0.1")
+
+
+def test_no_queries_get_no_gaps_and_a_float32_default_window_is_the_default():
+    """A mask that selects no query is answered with no gaps (not refused as empty input), and 0.05 s that
+    went through float32 is the default window, not a value "auto" would ignore."""
+    rng = np.random.default_rng(0)
+    ev = Events(np.sort(rng.uniform(0, 1, 400)), rng.integers(0, 40, 400), rng.integers(0, 30, 400),
+                rng.choice([-1, 1], 400), (30, 40))
+    assert neighbour_gaps(ev, [], [], [], []).shape == (0,)
+    cfg = EvINRConfig(background_dt=np.float32(0.05))
+    assert cfg.background == "auto" and cfg.background_dt == 0.05
+    with pytest.raises(EventDataError, match="background='filter'"):
+        EvINRConfig(background_dt=0.2)

@@ -102,3 +102,28 @@ def test_a_window_past_the_events_is_noted_by_both_jobs(recording, tmp_path, mon
             recon_job.run_reconstruct(recording, tmp_path / f"p{streamed}", C=0.25, video=False, progress=False,
                                       t_end=0.5, fps=5, log=said.append)
         assert not [s for s in said if s.startswith("note: the window")], said
+
+
+def test_both_jobs_record_and_report_the_background_window_auto_chose(recording, tmp_path, monkeypatch):
+    """run.json says which background filter ran (what background="auto" chose), in its settings and in the
+    config it records, the same for both jobs, and the log says it once; a streamed run recorded the
+    config as given ("auto") before, so its run.json could not reproduce the filter."""
+    got = {}
+    for streamed in (True, False):
+        lines = []
+        with monkeypatch.context() as m:
+            if not streamed:
+                m.setattr(recon_job, "streamable", lambda options: False)
+            run = recon_job.run_reconstruct(recording, tmp_path / f"b{streamed}", C=0.25, video=False, progress=False,
+                                            log=lines.append, fps=10)
+        saved = json.loads((tmp_path / f"b{streamed}" / "run.json").read_text())
+        used = saved["background_used"]
+        assert used["background"] in ("filter", "keep")
+        assert (used["background_dt"] is None) == (used["background"] == "keep")
+        assert saved["evinr_config"]["background"] == used["background"]
+        if used["background"] == "filter":
+            assert saved["evinr_config"]["background_dt"] == used["background_dt"]
+        assert sum(("background filter" in ln or "background activity filtered" in ln) for ln in lines) == 1
+        got[streamed] = used
+        assert run["background_used"] == used
+    assert got[True] == got[False]

@@ -85,6 +85,19 @@ def report_lam(lam, used, settings: dict, log) -> None:
         "smooths more, e.g. 0.03-0.1 under heavy background activity)")
 
 
+def report_background(background, used, dt, settings: dict, log) -> None:
+    """When the background filter's window was chosen from the events (``background="auto"``): log the choice
+    and record it in ``settings["background_used"]`` (the in-memory and the streamed job both)."""
+    if background != "auto" or used is None:
+        return
+    settings["background_used"] = {"background": used, "background_dt": float(dt) if used == "filter" else None}
+    if used == "filter":
+        log(f"background activity filtered with a {float(dt):g} s window chosen from the events' share of noise "
+            "(pass --keep-background to train on every event)")
+    else:
+        log("no background filter: the events' share of noise is too small to pay for one (every event kept)")
+
+
 def report_level(options, config, log) -> None:
     """When the frames' level is the tone map's prior (no ``display_mean`` given, no APS anchor): say so once,
     with the option that sets it (the in-memory and the streamed job both)."""
@@ -260,12 +273,17 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     written = ["frames/", "timestamps.txt"] + writer.finish()
     scores = score_predictions(writer.gt_frames(), gt.t, gt) if gt is not None else None
     used = history.get("C_used")
-    history = {**history, "config": asdict(config if used is None or len(used) != 2 else replace(config, C=tuple(used))),
-               "streamed": True}
+    resolved = config if used is None or len(used) != 2 else replace(config, C=tuple(used))
+    if history.get("background_used") is not None:     # what background="auto" chose, so run.json reproduces it
+        resolved = replace(resolved, background=history["background_used"],
+                           background_dt=history["background_dt_used"])
+    history = {**history, "config": asdict(resolved), "streamed": True}
     settings = {"C": C, "C_source": C_source, "times_source": times_source, "device": device_name,
                 "seed": options.seed, "memory_estimate_bytes": est["total"]}
     report_balance(C, used, settings, log)
     report_lam(config.lam, history.get("lam_used"), settings, log)
+    report_background(config.background, history.get("background_used"), history.get("background_dt_used"),
+                      settings, log)
     report_level(options, config, log)
     if writer.video_fps is not None:
         settings["video_fps"] = writer.video_fps

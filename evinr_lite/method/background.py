@@ -157,7 +157,7 @@ def _queries(sensor_size, t, x, y, p) -> tuple:
     """(t, x, y, p) of :func:`neighbour_gaps` checked and broadcast to one length."""
     H, W = sensor_size
     try:
-        t = seconds_array(t, "t")
+        t = seconds_array(t, "t", allow_empty=True)   # no queries: no gaps (a mask that selects nothing)
     except EventDataError as e:
         raise EventDataError(f"neighbour_gaps: {e}") from None
     cols = {}

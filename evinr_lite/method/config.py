@@ -481,11 +481,15 @@ class EvINRConfig:
             raise EventDataError(f"background_dt must be a positive number of seconds (the filter's window, e.g. 0.05), "
                                  f"got {self.background_dt!r}")
         self.background_dt = float(self.background_dt)
-        if self.background == "auto" and self.background_dt != DEFAULT_DT:   # "auto" would set it without a word
-            raise EventDataError(f"background_dt={self.background_dt!r} is the filter's window with background='filter', "
-                                 f"but background='auto' (the kit's default) chooses the window itself from the events "
-                                 f"and would not use it; pass background='filter' with background_dt="
-                                 f"{self.background_dt!r}, or leave background_dt at {DEFAULT_DT} with 'auto'")
+        if self.background == "auto":                 # "auto" would set it without a word
+            if not math.isclose(self.background_dt, DEFAULT_DT, rel_tol=1e-6):   # 0.05 through float32 is 0.05
+                raise EventDataError(
+                    f"background_dt={self.background_dt!r} is the filter's window with background='filter', but "
+                    f"background='auto' (the kit's default) chooses the window itself from the events and would not "
+                    f"use it; pass background='filter' with background_dt={self.background_dt!r} (both at once: "
+                    f"dataclasses.replace(cfg, background='filter', background_dt=...), or set cfg.background = "
+                    f"'filter' first), or leave background_dt at {DEFAULT_DT} with 'auto'")
+            self.background_dt = DEFAULT_DT
         if not 0 <= number("prior_time_order", self.prior_time_order) <= 1:
             raise EventDataError(f"prior_time_order must be within [0, 1] (0: the frames' roughness, the paper's; 1: the "
                                  f"per-bin changes'; the kit's 0.25), got {self.prior_time_order!r}")

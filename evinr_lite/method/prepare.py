@@ -36,7 +36,7 @@ import numpy as np
 from ..core.checks import real_number
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
-from .background import MIN_EVENTS, busy_spans, checked_span, fit_background, sample_spans, tile_counts
+from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, checked_span, fit_background, sample_spans, tile_counts
 from .denoise import DEFAULT_DT, denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
@@ -242,7 +242,9 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         return cfg, _Prepared(source, span, held=held)
     # with the filter, this first pass only finds the hot pixels (the balance reads the second one's counts)
     # and, with "auto", counts the events on the span's tiles (where they are, for the window's statistics)
-    tiles = tile_counts([], t_start, t_end) if cfg.background == "auto" else None     # zeros, one per tile
+    # (a span measured whole, up to WHOLE_SPAN, never looks at them)
+    tiles = (tile_counts([], t_start, t_end) if cfg.background == "auto" and t_end - t_start > WHOLE_SPAN
+             else None)                                                                  # zeros, one per tile
     counts = _counts(source, t_start, t_end, chunk_s, "counting events" if progress else None, counts_only=filtered,
                      tiles=tiles)
     if filtered:

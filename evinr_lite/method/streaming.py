@@ -71,7 +71,9 @@ class StreamPart:
     [0, 1]), ``window`` (index, t_lo, t_hi) of the window that finished them (None for the final
     pass of ``offset_from="span"``) and ``history`` (training so far: train_time_s, n_windows, per window;
     C_used: [C] or [C+, C-], the thresholds the events were integrated with, after the ON/OFF balance;
-    lam_used: the regularizer's weight trained with, ``lam="auto"`` resolved)."""
+    lam_used: the regularizer's weight trained with, ``lam="auto"`` resolved; background_used and
+    background_dt_used: the background filter applied, ``background="auto"`` resolved to "filter" with its
+    window in seconds, or "keep")."""
 
     times: np.ndarray
     indices: np.ndarray
@@ -273,6 +275,12 @@ def _count_up_to_two(source, t_start: float, t_end: float) -> int:
     return found
 
 
+def _resolved(cfg, used) -> dict:
+    """What the events chose, for a part's history: the thresholds, lam and the background filter."""
+    return {"C_used": used, "lam_used": float(cfg.lam), "background_used": cfg.background,
+            "background_dt_used": float(cfg.background_dt)}
+
+
 def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *, t_start: float | None = None,
                        t_end: float | None = None, offset_from: str = "span", workdir=None,
                        state: StreamState | None = None, on_state=None, progress: bool | None = None):
@@ -325,7 +333,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
     used = [float(c) for c in np.atleast_1d(cfg.C)]           # the thresholds the events are integrated with
     if offset_from == "first_window":
         for part, _ in _windows(source, q, grid, cfg, state, None, on_state, show):
-            part.history.update(C_used=used, lam_used=float(cfg.lam))
+            part.history.update(_resolved(cfg, used))
             yield part
         return
     with tempfile.TemporaryDirectory(prefix="evinr-stream-") if workdir is None else _nothing(workdir) as folder:
@@ -334,7 +342,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
             pass
         offset = span_offset(state.grid, cfg, grid, read_chunks(source, t_start, t_end, cfg.tau or t_end - t_start),
                              progress=show)
-        yield from _final_pass(spill, q, offset, cfg, source.sensor_size, {**_history(state), "C_used": used, "lam_used": float(cfg.lam)},
+        yield from _final_pass(spill, q, offset, cfg, source.sensor_size, {**_history(state), **_resolved(cfg, used)},
                                progress=show)
 
 
