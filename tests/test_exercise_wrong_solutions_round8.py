@@ -872,3 +872,19 @@ def test_the_wrong_versions_differ_from_the_reference():
     t = 1000.0 + np.array([0.1, 0.5 + 4e-6, 0.6, 0.7, 0.9])          # 4 us after the edge: in bin 1, not in float32
     b = np.array([1000.0, 1000.5, 1001.0])
     assert not np.allclose(bis_float32(t, b), R("bisect_equal_count")(t, b), rtol=0, atol=1e-4)
+
+
+def test_library_frames_are_told_from_the_kit_and_the_learner(monkeypatch, tmp_path):
+    """A report points at the learner's line, skipping numpy's and torch's frames but keeping the kit's, wherever
+    they are installed: the kit in site-packages (a non-editable install) is still the kit, and a library in a
+    site-packages folder that sysconfig does not name (the user's, Debian's dist-packages) is still a library."""
+    from evinr_lite.teaching import exercises
+
+    assert exercises._library_file(np.__file__)
+    assert not exercises._library_file(exercises.__file__)
+    site_dir = tmp_path / "site-packages"
+    monkeypatch.setattr(exercises, "_LIBRARY_ROOTS", (str(site_dir),))
+    monkeypatch.setattr(exercises, "_KIT_ROOT", str(site_dir / "evinr_lite"))
+    assert exercises._library_file(str(site_dir / "numpy" / "core.py"))
+    assert not exercises._library_file(str(site_dir / "evinr_lite" / "method" / "solver.py"))
+    assert not exercises._library_file(str(tmp_path / "notebook.py"))

@@ -56,6 +56,7 @@ from __future__ import annotations
 import copy
 import inspect
 import os
+import site
 import sysconfig
 import traceback
 import warnings
@@ -546,11 +547,28 @@ def _library_file(filename: str) -> bool:
     """A file of an installed library or of Python itself (numpy, torch, the standard library), not the learner's
     notebook or module (nor this kit, whose frames say which of its functions the learner's call broke)."""
     path = os.path.realpath(filename)
+    if path.startswith(_KIT_ROOT + os.sep):          # the kit itself, installed into site-packages or not
+        return False
     return any(path.startswith(root + os.sep) for root in _LIBRARY_ROOTS)
 
 
-_LIBRARY_ROOTS = tuple(sorted({os.path.realpath(p) for key in ("stdlib", "platstdlib", "purelib", "platlib")
-                               if (p := sysconfig.get_paths().get(key))}))
+def _site_dirs() -> set:
+    """site-packages folders beyond sysconfig's: the user's and the system's (Debian's dist-packages)."""
+    dirs = set()
+    try:
+        dirs.update(site.getsitepackages())
+    except AttributeError:                            # some virtualenvs' site module lacks it
+        pass
+    user = getattr(site, "getusersitepackages", lambda: None)()
+    if user:
+        dirs.add(user)
+    return dirs
+
+
+_KIT_ROOT = os.path.realpath(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))   # evinr_lite/
+_LIBRARY_ROOTS = tuple(sorted({os.path.realpath(p) for p in
+                               [sysconfig.get_paths().get(k) for k in ("stdlib", "platstdlib", "purelib", "platlib")]
+                               + sorted(_site_dirs()) if p}))
 
 
 def _where_raised(err: BaseException) -> list[str]:
