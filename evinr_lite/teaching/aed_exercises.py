@@ -78,7 +78,7 @@ def jensen_gap(intensity, block: int = 4):
 
 def _inputs_channel(rng):
     y, x = np.mgrid[0:6, 0:7]
-    cases = [dict(y=y, x=x, phase=ph) for ph in ((0, 0), (1, 0), (0, 3), (2, 1))]
+    cases = [dict(y=y, x=x, phase=ph) for ph in ((0, 0), (1, 0), (0, 3), (-2, -3))]   # a negative phase: a floor modulo
     cases.append(dict(y=rng.integers(0, 1000, 20), x=rng.integers(0, 1000, 20), phase=(3, 2)))
     return cases
 
@@ -106,6 +106,10 @@ def _channel_no_block_division(y, x, phase):
 exercises.register(
     "quad_bayer_channel", quad_bayer_channel, _inputs_channel,
     hints={
+        "np.fmod (C's remainder, like math.fmod and torch.fmod) keeps the sign of y + dy, so a negative phase gives "
+        "negative tile rows: use Python's and numpy's % (a floor modulo, always in 0..3)":
+            lambda y, x, phase: (np.fmod(np.asarray(y) + phase[0], 4) // 2
+                                 + np.fmod(np.asarray(x) + phase[1], 4) // 2).astype(np.int64),
         "that is a plain 2x2 Bayer pattern: in Quad Bayer each colour covers a 2x2 block, so the block index "
         "is ((y + dy) % 4) // 2": _channel_plain_bayer,
         "phase is (dy, dx): the row offset first, then the column offset": _channel_phase_swapped,

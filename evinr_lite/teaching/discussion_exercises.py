@@ -171,7 +171,7 @@ exercises.register(
 
 def _inputs_render(rng):
     cases = []
-    for B, shape, C in ((4, (2, 3), 0.2), (6, (3, 4), 0.25), (5, (1, 6), 0.5)):
+    for B, shape, C in ((4, (2, 3), 0.2), (6, (3, 4), 0.25), (5, (6,), 0.5)):       # [B + 1, P] too
         steps = rng.normal(0.0, 2.5 * C, (B,) + shape)
         L = np.concatenate([rng.normal(0.0, 1.0, (1,) + shape), steps]).cumsum(axis=0)
         cases.append(dict(L_boundaries=L, C=C))
