@@ -111,6 +111,8 @@ def _ridge_over_bins(A, E, ridge):
 exercises.register(
     "head_closed_form", head_closed_form, _inputs, rtol=1e-6, atol=1e-9,
     hints={
+        "the penalty is ridge |W|^2: add ridge * I to A^T A, not ridge ** 2 * I":
+            lambda A, E, ridge: head_closed_form(A, E, ridge ** 2),
         "add ridge times the identity to A^T A (the ridge term is part of the loss being minimised)":
             _no_ridge,
         "the ridge is added once to A^T A, not once per bin (the loss is a sum, |A W - E|^2 + ridge |W|^2)":

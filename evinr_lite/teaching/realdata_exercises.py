@@ -179,6 +179,9 @@ def _threshold_means_over_other_pixels(log_changes, net_counts):
 exercises.register(
     "estimate_contrast_threshold", estimate_contrast_threshold, _inputs_threshold, rtol=1e-6,
     hints={
+        "every pixel counts, those with more OFF than ON events (n < 0) too: n^2 and ΔL n do not care about the sign":
+            lambda log_changes, net_counts: estimate_contrast_threshold(
+                np.asarray(log_changes)[np.asarray(net_counts) > 0], np.asarray(net_counts)[np.asarray(net_counts) > 0]),
         "C multiplies n: the least-squares slope is sum(ΔL n) / sum(n^2), not sum(n^2) / sum(ΔL n)":
             lambda log_changes, net_counts: float(np.sum(np.square(np.asarray(net_counts, float)))
                                                   / np.sum(np.asarray(log_changes) * net_counts)),
