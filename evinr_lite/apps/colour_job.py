@@ -58,6 +58,10 @@ def split_colour_events(rec: Recording):
     phase = cfa_phase(check_colour_recording(rec))
     ev = rec.events
     H, W = ev.sensor_size
+    if H < 2 or W < 2:      # was refused as a sensor of (0, W) nobody gave
+        raise EventDataError(f"{rec.meta.get('path') or 'the recording'}: a {H} x {W} sensor holds no full 2 x 2 "
+                             "window of its colour filter; --colour needs at least 2 x 2 photosites (check the "
+                             "sensor size, H x W)")
     if H % 2 or W % 2:
         ev = ev.take((ev.x < W - W % 2) & (ev.y < H - H % 2))
         ev = Events(ev.t, ev.x, ev.y, ev.p, (H - H % 2, W - W % 2), t_origin=ev.t_origin, polarity_encoding="pm1")

@@ -80,6 +80,17 @@ class Frames:
         order = np.argsort(self.t, kind="stable")
         return Frames(self.images[order], self.t[order], self.t_origin)
 
+    def sorted_distinct(self, use: str) -> "Frames":
+        """:meth:`sorted`, refusing two frames at one timestamp (which of them holds at that time is unknown:
+        an anchor, or a log change over no time, would be made of either); ``use`` names what needs them."""
+        out = self.sorted()
+        same = np.flatnonzero(np.diff(out.t) == 0)
+        if same.size:
+            raise EventDataError(f"{use}: {same.size} APS frame(s) share a timestamp with the previous one (first at "
+                                 f"t = {out.t[same[0]]:.6f} s); frames need distinct times: drop the duplicates "
+                                 "(e.g. keep = np.r_[True, np.diff(frames.t) > 0] on sorted frames)")
+        return out
+
 
 def in_window(t, t_start: float | None = None, t_end: float | None = None) -> np.ndarray:
     """bool [N]: which of the times ``t`` [N] (seconds) lie in [t_start, t_end) (None: open on that side)."""

@@ -34,9 +34,10 @@ COARSE_PX = 8.0    # the Gaussian's sigma (pixels) above which an error counts a
 
 def _frames(a, name: str) -> np.ndarray:
     a = np.asarray(a)
-    if a.ndim != 3 or a.shape[0] < 1:
+    if a.ndim != 3 or a.size == 0:
         raise EventDataError(f"{name} must be a stack [K, H, W] of frames, got shape {a.shape}"
-                             + ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else ""))
+                             + ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else
+                                "; no frame or no pixel to score" if a.ndim == 3 else ""))
     check_image_values(a, name, clipped=(name == "pred"))   # uint8, or finite floats in [0, 1] (not 0..255)
     f = a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else a.astype(np.float64)
     return np.clip(f, 0.0, 1.0)     # predictions as displayed (the protocol clips them too)

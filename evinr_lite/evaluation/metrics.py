@@ -75,7 +75,9 @@ def _image(a, name: str) -> np.ndarray:
 
 
 def _pair(pred, gt):
-    pred = np.clip(_image(pred, "prediction"), 0.0, 1.0)
+    pred = _image(pred, "prediction")
+    check_image_values(pred, "predictions", clipped=True)   # 0..255 floats were clipped to white, not refused
+    pred = np.clip(pred, 0.0, 1.0)
     gt = _image(gt, "ground truth")
     check_image_values(gt, "ground-truth images")   # floats on the 0..255 scale are refused, not scored
     if pred.shape != gt.shape:
@@ -129,6 +131,9 @@ def equalize(img, method: str = "none") -> np.ndarray:
     if img.dtype.kind == "f" and not np.all(np.isfinite(img)):   # NaN would become 0 silently
         raise EventDataError("the image to equalise contains NaN or inf; repair or drop that frame (an image must be "
                              "finite to be scored)")
+    if img.size == 0:
+        raise EventDataError(f"the image to equalise is empty (shape {img.shape}); pass an image [H, W]")
+    check_image_values(img, "the image's values", clipped=True)   # 0..255 floats or uint16 became white
     if method == "none":
         if img.dtype == np.uint8:
             return img.astype(np.float64) / 255.0

@@ -72,6 +72,9 @@ def resolve_lpips(lpips_model=None):
     a model is used as is. The note says why LPIPS is missing ("" when it is computed)."""
     if lpips_model is False:
         return None, "LPIPS not requested (lpips_model=False)"
+    if isinstance(lpips_model, (str, bytes)) and lpips_model != "auto":   # a name is no model ("none" is False)
+        raise EventDataError(f"lpips_model must be None or 'auto' (the cached weights), False (skip LPIPS) or an LPIPS "
+                             f"model, got the text {lpips_model!r}")
     if lpips_model is not None and lpips_model != "auto":
         return lpips_model, ""
     from ..core.runtime import default_device
@@ -182,6 +185,16 @@ def pool(rows) -> dict:
     n = np.array([r["n_frames"] for r in rows], dtype=np.float64)
     if np.any(n <= 0):
         raise EventDataError("every pooled row needs n_frames > 0")
+    for i, r in enumerate(rows):     # one NaN row would make the pooled mean NaN without a word
+        for key in ("mse", "ssim", "lpips"):
+            v = r.get(key)
+            try:
+                bad = (v is not None or key != "lpips") and not np.isfinite(float(v))
+            except (TypeError, ValueError):
+                bad = True
+            if bad:
+                raise EventDataError(f"pool: row {i} has {key} = {v}, not a score; pool the rows score_sequence "
+                                     "returns (drop or rescore that sequence)")
 
     def mean(key):
         return float(np.sum(n * np.array([r[key] for r in rows], dtype=np.float64)) / n.sum())
@@ -368,7 +381,9 @@ def measure_inference_fps(model, n_frames: int = 64, batch_size: int = 32, repea
 
 def frames_to_score(frame_t, events: Events, margin: float = 0.005) -> np.ndarray:
     """Indices of the frames whose timestamps lie in [first event - margin, last event + margin] (s)."""
-    frame_t = np.asarray(frame_t, dtype=np.float64)
+    frame_t = seconds_array(frame_t, "frame_t", allow_empty=True)   # NaN times were dropped without a word
+    margin = real_number(margin, "margin", lo=0, hint="seconds around the events' span (e.g. 0.005)")
+    require(events, Events, "events")
     if len(events) == 0:
         raise EventDataError("no events: nothing to reconstruct or score; choose a window with events")
     keep = (frame_t >= events.t[0] - margin) & (frame_t <= events.t[-1] + margin)

@@ -104,7 +104,7 @@ def frames_in_window(frames, sensor_size, t_start: float, t_end: float, mode: st
                              f"(the frames cover {span}); choose a window (t_start=/t_end=) that contains a frame, "
                              "or use anchor='none'")
     inside = Frames(frames.images[keep], frames.t[keep], frames.t_origin)
-    return inside.sorted()
+    return inside.sorted_distinct(f"anchor={mode!r}")
 
 
 def select_anchors(n_frames: int, mode: str, every: int = 2) -> np.ndarray:

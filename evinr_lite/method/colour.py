@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.cfa import CHANNELS, QUAD_BAYER, effective_thresholds
+from ..core.checks import require, seconds_array
 from ..core.events import EventDataError, Events
 from .solver import EvINRConfig, reconstruct
 from .tonemap import to_display
@@ -59,8 +60,8 @@ def channel_offsets_from(rgb) -> np.ndarray:
     and leave the overall brightness anchor alone. ``rgb``: [..., 3] positive linear intensities.
     """
     rgb = np.asarray(rgb, dtype=np.float64)
-    if rgb.ndim < 2 or rgb.shape[-1] != 3 or not np.all(rgb > 0):
-        raise EventDataError(f"rgb must be positive intensities of shape [..., 3], got {rgb.shape}")
+    if rgb.ndim < 2 or rgb.shape[-1] != 3 or not np.all((rgb > 0) & np.isfinite(rgb)):   # inf gave NaN offsets
+        raise EventDataError(f"rgb must be positive finite intensities of shape [..., 3], got {rgb.shape}")
     logs = np.log(rgb.reshape(-1, 3).mean(axis=0))
     return logs - logs.mean()
 
@@ -82,8 +83,9 @@ def reconstruct_colour(streams, query_times, config: EvINRConfig | None = None, 
     Returns:
         ColourReconstruction with frames [Q, h, w, 3] in [0, 1].
     """
-    cfg = config or EvINRConfig()
-    if len(streams) != 3 or not all(isinstance(s, Events) for s in streams):
+    cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")   # {} was taken as None
+    streams = tuple(streams) if isinstance(streams, (list, tuple)) or hasattr(streams, "__next__") else streams
+    if not isinstance(streams, tuple) or len(streams) != 3 or not all(isinstance(s, Events) for s in streams):
         raise EventDataError("streams must be three Events streams (R, G, B); use quadbayer.demosaic_events_rgb")
     if len({s.sensor_size for s in streams}) != 1:
         raise EventDataError(f"the three streams must share one grid, got {[s.sensor_size for s in streams]}")
@@ -92,19 +94,24 @@ def reconstruct_colour(streams, query_times, config: EvINRConfig | None = None, 
             raise EventDataError("pass C (the photosites' threshold) or thresholds=(C_R, C_G, C_B)")
         eff = effective_thresholds(C, block)
         thresholds = tuple(eff[name] for name in CHANNELS)
-    thresholds = tuple(float(c) for c in thresholds)
+    try:
+        thresholds = tuple(float(c) for c in thresholds)
+    except (TypeError, ValueError):      # text, or not a sequence: Python's own error named nothing
+        raise EventDataError(f"thresholds must be three positive numbers (C_R, C_G, C_B), got {thresholds!r}") from None
     if len(thresholds) != 3 or not all(c > 0 for c in thresholds):
         raise EventDataError(f"thresholds must be three positive numbers, got {thresholds!r}")
-    q = np.atleast_1d(np.asarray(query_times, dtype=np.float64))
+    q = seconds_array(query_times, "query_times")      # none at all was numpy's error on an empty minimum
+    if channel_offsets is not None:
+        offsets = np.asarray(channel_offsets, dtype=np.float64)
+        if offsets.shape != (3,) or not np.all(np.isfinite(offsets)):   # NaN made every frame NaN
+            raise EventDataError(f"channel_offsets must be 3 finite numbers (log units), got {channel_offsets!r}")
     firsts = [s.t[0] for s in streams if len(s)]
     lasts = [s.t[-1] for s in streams if len(s)]
     t_start = float(min(firsts + [q.min()])) if t_start is None else float(t_start)
     t_end = float(max(lasts + [q.max()])) if t_end is None else float(t_end)
     recs = tuple(reconstruct(s, q, dataclasses.replace(cfg, C=c), t_start=t_start, t_end=t_end)
                  for s, c in zip(streams, thresholds))
-    offsets = np.zeros(3) if channel_offsets is None else np.asarray(channel_offsets, dtype=np.float64)
-    if offsets.shape != (3,):
-        raise EventDataError(f"channel_offsets must be 3 numbers (log units), got shape {offsets.shape}")
+    offsets = np.zeros(3) if channel_offsets is None else offsets
     L = np.stack([r.log_intensity for r in recs], axis=-1) + offsets.astype(np.float32)
     frames = to_display(L, cfg.tonemap, cfg.gamma).astype(np.float32)
     return ColourReconstruction(q, L.astype(np.float32), frames, recs, thresholds, offsets)
@@ -123,6 +130,9 @@ def chroma_correlation(L_rgb, L_rgb_true) -> dict:
     est, true = np.asarray(L_rgb, np.float64), np.asarray(L_rgb_true, np.float64)
     if est.shape != true.shape or est.ndim != 4 or est.shape[-1] != 3:
         raise EventDataError(f"expected two [Q, H, W, 3] stacks of one shape, got {est.shape} and {true.shape}")
+    if not (np.all(np.isfinite(est)) and np.all(np.isfinite(true))):      # a correlation of NaN is NaN
+        raise EventDataError("the log intensities contain NaN or inf; the colour pattern cannot be compared (the "
+                             "truth's log of a black pixel needs an eps: np.log(rgb + 1 / 255))")
     out = {}
     for name, c in (("R-G", 0), ("B-G", 2)):
         e, t = est[..., c] - est[..., 1], true[..., c] - true[..., 1]

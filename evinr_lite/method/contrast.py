@@ -68,7 +68,7 @@ __all__ = ["frame_log_changes", "estimate_contrast_threshold", "frame_event_coun
 
 
 def _usable_pairs(frames: Frames, events: Events) -> np.ndarray:
-    t = frames.t
+    t = frames.t     # in time order, distinct (:func:`_in_order`)
     if len(t) < 2 or len(events) == 0:
         raise EventDataError(f"{len(t)} frame(s) and {len(events)} event(s): fitting C needs at least two frames "
                              "with events between them")
@@ -77,6 +77,11 @@ def _usable_pairs(frames: Frames, events: Events) -> np.ndarray:
         raise EventDataError("no two consecutive frames lie inside the events' time span; a frame pair with "
                              "events between them is needed")
     return usable
+
+
+def _in_order(frames: Frames) -> Frames:
+    """The frames in time order (a list of frames out of order is a fit of the same C), refusing two at one time."""
+    return require(frames, Frames, "frames").sorted_distinct("fitting C")
 
 
 def _counts(events: Events, t: np.ndarray, usable: np.ndarray) -> np.ndarray:
@@ -112,6 +117,7 @@ def frame_log_changes(frames: Frames, events: Events, *, eps: float = 1 / 255, e
         OFF events in (t_k, t_{k+1}]; bool [K, H, W] the well-exposed pixels. K = usable pairs.
         :func:`frame_event_counts` gives the ON and OFF counts apart.
     """
+    frames = _in_order(frames)
     usable = _usable_pairs(frames, events)
     dL, mask = _log_changes(frames, usable, eps, exposed)
     return dL, _counts(events, frames.t, usable), mask
@@ -125,6 +131,7 @@ def frame_event_counts(frames: Frames, events: Events, *, eps: float = 1 / 255, 
         events (both >= 0) in (t_k, t_{k+1}]; bool [K, H, W] the well-exposed pixels.
         ``n_on - n_off`` is :func:`frame_log_changes`'s net count.
     """
+    frames = _in_order(frames)
     usable = _usable_pairs(frames, events)
     dL, mask = _log_changes(frames, usable, eps, exposed)
     n_on = _counts(events.take(events.p > 0), frames.t, usable)
@@ -341,6 +348,7 @@ def frame_trajectories(frames: Frames, events: Events, *, eps: float = 1 / 255, 
         float64 [K, H, W] ON and OFF events (>= 0) in (t_0, t_k] (zero at k = 0); bool [K, H, W] the
         well-exposed samples.
     """
+    frames = _in_order(frames)
     t = frames.t
     if len(events) == 0:
         raise EventDataError("no events: fitting C needs events between frames")

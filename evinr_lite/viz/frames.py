@@ -38,6 +38,13 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
         raise ValueError(f"every entry of rows must be [Q, H, W] with the same Q, got "
                          f"{[v.shape for v in stacks.values()]}")
     Q = shapes.pop()
+    if Q == 0:
+        raise ValueError("rows hold no frames (Q = 0): pass stacks [Q, H, W] of at least one frame")
+    _drawable(stacks, "rows")
+    if times is not None:
+        times = np.ravel(np.asarray(times, dtype=np.float64))
+        if times.size != Q:   # was an IndexError at the first missing title, or titles for the wrong frames
+            raise ValueError(f"times has {times.size} value(s) for {Q} frame(s) per row; pass one time per frame")
     H, W = next(iter(stacks.values())).shape[1:]
     n = len(stacks)
     if fig is None:
@@ -53,13 +60,21 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
             ax.set_xticks([])
             ax.set_yticks([])
             if r == 0 and times is not None:
-                ax.set_title(f"t = {float(np.asarray(times)[q]):.2f} s", fontsize=9)
+                ax.set_title(f"t = {times[q]:.2f} s", fontsize=9)
         extra = (row_titles or {}).get(label)
         axes[r, 0].set_ylabel(label if extra is None else f"{label}\n{extra}", fontsize=9)
     fig.subplots_adjust(wspace=0.03, hspace=0.12)
     if colorbar_label is not None:
         fig.colorbar(image, ax=list(axes.ravel()), fraction=0.02, pad=0.01).set_label(colorbar_label, fontsize=9)
     return fig
+
+
+def _drawable(arrays: dict, name: str) -> None:
+    """Refuse arrays holding NaN or inf: imshow draws them as blank pixels, a wrong picture without a word."""
+    for k, a in arrays.items():
+        a = np.asarray(a)
+        if a.dtype.kind in "fc" and not np.all(np.isfinite(a)):
+            raise ValueError(f"{name}[{k!r}] holds NaN or inf (drawn as blank pixels); repair or drop those frames")
 
 
 def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=None, symmetric: bool = False,
@@ -81,6 +96,10 @@ def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=N
     if not images:
         raise ValueError("images is empty: pass {title: image [H, W]}")
     arrays = {k: np.asarray(v, dtype=np.float64) for k, v in images.items()}
+    bad = {k: a.shape for k, a in arrays.items() if a.ndim != 2 or a.size == 0}
+    if bad:
+        raise ValueError(f"every image must be [H, W] with pixels, got {bad}")
+    _drawable(arrays, "images")
     if symmetric:
         m = max(float(np.abs(a).max()) for a in arrays.values()) or 1.0
         vmin, vmax = -m, m
@@ -104,6 +123,12 @@ def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=N
 def plot_histories(histories: dict, key: str = "loss", *, ax=None, xlabel: str = "iteration"):
     """Training curves (log scale): ``{label: history dict or sequence of floats}``; ``key`` picks
     the curve inside a history dict. Returns the axes."""
+    if not histories:   # an empty figure with an empty legend
+        raise ValueError("histories is empty: pass {label: history dict or sequence of floats}")
+    missing = [label for label, h in histories.items() if isinstance(h, dict) and key not in h]
+    if missing:
+        raise ValueError(f"no {key!r} in the history of {missing}; pass key= one of its curves "
+                         f"(e.g. {sorted(histories[missing[0]])[:5]})")
     if ax is None:
         _, ax = plt.subplots(figsize=(5, 3))
     for label, h in histories.items():

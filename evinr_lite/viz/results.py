@@ -12,7 +12,17 @@ __all__ = ["plot_results", "plot_ablation", "plot_tradeoff", "plot_robustness"]
 def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
     """Bar charts, one panel per metric: methods along x, one bar per equalisation. Returns the figure."""
     rows = list(rows)
+    if not rows or not all(isinstance(r, dict) and "method" in r for r in rows):
+        raise ValueError("plot_results needs the result rows evaluate() returns (dicts with 'method'), got "
+                         + ("none" if not rows else repr(rows[0])[:80]))
     metrics = [m for m in metrics if any(r.get(m) is not None for r in rows)]
+    if not metrics:
+        raise ValueError("no row holds any of the metrics asked for; pass metrics= among the rows' keys")
+    for r in rows:     # a NaN score drew no bar: read as a missing method, not as a broken score
+        for m in metrics:
+            v = r.get(m)
+            if v is not None and not np.isfinite(float(v)):
+                raise ValueError(f"{r['method']}: {m} = {v}, not a score; rescore it (or drop the row)")
     methods = list(dict.fromkeys(r["method"] for r in rows))
     eqs = list(dict.fromkeys(r.get("equalization", "") for r in rows))
     fig = fig or plt.figure(figsize=(3.6 * len(metrics), 3.0))

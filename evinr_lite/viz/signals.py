@@ -27,8 +27,10 @@ def _axes(ax, figsize=(8, 3.5)):
 def plot_event_ticks(ax, t_events, p_events, height: float = 0.08, legend: bool = True):
     """Short vertical ticks at the bottom of ``ax`` (axes fraction ``height``), one per event,
     red for ON and blue for OFF."""
-    t_events = np.asarray(t_events)
-    p_events = np.asarray(p_events)
+    t_events = np.ravel(np.asarray(t_events, dtype=np.float64))
+    p_events = np.ravel(np.asarray(p_events))
+    if t_events.shape != p_events.shape:   # numpy's boolean-index error before
+        raise ValueError(f"{t_events.size} event times but {p_events.size} polarities; pass one polarity per event")
     trans = blended_transform_factory(ax.transData, ax.transAxes)
     for sign, color, name in ((1, ON_COLOR, "ON event"), (-1, OFF_COLOR, "OFF event")):
         sel = t_events[p_events * sign > 0]
