@@ -113,6 +113,10 @@ def test_scoring_frames_to_score_refuses_nan_and_column_times(ev):
     _no(lambda: frames_to_score([np.nan, 0.1], ev), r"frame_t\[0\] is nan")
     _no(lambda: frames_to_score([[0.1], [0.2]], ev), r"1-D")
     assert frames_to_score([0.1, 5.0], ev).tolist() == [0]
+    # guard (review of this round): a negative margin keeps the frames well inside the span, as it always did
+    first, last = float(ev.t[0]), float(ev.t[-1])
+    inside = frames_to_score([first, (first + last) / 2, last], ev, margin=-1e-6).tolist()
+    assert inside == [1]
 
 
 # ---- 2. the scorer: guards ---------------------------------------------------------------------------------------
@@ -298,6 +302,15 @@ def test_colour_a_config_given_as_an_empty_dict_is_refused(small):
 def test_colour_streams_as_a_generator_are_read(small):
     rec = reconstruct_colour(iter((small, small, small)), Q, EvINRConfig(**FAST), C=0.2)
     assert rec.frames.shape == (3, 12, 16, 3) and np.all(np.isfinite(rec.frames))
+
+
+def test_colour_streams_in_any_container_are_read(small):
+    """Guard (review of this round): a dict's values or a deque were read before the generator fix and still are."""
+    from collections import deque
+
+    for streams in ({"R": small, "G": small, "B": small}.values(), deque((small,) * 3)):
+        rec = reconstruct_colour(streams, Q, EvINRConfig(**FAST), C=0.2)
+        assert rec.frames.shape == (3, 12, 16, 3)
 
 
 @pytest.mark.parametrize("q,pattern", [([], "empty"), ([np.nan], "finite")])

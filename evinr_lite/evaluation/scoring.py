@@ -380,9 +380,10 @@ def measure_inference_fps(model, n_frames: int = 64, batch_size: int = 32, repea
 
 
 def frames_to_score(frame_t, events: Events, margin: float = 0.005) -> np.ndarray:
-    """Indices of the frames whose timestamps lie in [first event - margin, last event + margin] (s)."""
+    """Indices of the frames whose timestamps lie in [first event - margin, last event + margin] (s); a
+    negative margin keeps only the frames at least |margin| inside the events' span."""
     frame_t = seconds_array(frame_t, "frame_t", allow_empty=True)   # NaN times were dropped without a word
-    margin = real_number(margin, "margin", lo=0, hint="seconds around the events' span (e.g. 0.005)")
+    margin = real_number(margin, "margin", hint="seconds around the events' span (e.g. 0.005; negative: inside it)")
     require(events, Events, "events")
     if len(events) == 0:
         raise EventDataError("no events: nothing to reconstruct or score; choose a window with events")

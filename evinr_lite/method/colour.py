@@ -84,7 +84,8 @@ def reconstruct_colour(streams, query_times, config: EvINRConfig | None = None, 
         ColourReconstruction with frames [Q, h, w, 3] in [0, 1].
     """
     cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")   # {} was taken as None
-    streams = tuple(streams) if isinstance(streams, (list, tuple)) or hasattr(streams, "__next__") else streams
+    if not isinstance(streams, (str, bytes, Events)) and hasattr(streams, "__iter__"):   # any container or iterator
+        streams = tuple(streams)
     if not isinstance(streams, tuple) or len(streams) != 3 or not all(isinstance(s, Events) for s in streams):
         raise EventDataError("streams must be three Events streams (R, G, B); use quadbayer.demosaic_events_rgb")
     if len({s.sensor_size for s in streams}) != 1:

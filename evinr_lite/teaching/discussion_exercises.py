@@ -171,7 +171,8 @@ exercises.register(
 
 def _inputs_render(rng):
     cases = []
-    for B, shape, C in ((4, (2, 3), 0.2), (6, (3, 4), 0.25), (5, (6,), 0.5)):       # [B + 1, P] too
+    # [B + 1, H, W], as notebook 08 states it (a [B + 1, P] case would refuse its `B1, H, W = L.shape`)
+    for B, shape, C in ((4, (2, 3), 0.2), (6, (3, 4), 0.25), (5, (1, 6), 0.5)):
         steps = rng.normal(0.0, 2.5 * C, (B,) + shape)
         L = np.concatenate([rng.normal(0.0, 1.0, (1,) + shape), steps]).cumsum(axis=0)
         cases.append(dict(L_boundaries=L, C=C))
