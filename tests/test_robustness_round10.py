@@ -19,7 +19,10 @@ NaN gave NaN; ``--colour`` on a sensor one photosite high was refused as a (0, W
 no frames matplotlib's error), ``show_frames`` / ``show_images`` drew NaN as blank pixels, ``show_images`` of a 1-D
 array failed unpacking its shape, ``plot_histories`` of nothing drew an empty figure and of a history without the
 curve a KeyError, ``plot_results`` of no rows was matplotlib's error and of a NaN score drew no bar without a word,
-``plot_event_ticks`` with fewer polarities than times numpy's boolean-index error.
+``plot_event_ticks`` with fewer polarities than times numpy's boolean-index error. Closed after (round 10b, each
+test failed before its fix too): ``mse`` / ``ssim`` of a 1-D array, a number, a stack [F, H, W] or a colour image
+(the docstrings say [H, W]; no caller in the kit passes other shapes) were the mean over all of it, an SSIM along a
+line or over a volume, or "SSIM needs images of at least 11 x 11 pixels".
 
 Guards: odd inputs next to these that already behave and must keep their outcome (uint8 truth against float
 predictions, 0..255 floats, NaN or inf pixels, constant and black frames, transposed frames, one image given as
@@ -27,7 +30,7 @@ predictions, 0..255 floats, NaN or inf pixels, constant and black frames, transp
 out-of-span, missing and single anchor frames, and frames out of order; the fit of C on black, saturated or constant
 frames, one frame or frames outside the events; odd-sized colour sensors, a recording without a colour filter, a
 channel with no events, bad thresholds and C; the viz functions' existing refusals; the command line's --anchor,
---C auto and --colour on such recordings).
+--C auto and --colour on such recordings; one image with a trailing channel of one in mse / ssim).
 """
 import matplotlib
 
@@ -115,7 +118,24 @@ def test_scoring_frames_to_score_refuses_nan_and_column_times(ev):
     assert frames_to_score([0.1, 5.0], ev).tolist() == [0]
 
 
+@pytest.mark.parametrize("shape,pattern", [((320,), r"1-D .* reshape it to \[H, W\]"), ((), r"1-D .*\[H, W\]"),
+                                           ((3, 16, 20), r"\(3, 16, 20\); for a stack .*score_frames"),
+                                           ((12, 16, 20), r"score_frames"), ((16, 20, 3), r"grey first")])
+@pytest.mark.parametrize("metric", [mse, ssim])
+def test_scoring_mse_and_ssim_refuse_what_is_not_one_image(metric, shape, pattern):
+    """Before: mse of a 1-D array, a number, a stack or a colour image was the mean over all of it, ssim of a 1-D
+    array an SSIM along a line and of a stack of 11 or more frames one 3-D SSIM over the volume (of fewer frames, or
+    colour, "SSIM needs images of at least 11 x 11 pixels"); no caller in the kit passes them."""
+    a = np.random.default_rng(2).uniform(0.1, 0.9, shape)
+    _no(lambda: metric(a, a), pattern)
+
+
 # ---- 2. the scorer: guards ---------------------------------------------------------------------------------------
+
+def test_scoring_mse_and_ssim_take_one_image_with_a_trailing_channel_of_one():
+    assert mse(GT[0][..., None], GT[1]) == mse(GT[0], GT[1]) and ssim(GT[0], GT[1][..., None]) == ssim(GT[0], GT[1])
+    assert score_frames(GT, GT * 0.9)["mse"] == pytest.approx(np.mean([mse(a, a * 0.9) for a in GT]))
+
 
 def test_scoring_uint8_truth_matches_float_truth():
     u8 = np.round(GT * 255).astype(np.uint8)
