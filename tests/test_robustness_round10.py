@@ -22,7 +22,10 @@ curve a KeyError, ``plot_results`` of no rows was matplotlib's error and of a Na
 ``plot_event_ticks`` with fewer polarities than times numpy's boolean-index error. Closed after (round 10b, each
 test failed before its fix too): ``mse`` / ``ssim`` of a 1-D array, a number, a stack [F, H, W] or a colour image
 (the docstrings say [H, W]; no caller in the kit passes other shapes) were the mean over all of it, an SSIM along a
-line or over a volume, or "SSIM needs images of at least 11 x 11 pixels".
+line or over a volume, or "SSIM needs images of at least 11 x 11 pixels"; ``plot_signal_and_events`` of None, ``[]``
+or an [N, 2] array said only "events must be an Events or a (t, p) pair", of fewer polarities than times was numpy's
+boolean-index error, of no sample times an IndexError and of an L shorter than t matplotlib's error;
+``plot_window_errors({})`` was a KeyError (and of no windows empty axes).
 
 Guards: odd inputs next to these that already behave and must keep their outcome (uint8 truth against float
 predictions, 0..255 floats, NaN or inf pixels, constant and black frames, transposed frames, one image given as
@@ -30,7 +33,8 @@ predictions, 0..255 floats, NaN or inf pixels, constant and black frames, transp
 out-of-span, missing and single anchor frames, and frames out of order; the fit of C on black, saturated or constant
 frames, one frame or frames outside the events; odd-sized colour sensors, a recording without a colour filter, a
 channel with no events, bad thresholds and C; the viz functions' existing refusals; the command line's --anchor,
---C auto and --colour on such recordings; one image with a trailing channel of one in mse / ssim).
+--C auto and --colour on such recordings; one image with a trailing channel of one in mse / ssim; a 1-D signal with
+no events, as ``([], [])`` or as an empty Events).
 """
 import matplotlib
 
@@ -450,6 +454,37 @@ def test_viz_event_ticks_with_fewer_polarities():
     _no(lambda: plot_event_ticks(plt.gca(), [0.1, 0.2], [1]), r"2 event times but 1 polarities")
 
 
+SIG_T = np.linspace(0.0, 1.0, 50)
+
+
+@pytest.mark.parametrize("t,L,events,pattern", [
+    (SIG_T, np.sin(SIG_T), None, r"events is None.*\(\[\], \[\]\) for no events"),
+    (SIG_T, np.sin(SIG_T), [], r"got an empty list"),
+    (SIG_T, np.sin(SIG_T), np.zeros((5, 2)), r"columns \[N, 2\] are \(events\[:, 0\], events\[:, 1\]\)"),
+    (SIG_T, np.sin(SIG_T), ([0.1, 0.2], [1]), r"2 event time\(s\) but 1 polarities"),
+    ([], [], ([0.1], [1]), r"t must be the sample times"),
+    (SIG_T, np.sin(SIG_T)[:10], ([0.1], [1]), r"L has shape \(10,\) for 50 sample times"),
+])
+def test_viz_signal_and_events_of_empty_or_mismatched_inputs(t, L, events, pattern):
+    """Before: None, [] and an [N, 2] array were a TypeError saying only "an Events or a (t, p) pair", fewer
+    polarities than times numpy's boolean-index error, no sample times an IndexError and L shorter than t
+    matplotlib's "x and y must have same first dimension"."""
+    from evinr_lite.viz import plot_signal_and_events
+
+    _no(lambda: plot_signal_and_events(t, L, events, 0.2), pattern)
+
+
+@pytest.mark.parametrize("result,pattern", [({}, r"'window' and 'taylor'.*got keys \[\]"),
+                                            ({"window": [0.1, 0.2]}, r"got keys \['window'\]"),
+                                            ({"window": [], "taylor": []}, r"no window lengths"),
+                                            ({"window": [0.1, 0.2], "taylor": [1.0]}, r"2 window length\(s\)")])
+def test_viz_window_errors_of_an_odd_result(result, pattern):
+    """Before: a KeyError ('window'), empty axes, or matplotlib's "x and y must have same first dimension"."""
+    from evinr_lite.viz import plot_window_errors
+
+    _no(lambda: plot_window_errors(result, C=0.1), pattern)
+
+
 # ---- 8. the figures: guards --------------------------------------------------------------------------------------
 
 def test_viz_existing_refusals_keep_their_outcome():
@@ -469,3 +504,12 @@ def test_viz_existing_refusals_keep_their_outcome():
     _no(lambda: viz.plot_robustness({}), r"no sweeps")
     assert viz.count_map(EMPTY).sum() == 0 and viz.plot_event_ticks(plt.gca(), [], []) is not None
     assert viz.show_frames({"a": np.zeros((2, 4, 5))}, [0.1, 0.2]) is not None
+
+
+def test_viz_signal_with_no_events_draws_the_signal_alone():
+    from evinr_lite.viz import plot_signal_and_events
+
+    for no_events in (([], []), Events.from_arrays(np.zeros(0), np.zeros(0, int), np.zeros(0, int), np.zeros(0, int),
+                                                   (1, 3))):
+        ax = plot_signal_and_events(SIG_T, np.sin(SIG_T), no_events, 0.2)
+        assert ax.get_legend_handles_labels()[1] == ["L(t) = log I(t)", "ON events (0)", "OFF events (0)"]
