@@ -25,7 +25,9 @@ test failed before its fix too): ``mse`` / ``ssim`` of a 1-D array, a number, a 
 line or over a volume, or "SSIM needs images of at least 11 x 11 pixels"; ``plot_signal_and_events`` of None, ``[]``
 or an [N, 2] array said only "events must be an Events or a (t, p) pair", of fewer polarities than times was numpy's
 boolean-index error, of no sample times an IndexError and of an L shorter than t matplotlib's error;
-``plot_window_errors({})`` was a KeyError (and of no windows empty axes).
+``plot_window_errors({})`` was a KeyError (and of no windows empty axes); ``show_event_frames(None)`` "object of type
+'NoneType' has no len()"; ``plot_tradeoff([])``, ``plot_xyt`` of no events and ``plot_boundaries`` with no
+boundaries or of no events drew empty axes without a word.
 
 Guards: odd inputs next to these that already behave and must keep their outcome (uint8 truth against float
 predictions, 0..255 floats, NaN or inf pixels, constant and black frames, transposed frames, one image given as
@@ -483,6 +485,31 @@ def test_viz_window_errors_of_an_odd_result(result, pattern):
     from evinr_lite.viz import plot_window_errors
 
     _no(lambda: plot_window_errors(result, C=0.1), pattern)
+
+
+@pytest.mark.parametrize("frames,pattern", [(None, r"EventFrames, got NoneType.*events_to_frames"),
+                                            (np.zeros((3, 4, 5)), r"EventFrames, got ndarray")])
+def test_viz_show_event_frames_of_what_is_not_event_frames(frames, pattern):
+    """Before: "object of type 'NoneType' has no len()" (a TypeError) and, of an array, an AttributeError."""
+    from evinr_lite.viz import show_event_frames
+
+    _no(lambda: show_event_frames(frames), pattern)
+
+
+@pytest.mark.parametrize("case,pattern", [("tradeoff", r"no rows to plot"), ("xyt", r"no events to draw"),
+                                          ("no boundaries", r"boundaries is empty.*\{label: edges"),
+                                          ("boundaries of no events", r"no events")])
+def test_viz_empty_axes_without_a_word(case, pattern):
+    """Before: plot_tradeoff([]), plot_xyt of no events and plot_boundaries with no boundaries (or of no events)
+    drew empty axes (a legend of nothing, "0 of 0 events") and returned them."""
+    from evinr_lite import viz
+
+    e = _events((4, 5), n=50, span=1.0)
+    draw = {"tradeoff": lambda: viz.plot_tradeoff([]), "xyt": lambda: viz.plot_xyt(EMPTY),
+            "no boundaries": lambda: viz.plot_boundaries(e, {}),
+            "boundaries of no events": lambda: viz.plot_boundaries(EMPTY, {"a": [0.0, 1.0]})}[case]
+    _no(draw, pattern)
+    assert not plt.get_fignums()          # refused before a figure was made
 
 
 # ---- 8. the figures: guards --------------------------------------------------------------------------------------
