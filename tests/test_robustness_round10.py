@@ -19,7 +19,15 @@ NaN gave NaN; ``--colour`` on a sensor one photosite high was refused as a (0, W
 no frames matplotlib's error), ``show_frames`` / ``show_images`` drew NaN as blank pixels, ``show_images`` of a 1-D
 array failed unpacking its shape, ``plot_histories`` of nothing drew an empty figure and of a history without the
 curve a KeyError, ``plot_results`` of no rows was matplotlib's error and of a NaN score drew no bar without a word,
-``plot_event_ticks`` with fewer polarities than times numpy's boolean-index error.
+``plot_event_ticks`` with fewer polarities than times numpy's boolean-index error. Closed after (round 10b, each
+test failed before its fix too): ``mse`` / ``ssim`` of a 1-D array, a number, a stack [F, H, W] or a colour image
+(the docstrings say [H, W]; no caller in the kit passes other shapes) were the mean over all of it, an SSIM along a
+line or over a volume, or "SSIM needs images of at least 11 x 11 pixels"; ``plot_signal_and_events`` of None, ``[]``
+or an [N, 2] array said only "events must be an Events or a (t, p) pair", of fewer polarities than times was numpy's
+boolean-index error, of no sample times an IndexError and of an L shorter than t matplotlib's error;
+``plot_window_errors({})`` was a KeyError (and of no windows empty axes); ``show_event_frames(None)`` "object of type
+'NoneType' has no len()"; ``plot_tradeoff([])``, ``plot_xyt`` of no events and ``plot_boundaries`` with no
+boundaries or of no events drew empty axes without a word.
 
 Guards: odd inputs next to these that already behave and must keep their outcome (uint8 truth against float
 predictions, 0..255 floats, NaN or inf pixels, constant and black frames, transposed frames, one image given as
@@ -27,7 +35,8 @@ predictions, 0..255 floats, NaN or inf pixels, constant and black frames, transp
 out-of-span, missing and single anchor frames, and frames out of order; the fit of C on black, saturated or constant
 frames, one frame or frames outside the events; odd-sized colour sensors, a recording without a colour filter, a
 channel with no events, bad thresholds and C; the viz functions' existing refusals; the command line's --anchor,
---C auto and --colour on such recordings).
+--C auto and --colour on such recordings; one image with a trailing channel of one in mse / ssim; a 1-D signal with
+no events, as ``([], [])`` or as an empty Events).
 """
 import matplotlib
 
@@ -119,7 +128,24 @@ def test_scoring_frames_to_score_refuses_nan_and_column_times(ev):
     assert inside == [1]
 
 
+@pytest.mark.parametrize("shape,pattern", [((320,), r"1-D .* reshape it to \[H, W\]"), ((), r"1-D .*\[H, W\]"),
+                                           ((3, 16, 20), r"\(3, 16, 20\); for a stack .*score_frames"),
+                                           ((12, 16, 20), r"score_frames"), ((16, 20, 3), r"grey first")])
+@pytest.mark.parametrize("metric", [mse, ssim])
+def test_scoring_mse_and_ssim_refuse_what_is_not_one_image(metric, shape, pattern):
+    """Before: mse of a 1-D array, a number, a stack or a colour image was the mean over all of it, ssim of a 1-D
+    array an SSIM along a line and of a stack of 11 or more frames one 3-D SSIM over the volume (of fewer frames, or
+    colour, "SSIM needs images of at least 11 x 11 pixels"); no caller in the kit passes them."""
+    a = np.random.default_rng(2).uniform(0.1, 0.9, shape)
+    _no(lambda: metric(a, a), pattern)
+
+
 # ---- 2. the scorer: guards ---------------------------------------------------------------------------------------
+
+def test_scoring_mse_and_ssim_take_one_image_with_a_trailing_channel_of_one():
+    assert mse(GT[0][..., None], GT[1]) == mse(GT[0], GT[1]) and ssim(GT[0], GT[1][..., None]) == ssim(GT[0], GT[1])
+    assert score_frames(GT, GT * 0.9)["mse"] == pytest.approx(np.mean([mse(a, a * 0.9) for a in GT]))
+
 
 def test_scoring_uint8_truth_matches_float_truth():
     u8 = np.round(GT * 255).astype(np.uint8)
@@ -443,6 +469,62 @@ def test_viz_event_ticks_with_fewer_polarities():
     _no(lambda: plot_event_ticks(plt.gca(), [0.1, 0.2], [1]), r"2 event times but 1 polarities")
 
 
+SIG_T = np.linspace(0.0, 1.0, 50)
+
+
+@pytest.mark.parametrize("t,L,events,pattern", [
+    (SIG_T, np.sin(SIG_T), None, r"events is None.*\(\[\], \[\]\) for no events"),
+    (SIG_T, np.sin(SIG_T), [], r"got an empty list"),
+    (SIG_T, np.sin(SIG_T), np.zeros((5, 2)), r"columns \[N, 2\] are \(events\[:, 0\], events\[:, 1\]\)"),
+    (SIG_T, np.sin(SIG_T), ([0.1, 0.2], [1]), r"2 event time\(s\) but 1 polarities"),
+    ([], [], ([0.1], [1]), r"t must be the sample times"),
+    (SIG_T, np.sin(SIG_T)[:10], ([0.1], [1]), r"L has shape \(10,\) for 50 sample times"),
+])
+def test_viz_signal_and_events_of_empty_or_mismatched_inputs(t, L, events, pattern):
+    """Before: None, [] and an [N, 2] array were a TypeError saying only "an Events or a (t, p) pair", fewer
+    polarities than times numpy's boolean-index error, no sample times an IndexError and L shorter than t
+    matplotlib's "x and y must have same first dimension"."""
+    from evinr_lite.viz import plot_signal_and_events
+
+    _no(lambda: plot_signal_and_events(t, L, events, 0.2), pattern)
+
+
+@pytest.mark.parametrize("result,pattern", [({}, r"'window' and 'taylor'.*got keys \[\]"),
+                                            ({"window": [0.1, 0.2]}, r"got keys \['window'\]"),
+                                            ({"window": [], "taylor": []}, r"no window lengths"),
+                                            ({"window": [0.1, 0.2], "taylor": [1.0]}, r"2 window length\(s\)")])
+def test_viz_window_errors_of_an_odd_result(result, pattern):
+    """Before: a KeyError ('window'), empty axes, or matplotlib's "x and y must have same first dimension"."""
+    from evinr_lite.viz import plot_window_errors
+
+    _no(lambda: plot_window_errors(result, C=0.1), pattern)
+
+
+@pytest.mark.parametrize("frames,pattern", [(None, r"EventFrames, got NoneType.*events_to_frames"),
+                                            (np.zeros((3, 4, 5)), r"EventFrames, got ndarray")])
+def test_viz_show_event_frames_of_what_is_not_event_frames(frames, pattern):
+    """Before: "object of type 'NoneType' has no len()" (a TypeError) and, of an array, an AttributeError."""
+    from evinr_lite.viz import show_event_frames
+
+    _no(lambda: show_event_frames(frames), pattern)
+
+
+@pytest.mark.parametrize("case,pattern", [("tradeoff", r"no rows to plot"), ("xyt", r"no events to draw"),
+                                          ("no boundaries", r"boundaries is empty.*\{label: edges"),
+                                          ("boundaries of no events", r"no events")])
+def test_viz_empty_axes_without_a_word(case, pattern):
+    """Before: plot_tradeoff([]), plot_xyt of no events and plot_boundaries with no boundaries (or of no events)
+    drew empty axes (a legend of nothing, "0 of 0 events") and returned them."""
+    from evinr_lite import viz
+
+    e = _events((4, 5), n=50, span=1.0)
+    draw = {"tradeoff": lambda: viz.plot_tradeoff([]), "xyt": lambda: viz.plot_xyt(EMPTY),
+            "no boundaries": lambda: viz.plot_boundaries(e, {}),
+            "boundaries of no events": lambda: viz.plot_boundaries(EMPTY, {"a": [0.0, 1.0]})}[case]
+    _no(draw, pattern)
+    assert not plt.get_fignums()          # refused before a figure was made
+
+
 # ---- 8. the figures: guards --------------------------------------------------------------------------------------
 
 def test_viz_existing_refusals_keep_their_outcome():
@@ -462,3 +544,12 @@ def test_viz_existing_refusals_keep_their_outcome():
     _no(lambda: viz.plot_robustness({}), r"no sweeps")
     assert viz.count_map(EMPTY).sum() == 0 and viz.plot_event_ticks(plt.gca(), [], []) is not None
     assert viz.show_frames({"a": np.zeros((2, 4, 5))}, [0.1, 0.2]) is not None
+
+
+def test_viz_signal_with_no_events_draws_the_signal_alone():
+    from evinr_lite.viz import plot_signal_and_events
+
+    for no_events in (([], []), Events.from_arrays(np.zeros(0), np.zeros(0, int), np.zeros(0, int), np.zeros(0, int),
+                                                   (1, 3))):
+        ax = plot_signal_and_events(SIG_T, np.sin(SIG_T), no_events, 0.2)
+        assert ax.get_legend_handles_labels()[1] == ["L(t) = log I(t)", "ON events (0)", "OFF events (0)"]

@@ -57,7 +57,8 @@ def protocol_description(equalization: str = "none") -> str:
 def _image(a, name: str) -> np.ndarray:
     """An image as float64: uint8 divided by 255 (as :func:`equalize` reads it), floats as they are; NaN, inf,
     text and empty images are refused (a metric of them would be NaN or meaningless). [H, W, 1] (a trailing
-    channel of one, as image readers give) is the grey image [H, W]."""
+    channel of one, as image readers give) is the grey image [H, W]; other shapes (a number, a 1-D signal, a stack
+    [F, H, W], colour [H, W, 3]) are refused naming the fix (no caller in the kit passes them)."""
     a = np.asarray(host_array(a))
     if a.ndim == 3 and a.shape[-1] == 1:
         a = a[..., 0]
@@ -65,6 +66,12 @@ def _image(a, name: str) -> np.ndarray:
         raise EventDataError(f"{name} must be an image of numbers (uint8 0..255 or float in [0, 1]), got dtype {a.dtype}")
     if a.size == 0:
         raise EventDataError(f"{name} is empty (shape {a.shape}); pass an image [H, W]")
+    if a.ndim != 2:   # a stack or a signal was scored as one image: its mean, or SSIM over a volume or a line
+        fix = ("make it grey first (e.g. image.mean(axis=-1))" if a.ndim == 3 and a.shape[-1] in (3, 4) else
+               "for a stack [F, H, W] use score_frames(pred, gt), or score each frame" if a.ndim == 3 else
+               "a 1-D array (or a number) is not an image: reshape it to [H, W]" if a.ndim < 3 else
+               "pass one grey image [H, W]")
+        raise EventDataError(f"{name} must be one grey image [H, W] (or [H, W, 1]), got shape {a.shape}; {fix}")
     if a.dtype == np.uint8:
         return a.astype(np.float64) / 255.0
     a = a.astype(np.float64)
@@ -86,12 +93,16 @@ def _pair(pred, gt):
 
 
 def mse(pred, gt) -> float:
-    """Mean squared error of images in [0, 1] (prediction clipped first). Shapes [H, W]."""
+    """Mean squared error of two grey images [H, W] (or [H, W, 1]) in [0, 1] (prediction clipped first).
+
+    Other shapes are refused: a stack [F, H, W] goes to :func:`score_frames`."""
     return _mse(*_pair(pred, gt))
 
 
 def ssim(pred, gt) -> float:
-    """SSIM of two grey images [H, W] in [0, 1] (prediction clipped first); see the module docstring."""
+    """SSIM of two grey images [H, W] (or [H, W, 1]) in [0, 1] (prediction clipped first); see the module
+    docstring. Other shapes are refused (SSIM of a stack would be one 3-D SSIM over the volume): a stack
+    [F, H, W] goes to :func:`score_frames`."""
     pred, gt = _pair(pred, gt)
     _check_ssim_size(pred.shape)
     return _ssim(pred, gt)

@@ -46,7 +46,7 @@ from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
-from ..core.checks import check_seconds_precision, host_array, is_real_number
+from ..core.checks import ArgumentTypeError, check_seconds_precision, host_array, is_real_number
 from ..core.guard import dense_array
 from ..core.events import MAX_SPAN_S, EventDataError, Events
 
@@ -384,7 +384,9 @@ def simulate_events_1d(L, t, C=0.2, *, C_pos=None, C_neg=None, threshold_sigma=0
 
 def pixel_events(events, pixel: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(t, p) of one pixel: from an ``Events`` with sensor_size (1, P) (x = pixel index), or a
-    ``(t, p)`` pair of arrays passed through."""
+    ``(t, p)`` pair of arrays passed through (as float64 [N] each; ``([], [])`` is no events). Anything
+    else (None, ``[]``, an [N, 2] array) is an ArgumentTypeError, and a pair whose t and p differ in
+    length an EventDataError, each naming the fix."""
     if isinstance(events, Events):
         H, W = events.sensor_size
         if H != 1:
@@ -393,11 +395,30 @@ def pixel_events(events, pixel: int = 0) -> tuple[np.ndarray, np.ndarray]:
             raise EventDataError(f"pixel {pixel} is outside the {W} pixels of these events")
         keep = events.x == pixel
         return events.t[keep], events.p[keep].astype(np.float64)
+    want = "an Events with sensor_size (1, P) or a (t, p) pair of arrays (([], []) for no events)"
+    if events is None:
+        raise ArgumentTypeError(f"events is None; pass {want}")
     try:
         t, p = events
-    except (TypeError, ValueError):
-        raise TypeError("events must be an Events or a (t, p) pair of arrays") from None
-    return np.asarray(t, dtype=np.float64), np.asarray(p, dtype=np.float64)
+    except (TypeError, ValueError):   # said "a (t, p) pair" of [], of an [N, 2] array, of (t, p, x): which fix?
+        raise ArgumentTypeError(f"events must be {want}, got {_what(events)}") from None
+    t = np.ravel(np.asarray(t, dtype=np.float64))
+    p = np.ravel(np.asarray(p, dtype=np.float64))
+    if t.shape != p.shape:   # plot_signal_and_events stopped on numpy's boolean-index error
+        raise EventDataError(f"events: {t.size} event time(s) but {p.size} polarities; pass one polarity per event")
+    return t, p
+
+
+def _what(events) -> str:
+    """What :func:`pixel_events` was given instead of events, with the fix for an array of columns."""
+    shape = getattr(events, "shape", None)
+    if shape is not None:
+        fix = "; columns [N, 2] are (events[:, 0], events[:, 1])" if len(shape) == 2 and shape[1] == 2 else ""
+        return f"an array of shape {tuple(shape)}{fix}"
+    if not hasattr(events, "__len__"):
+        return type(events).__name__
+    n = len(events)
+    return f"an empty {type(events).__name__}" if n == 0 else f"a {type(events).__name__} of {n} items"
 
 
 def _check_video(log_frames, t) -> tuple[np.ndarray, np.ndarray]:

@@ -23,6 +23,7 @@ from matplotlib.animation import FuncAnimation
 from matplotlib.colors import to_rgb
 from matplotlib.transforms import blended_transform_factory
 
+from ..core.checks import ArgumentTypeError
 from ..core.events import EventDataError, Events
 from ..method.binning import EventFrames, event_rate
 from .signals import OFF_COLOR, ON_COLOR
@@ -109,9 +110,11 @@ def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, siz
     vertical, pointing down as in an image. ``ax`` must be a 3-D axes (``projection='3d'``)
     if given; ``view`` is the (elevation, azimuth) in degrees.
     """
+    if len(events) == 0:   # empty 3-D axes titled "0 of 0 events"
+        raise EventDataError("plot_xyt: no events to draw; pick a time window or a recording that holds some")
+    sub = subsample(events, max_points, seed)
     if ax is None:
         ax = plt.figure(figsize=(7, 5)).add_subplot(projection="3d")
-    sub = subsample(events, max_points, seed)
     for sign, color, name in ((1, ON_COLOR, "ON"), (-1, OFF_COLOR, "OFF")):
         sel = sub.p == sign
         ax.scatter(sub.t[sel], sub.x[sel], sub.y[sel], s=size, c=color, depthshade=False,
@@ -178,6 +181,10 @@ def plot_boundaries(events: Events, boundaries: dict, ax=None, max_points: int =
     Between two boundaries of an equal-count set the curve rises by the same amount; between
     two boundaries of a fixed-duration set the lines are evenly spaced.
     """
+    if not boundaries:   # the cumulative curve alone, with an empty legend entry for the sets
+        raise ValueError("boundaries is empty: pass {label: edges [B + 1]}, e.g. {'fixed': frames.boundaries}")
+    if len(events) == 0:  # empty axes: no curve to compare the boundaries with
+        raise EventDataError("plot_boundaries: no events, so no cumulative count to draw; pass events that hold some")
     ax = _axes(ax, (9, 3.5))
     n = len(events)
     k = np.unique(np.linspace(0, n - 1, min(n, max_points)).round().astype(np.int64))
@@ -207,6 +214,9 @@ def show_event_frames(frames: EventFrames, indices=None, max_frames: int = 8, nc
     Returns:
         The figure; each panel's title gives the bin's interval in ms and its event count.
     """
+    if not isinstance(frames, EventFrames):   # None was "object of type 'NoneType' has no len()"
+        raise ArgumentTypeError(f"frames must be EventFrames, got {type(frames).__name__}; make them with "
+                                "events_to_frames(events, boundaries, C) (evinr_lite.method.binning) first")
     B = len(frames)
     if indices is None:
         indices = np.unique(np.linspace(0, B - 1, min(B, max_frames)).round().astype(int))

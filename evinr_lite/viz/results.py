@@ -111,11 +111,15 @@ def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = 
     Returns:
         The axes.
     """
-    if ax is None:
-        _, ax = plt.subplots(figsize=(8, 4.5))
+    rows = list(rows)
+    if not rows:   # empty axes titled "time against quality"
+        raise ValueError("no rows to plot: pass the rows of run_variants (dicts with 'name', the quality and the "
+                         "cost keys)")
     c = np.array([r[cost] for r in rows], dtype=np.float64)
     q = np.array([r[quality] for r in rows], dtype=np.float64)
     front = pareto_front(c, q) if front is None else np.asarray(front, bool)
+    if ax is None:
+        _, ax = plt.subplots(figsize=(8, 4.5))
     ax.scatter(c[~front], q[~front], color="0.6", s=18, label="dominated")
     ax.scatter(c[front], q[front], color="tab:red", s=30, label="Pareto front")
     order = np.flatnonzero(front)[np.argsort(c[front])]

@@ -46,14 +46,19 @@ def plot_signal_and_events(t, L, events, C: float | None = None, *, ax=None, pix
     Args:
         t: float [T] sample times (s).
         L: float [T] log intensity at ``t``, or a callable of t.
-        events: ``Events`` with sensor_size (1, P) (``pixel`` picks one) or a (t, p) pair.
+        events: ``Events`` with sensor_size (1, P) (``pixel`` picks one) or a (t, p) pair (``([], [])``:
+            no events, the signal and its levels only).
         C: contrast threshold; draws the levels L0 + k*C and the level each event reached.
         L0: the reference level at the start (default ``L[0]``).
     """
-    ax = _axes(ax)
     t = np.asarray(t, dtype=np.float64)
+    if t.ndim != 1 or t.size == 0:   # L[0] was numpy's IndexError
+        raise ValueError(f"t must be the sample times [T] (1-D, at least one), got shape {t.shape}")
     L = np.asarray(L(t) if callable(L) else L, dtype=np.float64)
-    te, pe = pixel_events(events, pixel)
+    if L.shape != t.shape:           # matplotlib's "x and y must have same first dimension"
+        raise ValueError(f"L has shape {L.shape} for {t.size} sample times; pass one log intensity per time in t")
+    te, pe = pixel_events(events, pixel)   # refuses None, [] and t / p of different lengths, naming the fix
+    ax = _axes(ax)
     L0 = L[0] if L0 is None else float(L0)
     ax.plot(t, L, color="black", lw=1.5, label=label)
     if C is not None and show_levels:
@@ -97,9 +102,19 @@ def plot_reconstruction_1d(t, curves: dict, truth=None, *, events=None, ax=None,
 
 
 def plot_window_errors(result: dict, *, ax=None, C: float | None = None):
-    """Error of the dL/dt estimate versus window length (from :func:`evinr_lite.teaching.pde1d.eq4_error_vs_window`)."""
+    """Error of the dL/dt estimate versus window length (from :func:`evinr_lite.teaching.pde1d.eq4_error_vs_window`):
+    ``result`` holds ``"window"`` and ``"taylor"`` [K] (and optionally ``"events"`` [K])."""
+    if not isinstance(result, dict) or not {"window", "taylor"} <= result.keys():   # a KeyError before
+        got = f"keys {sorted(result)}" if isinstance(result, dict) else type(result).__name__
+        raise ValueError(f"result must be the dict eq4_error_vs_window returns, with 'window' and 'taylor' "
+                         f"(and 'events'), got {got}")
+    w = np.ravel(np.asarray(result["window"], dtype=np.float64))
+    bad = {k: np.shape(result[k]) for k in ("taylor", "events") if k in result and np.size(result[k]) != w.size}
+    if w.size == 0:
+        raise ValueError("result holds no window lengths; pass eq4_error_vs_window at least one window")
+    if bad:
+        raise ValueError(f"result holds {w.size} window length(s) but errors of shape {bad}; pass one error per window")
     ax = _axes(ax, (5, 3.5))
-    w = np.asarray(result["window"])
     ax.loglog(w, result["taylor"], "o-", label="Eq. 3 with the exact ΔL (Taylor error)")
     if "events" in result:
         ax.loglog(w, result["events"], "s-", label="Eq. 4 with events")
