@@ -553,3 +553,25 @@ def test_viz_signal_with_no_events_draws_the_signal_alone():
                                                    (1, 3))):
         ax = plot_signal_and_events(SIG_T, np.sin(SIG_T), no_events, 0.2)
         assert ax.get_legend_handles_labels()[1] == ["L(t) = log I(t)", "ON events (0)", "OFF events (0)"]
+
+
+def test_review_mends_plot_polarity_with_a_title_and_integer_and_overshooting_images():
+    """Review of this round: plot_polarity of no events with a title of its own draws as before (the refusal is for
+    a title read from the events); mse / ssim name the fix for uint16 and int64 images as score_pairs does (they
+    were cast to float first and told to divide by 255); a prediction a little above 2 (an unclipped exp) is not
+    told it looks like 0..255."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from evinr_lite.core.events import Events
+    from evinr_lite.viz import plot_polarity
+
+    empty = Events(np.zeros(0), np.zeros(0, int), np.zeros(0, int), np.zeros(0, int), (4, 5))
+    ax = plot_polarity(empty, title="an empty slice")
+    assert ax.get_title() == "an empty slice"
+    plt.close("all")
+    gt = np.full((8, 8), 0.5)
+    _no(lambda: mse(np.full((8, 8), 40000, np.uint16), gt), r"uint16 integers .*65535")
+    _no(lambda: mse(np.ones((8, 8), np.int64), gt), r"int64 integers")
+    _no(lambda: mse(np.full((8, 8), 3.3), gt), r"clip them to \[0, 1\]")
+    _no(lambda: mse(np.full((8, 8), 200.0), gt), r"look like 0\.\.255")

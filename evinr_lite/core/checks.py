@@ -231,7 +231,8 @@ def check_image_values(images, name: str = "images", *, clipped: bool = False) -
             lo, hi = float(images.min()), float(images.max())
             slack = 1.0 if clipped else FLOAT_IMAGE_SLACK
             if hi > 1.0 + slack or lo < -slack:
-                scale = " (they look like 0..255: divide by 255, or pass uint8)" if hi > 2.0 else ""
+                scale = (" (they look like 0..255: divide by 255, or pass uint8)" if hi > 10.0 else
+                         " (clip them to [0, 1], or check their scale)")
                 raise EventDataError(f"{name} are floats in [{lo:.4g}, {hi:.4g}]; float images must lie in [0, 1]"
                                  f"{scale}")
         return images

@@ -74,6 +74,8 @@ def _image(a, name: str) -> np.ndarray:
         raise EventDataError(f"{name} must be one grey image [H, W] (or [H, W, 1]), got shape {a.shape}; {fix}")
     if a.dtype == np.uint8:
         return a.astype(np.float64) / 255.0
+    if a.dtype.kind in "iu":   # uint16 / int64: refused with their own fix (cast to float, they read as 0..255)
+        check_image_values(a, f"{name} values")
     a = a.astype(np.float64)
     if not np.all(np.isfinite(a)):
         raise EventDataError(f"{name} contains NaN or inf; repair or drop that frame (an image must be finite to be "

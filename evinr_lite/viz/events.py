@@ -143,7 +143,7 @@ def plot_count_map(events: Events, ax=None, polarity: int | None = None, title: 
 def plot_polarity(events: Events, t0: float | None = None, t1: float | None = None, ax=None,
                   title: str | None = None):
     """:func:`polarity_image` of the window ``(t0, t1]``, titled with the window and its event count."""
-    if len(events) == 0 and (t0 is None or t1 is None):   # the title read events.t[0]: numpy's IndexError
+    if len(events) == 0 and title is None and (t0 is None or t1 is None):   # the title read events.t[0]
         raise EventDataError("plot_polarity: no events, so no window to title; pass t0 and t1 (seconds) for an "
                              "empty image, or events that hold some")
     ax = _axes(ax, (4, 3))
