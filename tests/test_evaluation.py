@@ -120,6 +120,8 @@ def test_evaluate_scores_evinr_and_baselines_through_one_path():
     assert "clipLimit=2.0" in table and "python -m data_fetch get lpips all" in table
     fig = plot_results(rows)
     assert len(fig.axes) == 2                                           # MSE and SSIM; no LPIPS values
+    import matplotlib.pyplot as plt
+    plt.close(fig)                                                      # no figure left for the next test file
     kept = evaluate(events, gt, gt_t, methods=("hf",), equalizations=("none",), keep_frames=True, lpips_model=False)
     assert kept[0]["frames"].shape == (3, 32, 40) and kept[0]["reconstruction"].method == "hf"
     with pytest.raises(ValueError, match="unknown method"):
