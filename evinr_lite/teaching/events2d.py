@@ -431,15 +431,20 @@ def _inputs_intervals(rng):
     return cases
 
 
+def _b_from(log_dt, pair, on):
+    """The wrong versions' last step, as :func:`interval_imbalance` takes it: tanh of half the mean log ON interval
+    minus the mean log OFF one over the pairs ``pair`` (``on``: the pair's polarity is ON); NaN without both."""
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
 def _intervals_unsorted(events):
     """A wrong version (for the hint): consecutive events of the whole stream, not of one pixel."""
     t, p = np.asarray(events.t, np.float64), events.p
     pair = p[1:] == p[:-1]
     log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
-    on = p[1:] > 0
-    if not (pair & on).any() or not (pair & ~on).any():
-        return float("nan")
-    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+    return _b_from(log_dt, pair, p[1:] > 0)
 
 
 def _by_pixel(events):
@@ -510,10 +515,7 @@ def _imbalance_of_pixel_numbers(events, pix, kind):
     pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
     pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
     log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
-    on = p[1:] > 0
-    if not (pair & on).any() or not (pair & ~on).any():
-        return float("nan")
-    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+    return _b_from(log_dt, pair, p[1:] > 0)
 
 
 def _intervals_stat(events, log=np.log, stat=np.mean, to_b=lambda r: np.tanh(r / 2), none=float("nan")):
@@ -558,20 +560,14 @@ def _intervals_floor_added(events):
     """A wrong version (for the hint): MIN_INTERVAL added to every interval instead of a floor."""
     pix, t, p, pair = _by_pixel(events)
     log_dt = np.log(np.diff(t) + MIN_INTERVAL)
-    on = p[1:] > 0
-    if not (pair & on).any() or not (pair & ~on).any():
-        return float("nan")
-    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+    return _b_from(log_dt, pair, p[1:] > 0)
 
 
 def _intervals_floor_in_ms(events):
     """A wrong version (for the hint): the floor at a millisecond, 1e-3 s."""
     pix, t, p, pair = _by_pixel(events)
     log_dt = np.log(np.maximum(np.diff(t), 1e-3))
-    on = p[1:] > 0
-    if not (pair & on).any() or not (pair & ~on).any():
-        return float("nan")
-    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+    return _b_from(log_dt, pair, p[1:] > 0)
 
 
 def _intervals_across_pixels(events):
@@ -581,10 +577,7 @@ def _intervals_across_pixels(events):
     pair = p[1:] == p[:-1]
     with np.errstate(divide="ignore", invalid="ignore"):
         log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
-    on = p[1:] > 0
-    if not (pair & on).any() or not (pair & ~on).any():
-        return float("nan")
-    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+    return _b_from(log_dt, pair, p[1:] > 0)
 
 
 def _intervals_lexsort_by_time(events):
@@ -595,10 +588,7 @@ def _intervals_lexsort_by_time(events):
     pix, t, p = pix[order], np.asarray(events.t, np.float64)[order], events.p[order]
     pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
     log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
-    on = p[1:] > 0
-    if not (pair & on).any() or not (pair & ~on).any():
-        return float("nan")
-    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+    return _b_from(log_dt, pair, p[1:] > 0)
 
 
 def _intervals_log_ratio(events):
