@@ -18,7 +18,7 @@ from .guard import InputError, check_unmasked, dense_array, host_array
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
-           "host_array", "check_seconds_precision", "check_reach", "image_stack"]
+           "host_array", "check_seconds_precision", "check_reach", "image_stack", "checked_span"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -183,6 +183,15 @@ def is_real_number(value) -> bool:
         return not isinstance(value, (bool, np.bool_))
     value = host_array(value)
     return isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"
+
+
+def checked_span(t_start, t_end, name: str) -> tuple:
+    """(t_start, t_end) as floats: finite seconds, t_end >= t_start; else an EventDataError naming ``name``."""
+    a = real_number(t_start, f"{name}: t_start", hint="seconds on the events' clock")
+    b = real_number(t_end, f"{name}: t_end", hint="seconds on the events' clock")
+    if b < a:
+        raise EventDataError(f"{name}: the span [{a}, {b}] s is reversed; t_end must not come before t_start")
+    return a, b
 
 
 def real_number(value, name: str, *, lo: float | None = None, hi: float | None = None, lo_open: bool = False,

@@ -57,12 +57,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.checks import real_number, seconds_array, whole_number
+from ..core.checks import checked_span, seconds_array, whole_number
 from ..core.events import EventDataError, Events
 from .denoise import DEFAULT_DT
 
 __all__ = ["GRID", "MIN_ROOM", "N_QUERY", "WHOLE_SPAN", "SLICES", "SLICE_S", "MARGIN", "MIN_EVENTS", "CROP_PX", "NOISE_COST",
-           "MAX_TILES", "BackgroundFit", "neighbour_gaps", "checked_span", "sample_spans", "tile_counts", "busy_spans",
+           "MAX_TILES", "BackgroundFit", "neighbour_gaps", "sample_spans", "tile_counts", "busy_spans",
            "fit_background"]
 
 GRID = (0.05, 0.1, 0.2, 0.4)   # s: the filter's windows tried (50 ms: the fixed default before; 0.4 s keeps ~all signal)
@@ -203,15 +203,6 @@ def _busiest_crop(samples, sensor_size) -> tuple:
     sums = s[h:, w:] - s[:-h, w:] - s[h:, :-w] + s[:-h, :-w]      # [H - h + 1, W - w + 1]: by top-left corner
     i, j = np.unravel_index(int(np.argmax(sums)), sums.shape)
     return int(i), int(i) + h, int(j), int(j) + w
-
-
-def checked_span(t_start, t_end, name: str) -> tuple:
-    """(t_start, t_end) as floats: finite seconds, t_end >= t_start; else an EventDataError naming ``name``."""
-    a = real_number(t_start, f"{name}: t_start", hint="seconds on the events' clock")
-    b = real_number(t_end, f"{name}: t_end", hint="seconds on the events' clock")
-    if b < a:
-        raise EventDataError(f"{name}: the span [{a}, {b}] s is reversed; t_end must not come before t_start")
-    return a, b
 
 
 def sample_spans(t_start: float, t_end: float) -> list:

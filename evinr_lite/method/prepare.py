@@ -33,10 +33,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..core.checks import real_number
+from ..core.checks import checked_span, real_number
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
-from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, checked_span, fit_background, sample_spans, tile_counts
+from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, fit_background, sample_spans, tile_counts
 from .denoise import DEFAULT_DT, denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 
