@@ -552,23 +552,17 @@ def _library_file(filename: str) -> bool:
     return any(path.startswith(root + os.sep) for root in _LIBRARY_ROOTS)
 
 
-def _site_dirs() -> set:
-    """site-packages folders beyond sysconfig's: the user's and the system's (Debian's dist-packages)."""
-    dirs = set()
-    try:
-        dirs.update(site.getsitepackages())
-    except AttributeError:                            # some virtualenvs' site module lacks it
-        pass
+def _site_dirs() -> list:
+    """site-packages folders beyond sysconfig's: the system's (Debian's dist-packages) and the user's (some
+    virtualenvs' site module lacks either function)."""
     user = getattr(site, "getusersitepackages", lambda: None)()
-    if user:
-        dirs.add(user)
-    return dirs
+    return [*getattr(site, "getsitepackages", lambda: [])(), *([user] if user else [])]
 
 
 _KIT_ROOT = os.path.realpath(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))   # evinr_lite/
 _LIBRARY_ROOTS = tuple(sorted({os.path.realpath(p) for p in
-                               [sysconfig.get_paths().get(k) for k in ("stdlib", "platstdlib", "purelib", "platlib")]
-                               + sorted(_site_dirs()) if p}))
+                               [*(sysconfig.get_paths().get(k) for k in ("stdlib", "platstdlib", "purelib", "platlib")),
+                                *_site_dirs()] if p}))
 
 
 def _where_raised(err: BaseException) -> list[str]:
