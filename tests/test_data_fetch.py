@@ -802,9 +802,10 @@ def _packet_stream(n=3000, H=30, W=40, seed=3, encoding="evt3"):
     ev = np.zeros(n, dtype=faery.EVENTS_DTYPE)
     ev["t"] = np.sort(1_200_000 + rng.integers(0, 2_500_000, n)).astype(np.uint64)
     ev["x"], ev["y"], ev["on"] = rng.integers(0, W, n), rng.integers(0, H, n), rng.random(n) < 0.5
-    path = Path(__import__("tempfile").mkdtemp()) / "s.raw"
-    faery.events_stream_from_array(ev, dimensions=(W, H)).to_file(path, version=encoding)
-    data = path.read_bytes()
+    with __import__("tempfile").TemporaryDirectory() as folder:     # nothing left behind in /tmp
+        path = Path(folder) / "s.raw"
+        faery.events_stream_from_array(ev, dimensions=(W, H)).to_file(path, version=encoding)
+        data = path.read_bytes()
     pos, t0 = 0, 0
     while data[pos:pos + 1] == b"%":
         end = data.index(b"\n", pos)

@@ -20,7 +20,10 @@ NOTEBOOKS = sorted(p for p in (ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb") if
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
-def test_student_copy_runs_and_warns(path, tmp_path):
+def test_student_copy_runs_and_warns(path, tmp_path, monkeypatch):
+    # the kernel inherits TMPDIR: a notebook's tempfile.mkdtemp scratch (notebook 11's) lands in tmp_path,
+    # which pytest removes, instead of one more folder left in /tmp by every run of the suite
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
     instructor = json.loads(path.read_text())
     n_exercises = make_student_copies.count_exercises(instructor)
     assert n_exercises >= 2, f"{path.name}: a notebook with exercises needs at least 2"

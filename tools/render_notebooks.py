@@ -135,7 +135,8 @@ def execute(path: Path, *, full: bool, timeout: int) -> tuple:
     from nbclient import NotebookClient
 
     nb = nbformat.read(path, as_version=4)
-    env = {"EVINR_FAST": "0" if full else "1", "EVINR_LIVE_WIDGETS": "0",
+    scratch = tempfile.TemporaryDirectory(prefix="evinr_render_")   # a notebook's mkdtemp lands here, then goes
+    env = {"EVINR_FAST": "0" if full else "1", "EVINR_LIVE_WIDGETS": "0", "TMPDIR": scratch.name,
            "MPLBACKEND": "module://matplotlib_inline.backend_inline"}   # figures as PNG outputs, even under Agg
     saved = {k: os.environ.get(k) for k in env}
     os.environ.update(env)   # the kernel inherits this process's environment
@@ -151,6 +152,7 @@ def execute(path: Path, *, full: bool, timeout: int) -> tuple:
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
+        scratch.cleanup()
 
 
 def write_page(nb, stem: str, site: Path) -> int:
