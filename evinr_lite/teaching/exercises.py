@@ -45,7 +45,12 @@ where that mistake shows, so that one input cannot make two different mistakes l
 values, a check fails a function that changes an input array in place (even when its result is right),
 a tensor result cut off from the autograd graph where the reference's is differentiable (cases mark such
 inputs with ``requires_grad``), and a list or a tensor where the reference returns a numpy array. An
-exception is reported at the learner's own line, even when numpy or torch raised it deeper down.
+exception is reported at the learner's own line, even when numpy or torch raised it deeper down. The last input
+is run a second time, from other states of the global random generators: a function fails that then answers
+differently (state kept between calls), that hands out the same array, tensor or dict again (a buffer or a cached
+result, which the next call or the caller changes), or that reseeds a global generator (np.random.seed,
+torch.manual_seed, random.seed); so does one that changes torch's settings for the whole notebook (gradients
+switched off, the default dtype), which the check sets back.
 
 ``use`` says "not finished" for a stub that still raises ``NotImplementedError`` and "does not
 pass the check yet" for a finished function that gives wrong results. For a function with side
@@ -56,7 +61,9 @@ from __future__ import annotations
 import copy
 import inspect
 import os
+import random
 import site
+import sys
 import sysconfig
 import traceback
 import warnings
@@ -175,8 +182,13 @@ def _is_tensor(x) -> bool:
 
 def _to_numpy(x):
     if _is_tensor(x):
-        return x.detach().cpu().numpy()
+        x = x.detach().cpu()
+        return (x.float() if str(x.dtype) == "torch.bfloat16" else x).numpy()   # numpy has no bfloat16
     return np.asarray(x)
+
+
+def _is_bfloat16(x) -> bool:
+    return _is_tensor(x) and str(x.dtype) == "torch.bfloat16"
 
 
 def _fmt(v) -> str:
@@ -285,6 +297,10 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
         if g.dtype.kind == "u" and np.any(e < 0):
             return _Problem(f"wrong values{at}: an unsigned dtype ({g.dtype}) cannot hold the negative values "
                             "expected (-1 wraps round to the largest value): use a signed integer dtype (np.int64)")
+        if _is_bfloat16(got) and not _is_bfloat16(expected):
+            return _Problem(f"wrong values{at}: the result is bfloat16 (about 3 significant digits: `.bfloat16()`, "
+                            "or torch.autocast), too coarse for these values: compute and return float32 like the "
+                            "inputs")
         if g.dtype == np.float16 and e.dtype != np.float16:
             return _Problem(f"wrong values{at}: the result is float16 (half precision, about 3 significant "
                             "digits), too coarse for these values: compute and return float64 (or float32)")
@@ -739,6 +755,36 @@ def _state_hint(fn: Callable, before: dict[str, Any], ex: Exercise, args, kwargs
     return None
 
 
+def _global_containers(fn: Callable) -> dict[str, tuple[int, int]]:
+    """The dicts, lists and sets among the notebook variables (``fn``'s globals) that ``fn``'s code names:
+    {name: (id, length)}."""
+    code, names = getattr(fn, "__code__", None), set()
+    namespace = getattr(fn, "__globals__", None)
+    if code is None or not isinstance(namespace, dict):
+        return {}
+    stack = [code]
+    while stack:                               # the function's code and the code nested in it (comprehensions)
+        c = stack.pop()
+        names.update(c.co_names)
+        stack += [k for k in c.co_consts if inspect.iscode(k)]
+    return {name: (id(v), len(v)) for name in names
+            if isinstance(v := namespace.get(name), (dict, list, set))}
+
+
+def _global_cache_hint(fn: Callable, before: dict[str, tuple[int, int]]) -> str | None:
+    """A notebook dict, list or set named in ``fn``'s code that gained entries during the check: results (or parts
+    of them) kept from one call to the next."""
+    now = _global_containers(fn)
+    for name, (ident, length) in sorted(before.items()):
+        if name in now and now[name][0] == ident and now[name][1] > length:
+            return (f"your function keeps data in the notebook variable `{name}` (it gained {now[name][1] - length} "
+                    f"entr{'y' if now[name][1] - length == 1 else 'ies'} during the check) and reads it back: an "
+                    "input that shares an earlier one's key (the same settings, the same size) gets what was kept "
+                    "for the earlier one; compute each result from the arguments, afresh in each call (a cache must "
+                    "be keyed by everything the result depends on, the data too)")
+    return None
+
+
 def _stale_elsewhere(ex: Exercise, cases: list, k: int, subset: tuple, fn_outputs) -> bool:
     """On every other input (but #1) where the learner is wrong, its output is also the reference's with the
     arguments ``subset`` taken from input #1: a coincidence on one input (a phase (0, 0) both times) says nothing."""
@@ -991,7 +1037,22 @@ def _generic_mistakes(ex: Exercise) -> list[tuple[str, Callable]]:
     for d in range(7):
         out.append((f"the values are rounded to {d} decimal{'s' if d != 1 else ''}: return them as computed "
                     "(round only where you print them)", on_output(lambda v, d=d: _map_numbers(v, _round_to(d)))))
+    for only in params:                      # one float array input rounded (times to milliseconds, say); confirmed
+        for d in range(7):                   # on a second input: float32 or another rounding can land alike on one
+            wrong = on_inputs(lambda kw, only=only, d=d: _rounded_input(kw, only, d))
+            wrong.support = 1
+            out.append((f"`{only}` was rounded to {d} decimal{'s' if d != 1 else ''} (np.round) before use: nothing "
+                        "here asks for that; use the values as given (rounded times move events past one another "
+                        "and past the edges of a window or a bin)", wrong))
     return out
+
+
+def _rounded_input(kwargs: dict, only: str, d: int) -> dict | None:
+    """``kwargs`` with the float numpy array ``only`` rounded to ``d`` decimals; None when that changes nothing."""
+    v = kwargs.get(only)
+    if not (isinstance(v, np.ndarray) and v.dtype.kind == "f" and v.size) or np.array_equal(np.round(v, d), v):
+        return None
+    return dict(kwargs, **{only: np.round(v, d)})
 
 
 def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
@@ -1004,17 +1065,30 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         return False, f"could not build the test inputs ({type(err).__name__}: {err})", []
     n = len(cases)
     defaults = _mutable_defaults(fn)
+    containers = _global_containers(fn)
     for k, (args, kwargs) in enumerate(cases):
         where = f"input #{k + 1} of {n} ({_describe_case(args, kwargs)})"
         after: list = []
+        if k == n - 1:
+            rng_before = _rng_states()       # the last input is run again below, from other generator states
+        settings = _torch_settings()
         try:
             got = _run(fn, args, kwargs, ex.observe, inputs_after=after)
+            if k == n - 1:
+                rng_after = _rng_states()
         except NotImplementedError:
+            _restore_torch_settings(settings)
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except Exception as err:
             details = [f"{type(err).__name__}: {err}"] + _where_raised(err)
-            if isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
+            changed_settings = _restore_torch_settings(settings)
+            if isinstance(err, TypeError) and "unhashable type" in str(err):
+                details.append("hint: a cache (functools.lru_cache, functools.cache, or a dict keyed by the "
+                               "arguments) needs hashable arguments, and an array, a list or a dict is not one; "
+                               "drop the cache (nothing here is slow enough to need one), or key it by "
+                               "something hashable that holds all of the data (a.tobytes()) and return copies")
+            elif isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
                 names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
                 details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
                                "stub's parameter names and order")
@@ -1027,10 +1101,15 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                 details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
                                "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
                                "`np.zeros((H, W))`, `frame[y, x]`")
-            state = _mutable_default_hint(fn, defaults) if k > 0 else None
+            state = (_mutable_default_hint(fn, defaults) or _global_cache_hint(fn, containers)) if k > 0 else None
             if state:
                 details.append(f"hint: {state}")
+            if changed_settings:
+                details.append("also: " + _settings_message(changed_settings))
             return False, f"raised {type(err).__name__} on {where}", details
+        changed_settings = _restore_torch_settings(settings)
+        if changed_settings:
+            return False, f"changed torch's global settings on {where}", [_settings_message(changed_settings)]
         expected = _run(ex.reference, args, kwargs, ex.observe)
         if ex.compare is not None:
             try:
@@ -1047,11 +1126,13 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         if problem is None:
             return False, f"changed its input on {where}", [_in_place_message(changed, _container_names(args, kwargs))]
         details = [problem.message]
-        hint = None
+        # results kept in a notebook dict (or list) that the function fills: an input that shares an earlier
+        # one's key gets that input's result, whatever mistake its output happens to look like
+        hint = _global_cache_hint(fn, containers) if k > 0 else None
         # a known mistake is recognised by its output, whatever the first difference is (a wrong
         # count of events is a wrong shape, not wrong values), and confirmed on the other inputs where
         # it shows: one input alone can make two different mistakes look alike
-        for message, wrong in ex.hints.items():
+        for message, wrong in ex.hints.items() if hint is None else ():
             try:
                 w = _run(wrong, args, kwargs, ex.observe)
                 if _compare(got, w, ex.rtol, ex.atol) is None and _same_mistake_elsewhere(ex, fn, wrong, cases, k):
@@ -1067,6 +1148,8 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
             hint = _state_hint(fn, defaults, ex, args, kwargs, got, first=k == 0)
         if hint is None:
             hint = _stale_argument_hint(ex, fn, cases, k, got, expected)
+        if hint is None:
+            hint = _reseed_hint(ex, fn, args, kwargs)
         # mistakes any exercise can show (polarities read as 0/1, a clip to [0, 1], a rounded result), recognised
         # the same way from wrong versions made from the reference
         if hint is None and ex.observe is None:
@@ -1075,7 +1158,7 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                     w = _run(wrong, args, kwargs)
                     if _compare(w, expected, ex.rtol, ex.atol) is not None \
                             and _compare(got, w, ex.rtol, ex.atol) is None \
-                            and _same_mistake_elsewhere(ex, fn, wrong, cases, k):
+                            and _same_mistake_elsewhere(ex, fn, wrong, cases, k, getattr(wrong, "support", 0)):
                         hint = message
                         break
                 except Exception:
@@ -1101,22 +1184,212 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         if changed:
             details.append("also: " + _in_place_message(changed, _container_names(args, kwargs)))
         return False, f"does not match the reference on {where}", details
-    # the same input once more (the last one, right after its first run): a function that keeps state between
-    # calls (a notebook variable it changes, a mutable default argument) gives another result the second time
-    if n and ex.observe is None:
+    # the same input once more (the last one, right after its first run), from other states of the global random
+    # generators: a function that keeps state between calls (a notebook variable it changes, a mutable default
+    # argument) gives another result the second time; one that keeps its result (a buffer, a cache) returns the
+    # same array again; one that reseeds a global generator leaves it in the same state whatever it held before
+    if n:
         args, kwargs = cases[-1]
+        rng_now, rng_other = _rng_states(), _other_rng_states(rng_before)
+        settings = _torch_settings()
         try:
-            again = _run(fn, args, kwargs)
-            problem = _compare(again, _run(ex.reference, args, kwargs), ex.rtol, ex.atol) if ex.compare is None \
-                else (None if ex.compare(again, _run(ex.reference, args, kwargs)) is None else _Problem("", True))
+            _set_rng_states(rng_other)
+            again = _run(fn, args, kwargs, ex.observe)
+            rng_again = _rng_states()
+            if ex.observe is not None:
+                problem = None
+            elif ex.compare is None:
+                problem = _compare(again, _run(ex.reference, args, kwargs), ex.rtol, ex.atol)
+            else:
+                problem = None if ex.compare(again, _run(ex.reference, args, kwargs)) is None else _Problem("", True)
         except Exception as err:
-            problem = _Problem(f"{type(err).__name__}: {err}")
+            again, rng_again, problem = None, None, _Problem(f"{type(err).__name__}: {err}")
+        finally:
+            _set_rng_states(rng_now)
+            changed_settings = _restore_torch_settings(settings)
+        if changed_settings:
+            return False, f"changed torch's global settings on input #{n} of {n}", [_settings_message(changed_settings)]
         if problem is not None:
             return False, f"gives another result when input #{n} of {n} is run a second time", [
                 "every input matched once, but a second call on the same input does not: your function keeps "
                 "state between calls (a notebook variable it changes, a mutable default argument such as "
                 "`state={}`, or unseeded randomness); compute everything from the arguments, afresh in each call"]
+        shared = _shares_output(got, again) if ex.observe is None else None
+        if shared:
+            return False, f"returns the same {shared} again when input #{n} of {n} is run a second time", [
+                "every input matched, but two calls return the same array (or dict) object, or views of one: a "
+                "buffer or a cached result kept between calls (a notebook variable, a dict of results keyed by the "
+                "shape or the arguments, a default argument) is handed out again, so each call changes what the "
+                "earlier ones returned, and a caller that changes a result changes the cache (`frames = [f(...) "
+                "for ...]` would hold one array many times); create the result afresh in each call (np.zeros(...) "
+                "inside the function), or return a copy of a cached one (`.copy()`)"]
+        reseeded = _reseeded(rng_before, rng_other, rng_after, rng_again) if rng_again is not None else []
+        if reseeded:
+            return False, f"reseeds the global random generator ({', '.join(reseeded)})", [
+                "every input matched, but after a call the global generator is in the same state whatever it held "
+                "before: your function seeds it (np.random.seed, torch.manual_seed, random.seed), which resets the "
+                "random numbers of the whole notebook at every call (a later cell's random minibatches or noise "
+                "repeat); nothing here asks for randomness: remove the seed, or draw from a generator of your own "
+                "(rng = np.random.default_rng(seed), torch.Generator().manual_seed(seed))"]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
+
+
+# ---- a second call on the last input: kept results, reseeded generators ----------------------------------------
+
+def _mutable_leaves(v) -> list:
+    """The arrays, tensors, dicts and lists inside a result that a caller could change in place."""
+    if isinstance(v, dict):
+        return [v] + [leaf for x in v.values() for leaf in _mutable_leaves(x)]
+    if isinstance(v, list):
+        return [v] + [leaf for x in v for leaf in _mutable_leaves(x)]
+    if isinstance(v, tuple):
+        return [leaf for x in v for leaf in _mutable_leaves(x)]
+    if isinstance(v, np.ndarray) and v.size > 0 and v.flags.writeable:
+        return [v]
+    if _is_tensor(v) and v.numel() > 0:
+        return [v]
+    return []
+
+
+def _shares_output(first, second) -> str | None:
+    """What two results of the same call share: an array (memory), a tensor (storage), a dict or a list (the
+    object); None when they share nothing."""
+    try:
+        a, b = _mutable_leaves(first), _mutable_leaves(second)
+        for x in a:
+            for y in b:
+                if isinstance(x, (dict, list)) or isinstance(y, (dict, list)):
+                    if x is y:
+                        return type(x).__name__
+                elif isinstance(x, np.ndarray) and isinstance(y, np.ndarray):
+                    if np.shares_memory(x, y, max_work=10 ** 6):
+                        return "array"
+                elif _is_tensor(x) and _is_tensor(y):
+                    if x.untyped_storage().data_ptr() == y.untyped_storage().data_ptr():
+                        return "tensor"
+    except Exception:
+        return None           # cannot tell: say nothing
+    return None
+
+
+def _reseed_hint(ex: Exercise, fn: Callable, args, kwargs) -> str | None:
+    """A function that seeds a global generator (its random numbers the same on every call, but random all the
+    same): two runs from different generator states leave the generators in one state."""
+    now = _rng_states()
+    try:
+        afters = []
+        for start in (now, _other_rng_states(now)):
+            _set_rng_states(start)
+            try:
+                _run(fn, args, kwargs, ex.observe)
+            except Exception:
+                return None
+            afters.append(_rng_states())
+    finally:
+        _set_rng_states(now)
+    seeded = _reseeded(now, _other_rng_states(now), *afters)
+    if not seeded:
+        return None
+    return (f"your function seeds the global random generator ({', '.join(seeded)}) and draws from it: seeded, the "
+            "numbers are the same at every call, but they are random numbers all the same (a random sample of the "
+            "pixels, noise, a random start or tie-break), and nothing here asks for any; compute the result from "
+            "all of the data, without randomness (and a seed inside a function resets the whole notebook's "
+            "random numbers)")
+
+
+def _torch_settings() -> dict | None:
+    """torch's global settings a function may change for the whole notebook: gradients on or off, the default
+    float dtype; None when torch is not imported."""
+    torch = sys.modules.get("torch")
+    if torch is None:
+        return None
+    return {"grad": torch.is_grad_enabled(), "dtype": torch.get_default_dtype()}
+
+
+def _restore_torch_settings(before: dict | None) -> dict:
+    """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was."""
+    torch = sys.modules.get("torch")
+    if before is None or torch is None:
+        return {}
+    now = _torch_settings()
+    changed = {k: (before[k], now[k]) for k in before if now[k] != before[k]}
+    if "grad" in changed:
+        torch.set_grad_enabled(before["grad"])
+    if "dtype" in changed:
+        torch.set_default_dtype(before["dtype"])
+    return changed
+
+
+def _settings_message(changed: dict) -> str:
+    parts = []
+    if "grad" in changed:
+        parts.append("it turned gradients " + ("off" if changed["grad"][0] else "on") + " for the whole notebook "
+                     "(torch.set_grad_enabled(...), or torch.no_grad().__enter__() without its exit), so every later "
+                     "training step runs without autograd; use `with torch.no_grad():` around the lines that need "
+                     "it, which switches gradients back on at its end")
+    if "dtype" in changed:
+        parts.append(f"it changed torch's default dtype from {changed['dtype'][0]} to {changed['dtype'][1]} "
+                     "(torch.set_default_dtype) for the whole notebook, so every tensor made later (a model's "
+                     "weights, torch.zeros, torch.tensor of floats) has the new dtype; give the dtype where you need "
+                     "it (x.double(), torch.zeros(..., dtype=torch.float64)) and leave the default alone")
+    return "; and ".join(parts) + " (the check has set it back)"
+
+
+def _rng_states() -> dict:
+    """The states of the global random generators a learner may seed: numpy's, Python's, torch's (CPU)."""
+    states = {"numpy": np.random.get_state(), "random": random.getstate()}
+    torch = sys.modules.get("torch")
+    if torch is not None:
+        states["torch"] = torch.random.get_rng_state()
+    return states
+
+
+def _set_rng_states(states: dict) -> None:
+    np.random.set_state(states["numpy"])
+    random.setstate(states["random"])
+    torch = sys.modules.get("torch")
+    if torch is not None and "torch" in states:
+        torch.random.set_rng_state(states["torch"])
+
+
+def _other_rng_states(states: dict) -> dict:
+    """States of the global generators that differ from ``states`` (built from generators of their own, so that
+    nothing else is seeded: CUDA's generators stay as they are)."""
+    for seed in (20240607, 7):
+        other = {"numpy": np.random.RandomState(seed).get_state(), "random": random.Random(seed).getstate()}
+        torch = sys.modules.get("torch")
+        if torch is not None:
+            other["torch"] = torch.Generator().manual_seed(seed).get_state()
+        if not any(_same_rng_state(states[k], other[k]) for k in other if k in states):
+            return other
+    return other
+
+
+def _same_rng_state(a, b) -> bool:
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(_same_rng_state(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return bool(np.array_equal(a, b))
+    if _is_tensor(a) and _is_tensor(b):
+        return a.shape == b.shape and bool((a == b).all())
+    return a == b
+
+
+_SEED_CALLS = {"numpy": "np.random.seed", "random": "random.seed", "torch": "torch.manual_seed"}
+
+
+def _reseeded(before: dict, other: dict, after: dict, again: dict) -> list[str]:
+    """The generators that two runs, started from different states (``before``, ``other``), left in one state
+    (``after``, ``again``): the function seeded them."""
+    out = []
+    for name, call in _SEED_CALLS.items():
+        if all(name in d for d in (before, other, after, again)):
+            try:
+                if not _same_rng_state(before[name], other[name]) and _same_rng_state(after[name], again[name]):
+                    out.append(call)
+            except Exception:
+                continue
+    return out
 
 
 def _differing_leaf(got, expected, rtol: float, atol: float):
@@ -1135,10 +1408,14 @@ def _differing_leaf(got, expected, rtol: float, atol: float):
     return got, expected
 
 
-def _same_mistake_elsewhere(ex: Exercise, fn: Callable, wrong: Callable, cases: list, skip: int) -> bool:
+def _same_mistake_elsewhere(ex: Exercise, fn: Callable, wrong: Callable, cases: list, skip: int,
+                            support: int = 0) -> bool:
     """On every case but ``skip`` where the wrong version ``wrong`` shows its mistake (differs from the
     reference), ``fn`` gives the same output. Cases where either raises say nothing, and so do cases where
-    the wrong version happens to be right (the learner's variant of the mistake may be broader)."""
+    the wrong version happens to be right (the learner's variant of the mistake may be broader). ``support``:
+    how many other cases must show the mistake (a wrong version that changes almost any output needs none; one
+    that changes only an input's last digits, where some other mistake may land alike, needs one)."""
+    shown = 0
     for j, (args, kwargs) in enumerate(cases):
         if j == skip:
             continue
@@ -1154,7 +1431,8 @@ def _same_mistake_elsewhere(ex: Exercise, fn: Callable, wrong: Callable, cases: 
                 return False
         except Exception:
             return False
-    return True
+        shown += 1
+    return shown >= support
 
 
 def check(name: str, fn: Callable, *, verbose: bool = True) -> bool:
