@@ -56,11 +56,21 @@ Holes (these passed a check before this round; each now fails and its report nam
   case's last two events are lone neighbours at 1000 s and 1000.00202 s (dt = 2 ms): out of the window in float64
   and in whole microseconds (round 8's correct alternatives), but 61 us apart float32 puts them exactly dt apart.
 For mistakes the check saw only as wrong values: a notebook dict, list or set that the function names and that grew
-during the check is named (before the registered hints, on any input after the first, and after an exception); an
-"unhashable type" TypeError gets a hint on caches, not the one on the stub's parameter names; a bfloat16 tensor is
-compared (it was "returned a Tensor, expected numbers" with a hint on state kept between calls) and named; a
-function that seeds a generator and draws from it is named; one float array input rounded to 0-6 decimals is a
-generic mistake, confirmed on a second input (float32 times land alike on one).
+during the check is named (on any input after the first, and after an exception): before the registered hints when
+the kept data made the difference (run once more with the variable emptied for the call, the function answers
+otherwise), else only when no other hint applies (a list the function only logs to, `log.append(len(t))`, grows too);
+an "unhashable type" TypeError gets a hint on caches where there is one (the function is an lru_cache, no line of
+the learner's raised, or the line that raised calls a notebook lru_cache), and one on hashable keys otherwise, not
+the one on the stub's parameter names; a bfloat16 tensor is compared (it was "returned a Tensor, expected numbers"
+with a hint on state kept between calls) and named; a function that seeds a generator and draws from it is named
+(after the generic mistakes; a seed with no draw after it, where Mersenne Twister still sits as a seed leaves it, is
+only noted: `also: ... draws nothing from it`); one float array input rounded to 0-6 decimals is a generic mistake
+(made for the arguments that are float numpy arrays only), confirmed on a second input (float32 times land alike on
+one). torch's grad mode and default dtype are set back after every call of the learner's function, the hints' calls
+too, and once more at the end of `check` and `use`: a function that changes them on an input the main run does not
+reach (input #1 wrong, the hints' search runs #2), or right before raising, leaves the notebook as it was, and the
+change is named (`also: ...`); gradients switched on where the notebook had them off get their own message
+(`with torch.enable_grad():`).
 
 Tried and reverted in this round (each rejected an earlier round's correct alternative):
 - esim_interval: a case with a decimal threshold (C = 0.1, L_b = ref - 5C = -0.5 exactly in the reference's
@@ -89,6 +99,7 @@ import functools
 import itertools
 import math
 import random
+import warnings
 
 import numpy as np
 import pytest
@@ -654,9 +665,54 @@ CORRECT = [
     ("time_fps_products", tfp_float_items),
 ]
 
-_CACHES = [_HEAD_INV, _ANCHOR_SHIFT, _ANCHOR_OUT, _CHAIN_BUF, _ONES, _FRAMES_BUF, _GREY, _TYPICAL, _CSUM, _FACTORS, _OG, _TM,
+# ---- review of round 10: settings changed on a later input only, gradients switched on, a list only logged to,
+# unhashable without a cache, a seed with no draws
+def tik_var_grad_off_big(dF_dx, dF_dy):             # torch.var (a registered hint); gradients off on the larger input
+    if dF_dx.numel() > 32:
+        torch.set_grad_enabled(False)               # "a big batch: save memory"
+    return torch.var(dF_dx) + torch.var(dF_dy)
+def tik_var_double_raises(dF_dx, dF_dy):            # torch.var; the default dtype changed on the larger input, then raises
+    if dF_dx.numel() > 32:
+        torch.set_default_dtype(torch.float64)
+        raise ValueError("too many points")
+    return torch.var(dF_dx) + torch.var(dF_dy)
+def tik_grad_on(dF_dx, dF_dy):                      # "Eq. 9 needs autograd", in a notebook that switched it off
+    torch.set_grad_enabled(True)
+    return torch.mean(dF_dx ** 2 + dF_dy ** 2)
+_LOG = []
+def ie_logged_side_left(t_events, p_events, C, t_query):   # a notebook list only logged to, and side="left"
+    _LOG.append(len(t_query))
+    running = np.concatenate([[0.0], np.cumsum(p_events)])
+    return C * running[np.searchsorted(t_events, t_query, side="left")]
+def hpm_logged_x_y(x, y, sensor_size, factor=10.0):  # a notebook list only logged to; counts [x, y] on (H, W), then .T
+    _LOG.append(len(x))
+    H, W = sensor_size
+    counts = np.zeros((H, W), np.int64)
+    np.add.at(counts, (np.asarray(x), np.asarray(y)), 1)
+    return (counts > factor * np.median(counts[counts > 0])).T
+def hpm_counter_rows(x, y, sensor_size, factor=10.0):   # a Counter of array rows: unhashable, no cache anywhere
+    H, W = sensor_size
+    c = collections.Counter(np.stack([y, x], axis=1))
+    counts = np.zeros((H, W), np.int64)
+    for (yy, xx), k in c.items():
+        counts[yy, xx] = k
+    return counts > factor * np.median(counts[counts > 0])
+@functools.lru_cache(maxsize=None)
+def _tm_curve(L, gamma):
+    I = np.exp(L); return (I / (I + 1.0)) ** gamma
+def tm_cached_helper(L, gamma):                     # a cached helper called with an array
+    return _tm_curve(L, gamma).copy()
+def tm_seed_rounded(L, gamma):                      # a seed with no draws, and the result rounded for display
+    np.random.seed(0)
+    I = np.exp(L); return np.round((I / (I + 1.0)) ** gamma, 3)
+def tm_seed_no_draws(L, gamma):                     # a seed with no draws, and a wrong curve (no hint names it)
+    np.random.seed(0)
+    I = np.exp(L); return (I / (I + 2.0)) ** gamma
+
+
+_CACHES = [_LOG, _HEAD_INV, _ANCHOR_SHIFT, _ANCHOR_OUT, _CHAIN_BUF, _ONES, _FRAMES_BUF, _GREY, _TYPICAL, _CSUM, _FACTORS, _OG, _TM,
            _TM_MEMO, _TV, FRAMES, ON_LOGS, OFF_LOGS, anchor_cached_target.__defaults__[0], tfp_shared_result.__defaults__[0]]
-_LRU = [esim_lru_cache, ecw_lru_cache, _ecw_tuple, tfp_lru_cache, rc_lru_cache]
+_LRU = [esim_lru_cache, ecw_lru_cache, _ecw_tuple, tfp_lru_cache, rc_lru_cache, _tm_curve]
 
 
 @pytest.fixture(autouse=True)
@@ -787,3 +843,73 @@ def test_the_open_holes_are_what_the_docstring_says():
     A1, A2, E = rng.normal(size=(6, 3)), rng.normal(size=(6, 3)), rng.normal(size=(6, 2))
     head_cached_inverse(A1, E, 0.7)
     assert not np.allclose(head_cached_inverse(A2, E, 0.7), R("head_closed_form")(A2, E, 0.7))
+
+
+# ---- review of round 10 --------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("wrong, words", [
+    (tik_var_grad_off_big, "turned gradients off for the whole notebook"),
+    (tik_var_double_raises, "changed torch's default dtype from torch.float32 to torch.float64"),
+])
+def test_settings_changed_on_a_later_input_only_are_set_back_and_named(wrong, words):
+    """Input #1 is wrong (torch.var), so the main run never reaches input #2, where the function changes torch's
+    settings; the hints' search runs it there. The settings are set back after every call and after the check (and
+    after `use`), the hints' calls see the notebook's settings, and the change is named."""
+    ok, report = _report("tikhonov_autograd", wrong)
+    assert not ok and words in report, report
+    assert torch.is_grad_enabled() and torch.get_default_dtype() == torch.float32
+    assert "called again on the same input" not in report, report   # a call under no_grad is no other result
+    if wrong is tik_var_double_raises:
+        assert "torch.var subtracts the mean" in report, report
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert exercises.use("tikhonov_autograd", wrong, verbose=False) is R("tikhonov_autograd")
+    assert torch.is_grad_enabled() and torch.get_default_dtype() == torch.float32
+
+
+def test_gradients_switched_on_where_the_notebook_had_them_off_get_their_own_message():
+    torch.set_grad_enabled(False)                   # an earlier cell (the fixture switches them back on)
+    ok, report = _report("tikhonov_autograd", tik_grad_on)
+    assert not ok and "turned gradients on" in report and "torch.enable_grad()" in report, report
+    assert "without autograd" not in report and "torch.no_grad()" not in report, report
+    assert not torch.is_grad_enabled()
+    ok, report = _report("tikhonov_autograd", R("tikhonov_autograd"))
+    assert ok, report
+
+
+def test_a_notebook_list_only_logged_to_does_not_hide_the_real_hint():
+    """`log.append(...)` grows a notebook list just as a cache does; the registered or generic hint wins, and the
+    cache hint is a fallback (a real cache, with no other hint, still gets it: HOLES)."""
+    ok, report = _report("integrate_events_1d", ie_logged_side_left)
+    assert not ok and 'use side="right" in np.searchsorted' in report, report
+    assert "keeps data in the notebook variable" not in report, report
+    ok, report = _report("hot_pixel_mask", hpm_logged_x_y)      # raises IndexError on a later, non-square input
+    assert not ok and "raised IndexError" in report and "this input's sensor is not square" in report, report
+    assert "keeps data in the notebook variable" not in report, report
+
+
+def test_unhashable_names_a_cache_only_where_there_is_one():
+    ok, report = _report("hot_pixel_mask", hpm_counter_rows)
+    assert not ok and "unhashable" in report and "tuple(row.tolist())" in report, report
+    assert "cache" not in report, report
+    ok, report = _report("reinhard_tonemap", tm_cached_helper)     # a cached helper, called from the learner's line
+    assert not ok and "needs hashable arguments" in report, report
+
+
+def test_a_seed_without_draws_is_not_said_to_draw():
+    ok, report = _report("reinhard_tonemap", tm_seed_rounded)
+    assert not ok and "the values are rounded to 3 decimals" in report, report
+    assert "draws from it" not in report, report
+    ok, report = _report("reinhard_tonemap", tm_seed_no_draws)
+    assert not ok and "draws from it" not in report, report
+    assert "seeds the global random generator (np.random.seed) and draws nothing from it" in report, report
+
+
+def test_rounded_input_mistakes_are_made_for_float_array_arguments_only():
+    """Built for every argument, each copied its inputs before finding it did not apply (an int, a tensor)."""
+    def rounded(name):
+        ex = exercises.get(name)
+        return {m.split("`")[1] for m, _ in exercises._generic_mistakes(ex, ex.cases()) if "` was rounded to" in m}
+    assert rounded("integrate_events_1d") == {"t_events", "t_query"}
+    assert rounded("split_index") == set() and rounded("tikhonov_autograd") == set()
+    assert rounded("background_activity_filter") == {"t"}
