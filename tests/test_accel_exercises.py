@@ -48,12 +48,12 @@ def test_bisect_halves_hold_equal_counts_and_fall_back_to_midpoints():
 def test_bisect_exercise_passes_the_reference_and_names_the_mistakes(capsys):
     assert exercises.check("bisect_equal_count", accel.bisect_equal_count)
     ex = exercises.get("bisect_equal_count")
-    assert len(ex.hints) == 12         # mid-points, mean, event n//2, the boundary rule [b_i, b_{i+1}), t == 0 for b_0,
+    assert len(ex.hints) == 13         # mid-points, mean, event n//2, the boundary rule [b_i, b_{i+1}), t == 0 for b_0,
                                        # a cut on the first edge (lo <= median: tools/mutate_exercises.py found it),
                                        # np.median of an odd count, the cuts without the edges (round 4), a sparse
                                        # bin cut at its first edge, bins closed at both ends (round 5), the edges
                                        # and the cuts concatenated, not interleaved (round 6), the last bin open
-                                       # at its end, t < b_B (round 7)
+                                       # at its end, t < b_B (round 7), round(n / 2) for n // 2 (round 10)
     for message, wrong in ex.hints.items():
         capsys.readouterr()
         assert not exercises.check("bisect_equal_count", wrong)

@@ -102,6 +102,17 @@ def _running_best_kept(cost, quality):
     return keep
 
 
+def _sweep_by_cost_alone(cost, quality):
+    """A sweep in order of cost alone (equal costs in the order given): a worse variant that comes before a better
+    one of the same cost is kept."""
+    c, q = np.asarray(cost, dtype=np.float64), np.asarray(quality, dtype=np.float64)
+    keep, best = np.zeros(len(c), dtype=bool), -np.inf
+    for i in np.argsort(c, kind="stable"):
+        if q[i] > best:
+            keep[i], best = True, q[i]
+    return keep
+
+
 def _best_quality_only(cost, quality):
     q = np.asarray(quality, dtype=np.float64)
     return q == q.max()
@@ -144,4 +155,8 @@ exercises.register(
            "q >= np.maximum.accumulate(q) in order of cost keeps a variant that costs more for only the same quality "
            "as a cheaper one (that one dominates it), and among equal costs keeps a worse one sorted before a better "
            "one: compare with the best quality of the strictly cheaper variants, and ties only in both":
-           _running_best_kept})
+           _running_best_kept,
+           "sorted by cost alone, variants of equal cost stay in the order given, and a worse one met before a "
+           "better one of the same cost is kept (that one dominates it): sort by cost and then by quality, best "
+           "first (np.lexsort((-quality, cost))), or compare every pair":
+           _sweep_by_cost_alone})

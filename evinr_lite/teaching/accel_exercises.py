@@ -214,6 +214,20 @@ def _bisect_edges_then_cuts(t_events, boundaries):
     return np.concatenate([out[0::2], out[1::2]])
 
 
+def _bisect_round_half(t_events, boundaries):
+    """The middle taken as round(n / 2): Python rounds halves to even, so for n = 3, 7, 11, ... it is n // 2 + 1."""
+    t = np.asarray(t_events, dtype=np.float64)
+    b = np.asarray(boundaries, dtype=np.float64)
+    out = bisect_equal_count(t, b)
+    for i, (lo, hi) in enumerate(zip(b[:-1], b[1:])):
+        s = t[((t > lo) | ((i == 0) & (t == lo))) & (t <= hi)]
+        if len(s) >= 2:
+            m = round(len(s) / 2)
+            cut = 0.5 * (s[m - 1] + s[m]) if m < len(s) else 0.5 * (lo + hi)
+            out[2 * i + 1] = cut if lo < cut < hi else 0.5 * (lo + hi)
+    return out
+
+
 def _last_bin_open(t_events, boundaries):
     """The last bin open at its end: an event exactly at b_B left out."""
     t = np.asarray(t_events, dtype=np.float64)
@@ -251,6 +265,10 @@ exercises.register(
             _bisect_edges_then_cuts,
         "an event exactly at the last edge b_B belongs to the last bin (b_{B-1}, b_B]: the bins are closed at their "
         "end, the last one too (no strict t < b_B)": _last_bin_open,
+        "round(n / 2) is not n // 2: Python (and np.round) round a half to the even neighbour, so round(3.5) is 4 "
+        "and round(2.5) is 2, and for n = 3, 7, 11, ... events the cut moves one event up; take the integer "
+        "division n // 2":
+            _bisect_round_half,
     })
 
 
@@ -487,6 +505,13 @@ def _chain_steps_before(prev, nxt):
     return np.concatenate([out[:1], out[:-1]])
 
 
+def _chain_floor_division(prev, nxt):
+    """The mean over the samples as sum // S: floor division rounds every step down to a whole number."""
+    prev, nxt = np.asarray(prev, dtype=np.float64), np.asarray(nxt, dtype=np.float64)
+    steps = (prev - nxt).sum(axis=1) // prev.shape[1]
+    return np.concatenate([np.zeros((1,) + prev.shape[2:]), np.cumsum(steps, axis=0)])
+
+
 def _chain_len_divisor(prev, nxt):
     """The sum over the samples divided by len(prev), the number of overlaps K, not the samples S."""
     prev, nxt = np.asarray(prev, dtype=np.float64), np.asarray(nxt, dtype=np.float64)
@@ -518,6 +543,9 @@ exercises.register(
         "len(prev) is K, the number of overlaps (the first axis): the mean over the S samples divides by "
         "prev.shape[1] (or use .mean(axis=1))":
             _chain_len_divisor,
+        "`//` is floor division, also on float arrays: the sum over the S samples // S rounds each step down to a "
+        "whole number; divide with `/`, or take .mean(axis=1)":
+            _chain_floor_division,
     })
 
 

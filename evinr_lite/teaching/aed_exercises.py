@@ -103,6 +103,12 @@ def _channel_no_block_division(y, x, phase):
     return ((((np.asarray(y) + phase[0]) % 4) + ((np.asarray(x) + phase[1]) % 4)) // 2).astype(np.int64)
 
 
+def _channel_rounded_halves(y, x, phase):
+    """np.round(((y + dy) % 4) / 2): 0.5 rounds to 0 but 1.5 to 2 (halves to even), not a floor."""
+    return (np.round(((np.asarray(y) + phase[0]) % 4) / 2)
+            + np.round(((np.asarray(x) + phase[1]) % 4) / 2)).astype(np.int64)
+
+
 exercises.register(
     "quad_bayer_channel", quad_bayer_channel, _inputs_channel,
     hints={
@@ -122,6 +128,9 @@ exercises.register(
         "rows and columns count from 0: the photosite at y = 0, x = 0 sees tile entry (dy % 4, dx % 4); (y - 1 + dy) "
         "counts them from 1 and shifts the pattern by one photosite":
             lambda y, x, phase: quad_bayer_channel(y, x, (phase[0] - 1, phase[1] - 1)),
+        "np.round(r / 2) is not r // 2: it rounds halves to the even neighbour (0.5 to 0, 1.5 to 2), so tile row 3 "
+        "counts as block 2; the block is the integer division ((y + dy) % 4) // 2, 0 or 1":
+            _channel_rounded_halves,
     })
 
 

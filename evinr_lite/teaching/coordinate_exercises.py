@@ -112,4 +112,7 @@ exercises.register(
         "torch.var subtracts the mean (and divides by M - 1): Eq. 9 is the mean of the squares themselves, "
         "torch.mean(dF_dx ** 2 + dF_dy ** 2)":
             lambda dF_dx, dF_dy: torch.var(dF_dx) + torch.var(dF_dy),
+        "`//` is floor division, also on float tensors: the sum // M rounds the mean down to a whole number (0 for "
+        "small gradients); divide with `/`, or use torch.mean":
+            lambda dF_dx, dF_dy: torch.sum(dF_dx ** 2 + dF_dy ** 2) // dF_dx.numel(),
     })

@@ -121,6 +121,10 @@ def _alpha_over_two_pi(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return highpass_per_event(t, x, y, p, sensor_size, C, alpha / (2 * math.pi), t_end, t_start)
 
 
+def _alpha_in_degrees(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    return highpass_per_event(t, x, y, p, sensor_size, C, np.deg2rad(alpha), t_end, t_start)
+
+
 def _t_last_set_first(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     """t_last set to the event's time before the decay, which is then exp(0) = 1: no decay between events."""
     H, W = sensor_size
@@ -151,6 +155,9 @@ exercises.register(
         "alpha is already in rad/s: decay by exp(-alpha dt), without dividing by 2 pi (that would make it a "
         "frequency in Hz)":
             _alpha_over_two_pi,
+        "alpha is an angular frequency in radians per second already, not degrees: decay by exp(-alpha dt) "
+        "as it is, without np.deg2rad / math.radians (a factor pi / 180)":
+            _alpha_in_degrees,
         "the state decays: exp(-alpha * (t - t_last)), with the minus sign (exp(+alpha dt) grows without bound)":
             _growth,
         "`state[y, x] += ...` adds only one of the events that share a pixel (fancy indexing does not accumulate "

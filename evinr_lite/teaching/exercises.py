@@ -45,7 +45,13 @@ where that mistake shows, so that one input cannot make two different mistakes l
 values, a check fails a function that changes an input array in place (even when its result is right),
 a tensor result cut off from the autograd graph where the reference's is differentiable (cases mark such
 inputs with ``requires_grad``), and a list or a tensor where the reference returns a numpy array. An
-exception is reported at the learner's own line, even when numpy or torch raised it deeper down.
+exception is reported at the learner's own line, even when numpy or torch raised it deeper down. The last input
+is run a second time, from other states of the global random generators: a function fails that then answers
+differently (state kept between calls), that hands out the same array, tensor or dict again (a buffer or a cached
+result, which the next call or the caller changes), or that reseeds a global generator (np.random.seed,
+torch.manual_seed, random.seed); so does one that changes torch's settings for the whole notebook (gradients
+switched off, or on where the notebook had them off; the default dtype), which the check sets back after every call
+(the hints' calls too) and once more at its end.
 
 ``use`` says "not finished" for a stub that still raises ``NotImplementedError`` and "does not
 pass the check yet" for a finished function that gives wrong results. For a function with side
@@ -56,7 +62,10 @@ from __future__ import annotations
 import copy
 import inspect
 import os
+import random
+import re
 import site
+import sys
 import sysconfig
 import traceback
 import warnings
@@ -175,8 +184,13 @@ def _is_tensor(x) -> bool:
 
 def _to_numpy(x):
     if _is_tensor(x):
-        return x.detach().cpu().numpy()
+        x = x.detach().cpu()
+        return (x.float() if str(x.dtype) == "torch.bfloat16" else x).numpy()   # numpy has no bfloat16
     return np.asarray(x)
+
+
+def _is_bfloat16(x) -> bool:
+    return _is_tensor(x) and str(x.dtype) == "torch.bfloat16"
 
 
 def _fmt(v) -> str:
@@ -285,6 +299,10 @@ def _compare(got, expected, rtol: float, atol: float, where: str = "") -> _Probl
         if g.dtype.kind == "u" and np.any(e < 0):
             return _Problem(f"wrong values{at}: an unsigned dtype ({g.dtype}) cannot hold the negative values "
                             "expected (-1 wraps round to the largest value): use a signed integer dtype (np.int64)")
+        if _is_bfloat16(got) and not _is_bfloat16(expected):
+            return _Problem(f"wrong values{at}: the result is bfloat16 (about 3 significant digits: `.bfloat16()`, "
+                            "or torch.autocast), too coarse for these values: compute and return float32 like the "
+                            "inputs")
         if g.dtype == np.float16 and e.dtype != np.float16:
             return _Problem(f"wrong values{at}: the result is float16 (half precision, about 3 significant "
                             "digits), too coarse for these values: compute and return float64 (or float32)")
@@ -565,6 +583,25 @@ _LIBRARY_ROOTS = tuple(sorted({os.path.realpath(p) for p in
                                 *_site_dirs()] if p}))
 
 
+def _cache_raised(fn: Callable, err: BaseException) -> bool:
+    """An "unhashable type" TypeError that a cache raised: ``fn`` is an lru_cache (it has ``cache_info``), the
+    error came from no line of the learner's code (the cache's wrapper, in C, builds the key before the call), or
+    the learner's line that raised calls a notebook function that is an lru_cache (a cached helper)."""
+    if hasattr(fn, "cache_info"):
+        return True
+    frames = [f for f in traceback.extract_tb(err.__traceback__) if f.filename != __file__]
+    own = [f for f in frames if not _library_file(f.filename)]
+    if not own:
+        return True
+    namespace = getattr(fn, "__globals__", None)
+    line = own[-1].line or ""
+    if isinstance(namespace, dict) and line:
+        for name in re.findall(r"[A-Za-z_][A-Za-z0-9_]*(?=\s*\()", line):
+            if hasattr(namespace.get(name), "cache_info"):
+                return True
+    return False
+
+
 def _where_raised(err: BaseException) -> list[str]:
     """The line of the learner's code that raised: the last frame outside this module and outside the libraries it
     called (an error raised deep inside numpy or torch is reported at the learner's line that called them)."""
@@ -590,12 +627,27 @@ def _deepcopy_with_grads(x):
     return y
 
 
-def _run(fn, args, kwargs, observe=None, inputs_after: list | None = None):
+def _run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None):
     """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
-    receives the copied ``(args, kwargs)`` as they are after the call."""
+    receives the copied ``(args, kwargs)`` as they are after the call.
+
+    torch's global settings (grad mode, default dtype) are set back after every call, whether it returns or
+    raises, so that a function that changes them on one input changes nothing for the calls after it (the
+    reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
+    the call changed ({name: (before, after)}). What the learner's function changed on any call of the check
+    (the hints' calls too) is also kept for the report (see :func:`_evaluate`)."""
     args, kwargs = _deepcopy_with_grads((args, kwargs))
-    result = fn(*args, **kwargs)
+    settings = _torch_settings()
+    try:
+        result = fn(*args, **kwargs)
+    finally:
+        changed = _restore_torch_settings(settings)
+        if settings_changed is not None:
+            settings_changed.update(changed)
+        if changed and _WATCH and fn is _WATCH[-1][0]:
+            for name, change in changed.items():
+                _WATCH[-1][1].setdefault(name, change)
     if inputs_after is not None:
         inputs_after.append((args, kwargs))
     return result if observe is None else observe(result, args, kwargs)
@@ -737,6 +789,69 @@ def _state_hint(fn: Callable, before: dict[str, Any], ex: Exercise, args, kwargs
     except Exception:
         return None
     return None
+
+
+def _global_containers(fn: Callable) -> dict[str, tuple[int, int]]:
+    """The dicts, lists and sets among the notebook variables (``fn``'s globals) that ``fn``'s code names:
+    {name: (id, length)}."""
+    code, names = getattr(fn, "__code__", None), set()
+    namespace = getattr(fn, "__globals__", None)
+    if code is None or not isinstance(namespace, dict):
+        return {}
+    stack = [code]
+    while stack:                               # the function's code and the code nested in it (comprehensions)
+        c = stack.pop()
+        names.update(c.co_names)
+        stack += [k for k in c.co_consts if inspect.iscode(k)]
+    return {name: (id(v), len(v)) for name in names
+            if isinstance(v := namespace.get(name), (dict, list, set))}
+
+
+def _global_cache_hint(fn: Callable, before: dict[str, tuple[int, int]], ex: Exercise | None = None,
+                       case: tuple | None = None, got: Any = None, raised: bool = False) -> tuple[str | None, bool]:
+    """A notebook dict, list or set named in ``fn``'s code that gained entries during the check: results (or parts
+    of them) kept from one call to the next. Returns (hint, proven): with ``ex`` and ``case`` (the failing input's
+    (args, kwargs), where ``fn`` returned ``got`` or ``raised``), ``proven`` says that the kept data made the
+    difference: run once more with that variable empty for the call (and put back after), ``fn`` answers otherwise.
+    A list the function only logs to (`log.append(len(t))`, a common habit) grows just the same and changes
+    nothing: then the hint is only a fallback, for when no other hint applies."""
+    now = _global_containers(fn)
+    for name, (ident, length) in sorted(before.items()):
+        if name in now and now[name][0] == ident and now[name][1] > length:
+            gained = now[name][1] - length
+            hint = (f"your function keeps data in the notebook variable `{name}` (it gained {gained} "
+                    f"entr{'y' if gained == 1 else 'ies'} during the check) and reads it back: an "
+                    "input that shares an earlier one's key (the same settings, the same size) gets what was kept "
+                    "for the earlier one; compute each result from the arguments, afresh in each call (a cache must "
+                    "be keyed by everything the result depends on, the data too)")
+            return hint, ex is not None and case is not None and _kept_data_matters(ex, fn, name, case, got, raised)
+    return None, False
+
+
+def _kept_data_matters(ex: Exercise, fn: Callable, name: str, case: tuple, got: Any, raised: bool) -> bool:
+    """``fn`` on ``case`` with the notebook variable ``name`` emptied for the call (a shallow copy, cleared: a
+    defaultdict keeps its factory) gives another answer than ``got`` (a result where it raised, or another
+    result); the variable is put back whatever happens. Cannot tell (it raises again, or otherwise): False."""
+    namespace = fn.__globals__
+    kept = namespace.get(name)
+    try:
+        empty = copy.copy(kept)
+        empty.clear()
+    except Exception:
+        return False
+    namespace[name] = empty
+    try:
+        fresh = _run(fn, *case, ex.observe)
+    except Exception:
+        return False
+    finally:
+        namespace[name] = kept
+    if raised:
+        return True
+    try:
+        return _compare(fresh, got, ex.rtol, ex.atol) is not None
+    except Exception:
+        return False
 
 
 def _stale_elsewhere(ex: Exercise, cases: list, k: int, subset: tuple, fn_outputs) -> bool:
@@ -948,9 +1063,12 @@ def _torch_round(v, d):
     return (v * 10.0 ** d).round() / 10.0 ** d
 
 
-def _generic_mistakes(ex: Exercise) -> list[tuple[str, Callable]]:
+def _generic_mistakes(ex: Exercise, cases: list | None = None) -> list[tuple[str, Callable]]:
     """Wrong versions made from the reference, for mistakes that any exercise can show: -1/+1 polarities treated
-    as 0/1 (or OFF events dropped), an input or the result clipped to [0, 1], a result rounded for display."""
+    as 0/1 (or OFF events dropped), an input or the result clipped to [0, 1], a result rounded for display, one
+    float array input rounded (made only for the arguments that are float numpy arrays in some case of
+    ``cases``, the exercise's own cases by default). A wrong version made from the inputs has ``applies(args,
+    kwargs)``: whether it changes them at all, asked before the inputs are copied for a run."""
     ref = ex.reference
 
     def on_inputs(change):
@@ -959,6 +1077,7 @@ def _generic_mistakes(ex: Exercise) -> list[tuple[str, Callable]]:
             if args or changed is None:
                 raise ValueError("not applicable")
             return ref(**changed)
+        wrong.applies = lambda args, kwargs: not args and change(kwargs) is not None
         return wrong
 
     def on_output(change):
@@ -991,11 +1110,56 @@ def _generic_mistakes(ex: Exercise) -> list[tuple[str, Callable]]:
     for d in range(7):
         out.append((f"the values are rounded to {d} decimal{'s' if d != 1 else ''}: return them as computed "
                     "(round only where you print them)", on_output(lambda v, d=d: _map_numbers(v, _round_to(d)))))
+    if cases is None:
+        try:
+            cases = ex.cases()
+        except Exception:
+            cases = []
+    float_arrays = [name for name in params if any(isinstance(kw.get(name), np.ndarray) and kw[name].dtype.kind == "f"
+                                                   for _, kw in cases)]
+    for only in float_arrays:                # one float array input rounded (times to milliseconds, say); confirmed
+        for d in range(7):                   # on a second input: float32 or another rounding can land alike on one
+            wrong = on_inputs(lambda kw, only=only, d=d: _rounded_input(kw, only, d))
+            wrong.support = 1
+            out.append((f"`{only}` was rounded to {d} decimal{'s' if d != 1 else ''} (np.round) before use: nothing "
+                        "here asks for that; use the values as given (rounded times move events past one another "
+                        "and past the edges of a window or a bin)", wrong))
     return out
 
 
+def _rounded_input(kwargs: dict, only: str, d: int) -> dict | None:
+    """``kwargs`` with the float numpy array ``only`` rounded to ``d`` decimals; None when that changes nothing."""
+    v = kwargs.get(only)
+    if not (isinstance(v, np.ndarray) and v.dtype.kind == "f" and v.size) or np.array_equal(np.round(v, d), v):
+        return None
+    return dict(kwargs, **{only: np.round(v, d)})
+
+
+_WATCH: list = []   # (the learner's function, what its calls changed of torch's settings), one per running check
+
+
 def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
-    """(passed, headline, detail lines) without printing."""
+    """(passed, headline, detail lines) without printing.
+
+    torch's global settings are set back after every call of a function (see :func:`_run`), and once more, to
+    what they were when the check began, after all of it: a function that changes them only on an input the
+    main run never reaches (a hint's search runs the others), or that raises right after, leaves the notebook as
+    it was. Such a change is named in the report (`also: ...`) when the main run did not name it already."""
+    settings = _torch_settings()
+    _WATCH.append((fn, {}))
+    try:
+        ok, headline, details = _evaluate_calls(ex, fn)
+        seen = _WATCH[-1][1]
+        if seen and not ok and not headline.startswith("changed torch's global settings"):
+            details = details + ["also: " + _settings_message(seen)]
+        return ok, headline, details
+    finally:
+        _WATCH.pop()
+        _restore_torch_settings(settings)
+
+
+def _evaluate_calls(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
+    """:func:`_evaluate`'s work: the calls and the report."""
     if not callable(fn):
         return False, f"expected a function, got {type(fn).__name__}", []
     try:
@@ -1004,17 +1168,33 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         return False, f"could not build the test inputs ({type(err).__name__}: {err})", []
     n = len(cases)
     defaults = _mutable_defaults(fn)
+    containers = _global_containers(fn)
     for k, (args, kwargs) in enumerate(cases):
         where = f"input #{k + 1} of {n} ({_describe_case(args, kwargs)})"
         after: list = []
+        if k == n - 1:
+            rng_before = _rng_states()       # the last input is run again below, from other generator states
+        changed_settings: dict = {}
         try:
-            got = _run(fn, args, kwargs, ex.observe, inputs_after=after)
+            got = _run(fn, args, kwargs, ex.observe, inputs_after=after, settings_changed=changed_settings)
+            if k == n - 1:
+                rng_after = _rng_states()
         except NotImplementedError:
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except Exception as err:
             details = [f"{type(err).__name__}: {err}"] + _where_raised(err)
-            if isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
+            if isinstance(err, TypeError) and "unhashable type" in str(err) and _cache_raised(fn, err):
+                details.append("hint: a cache (functools.lru_cache, functools.cache, or a dict keyed by the "
+                               "arguments) needs hashable arguments, and an array, a list or a dict is not one; "
+                               "drop the cache (nothing here is slow enough to need one), or key it by "
+                               "something hashable that holds all of the data (a.tobytes()) and return copies")
+            elif isinstance(err, TypeError) and "unhashable type" in str(err):
+                details.append("hint: an array, a list or a dict cannot be a dict key, a set's member or a "
+                               "Counter's item (it is unhashable: its contents can change); use a tuple of numbers "
+                               "(`tuple(row.tolist())`), one integer made of them (`y * W + x`), or numpy "
+                               "itself (np.unique(..., axis=0, return_counts=True), np.add.at)")
+            elif isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
                 names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
                 details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
                                "stub's parameter names and order")
@@ -1028,9 +1208,15 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                                "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
                                "`np.zeros((H, W))`, `frame[y, x]`")
             state = _mutable_default_hint(fn, defaults) if k > 0 else None
+            if state is None and k > 0:
+                cache, proven = _global_cache_hint(fn, containers, ex, (args, kwargs), raised=True)
+                if proven or not any(d.startswith("hint:") for d in details):
+                    state = cache        # a list only logged to, which changes nothing, is a fallback
             if state:
                 details.append(f"hint: {state}")
             return False, f"raised {type(err).__name__} on {where}", details
+        if changed_settings:
+            return False, f"changed torch's global settings on {where}", [_settings_message(changed_settings)]
         expected = _run(ex.reference, args, kwargs, ex.observe)
         if ex.compare is not None:
             try:
@@ -1047,11 +1233,16 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         if problem is None:
             return False, f"changed its input on {where}", [_in_place_message(changed, _container_names(args, kwargs))]
         details = [problem.message]
-        hint = None
+        # results kept in a notebook dict (or list) that the function fills: an input that shares an earlier
+        # one's key gets that input's result. Named first when the kept data made the difference (run with the
+        # variable emptied, the function answers otherwise), else only when no other hint applies (below): a list
+        # the function only logs to (`log.append(len(t))`, a common habit) grows just the same and explains nothing
+        cache_hint, proven = _global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
+        hint = cache_hint if proven else None
         # a known mistake is recognised by its output, whatever the first difference is (a wrong
         # count of events is a wrong shape, not wrong values), and confirmed on the other inputs where
         # it shows: one input alone can make two different mistakes look alike
-        for message, wrong in ex.hints.items():
+        for message, wrong in ex.hints.items() if hint is None else ():
             try:
                 w = _run(wrong, args, kwargs, ex.observe)
                 if _compare(got, w, ex.rtol, ex.atol) is None and _same_mistake_elsewhere(ex, fn, wrong, cases, k):
@@ -1070,16 +1261,24 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
         # mistakes any exercise can show (polarities read as 0/1, a clip to [0, 1], a rounded result), recognised
         # the same way from wrong versions made from the reference
         if hint is None and ex.observe is None:
-            for message, wrong in _generic_mistakes(ex):
+            for message, wrong in _generic_mistakes(ex, cases):
+                applies = getattr(wrong, "applies", None)
+                if applies is not None and not applies(args, kwargs):
+                    continue
                 try:
                     w = _run(wrong, args, kwargs)
                     if _compare(w, expected, ex.rtol, ex.atol) is not None \
                             and _compare(got, w, ex.rtol, ex.atol) is None \
-                            and _same_mistake_elsewhere(ex, fn, wrong, cases, k):
+                            and _same_mistake_elsewhere(ex, fn, wrong, cases, k, getattr(wrong, "support", 0)):
                         hint = message
                         break
                 except Exception:
                     continue
+        # a global generator seeded inside: random numbers, the same at every call (after the generic mistakes: a
+        # seed that draws nothing explains no value, and is only noted)
+        seed_note = None
+        if hint is None:
+            hint, seed_note = _reseed_hint(ex, fn, args, kwargs)
         if hint is None:
             hint = _size_from_events_hint(args, kwargs, got, expected)
         if hint is None:
@@ -1096,27 +1295,253 @@ def _evaluate(ex: Exercise, fn: Callable) -> tuple[bool, str, list[str]]:
                     hint = _generic_hint(*_differing_leaf(got, expected, ex.rtol, ex.atol), indexed=indexed)
             if hint is None:
                 hint = _scalar_factor_hint(ex, fn, cases, k, got, expected)
+        if hint is None:
+            hint = cache_hint
         if hint:
             details.append(f"hint: {hint}")
+        if seed_note:
+            details.append(f"also: {seed_note}")
         if changed:
             details.append("also: " + _in_place_message(changed, _container_names(args, kwargs)))
         return False, f"does not match the reference on {where}", details
-    # the same input once more (the last one, right after its first run): a function that keeps state between
-    # calls (a notebook variable it changes, a mutable default argument) gives another result the second time
-    if n and ex.observe is None:
+    # the same input once more (the last one, right after its first run), from other states of the global random
+    # generators: a function that keeps state between calls (a notebook variable it changes, a mutable default
+    # argument) gives another result the second time; one that keeps its result (a buffer, a cache) returns the
+    # same array again; one that reseeds a global generator leaves it in the same state whatever it held before
+    if n:
         args, kwargs = cases[-1]
+        rng_now, rng_other = _rng_states(), _other_rng_states(rng_before)
+        changed_settings = {}
         try:
-            again = _run(fn, args, kwargs)
-            problem = _compare(again, _run(ex.reference, args, kwargs), ex.rtol, ex.atol) if ex.compare is None \
-                else (None if ex.compare(again, _run(ex.reference, args, kwargs)) is None else _Problem("", True))
+            _set_rng_states(rng_other)
+            again = _run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
+            rng_again = _rng_states()
+            if ex.observe is not None:
+                problem = None
+            elif ex.compare is None:
+                problem = _compare(again, _run(ex.reference, args, kwargs), ex.rtol, ex.atol)
+            else:
+                problem = None if ex.compare(again, _run(ex.reference, args, kwargs)) is None else _Problem("", True)
         except Exception as err:
-            problem = _Problem(f"{type(err).__name__}: {err}")
+            again, rng_again, problem = None, None, _Problem(f"{type(err).__name__}: {err}")
+        finally:
+            _set_rng_states(rng_now)
+        if changed_settings:
+            return False, f"changed torch's global settings on input #{n} of {n}", [_settings_message(changed_settings)]
         if problem is not None:
             return False, f"gives another result when input #{n} of {n} is run a second time", [
                 "every input matched once, but a second call on the same input does not: your function keeps "
                 "state between calls (a notebook variable it changes, a mutable default argument such as "
                 "`state={}`, or unseeded randomness); compute everything from the arguments, afresh in each call"]
+        shared = _shares_output(got, again) if ex.observe is None else None
+        if shared:
+            return False, f"returns the same {shared} again when input #{n} of {n} is run a second time", [
+                "every input matched, but two calls return the same array (or dict) object, or views of one: a "
+                "buffer or a cached result kept between calls (a notebook variable, a dict of results keyed by the "
+                "shape or the arguments, a default argument) is handed out again, so each call changes what the "
+                "earlier ones returned, and a caller that changes a result changes the cache (`frames = [f(...) "
+                "for ...]` would hold one array many times); create the result afresh in each call (np.zeros(...) "
+                "inside the function), or return a copy of a cached one (`.copy()`)"]
+        reseeded = _reseeded(rng_before, rng_other, rng_after, rng_again) if rng_again is not None else []
+        if reseeded:
+            return False, f"reseeds the global random generator ({', '.join(reseeded)})", [
+                "every input matched, but after a call the global generator is in the same state whatever it held "
+                "before: your function seeds it (np.random.seed, torch.manual_seed, random.seed), which resets the "
+                "random numbers of the whole notebook at every call (a later cell's random minibatches or noise "
+                "repeat); nothing here asks for randomness: remove the seed, or draw from a generator of your own "
+                "(rng = np.random.default_rng(seed), torch.Generator().manual_seed(seed))"]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
+
+
+# ---- a second call on the last input: kept results, reseeded generators ----------------------------------------
+
+def _mutable_leaves(v) -> list:
+    """The arrays, tensors, dicts and lists inside a result that a caller could change in place."""
+    if isinstance(v, dict):
+        return [v] + [leaf for x in v.values() for leaf in _mutable_leaves(x)]
+    if isinstance(v, list):
+        return [v] + [leaf for x in v for leaf in _mutable_leaves(x)]
+    if isinstance(v, tuple):
+        return [leaf for x in v for leaf in _mutable_leaves(x)]
+    if isinstance(v, np.ndarray) and v.size > 0 and v.flags.writeable:
+        return [v]
+    if _is_tensor(v) and v.numel() > 0:
+        return [v]
+    return []
+
+
+def _shares_output(first, second) -> str | None:
+    """What two results of the same call share: an array (memory), a tensor (storage), a dict or a list (the
+    object); None when they share nothing."""
+    try:
+        a, b = _mutable_leaves(first), _mutable_leaves(second)
+        for x in a:
+            for y in b:
+                if isinstance(x, (dict, list)) or isinstance(y, (dict, list)):
+                    if x is y:
+                        return type(x).__name__
+                elif isinstance(x, np.ndarray) and isinstance(y, np.ndarray):
+                    if np.shares_memory(x, y, max_work=10 ** 6):
+                        return "array"
+                elif _is_tensor(x) and _is_tensor(y):
+                    if x.untyped_storage().data_ptr() == y.untyped_storage().data_ptr():
+                        return "tensor"
+    except Exception:
+        return None           # cannot tell: say nothing
+    return None
+
+
+def _reseed_hint(ex: Exercise, fn: Callable, args, kwargs) -> tuple[str | None, str | None]:
+    """A function that seeds a global generator (its random numbers the same on every call, but random all the
+    same): two runs from different generator states leave the generators in one state. Returns (hint, note): the
+    hint when it drew from a generator after seeding it (the generator is not where a seed leaves it), which can
+    explain wrong values; otherwise a note only (a seed with no draws changes no value, but resets the notebook's
+    random numbers at every call)."""
+    now = _rng_states()
+    try:
+        afters = []
+        for start in (now, _other_rng_states(now)):
+            _set_rng_states(start)
+            try:
+                _run(fn, args, kwargs, ex.observe)
+            except Exception:
+                return None, None
+            afters.append(_rng_states())
+    finally:
+        _set_rng_states(now)
+    seeded = _reseeded(now, _other_rng_states(now), *afters)
+    if not seeded:
+        return None, None
+    calls = ", ".join(seeded)
+    keys = [key for key, call in _SEED_CALLS.items() if call in seeded]
+    if any(not _fresh_seed_state(key, afters[0][key]) for key in keys):
+        return (f"your function seeds the global random generator ({calls}) and draws from it: seeded, the "
+                "numbers are the same at every call, but they are random numbers all the same (a random sample of "
+                "the pixels, noise, a random start or tie-break), and nothing here asks for any; compute the result "
+                "from all of the data, without randomness (and a seed inside a function resets the whole notebook's "
+                "random numbers)"), None
+    return None, (f"your function seeds the global random generator ({calls}) and draws nothing from it after: the "
+                  "seed changes no value here, but it resets the whole notebook's random numbers at every call (a "
+                  "later cell's random minibatches or noise repeat); remove it")
+
+
+def _fresh_seed_state(key: str, state) -> bool:
+    """The generator ``key`` ("numpy", "random", "torch") is in ``state`` as a seed leaves it, no number drawn
+    since: Mersenne Twister's position at the end of its fresh key (numpy's and Python's), or the state that
+    seeding a new generator with the state's own seed gives (torch's). Unreadable: False (say it drew)."""
+    try:
+        if key == "numpy":
+            return int(state[2]) == 624 and int(state[3]) == 0
+        if key == "random":
+            return int(state[1][-1]) == 624 and state[2] is None
+        torch = sys.modules.get("torch")
+        if key == "torch" and torch is not None:
+            g = torch.Generator()
+            g.set_state(state)
+            return bool(torch.equal(torch.Generator().manual_seed(g.initial_seed()).get_state(), state))
+    except Exception:
+        return False
+    return False
+
+
+def _torch_settings() -> dict | None:
+    """torch's global settings a function may change for the whole notebook: gradients on or off, the default
+    float dtype; None when torch is not imported."""
+    torch = sys.modules.get("torch")
+    if torch is None:
+        return None
+    return {"grad": torch.is_grad_enabled(), "dtype": torch.get_default_dtype()}
+
+
+def _restore_torch_settings(before: dict | None) -> dict:
+    """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was."""
+    torch = sys.modules.get("torch")
+    if before is None or torch is None:
+        return {}
+    now = _torch_settings()
+    changed = {k: (before[k], now[k]) for k in before if now[k] != before[k]}
+    if "grad" in changed:
+        torch.set_grad_enabled(before["grad"])
+    if "dtype" in changed:
+        torch.set_default_dtype(before["dtype"])
+    return changed
+
+
+def _settings_message(changed: dict) -> str:
+    parts = []
+    if "grad" in changed and changed["grad"][0]:
+        parts.append("it turned gradients off for the whole notebook (torch.set_grad_enabled(False), or "
+                     "torch.no_grad().__enter__() without its exit), so every later training step runs without "
+                     "autograd; use `with torch.no_grad():` around the lines that need it, which switches gradients "
+                     "back on at its end")
+    elif "grad" in changed:
+        parts.append("it turned gradients on for the whole notebook (torch.set_grad_enabled(True)), where an earlier "
+                     "cell had switched them off: the cells after it now record autograd graphs the notebook chose "
+                     "to do without; use `with torch.enable_grad():` around the lines that need gradients, which "
+                     "leaves the notebook's setting as it was at its end")
+    if "dtype" in changed:
+        parts.append(f"it changed torch's default dtype from {changed['dtype'][0]} to {changed['dtype'][1]} "
+                     "(torch.set_default_dtype) for the whole notebook, so every tensor made later (a model's "
+                     "weights, torch.zeros, torch.tensor of floats) has the new dtype; give the dtype where you need "
+                     "it (x.double(), torch.zeros(..., dtype=torch.float64)) and leave the default alone")
+    return "; and ".join(parts) + " (the check has set it back)"
+
+
+def _rng_states() -> dict:
+    """The states of the global random generators a learner may seed: numpy's, Python's, torch's (CPU)."""
+    states = {"numpy": np.random.get_state(), "random": random.getstate()}
+    torch = sys.modules.get("torch")
+    if torch is not None:
+        states["torch"] = torch.random.get_rng_state()
+    return states
+
+
+def _set_rng_states(states: dict) -> None:
+    np.random.set_state(states["numpy"])
+    random.setstate(states["random"])
+    torch = sys.modules.get("torch")
+    if torch is not None and "torch" in states:
+        torch.random.set_rng_state(states["torch"])
+
+
+def _other_rng_states(states: dict) -> dict:
+    """States of the global generators that differ from ``states`` (built from generators of their own, so that
+    nothing else is seeded: CUDA's generators stay as they are)."""
+    for seed in (20240607, 7):
+        other = {"numpy": np.random.RandomState(seed).get_state(), "random": random.Random(seed).getstate()}
+        torch = sys.modules.get("torch")
+        if torch is not None:
+            other["torch"] = torch.Generator().manual_seed(seed).get_state()
+        if not any(_same_rng_state(states[k], other[k]) for k in other if k in states):
+            return other
+    return other
+
+
+def _same_rng_state(a, b) -> bool:
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return len(a) == len(b) and all(_same_rng_state(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return bool(np.array_equal(a, b))
+    if _is_tensor(a) and _is_tensor(b):
+        return a.shape == b.shape and bool((a == b).all())
+    return a == b
+
+
+_SEED_CALLS = {"numpy": "np.random.seed", "random": "random.seed", "torch": "torch.manual_seed"}
+
+
+def _reseeded(before: dict, other: dict, after: dict, again: dict) -> list[str]:
+    """The generators that two runs, started from different states (``before``, ``other``), left in one state
+    (``after``, ``again``): the function seeded them."""
+    out = []
+    for name, call in _SEED_CALLS.items():
+        if all(name in d for d in (before, other, after, again)):
+            try:
+                if not _same_rng_state(before[name], other[name]) and _same_rng_state(after[name], again[name]):
+                    out.append(call)
+            except Exception:
+                continue
+    return out
 
 
 def _differing_leaf(got, expected, rtol: float, atol: float):
@@ -1135,12 +1560,17 @@ def _differing_leaf(got, expected, rtol: float, atol: float):
     return got, expected
 
 
-def _same_mistake_elsewhere(ex: Exercise, fn: Callable, wrong: Callable, cases: list, skip: int) -> bool:
+def _same_mistake_elsewhere(ex: Exercise, fn: Callable, wrong: Callable, cases: list, skip: int,
+                            support: int = 0) -> bool:
     """On every case but ``skip`` where the wrong version ``wrong`` shows its mistake (differs from the
     reference), ``fn`` gives the same output. Cases where either raises say nothing, and so do cases where
-    the wrong version happens to be right (the learner's variant of the mistake may be broader)."""
+    the wrong version happens to be right (the learner's variant of the mistake may be broader). ``support``:
+    how many other cases must show the mistake (a wrong version that changes almost any output needs none; one
+    that changes only an input's last digits, where some other mistake may land alike, needs one)."""
+    shown = 0
+    applies = getattr(wrong, "applies", None)
     for j, (args, kwargs) in enumerate(cases):
-        if j == skip:
+        if j == skip or (applies is not None and not applies(args, kwargs)):
             continue
         try:
             w = _run(wrong, args, kwargs, ex.observe)
@@ -1154,7 +1584,8 @@ def _same_mistake_elsewhere(ex: Exercise, fn: Callable, wrong: Callable, cases: 
                 return False
         except Exception:
             return False
-    return True
+        shown += 1
+    return shown >= support
 
 
 def check(name: str, fn: Callable, *, verbose: bool = True) -> bool:

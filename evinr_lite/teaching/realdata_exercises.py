@@ -76,6 +76,15 @@ def _rate_edges_to_later_bin(t, bin_s):
     return t[0] + (np.arange(n_bins) + 0.5) * bin_s, counts / bin_s
 
 
+def _rate_edges_to_later_bin_clipped(t, bin_s):
+    """Bins [b_k, b_{k+1}) with B = ceil(...) bins, the last one closed (np.histogram on edges t0 + k bin_s, or
+    floor clipped to B - 1): an event on an inner edge goes to the later bin."""
+    t = np.asarray(t, dtype=np.float64)
+    n_bins = max(int(np.ceil((t[-1] - t[0]) / bin_s)), 1)
+    k = np.clip(np.floor((t - t[0]) / bin_s).astype(np.int64), 0, n_bins - 1)
+    return t[0] + (np.arange(n_bins) + 0.5) * bin_s, np.bincount(k, minlength=n_bins) / bin_s
+
+
 def _rate_bins_from_zero(t, bin_s):
     """The mistake: bins counted from time 0 (edges k bin_s) instead of from the first event t0 = t[0]."""
     t = np.asarray(t, dtype=np.float64)
@@ -120,6 +129,10 @@ exercises.register(
            "library's rule; bin 0 also holds t0): use ceil((t - t0) / bin_s) - 1 clipped at 0, or "
            "searchsorted(edges, t, side='left') - 1, not floor or side='right'":
            _rate_edges_to_later_bin,
+           "an event exactly on an inner bin edge t0 + k bin_s belongs to bin k - 1, which ends there (bins are "
+           "(b_k, b_{k+1}]): np.histogram's bins are [b_k, b_{k+1}) but its last, and floor((t - t0) / bin_s) puts "
+           "the event in bin k; use ceil((t - t0) / bin_s) - 1 clipped at 0, or searchsorted(edges, t, side='left') - 1":
+           _rate_edges_to_later_bin_clipped,
            "count the bins from the first event t0 = t[0] (edges t0 + k bin_s), not from time 0: a recording's "
            "clock rarely starts at 0":
            _rate_bins_from_zero,
@@ -170,6 +183,12 @@ def _threshold_of_magnitudes(log_changes, net_counts):
     return float(np.sum(d * n) / np.sum(n * n))
 
 
+def _threshold_column_times_row(log_changes, net_counts):
+    """n as a column [M, 1] times ΔL [M]: an [M, M] table of every pair, whose sum is sum(ΔL) sum(n)."""
+    d, n = np.asarray(log_changes, float), np.asarray(net_counts, float)[:, None]
+    return float(np.sum(d * n) / np.sum(n * n))
+
+
 def _threshold_means_over_other_pixels(log_changes, net_counts):
     """np.mean(ΔL n) over all pixels divided by np.mean(n^2) over the pixels with n != 0: two different counts."""
     d, n = np.asarray(log_changes, float), np.asarray(net_counts, float)
@@ -217,6 +236,10 @@ exercises.register(
         "take both sums over the same pixels: np.mean(ΔL n) over all of them divided by np.mean(n^2) over the pixels "
         "that fired divides by two different counts; the ratio of sums, sum(ΔL n) / sum(n^2), needs no means":
             _threshold_means_over_other_pixels,
+        "one of the two is a column ([M, 1]: n[:, None], reshape(-1, 1), keepdims) and the other 1-D ([M]): their "
+        "product broadcasts to an [M, M] table of every pair of pixels, whose sum is sum(ΔL) sum(n); keep both 1-D "
+        "(np.ravel) so that ΔL * n pairs each pixel with itself":
+            _threshold_column_times_row,
     })
 
 

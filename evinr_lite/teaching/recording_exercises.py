@@ -89,13 +89,15 @@ def _inputs_hot(rng):
     # an even number of firing pixels (8), counts 1 1 2 2 | 5 10 11 20: the median is (2 + 5) / 2 = 3.5 (np.median
     # averages the two middle values), so with factor 3 the threshold is 10.5: 11 and 20 are hot, 10 is not. The
     # upper middle value (sorted[n // 2] = 5) flags only 20, the lower one (2) flags 10 too, and so does the median
-    # made a whole number (int(3.5) = 3: threshold 9). The sensor is 6 x 4 and its last row and column never fire:
-    # a mask sized from the events (y.max() + 1) is too small
-    counts = np.zeros((6, 4), np.int64)
-    for (r, c), n in {(0, 0): 1, (1, 1): 2, (2, 2): 1, (3, 0): 5, (4, 1): 10, (4, 2): 2, (0, 2): 11, (2, 0): 20}.items():
+    # made a whole number (int(3.5) = 3: threshold 9). The sensor is 6 x 9 and its last row and column never fire:
+    # a mask sized from the events (y.max() + 1) is too small (and counts indexed [x, y] raise: column 7 fires). It
+    # is the second case's sensor, with other events: a typical count kept from one call to the next (cached per
+    # sensor, as if it were the camera's) fails here
+    counts = np.zeros((6, 9), np.int64)
+    for (r, c), n in {(0, 0): 1, (1, 1): 2, (2, 7): 1, (3, 0): 5, (4, 1): 10, (4, 2): 2, (0, 2): 11, (2, 0): 20}.items():
         counts[r, c] = n
     x, y = _events_from_counts(counts, rng)
-    cases.append(dict(x=x, y=y, sensor_size=(6, 4), factor=3.0))
+    cases.append(dict(x=x, y=y, sensor_size=(6, 9), factor=3.0))
     return cases
 
 
@@ -167,6 +169,14 @@ def _hot_whole_median(x, y, sensor_size, factor=10.0):
     return counts > factor * int(np.median(counts[counts > 0]))
 
 
+def _hot_sorted_through_a_view(x, y, sensor_size, factor=10.0):
+    """counts.ravel() sorted in place for the median: ravel is a view, so the counts themselves get sorted."""
+    counts = _pixel_counts(x, y, sensor_size)
+    flat = counts.ravel()
+    flat.sort()
+    return counts > factor * np.median(flat[flat > 0])
+
+
 exercises.register(
     "hot_pixel_mask", hot_pixel_mask, _inputs_hot,
     hints={
@@ -194,6 +204,10 @@ exercises.register(
         "the median of an even number of counts can end in .5: keep it as np.median gives it (no int(...), round or "
         "`//`, which move the threshold factor x median)":
             _hot_whole_median,
+        "`counts.ravel()` (like counts.reshape(-1) or a slice) is a view of counts, not a copy: sorting it in place "
+        "(.sort()) sorts the counts image too, so the mask marks the pixels at the end of the sensor instead of the "
+        "hot ones; take the median of a copy (np.sort(...), .flatten()), or just np.median(counts[counts > 0])":
+            _hot_sorted_through_a_view,
     })
 
 
@@ -343,6 +357,11 @@ def _inputs_filter(rng):
             for v, column in ((0.0157, 20), (0.0197, 21)):
                 k = np.searchsorted(t, v)
                 t[k], x[k], y[k] = v, column, 20
+        else:
+            # the last two events, two lone neighbours on a clock at 1000 s, 20 us further apart than dt: out of the
+            # window in float64 (and in whole microseconds), but float32 times (spacing 61 us at 1000 s) put them
+            # exactly dt apart, and the later one is kept
+            t[-2:], x[-2:], y[-2:] = (1000.0, 1000.00202), (30, 31), (30, 30)
         cases.append(dict(t=t, x=x, y=y, dt=dt))
     return cases
 
@@ -461,6 +480,22 @@ def _filter_truncated_microseconds(t, x, y, dt):
     return np.any((cheb == 1) & (tu[None, :] <= tu[:, None]) & (tu[:, None] <= tu[None, :] + du), axis=1)
 
 
+def _filter_float32_times(t, x, y, dt):
+    """Times (and dt) in float32: spacing 61 us on a clock at 1000 s."""
+    t32 = np.asarray(t, np.float32)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    return np.any((cheb == 1) & (t32[None, :] <= t32[:, None]) & (t32[:, None] <= t32[None, :] + np.float32(dt)), axis=1)
+
+
+def _filter_time_slots(t, x, y, dt):
+    """Times cut into slots of width dt (floor(t / dt)), a neighbour in the same slot or the one before counted."""
+    k = np.floor(np.asarray(t, np.float64) / dt).astype(np.int64)
+    x, y = np.asarray(x, np.int64), np.asarray(y, np.int64)
+    cheb = np.maximum(np.abs(x[:, None] - x[None, :]), np.abs(y[:, None] - y[None, :]))
+    return np.any((cheb == 1) & (k[None, :] <= k[:, None]) & (k[:, None] <= k[None, :] + 1), axis=1)
+
+
 exercises.register(
     "background_activity_filter", background_activity_filter, _inputs_filter,
     hints={
@@ -499,6 +534,14 @@ exercises.register(
         "an event exactly dt after its neighbour falls out of the window; compare the seconds as they are (or "
         "np.round before astype)":
             _filter_truncated_microseconds,
+        "timestamps must stay float64: in float32 a time near 1000 s is rounded to a multiple of 61 us, so two "
+        "neighbours a few microseconds more than dt apart land exactly dt apart (or the other way round); keep t "
+        "as it is given (np.asarray(t, dtype=np.float64))":
+            _filter_float32_times,
+        "slots of width dt (floor(t / dt)) are not a window of dt before each event: a neighbour in the slot "
+        "before can be almost 2 dt earlier, and one just across a slot edge a moment earlier is missed when "
+        "the slots are compared for equality; compare the times of each pair, t_j <= t_i <= t_j + dt":
+            _filter_time_slots,
     })
 
 

@@ -82,12 +82,15 @@ def _as_float(value):
 
 
 def _observe_step(result, args, kwargs):
-    """The step's three losses (as floats) and the model's parameters after the step."""
+    """The step's three losses (as floats), the model's parameters after the step, and the optimiser's learning
+    rates after it (a step that changes them, a decay inside the step, changes every later step of the loop)."""
     model = kwargs["model"] if "model" in kwargs else args[0]
+    optimizer = kwargs["optimizer"] if "optimizer" in kwargs else args[1]
     if isinstance(result, (tuple, list)):
         result = tuple(_as_float(r) for r in result)
     params = {name: p.detach().clone() for name, p in model.named_parameters()}
-    return {"losses": result, "parameters after the step": params}
+    lrs = tuple(float(group["lr"]) for group in optimizer.param_groups)
+    return {"losses": result, "parameters after the step": params, "optimizer's learning rates after the step": lrs}
 
 
 def _no_zero_grad(model, optimizer, event_frames, centers, durations, lam):
@@ -158,6 +161,18 @@ def _two_steps(model, optimizer, event_frames, centers, durations, lam):
     return out
 
 
+def _own_optimizer(model, optimizer, event_frames, centers, durations, lam):
+    """A new Adam made inside the step at the paper's learning rate: the optimiser passed in is not used."""
+    return frame_train_step(model, torch.optim.Adam(model.parameters(), lr=1e-4), event_frames, centers, durations, lam)
+
+
+def _lr_changed(model, optimizer, event_frames, centers, durations, lam):
+    out = frame_train_step(model, optimizer, event_frames, centers, durations, lam)
+    for group in optimizer.param_groups:
+        group["lr"] *= 0.99
+    return out
+
+
 def _only_temporal(model, optimizer, event_frames, centers, durations, lam):
     return frame_train_step(model, optimizer, event_frames, centers, durations, 0.0)
 
@@ -188,4 +203,11 @@ exercises.register(
             _minus_regularizer,
         "one call makes one optimizer.step(): a second step moves the parameters again with the same gradients":
             _two_steps,
+        "the step changed the optimiser's learning rate (`group['lr'] *= ...`, a scheduler's step): one call is "
+        "one step of the loss at the learning rate it is given; the schedule belongs to the loop outside it "
+        "(notebook 04), so leave optimizer.param_groups as they are":
+            _lr_changed,
+        "use the optimiser passed in: a new one made inside the step (torch.optim.Adam(model.parameters(), ...)) "
+        "has its own learning rate and forgets what Adam keeps from one step to the next (its running means)":
+            _own_optimizer,
     })
