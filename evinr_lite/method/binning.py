@@ -96,7 +96,8 @@ def fixed_duration_boundaries(t_start: float, t_end: float, bin_duration: float 
     t_end = real_number(t_end, "t_end", hint="the bins' end in seconds")
     if t_end <= t_start:
         raise EventDataError(f"bin range [{t_start}, {t_end}] is empty or reversed; t_end must exceed t_start")
-    bin_duration = real_number(bin_duration, "bin_duration", lo=0, lo_open=True, hint="the bins' length in seconds")
+    bin_duration = real_number(bin_duration, "bin_duration", lo=0, lo_open=True,
+                               hint="positive seconds (the bins' length)")
     n = (t_end - t_start) / bin_duration
     if not n <= MAX_BINS:   # checked before the edges are allocated (1e-12 s over 1000 s: 7 PiB of edges)
         raise EventDataError(f"bins of {bin_duration:g} s over [{t_start}, {t_end}] s would be {n:,.0f} bins (at most "
