@@ -737,3 +737,25 @@ def test_ablation_run_variants_takes_one_equalization_by_name():
     row = run_variants(EV12, GT, GTT, VAR, equalizations="clahe")[0]
     assert "ssim_clahe" in row and "ssim_none" not in row
     assert row["ssim_clahe"] == run_variants(EV12, GT, GTT, VAR, equalizations=("clahe",))[0]["ssim_clahe"]
+
+
+# ---- from the review of this round ----------------------------------------------------------------
+
+@pytest.mark.parametrize("duration", [-1, 0, math.nan])
+def test_synthetic_recording_names_its_duration(duration):
+    """After the frame_rate check: a bad duration was blamed on a frame_rate the caller never passed (0: a
+    ZeroDivisionError)."""
+    from evinr_lite.sim import synthetic_recording
+    _no(lambda: synthetic_recording((20, 20), duration, n_frames=3), r"duration=")
+
+
+def test_ablation_table_of_none_says_no_rows():
+    """After the row check: None was Python's TypeError ("'NoneType' object is not iterable")."""
+    _no(lambda: ablation_table(None, ["ssim_none"]), r"no rows")
+
+
+@pytest.mark.parametrize("t_range,bin_s,pattern", [((0, math.inf), 0.1, r"t_range\[1\]"), ((0, 1), -1, r"bin_s"),
+                                                   ((1, 0), 0.1, r"t_range\[1\]")])
+def test_event_rate_names_its_own_arguments(t_range, bin_s, pattern):
+    """Before: fixed_duration_boundaries' names (t_end=, bin_duration=) for the caller's t_range and bin_s."""
+    _no(lambda: event_rate(EV12, bin_s, t_range), pattern)

@@ -250,8 +250,6 @@ def run_variants(events: Events, gt_frames, gt_times, variants: dict, *, t_start
                              "crop or resize them to the sensor size")
     if not variants:
         raise ValueError("variants is empty: pass {name: EvINRConfig or method(events, times)}")
-    if repeats < 1:
-        raise ValueError(f"repeats must be >= 1, got {repeats}")
     device = str(default_device(None))
     protocol = _protocol(len(times), equalizations, repeats, n_inference, device)
     rows = []
@@ -341,6 +339,8 @@ def ablation_table(rows: list[dict], columns=DEFAULT_COLUMNS, *, title: str | No
     Returns:
         The markdown text (print it, or display it with IPython.display.Markdown).
     """
+    if rows is None:
+        raise ValueError("no rows to tabulate: pass run_variants' rows (a list of dicts)")
     if isinstance(rows, dict) or not all(isinstance(r, dict) for r in rows):   # one row was Python's TypeError
         raise EventDataError(f"rows must be a list of dicts (run_variants' rows), got {type(rows).__name__}"
                              + ("; one row: pass [row]" if isinstance(rows, dict) else ""))

@@ -335,7 +335,11 @@ def event_rate(events: Events, bin_s: float, t_range=None) -> tuple[np.ndarray, 
         t_range = (events.t[0], events.t[-1])
     if isinstance(t_range, (str, bytes)) or np.ndim(t_range) != 1 or len(t_range) != 2:   # 3 values: 2 used
         raise EventDataError(f"t_range must be (t0, t1), two times in seconds, got {t_range!r}")
-    edges = fixed_duration_boundaries(t_range[0], t_range[1], bin_s)
+    # named as the caller gave them, not as fixed_duration_boundaries' t_start / t_end / bin_duration
+    t0 = real_number(t_range[0], "t_range[0]", hint="seconds")
+    t1 = real_number(t_range[1], "t_range[1]", lo=t0, lo_open=True, hint="seconds, after t_range[0]")
+    bin_s = real_number(bin_s, "bin_s", lo=0, lo_open=True, hint="a positive number of seconds per bin (e.g. 0.01)")
+    edges = fixed_duration_boundaries(t0, t1, bin_s)
     B = edges.size - 1
     idx = np.searchsorted(edges, events.t, side="left") - 1
     idx[events.t == edges[0]] = 0

@@ -34,7 +34,7 @@ from ..core.checks import host_array, is_real_number, real_number
 from ..core.events import EventDataError
 
 __all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "DISPLAY_MEANS", "tonemap_reinhard", "tonemap_linear", "to_display", "display_formula", "display_shift", "anchor_level",
-           "anchor_mean", "reinhard_unchecked"]
+           "anchor_mean", "reinhard_unchecked", "linear_unchecked"]
 
 TONEMAPS = ("linear", "reinhard")
 DEFAULT_TONEMAP = "linear"  # the kit's display (EvINRConfig and the baselines share it)

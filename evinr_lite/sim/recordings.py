@@ -60,6 +60,8 @@ def synthetic_recording(sensor_size=(90, 120), duration: float = 0.5, n_frames: 
     :func:`write_example_recording`)."""
     # the first frame at 0 and the last at duration: 1 frame was a ZeroDivisionError, 2.5 frames two
     n_frames = whole_number(n_frames, "n_frames", lo=2)
+    # the frame rate is derived from it: a bad duration would be blamed on a frame_rate nobody passed
+    duration = real_number(duration, "duration", lo=0, lo_open=True, hint="seconds (e.g. 0.5)")
     with tempfile.TemporaryDirectory() as tmp:
         folder = write_example_recording(Path(tmp) / "synthetic", sensor_size=sensor_size, duration=duration, C=C,
                                          frame_rate=(n_frames - 1) / duration, seed=seed)
