@@ -2,7 +2,7 @@
 
     python tests/robustness_table.py            every file below; exit status 1 unless the four counts are 0
     python tests/robustness_table.py --round3   only issue 25's classes (its test files)
-    python tests/robustness_table.py --later    only the later rounds (bad files 4 to 10, API arguments, fuzzed readers)
+    python tests/robustness_table.py --later    only the later rounds (bad files 4 to 11, API arguments, fuzzed readers)
 
 One pytest case is one row of the table. A passing case ended as it must (a clear error naming the
 problem, or the correct result, and nothing left behind). A failing one is counted by what its failure
@@ -27,7 +27,8 @@ ROUND3 = ["test_batch_ownership.py", "test_api_checks.py", "test_signals_edges.p
           "test_io_reliability.py", "test_options.py"]
 LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustness_round6.py", "test_api_bad_inputs.py",
          "test_api_round6.py", "test_ragged_inputs.py", "test_fuzz_readers.py", "test_robustness_round7.py",
-         "test_robustness_round8.py", "test_robustness_round9.py", "test_robustness_round10.py"]
+         "test_robustness_round8.py", "test_robustness_round9.py", "test_robustness_round10.py",
+         "test_robustness_round11.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
@@ -47,6 +48,9 @@ CLASSES = [
      "arguments, round 9", "test_robustness_round9.py", r"test_"),
     ("the scorer, APS anchors and the fit of C, the colour path and the figures: odd pixels, shapes, times, sensors "
      "and empty inputs, round 10", "test_robustness_round10.py", r"test_"),
+    ("the simulator (seeds, noise rates and spans, scenes, colour, recordings) and the method's helpers beside "
+     "reconstruct (baselines, bins, lam, windows, tone maps, denoiser, enhancement, ablation), round 11",
+     "test_robustness_round11.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"

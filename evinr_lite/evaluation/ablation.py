@@ -38,8 +38,11 @@ from dataclasses import asdict, replace
 
 import numpy as np
 
+from ..core.checks import ArgumentTypeError, check_image_values, real_number, require, whole_number
 from ..core.events import EventDataError, Events
+from ..core.guard import dense_array
 from ..core.runtime import default_device
+from ..method.binning import as_thresholds
 from ..method.integration import integrate_events
 from ..method.solver import EvINRConfig, reconstruct
 from ..method.tonemap import anchor_mean, reinhard_unchecked
@@ -86,8 +89,9 @@ def table2_variants(**common) -> dict[str, EvINRConfig]:
 def tau_for_networks(n_networks: int, duration: float, overlap: float) -> float | None:
     """The window length tau (s) for which :func:`~evinr_lite.method.solver.split_windows` cuts ``duration``
     seconds into exactly ``n_networks`` windows sharing ``overlap`` s; None for one network."""
-    if n_networks < 1:
-        raise ValueError(f"n_networks must be >= 1, got {n_networks}")
+    n_networks = whole_number(n_networks, "n_networks", lo=1)   # 2.5 gave a tau for 2.5 windows, "2" a TypeError
+    duration = real_number(duration, "duration", lo=0, lo_open=True, hint="the span in seconds")
+    overlap = real_number(overlap, "overlap", lo=0, hint="seconds shared by neighbouring windows")
     if n_networks == 1:
         return None
     tau = (duration - overlap) / n_networks + overlap
@@ -164,10 +168,13 @@ def recipe_variants(n_events: int, span_s: float, **common) -> dict[str, EvINRCo
 
 def integration_baseline(C: float, gamma: float = 0.6):
     """Direct event integration from L0 = 0, anchored and tone-mapped as the solver's output is:
-    a variant ``method(events, times) -> frames [Q, H, W]`` in [0, 1]."""
+    a variant ``method(events, times) -> frames [Q, H, W]`` in [0, 1]. ``C``: one threshold or a pair (c_pos, c_neg)."""
+    c_pos, c_neg = as_thresholds(C)   # checked when made: text was a format error, gamma 0 failed only when called
+    gamma = real_number(gamma, "gamma", lo=0, lo_open=True, hint="Reinhard's exponent (the paper's 0.6)")
+
     def method(events: Events, times: np.ndarray) -> np.ndarray:
         return reinhard_unchecked(anchor_mean(integrate_events(events, times, C=C), gamma), gamma).astype(np.float32)
-    method.__name__ = f"integration (C = {C:g})"
+    method.__name__ = f"integration (C = {c_pos:g})" if c_pos == c_neg else f"integration (C = ({c_pos:g}, {c_neg:g}))"
     return method
 
 
@@ -222,7 +229,18 @@ def run_variants(events: Events, gt_frames, gt_times, variants: dict, *, t_start
     Returns:
         One row (dict, see the module docstring) per variant, in order.
     """
+    events = require(events, Events, "events")
+    if not isinstance(variants, dict):   # a list was "'list' object has no attribute 'items'"
+        raise ArgumentTypeError(f"variants must be a dict {{name: EvINRConfig or method(events, times)}}, got "
+                                f"{type(variants).__name__}" + ("; name each: {name: variant for ...}"
+                                                               if isinstance(variants, (list, tuple)) else ""))
+    repeats = whole_number(repeats, "repeats", lo=1)
+    n_inference = whole_number(n_inference, "n_inference", lo=1)   # 0 was a ZeroDivisionError
+    if isinstance(equalizations, str):   # one protocol by name: "clahe" was scored letter by letter
+        equalizations = (equalizations,)
     gt = np.asarray(gt_frames)
+    if gt.dtype.kind in "iu" and gt.dtype != np.uint8:   # uint16 was cast to float and called 0..255
+        check_image_values(gt, "gt_frames")
     gt = gt.astype(np.float32) / 255.0 if gt.dtype == np.uint8 else gt.astype(np.float32)
     times = np.asarray(gt_times, dtype=np.float64)
     if gt.ndim != 3 or times.shape != (gt.shape[0],):
@@ -232,8 +250,6 @@ def run_variants(events: Events, gt_frames, gt_times, variants: dict, *, t_start
                              "crop or resize them to the sensor size")
     if not variants:
         raise ValueError("variants is empty: pass {name: EvINRConfig or method(events, times)}")
-    if repeats < 1:
-        raise ValueError(f"repeats must be >= 1, got {repeats}")
     device = str(default_device(None))
     protocol = _protocol(len(times), equalizations, repeats, n_inference, device)
     rows = []
@@ -323,6 +339,14 @@ def ablation_table(rows: list[dict], columns=DEFAULT_COLUMNS, *, title: str | No
     Returns:
         The markdown text (print it, or display it with IPython.display.Markdown).
     """
+    if rows is None:
+        raise ValueError("no rows to tabulate: pass run_variants' rows (a list of dicts)")
+    if isinstance(rows, dict) or not all(isinstance(r, dict) for r in rows):   # one row was Python's TypeError
+        raise EventDataError(f"rows must be a list of dicts (run_variants' rows), got {type(rows).__name__}"
+                             + ("; one row: pass [row]" if isinstance(rows, dict) else ""))
+    if isinstance(columns, str):   # one name made a column per letter
+        raise EventDataError(f"columns must be a list of row keys, got the text {columns!r}; one column: "
+                             f"columns=({columns!r},)")
     if not rows:
         raise ValueError("no rows to tabulate")
     headers = ["variant"] + [COLUMN_LABELS.get(c, (c, "{}"))[0] for c in columns]
@@ -356,6 +380,10 @@ def ablation_table(rows: list[dict], columns=DEFAULT_COLUMNS, *, title: str | No
 
 def relative_change(value: float, baseline: float, higher_is_better: bool) -> float:
     """Improvement of ``value`` over ``baseline`` in percent of the baseline; positive = better."""
+    value, baseline = real_number(value, "value"), real_number(baseline, "baseline")   # NaN gave NaN
+    if baseline == 0:   # was a ZeroDivisionError
+        raise EventDataError(f"no relative change from a baseline of 0 (value {value:g}): the baseline is 0; compare "
+                             "the values themselves")
     change = 100.0 * (value - baseline) / abs(baseline)
     return change if higher_is_better else -change
 
@@ -368,11 +396,27 @@ def pareto_front(cost, quality) -> np.ndarray:
     Args:
         cost: [K] lower is better (e.g. training seconds). quality: [K] higher is better (e.g. SSIM).
     """
-    c = np.asarray(cost, dtype=np.float64)[:, None]
-    q = np.asarray(quality, dtype=np.float64)[:, None]
+    c, q = _scores(cost, "cost"), _scores(quality, "quality")
+    if c.size != q.size:   # was numpy's broadcast error
+        raise EventDataError(f"{c.size} costs but {q.size} qualities; pass one of each per variant")
+    c, q = c[:, None], q[:, None]
     # dominated[i, j]: j dominates i
     dominated = (c.T <= c) & (q.T >= q) & ((c.T < c) | (q.T > q))
     return ~dominated.any(axis=1)
+
+
+def _scores(value, name: str) -> np.ndarray:
+    """One finite number per variant, float64 [K]: a NaN variant was on the front (nothing dominates NaN), a 2-D
+    array was taken as a matrix of variants."""
+    arr = None if isinstance(value, (str, bytes)) else dense_array(value, name, error=EventDataError)
+    if arr is None or arr.dtype.kind not in "iuf" or arr.ndim != 1:
+        raise EventDataError(f"{name} must be a 1-D list of numbers, one per variant, got "
+                             + (f"shape {arr.shape} dtype {arr.dtype}" if arr is not None else repr(value)[:60]))
+    arr = arr.astype(np.float64)
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise EventDataError(f"{name}[{bad[0]}] is {arr[bad[0]]}; every variant needs a finite {name} (drop that one)")
+    return arr
 
 
 def paper_frame_counts(table: dict) -> dict[str, float]:

@@ -18,7 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.checks import real_number, require
 from ..core.events import EventDataError, Events
+from ..core.guard import dense_array
+from ..method.binning import check_boundaries
 from ..sim.simulate import add_background_noise  # noqa: F401  (notebook 08 imports it from here too)
 
 __all__ = ["render_event_counts", "render_counts", "signed_to_polarity_counts", "event_counts", "model_event_counts",
@@ -41,7 +44,19 @@ def render_event_counts(L_boundaries, C: float) -> np.ndarray:
 
 def render_counts(L_boundaries, C, whole_steps=np.trunc):
     """Counts from a moving reference: n_k = whole_steps((L(b_{k+1}) - r_k) / C), r_{k+1} = r_k + n_k C."""
-    L = np.asarray(L_boundaries, dtype=np.float64)
+    # C 0 or NaN gave garbage counts (inf or NaN cast to int64), a negative C counts of the wrong sign
+    C = real_number(C, "C", lo=0, lo_open=True, hint="the contrast threshold in log units (e.g. 0.2)")
+    L = dense_array(L_boundaries, "L_boundaries", error=EventDataError, want="log intensities [B + 1, H, W]")
+    if L.dtype.kind not in "iuf":   # complex kept its real part, text was numpy's error
+        kind = "complex numbers" if L.dtype.kind == "c" else f"dtype {L.dtype}"
+        raise EventDataError(f"L_boundaries must be numbers (log intensities at the bin boundaries), got {kind}")
+    L = L.astype(np.float64)
+    if L.ndim < 1 or L.shape[0] < 1:   # was numpy's IndexError
+        raise EventDataError(f"L_boundaries must hold at least one boundary [B + 1, ...], got shape {L.shape}")
+    finite = np.isfinite(L)
+    if not finite.all():
+        raise EventDataError(f"L_boundaries contain {int(L.size - finite.sum()):,} NaN or inf value(s); log "
+                             "intensities must be finite to count events")
     ref = L[0].copy()
     out = np.empty((L.shape[0] - 1,) + L.shape[1:], dtype=np.int64)
     for k in range(1, L.shape[0]):
@@ -63,9 +78,8 @@ def event_counts(events: Events, boundaries) -> np.ndarray:
     Bin k holds the events with b_k < t <= b_{k+1} (bin 0 also t == b_0), as in
     :func:`evinr_lite.method.binning.events_to_frames`; events outside [b_0, b_B] are not counted.
     """
-    b = np.asarray(boundaries, dtype=np.float64)
-    if b.ndim != 1 or b.size < 2 or np.any(np.diff(b) <= 0):
-        raise EventDataError("boundaries must be a strictly increasing 1-D array of at least 2 times (s)")
+    events = require(events, Events, "events")
+    b = check_boundaries(boundaries)   # NaN and inf edges were taken (NaN never compares, so it was skipped)
     H, W = events.sensor_size
     B = b.size - 1
     lo = int(np.searchsorted(events.t, b[0], side="left"))
@@ -78,8 +92,24 @@ def event_counts(events: Events, boundaries) -> np.ndarray:
 
 def model_event_counts(rec, boundaries, C: float) -> np.ndarray:
     """Events re-rendered from a trained reconstruction (anything with ``.at(times)``): int64 [2, B, H, W]."""
-    L = np.asarray(rec.at(np.asarray(boundaries, dtype=np.float64)), dtype=np.float64)
+    if not callable(getattr(rec, "at", None)):
+        raise EventDataError(f"rec must be a reconstruction (anything with .at(times), e.g. reconstruct(...)'s "
+                             f"result), got {type(rec).__name__}")
+    L = np.asarray(rec.at(check_boundaries(boundaries)), dtype=np.float64)
     return signed_to_polarity_counts(render_event_counts(L, C))
+
+
+def _whole_counts(value, name: str) -> np.ndarray:
+    """Event counts as int64: whole numbers >= 0 (NaN, 0.5 or -3 were cast to int64 and scored)."""
+    arr = None if isinstance(value, (str, bytes)) else dense_array(value, name, error=EventDataError)
+    ok = arr is not None and arr.dtype.kind in "biuf"
+    if ok and arr.dtype.kind == "f":
+        ok = bool(np.all(np.isfinite(arr))) and bool(np.all(arr == np.round(arr)))
+    if not ok or (arr.size and arr.min() < 0):
+        raise EventDataError(f"{name}: counts must be whole numbers >= 0 (events per cell, [2, B, H, W]); got "
+                             + (f"dtype {arr.dtype}" if arr is not None and arr.dtype.kind not in "biuf" else
+                                "NaN, fractional or negative values" if arr is not None else repr(value)[:60]))
+    return arr.astype(np.int64)
 
 
 def count_scores(counts, clean_counts, C: float = 1.0) -> dict:
@@ -89,7 +119,8 @@ def count_scores(counts, clean_counts, C: float = 1.0) -> dict:
         {"precision", "recall", "f1": floats in [0, 1]; "frame_rmse": RMS of the difference of the
         signed event frames C (ON - OFF) per pixel and bin; "n_events", "n_clean": totals}.
     """
-    a, c = np.asarray(counts, np.int64), np.asarray(clean_counts, np.int64)
+    a, c = _whole_counts(counts, "counts"), _whole_counts(clean_counts, "clean_counts")
+    C = real_number(C, "C", lo=0, lo_open=True, hint="the contrast threshold in log units")
     if a.shape != c.shape or a.ndim != 4 or a.shape[0] != 2:
         raise ValueError(f"expected two [2, B, H, W] count arrays of one shape, got {a.shape} and {c.shape}")
     tp = float(np.minimum(a, c).sum())

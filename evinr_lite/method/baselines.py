@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.checks import (ArgumentTypeError, check_reach, check_seconds_precision, choice, host_array, optional_seconds,
-                           real_number, require)
+from ..core.checks import (ArgumentTypeError, check_reach, check_seconds_precision, choice, host_array, is_real_number,
+                           optional_seconds, real_number, require)
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 from ..core.frames import Frames
@@ -53,7 +53,9 @@ DEFAULT_CUTOFF_HZ = 1.0   # alpha = 2 pi rad/s; a tunable choice (Scheerlinck et
 # ---- argument checks -------------------------------------------------------------------------
 
 def _rate(value, name: str) -> float:
-    if isinstance(value, (str, bytes, bool, np.bool_)) or not (np.isscalar(value) and np.isfinite(value) and value >= 0):
+    """A rate as a float: a finite number >= 0, a 0-d array or tensor too (as C is taken); else an EventDataError."""
+    value = host_array(value)
+    if not (is_real_number(value) and np.isfinite(value) and value >= 0):
         raise EventDataError(f"{name} must be a finite number >= 0 (per second), got {value!r}")
     return float(value)
 
@@ -74,15 +76,22 @@ def _query(t_query) -> np.ndarray:
 def _initial(L0, sensor_size) -> np.ndarray | float:
     if L0 is None:
         return 0.0
-    L0 = np.asarray(L0, dtype=np.float64)
+    arr = None if isinstance(L0, (str, bytes)) else dense_array(L0, "L0", error=EventDataError)
+    if arr is None or arr.dtype.kind not in "iuf":   # text and complex were Python's float() errors
+        raise EventDataError(f"L0 must be log intensities (a number or an [H, W] array of numbers), got {L0!r:.60}")
+    L0 = arr.astype(np.float64)
     if np.ndim(L0) not in (0, 2) or (np.ndim(L0) == 2 and L0.shape != tuple(sensor_size)):
         raise EventDataError(f"L0 must be a scalar or an [H, W] = {tuple(sensor_size)} array, got shape {np.shape(L0)}")
+    if not np.all(np.isfinite(L0)):   # NaN gave NaN frames
+        raise EventDataError(f"L0 must be finite log intensities, but it holds {int(np.sum(~np.isfinite(L0)))} NaN or "
+                             "inf value(s); take the log of intensities clipped above 0")
     return L0
 
 
 def _start_time(events: Events, tq: np.ndarray, t_start) -> float:
     first = events.t[0] if len(events) else tq.min()
-    t0 = min(first, tq.min()) if t_start is None else float(t_start)
+    t_start = optional_seconds(t_start, "t_start")   # NaN gave NaN frames, "0" was read as a number
+    t0 = min(first, tq.min()) if t_start is None else t_start
     if tq.min() < t0:
         raise EventDataError(f"query time {tq.min()} s is before t_start = {t0} s; query at or after the start")
     return t0
@@ -142,6 +151,7 @@ def leaky_integration(events: Events, query_times, C=0.2, leak_hz: float = 0.0, 
     Returns:
         float64 [Q, H, W] log intensity ([H, W] for a scalar query).
     """
+    events = require(events, Events, "events")
     tq = _query(query_times)
     C_pos, C_neg = as_thresholds(C)
     leak = _rate(leak_hz, "leak_hz")
@@ -167,6 +177,7 @@ def highpass_filter(events: Events, query_times, C=0.2, cutoff_hz: float = DEFAU
     Returns:
         float64 [Q, H, W] ([H, W] for a scalar query).
     """
+    events = require(events, Events, "events")
     tq = _query(query_times)
     C_pos, C_neg = as_thresholds(C)
     alpha = 2 * math.pi * _rate(cutoff_hz, "cutoff_hz")
@@ -270,11 +281,13 @@ def complementary_filter(events: Events, frames, query_times, C=0.2, gain: float
     Returns:
         float64 [Q, H, W] log intensity ([H, W] for a scalar query).
     """
+    events = require(events, Events, "events")
     tq = _query(query_times)
     C_pos, C_neg = as_thresholds(C)
     alpha = _rate(gain, "gain")
     ft, LF = _frame_logs(frames, events.sensor_size)
-    t0 = float(ft[0]) if t_start is None else float(t_start)
+    t_start = optional_seconds(t_start, "t_start")   # NaN was said to lie before the first frame
+    t0 = float(ft[0]) if t_start is None else t_start
     if not ft[0] <= t0:
         raise EventDataError(f"the complementary filter starts from an APS frame, but t_start = {t0} s is before the "
                              f"first frame ({ft[0]} s); pass t_start at or after it")

@@ -11,11 +11,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.checks import host_array
+from ..core.checks import host_array, real_number, require, whole_number
 from ..core.events import EventDataError, Events
+from ..core.guard import dense_array
 
 __all__ = ["EventFrames", "fixed_duration_boundaries", "equal_count_boundaries", "events_to_frames",
-           "events_to_frames_chunked", "bisect_boundaries", "event_rate", "as_thresholds"]
+           "events_to_frames_chunked", "bisect_boundaries", "event_rate", "as_thresholds", "check_boundaries"]
 
 
 def as_thresholds(C, name: str = "C") -> tuple[float, float]:
@@ -90,10 +91,13 @@ def fixed_duration_boundaries(t_start: float, t_end: float, bin_duration: float 
 
     The last bin is shortened to end exactly at ``t_end``. Returns float64 [B + 1].
     """
-    if not (np.isfinite(t_start) and np.isfinite(t_end)) or t_end <= t_start:
+    # numbers (0-d arrays and tensors too) by name: text or None were numpy's ufunc or Python's TypeError
+    t_start = real_number(t_start, "t_start", hint="the bins' start in seconds")
+    t_end = real_number(t_end, "t_end", hint="the bins' end in seconds")
+    if t_end <= t_start:
         raise EventDataError(f"bin range [{t_start}, {t_end}] is empty or reversed; t_end must exceed t_start")
-    if not bin_duration > 0:
-        raise EventDataError(f"bin_duration must be positive seconds, got {bin_duration}")
+    bin_duration = real_number(bin_duration, "bin_duration", lo=0, lo_open=True,
+                               hint="positive seconds (the bins' length)")
     n = (t_end - t_start) / bin_duration
     if not n <= MAX_BINS:   # checked before the edges are allocated (1e-12 s over 1000 s: 7 PiB of edges)
         raise EventDataError(f"bins of {bin_duration:g} s over [{t_start}, {t_end}] s would be {n:,.0f} bins (at most "
@@ -111,15 +115,16 @@ def equal_count_boundaries(events: Events, events_per_bin: int | None = None, n_
     last event of one bin and the first of the next; the outer edges are the first and last
     event times. Returns float64 [B + 1].
     """
+    events = require(events, Events, "events")
     n = len(events)
     if n < 2:
         raise EventDataError(f"equal-count bins need at least 2 events, got {n}; choose a longer time window")
     if (events_per_bin is None) == (n_bins is None):
         raise EventDataError("give exactly one of events_per_bin or n_bins")
     if n_bins is None:
-        if events_per_bin < 1:
-            raise EventDataError(f"events_per_bin must be >= 1, got {events_per_bin}")
+        events_per_bin = real_number(events_per_bin, "events_per_bin", lo=1, hint="events in each bin")
         n_bins = max(1, int(round(n / events_per_bin)))
+    n_bins = whole_number(n_bins, "n_bins", lo=1)   # 2.5 and "3" were Python's TypeErrors
     if not 1 <= n_bins <= n:
         raise EventDataError(f"n_bins must be between 1 and the number of events ({n}), got {n_bins}")
     # split index k: bin i holds events [k_i, k_{i+1})
@@ -132,8 +137,12 @@ def equal_count_boundaries(events: Events, events_per_bin: int | None = None, n_
 _GROUP_CELLS = 1 << 16   # bins x pixels summed per np.bincount call: small enough to stay in cache
 
 
-def _check_boundaries(boundaries) -> np.ndarray:
-    b = np.asarray(boundaries, dtype=np.float64)
+def check_boundaries(boundaries) -> np.ndarray:
+    """Bin edges as float64 [B + 1]: numbers, finite, strictly increasing, at least 2; else an EventDataError."""
+    b = None if isinstance(boundaries, (str, bytes)) else dense_array(boundaries, "boundaries", error=EventDataError)
+    if b is None or b.dtype.kind not in "iuf":   # text was numpy's "could not convert string to float"
+        raise EventDataError(f"boundaries must be numbers (bin edges in seconds), got {boundaries!r:.60}")
+    b = b.astype(np.float64)
     if b.ndim != 1 or b.size < 2:
         raise EventDataError(f"boundaries must be a 1-D array of at least 2 edges, got shape {b.shape}")
     if not np.all(np.isfinite(b)):
@@ -141,6 +150,9 @@ def _check_boundaries(boundaries) -> np.ndarray:
     if np.any(np.diff(b) <= 0):
         raise EventDataError("boundaries must be strictly increasing")
     return b
+
+
+_check_boundaries = check_boundaries
 
 
 def _bin_edges(t: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -192,6 +204,7 @@ def events_to_frames(events: Events, boundaries, C: float | tuple = 1.0) -> Even
     Returns:
         EventFrames with frames [B, H, W] float32, the boundaries and per-bin counts.
     """
+    events = require(events, Events, "events")
     b = _check_boundaries(boundaries)
     c_pos, c_neg = as_thresholds(C)
     H, W = events.sensor_size
@@ -280,7 +293,8 @@ def bisect_boundaries(events: Events, boundaries) -> np.ndarray:
     event n//2 (0-based, in time order); a bin with fewer than 2 events, or whose cut would
     coincide with an edge, is cut at its time mid-point. Returns float64 [2B + 1].
     """
-    b = np.asarray(boundaries, dtype=np.float64)
+    events = require(events, Events, "events")
+    b = _check_boundaries(boundaries)   # NaN edges came back NaN, decreasing ones reversed, one edge an IndexError
     t = events.t
     # index range of each bin's events under the (b_i, b_{i+1}] convention (bin 0 closed on the left)
     start = np.searchsorted(t, b[:-1], side="right")
@@ -314,11 +328,18 @@ def event_rate(events: Events, bin_s: float, t_range=None) -> tuple[np.ndarray, 
         Bin i holds the events with ``edges[i] < t <= edges[i+1]`` (bin 0 also those at edges[0]),
         so ``rate * np.diff(edges)`` gives the counts.
     """
+    events = require(events, Events, "events")
     if t_range is None:
         if len(events) < 2:
             raise EventDataError("event_rate needs t_range when there are fewer than 2 events")
         t_range = (events.t[0], events.t[-1])
-    edges = fixed_duration_boundaries(float(t_range[0]), float(t_range[1]), bin_s)
+    if isinstance(t_range, (str, bytes)) or np.ndim(t_range) != 1 or len(t_range) != 2:   # 3 values: 2 used
+        raise EventDataError(f"t_range must be (t0, t1), two times in seconds, got {t_range!r}")
+    # named as the caller gave them, not as fixed_duration_boundaries' t_start / t_end / bin_duration
+    t0 = real_number(t_range[0], "t_range[0]", hint="seconds")
+    t1 = real_number(t_range[1], "t_range[1]", lo=t0, lo_open=True, hint="seconds, after t_range[0]")
+    bin_s = real_number(bin_s, "bin_s", lo=0, lo_open=True, hint="a positive number of seconds per bin (e.g. 0.01)")
+    edges = fixed_duration_boundaries(t0, t1, bin_s)
     B = edges.size - 1
     idx = np.searchsorted(edges, events.t, side="left") - 1
     idx[events.t == edges[0]] = 0

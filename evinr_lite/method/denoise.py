@@ -60,6 +60,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.events import EventDataError, Events
+from ..core.guard import dense_array
 
 __all__ = ["hot_pixel_mask", "hot_threshold", "remove_hot_pixels", "correlation_filter", "denoise", "denoise_mask",
            "DenoiseReport", "DEFAULT_WINDOW", "DEFAULT_SAME_POLARITY",
@@ -115,6 +116,7 @@ def hot_threshold(counts: np.ndarray, factor: float = DEFAULT_HOT_FACTOR, rule: 
     Returns +inf when no pixel fired.
     """
     factor = _check_factor(factor, rule)
+    counts = _check_counts(counts)
     active = counts[counts > 0].astype(np.float64)
     if active.size == 0:
         return float("inf")
@@ -123,6 +125,26 @@ def hot_threshold(counts: np.ndarray, factor: float = DEFAULT_HOT_FACTOR, rule: 
         return factor * m
     s = max(_MAD_TO_SIGMA * float(np.median(np.abs(active - m))), float(np.sqrt(m)))
     return m + factor * s
+
+
+def _check_counts(counts) -> np.ndarray:
+    """Per-pixel event counts as an array: numbers, finite, >= 0 (a list was Python's TypeError; NaN and negative
+    counts were left out of the statistics without a word)."""
+    arr = None if isinstance(counts, (str, bytes)) else dense_array(counts, "counts", error=EventDataError)
+    if arr is None or arr.dtype.kind not in "biuf":
+        raise EventDataError(f"counts must be event counts per pixel (numbers >= 0), got {counts!r:.60}")
+    bad = ~(np.isfinite(arr) & (arr >= 0)) if arr.dtype.kind == "f" else arr < 0
+    if bad.any():
+        raise EventDataError(f"counts must be finite event counts >= 0, but {int(bad.sum())} of them are NaN, inf or "
+                             "negative")
+    return arr
+
+
+def _check_switch(value, name: str) -> bool:
+    """A switch: True or False (numpy's bool too); "no", "yes" or 1 were taken as truthy without a word."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise EventDataError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
 
 
 def hot_pixel_mask(events: Events, *, factor: float = DEFAULT_HOT_FACTOR, rule: str = DEFAULT_HOT_RULE) -> np.ndarray:
@@ -200,6 +222,7 @@ def correlation_filter(events: Events, dt: float = DEFAULT_DT, *, neighbourhood:
         bool [N]: True for the events kept.
     """
     _check_events(events)
+    same_polarity = _check_switch(same_polarity, "same_polarity")
     t = events.t
     dt = _check_dt(dt, t)
     H, W = events.sensor_size
@@ -383,6 +406,8 @@ def denoise_mask(events: Events, *, hot_pixels: bool = True, background: bool = 
                  ) -> tuple[np.ndarray, DenoiseReport]:
     """:func:`denoise`'s decisions: (bool [N] kept, :class:`DenoiseReport`); same arguments."""
     _check_events(events)
+    hot_pixels, background = _check_switch(hot_pixels, "hot_pixels"), _check_switch(background, "background")
+    same_polarity = _check_switch(same_polarity, "same_polarity")
     _check_factor(hot_factor, hot_rule)
     _check_dt(dt, events.t)
     settings = dict(hot_pixels=bool(hot_pixels), background=bool(background), dt=float(dt),

@@ -14,6 +14,7 @@ import math
 import numpy as np
 import torch
 
+from ..core.checks import real_number
 from ..core.events import EventDataError
 from .models import FrameINR
 
@@ -25,6 +26,14 @@ def split_windows(t_start: float, t_end: float, tau: float | None, overlap: floa
 
     Returns float64 [N, 2] (seconds). N = 1 when tau is None or the span fits in one window.
     """
+    # numbers by name (0-d arrays and tensors too): NaN, inf or text were Python's conversion errors
+    t_start, t_end = real_number(t_start, "t_start", hint="seconds"), real_number(t_end, "t_end", hint="seconds")
+    if tau is not None:
+        tau = real_number(tau, "tau", lo=0, lo_open=True, hint="each window's length in seconds (None: one window)")
+        overlap = real_number(overlap, "overlap", lo=0, hint="seconds shared by neighbouring windows")
+        if not tau > overlap:   # tau == overlap was a ZeroDivisionError; a negative overlap left gaps
+            raise EventDataError(f"tau = {tau:g} s must exceed the overlap ({overlap:g} s): each window has to reach "
+                                 "past the one before it; use a longer tau or a shorter overlap")
     span = t_end - t_start
     if not span > 0:
         raise EventDataError(f"time span [{t_start}, {t_end}] is empty; t_end must exceed t_start")

@@ -23,6 +23,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.checks import real_number
+from ..core.events import EventDataError
+from ..core.guard import dense_array
+
 __all__ = ["activity", "auto_lam", "covered_fraction", "window_fraction", "LAM_SCALE", "LAM_MIN", "LAM_MAX"]
 
 LAM_SCALE = 0.3     # lam x m^2: lam reaches LAM_MAX below about 5.5 events per pixel per window
@@ -32,14 +36,32 @@ LAM_MAX = 0.01      # the most: the fixed default before issue 21 (sparser windo
 
 def activity(n_on, n_off) -> float:
     """Mean over pixels of ``2 min(n_on, n_off)`` ([H, W] counts): events that came and went."""
-    n_on = np.asarray(n_on, np.float64)
-    n_off = np.asarray(n_off, np.float64)
+    n_on, n_off = _counts(n_on, "n_on"), _counts(n_off, "n_off")
+    if n_on.shape != n_off.shape:   # was numpy's broadcast error (or a silent broadcast of one over the other)
+        raise EventDataError(f"n_on and n_off must be counts of one shape [H, W] (one per pixel), got shapes "
+                             f"{n_on.shape} and {n_off.shape}")
     return float(2 * np.minimum(n_on, n_off).mean()) if n_on.size else 0.0
+
+
+def _counts(value, name: str) -> np.ndarray:
+    """Per-pixel event counts as float64: numbers, finite, >= 0 (NaN or negative counts gave LAM_MAX silently)."""
+    arr = None if isinstance(value, (str, bytes)) else dense_array(value, name, error=EventDataError)
+    if arr is None or arr.dtype.kind not in "biuf":
+        raise EventDataError(f"{name} must be finite counts >= 0 (events per pixel), got {value!r:.60}")
+    arr = arr.astype(np.float64)
+    bad = ~(np.isfinite(arr) & (arr >= 0))
+    if bad.any():
+        raise EventDataError(f"{name} must be finite counts >= 0 (events per pixel), but it holds {int(bad.sum())} "
+                             "NaN, inf or negative value(s)")
+    return arr
 
 
 def covered_fraction(windows) -> float:
     """The share of the span of ``windows`` [N, 2] (s) that the first window covers (1 for one window)."""
-    w = np.asarray(windows, np.float64)
+    w = dense_array(windows, "windows", error=EventDataError)
+    if w.dtype.kind not in "iuf" or w.ndim != 2 or w.shape[0] < 1 or w.shape[1] != 2:   # was numpy's IndexError
+        raise EventDataError(f"windows must be [N, 2] (start, end) pairs in seconds, at least one, got shape {w.shape}")
+    w = w.astype(np.float64)
     span = float(w[-1, 1] - w[0, 0])
     return float(min(1.0, (w[0, 1] - w[0, 0]) / span)) if span > 0 else 1.0
 
@@ -48,7 +70,8 @@ def window_fraction(t_start: float, t_end: float, tau: float | None, overlap: fl
     """The share of the span [t_start, t_end] (s) that one network window covers (1 for one window)."""
     from .ensemble import split_windows
 
-    if not float(t_end) - float(t_start) > 0:
+    t_start, t_end = real_number(t_start, "t_start", hint="seconds"), real_number(t_end, "t_end", hint="seconds")
+    if not t_end - t_start > 0:   # a NaN span was 1 without a word
         return 1.0
     return covered_fraction(split_windows(t_start, t_end, tau, overlap))
 
@@ -57,7 +80,9 @@ def auto_lam(n_on, n_off, fraction: float = 1.0) -> float:
     """lam for a span whose per-pixel ON / OFF counts are ``n_on``, ``n_off`` [H, W], trained in
     windows that each cover ``fraction`` of it: LAM_SCALE / m^2 within [LAM_MIN, LAM_MAX], with m the
     activity per window (:func:`activity` x fraction)."""
-    m = activity(n_on, n_off) * float(fraction)
+    fraction = real_number(fraction, "fraction", lo=0, hi=1, lo_open=True,
+                           hint="the share of the span one network window covers")
+    m = activity(n_on, n_off) * fraction
     if not m > 0:
         return LAM_MAX
     return float(np.clip(LAM_SCALE / m ** 2, LAM_MIN, LAM_MAX))

@@ -284,5 +284,7 @@ def _checked_anchor_frames(frames, sensor_size, t_start: float, t_end: float, cf
 
 def _level_shift(L_grid: np.ndarray, cfg: EvINRConfig) -> np.float32:
     """The constant added to every offset so that the sequence (``L_grid`` [G, H, W]) displays at
-    ``cfg.display_mean`` (:func:`~evinr_lite.method.tonemap.display_shift`): the level events never fix."""
+    ``cfg.display_mean`` (:func:`~evinr_lite.method.tonemap.display_shift`): the level events never fix. A grid
+    that is not finite (a diverged run) is a ResultError here, as the frames would be, not display_shift's refusal."""
+    check_result_frames(L_grid, what="EvINR's log intensity", input_varies=False, fix=RESULT_FIX)
     return np.float32(display_shift(L_grid, cfg.tonemap, cfg.gamma, cfg.display_mean))

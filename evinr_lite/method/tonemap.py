@@ -30,10 +30,11 @@ import math
 
 import numpy as np
 
+from ..core.checks import host_array, is_real_number, real_number
 from ..core.events import EventDataError
 
 __all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "DISPLAY_MEANS", "tonemap_reinhard", "tonemap_linear", "to_display", "display_formula", "display_shift", "anchor_level",
-           "anchor_mean", "reinhard_unchecked"]
+           "anchor_mean", "reinhard_unchecked", "linear_unchecked"]
 
 TONEMAPS = ("linear", "reinhard")
 DEFAULT_TONEMAP = "linear"  # the kit's display (EvINRConfig and the baselines share it)
@@ -54,14 +55,24 @@ def tonemap_reinhard(L, gamma: float = 0.6):
     if isinstance(gamma, (bool, np.bool_, str, bytes)) or not np.isscalar(gamma) or not gamma > 0 or \
             not np.isfinite(gamma):
         raise EventDataError(f"gamma must be a positive finite number (the paper's 0.6), got {gamma!r}")
-    if not hasattr(L, "sigmoid"):   # numpy: numbers only, and no NaN (it would come out as NaN frames)
+    return reinhard_unchecked(_log_values(L), gamma)
+
+
+def _log_values(L, name: str = "L"):
+    """``L`` (numpy: as an array) after refusing what is no log intensity: not numbers, or NaN (it would come out as
+    NaN frames); a torch tensor is checked for NaN and passed through. +-inf are log intensities of 0 and of
+    saturation, displayed as 0 and 1."""
+    if hasattr(L, "sigmoid"):   # torch: a NaN tensor gave NaN frames, where a NaN array was refused
+        n_nan = int(L.isnan().sum())
+    else:
         L = np.asarray(L) if not isinstance(L, (str, bytes)) else np.asarray([L])
         if L.dtype.kind not in "iuf" or L.dtype == bool:
-            raise EventDataError(f"L must be log intensities (numbers), got dtype {L.dtype}")
-        if np.isnan(L).any():
-            raise EventDataError(f"L contains {int(np.isnan(L).sum()):,} NaN value(s); a log intensity must be a number "
-                                 "(log of an intensity clipped above 0)")
-    return reinhard_unchecked(L, gamma)
+            raise EventDataError(f"{name} must be log intensities (numbers), got dtype {L.dtype}")
+        n_nan = int(np.isnan(L).sum())
+    if n_nan:
+        raise EventDataError(f"{name} contains {n_nan:,} NaN value(s); a log intensity must be a number "
+                             "(log of an intensity clipped above 0)")
+    return L
 
 
 def reinhard_unchecked(L, gamma: float):
@@ -73,7 +84,13 @@ def reinhard_unchecked(L, gamma: float):
 
 
 def tonemap_linear(L):
-    """clip(exp(L), 0, 1), elementwise; numpy array or torch tensor, any shape (float64 for numpy)."""
+    """clip(exp(L), 0, 1), elementwise; numpy array or torch tensor, any shape (float64 for numpy). ``L`` must be
+    numbers without NaN (as :func:`tonemap_reinhard`'s)."""
+    return linear_unchecked(_log_values(L))
+
+
+def linear_unchecked(L):
+    """:func:`tonemap_linear` without its argument checks (the solver's own, already checked values)."""
     if hasattr(L, "exp"):  # torch tensor
         return L.clamp(max=0.0).exp()
     L = np.asarray(L, dtype=np.float64)
@@ -84,10 +101,20 @@ def to_display(L, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6):
     """Frames in [0, 1] from log intensity ``L`` (any shape) by the tone map ``tonemap``
     ("linear" or "reinhard"; gamma is Reinhard's exponent)."""
     if tonemap == "linear":
-        return tonemap_linear(L)
+        return linear_unchecked(L)
     if tonemap == "reinhard":
         return reinhard_unchecked(L, gamma)
     raise EventDataError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
+
+
+def _check_display_mean(display_mean) -> float:
+    if not (is_real_number(display_mean) and 0 < float(host_array(display_mean)) < 1):
+        raise EventDataError(f"display_mean= must be a finite number in (0, 1), got {display_mean!r}")
+    return float(host_array(display_mean))
+
+
+def _check_gamma(gamma) -> float:
+    return real_number(gamma, "gamma", lo=0, lo_open=True, hint="Reinhard's exponent (the paper's 0.6)")
 
 
 def display_formula(tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6) -> str:
@@ -109,13 +136,20 @@ def display_shift(reference, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6,
       as 1, so a few hot pixels or highlights cannot darken the rest. Solved by bisection on the
       sorted values (at most SHIFT_SAMPLES of them, an even stride through ``reference``).
     """
-    if not 0 < display_mean < 1:
-        raise EventDataError(f"display_mean must be in (0, 1), got {display_mean}")
-    if tonemap == "reinhard":
-        return anchor_level(gamma, display_mean) - float(np.mean(reference))
-    if tonemap != "linear":
+    display_mean = _check_display_mean(display_mean)
+    if tonemap not in TONEMAPS:
         raise EventDataError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
-    v = np.asarray(reference).reshape(-1)
+    reference = np.asarray(reference)
+    if reference.dtype.kind not in "iuf" or reference.dtype == bool:
+        raise EventDataError(f"reference must be log intensities (numbers), got dtype {reference.dtype}")
+    if tonemap == "reinhard":   # NaN gave a NaN shift, no values numpy's "mean of empty slice" and NaN
+        level = anchor_level(gamma, display_mean)
+        mean = float(np.mean(reference)) if reference.size else math.nan
+        if not math.isfinite(mean):
+            raise EventDataError(f"display_shift needs finite log intensities, got {reference.size:,} value(s) whose "
+                                 f"mean is {mean} (NaN or inf among them, or none)")
+        return level - mean
+    v = reference.reshape(-1)
     v = np.sort(v[::max(1, -(-v.size // SHIFT_SAMPLES))].astype(np.float64))
     if v.size == 0 or not np.isfinite(v[0]) or not np.isfinite(v[-1]):
         raise EventDataError("display_shift needs finite log intensities")
@@ -140,9 +174,8 @@ def anchor_level(gamma: float = 0.6, display_mean: float = 0.5) -> float:
     Events fix log intensity only up to a constant; the solvers shift their output so that its
     mean sits at this level (mid-grey on screen by default).
     """
-    if not 0 < display_mean < 1:
-        raise EventDataError(f"display_mean must be in (0, 1), got {display_mean}")
-    s = display_mean ** (1.0 / gamma)
+    display_mean = _check_display_mean(display_mean)
+    s = display_mean ** (1.0 / _check_gamma(gamma))   # gamma 0 was a ZeroDivisionError, -1 a "math domain error"
     return math.log(s / (1.0 - s))
 
 
@@ -155,5 +188,5 @@ def anchor_mean(L, gamma: float = 0.6, display_mean: float = 0.5, reference=None
     Pass log intensities on a time grid as ``reference`` to anchor a few frames the way
     :func:`evinr_lite.method.solver.reconstruct` anchors a whole sequence.
     """
-    L = np.asarray(L)
+    L = _log_values(L) if not hasattr(L, "sigmoid") else np.asarray(L)
     return L + display_shift(L if reference is None else reference, tonemap, gamma, display_mean)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.checks import real_number
 from ..core.events import EventDataError
 from ..core.frames import Frames, to_grey_uint8
 from ..core.recording import Recording
@@ -49,8 +50,7 @@ def colour_davis_recording(image="coffee", *, sensor_size=(48, 64), duration: fl
     cfa = check_cfa(cfa)
     if cfa is None:
         raise EventDataError(f"cfa must name a colour filter ({', '.join(CFA_NAMES)}), got None")
-    if not (np.isfinite(frame_rate) and frame_rate > 0):
-        raise EventDataError(f"frame_rate must be a positive number of frames per second, got {frame_rate!r}")
+    frame_rate = real_number(frame_rate, "frame_rate", lo=0, lo_open=True, hint="APS frames per second (e.g. 20)")
     scene = QuadBayerScene(image, sensor_size, duration, phase=cfa_phase(cfa), block=BAYER, **motion)
     events = simulate_scene(scene, 0.0, duration, C=C, seed=seed)
     t = np.arange(0.0, duration + 1e-9, 1.0 / frame_rate)

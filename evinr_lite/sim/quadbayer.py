@@ -51,8 +51,10 @@ from scipy import ndimage
 
 from ..core.cfa import (BAYER, CHANNELS, QUAD_BAYER, TILE_COLOURS, cfa_channel, cfa_pattern, cfa_tile,  # noqa: F401
                         check_block, check_phase, effective_thresholds, period, photosites_per_window)
+from ..core.checks import ArgumentTypeError
 from ..core.events import EventDataError, Events, check_sensor_size
-from .scenes import MovingImageScene
+from ..core.guard import dense_array
+from .scenes import MOTION_PARAMETERS, MovingImageScene, check_intensity_range, real_image
 
 __all__ = ["CHANNELS", "QUAD_BAYER", "BAYER", "TILE_COLOURS", "period", "photosites_per_window", "cfa_tile",
            "cfa_channel", "cfa_pattern", "mosaic", "demosaic_grey", "demosaic_rgb", "demosaic_rgb_full",
@@ -277,10 +279,12 @@ class QuadBayerScene:
         H, W = check_sensor_size(sensor_size)
         if H % P or W % P:
             raise EventDataError(f"sensor_size {(H, W)} must be multiples of the tile period {P}")
+        unknown = sorted(set(motion) - set(MOTION_PARAMETERS))
+        if unknown:   # was MovingImageScene.__init__'s TypeError, naming a class nobody called
+            raise ArgumentTypeError(f"QuadBayerScene got unknown parameter(s) {unknown}; it takes phase, block, "
+                                    f"intensity_range and the motion {', '.join(MOTION_PARAMETERS)}")
         rgb = self._load(image)
-        lo, hi = float(intensity_range[0]), float(intensity_range[1])
-        if not 0 < lo < hi:
-            raise EventDataError(f"intensity_range must be (low, high) with 0 < low < high, got {intensity_range!r}")
+        lo, hi = check_intensity_range(intensity_range)
         span = rgb.max() - rgb.min()
         self.channels = []
         for c in range(3):
@@ -305,7 +309,7 @@ class QuadBayerScene:
             if not hasattr(skimage.data, image):
                 raise EventDataError(f"unknown scikit-image sample {image!r}; try 'coffee', 'astronaut' or 'chelsea'")
             image = getattr(skimage.data, image)()
-        rgb = np.asarray(image, dtype=np.float64)
+        rgb = real_image(image).astype(np.float64)
         if rgb.ndim != 3 or rgb.shape[-1] not in (3, 4) or min(rgb.shape[:2]) < 4:
             raise EventDataError(f"image must be colour [h, w, 3], at least 4 x 4; got shape {rgb.shape}")
         rgb = rgb[..., :3]
@@ -361,9 +365,18 @@ def simulate_colour_video(rgb_frames, t, C=0.2, *, phase=(0, 0), block: int = QU
     """
     from .simulate import simulate_video
 
-    rgb = np.asarray(rgb_frames, dtype=np.float64)
+    rgb = dense_array(rgb_frames, "rgb_frames", error=EventDataError, want="frames of one size [T, H, W, 3]")
+    if rgb.dtype.kind not in "iuf" or rgb.dtype == bool:
+        kind = "complex numbers" if rgb.dtype.kind == "c" else f"dtype {rgb.dtype}"
+        raise EventDataError(f"rgb_frames must be numbers (linear intensities > 0), got {kind}")
+    rgb = rgb.astype(np.float64)
     if rgb.ndim != 4 or rgb.shape[-1] != 3:
         raise EventDataError(f"rgb_frames must have shape [T, H, W, 3], got {rgb.shape}")
+    finite = np.isfinite(rgb)
+    if not finite.all():
+        n_nan, n_inf = int(np.isnan(rgb).sum()), int(np.isinf(rgb).sum())
+        raise EventDataError(f"rgb_frames contain {n_nan:,} NaN and {n_inf:,} inf value(s); intensities must be finite "
+                             "(repair or drop those frames)")
     if not np.all(rgb > 0):
         raise EventDataError("rgb_frames must be positive intensities (the simulator takes their log); clip them above 0")
     return simulate_video(np.log(mosaic(rgb, phase, block)), t, C, **kwargs)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.checks import real_number, whole_number
 from ..core.events import EventDataError
 from ..io.output import atomic_output_dir, save_png
 from ..io.readers import read_recording
@@ -32,6 +33,8 @@ def write_example_recording(folder, *, scene: str = "camera", sensor_size=(60, 8
     about [0.05, 1] -> uint8) at ``frame_rate`` per second. The folder is written atomically.
     Returns the folder's path.
     """
+    # before any work: 0 was a ZeroDivisionError, -1 a recording without frames, NaN numpy's arange error
+    frame_rate = real_number(frame_rate, "frame_rate", lo=0, lo_open=True, hint="APS frames per second (e.g. 20)")
     sc = make_scene(scene, sensor_size=sensor_size, duration=duration)
     events = simulate_scene(sc, 0.0, duration, C=C, seed=seed)
     frame_t = np.arange(0.0, duration + 1e-9, 1.0 / frame_rate)
@@ -55,6 +58,10 @@ def synthetic_recording(sensor_size=(90, 120), duration: float = 0.5, n_frames: 
     """A stand-in Recording when no real data is around: the 'camera' scene's events and ``n_frames``
     ground-truth frames spread over ``duration`` seconds (written and read back as an IJRR folder by
     :func:`write_example_recording`)."""
+    # the first frame at 0 and the last at duration: 1 frame was a ZeroDivisionError, 2.5 frames two
+    n_frames = whole_number(n_frames, "n_frames", lo=2)
+    # the frame rate is derived from it: a bad duration would be blamed on a frame_rate nobody passed
+    duration = real_number(duration, "duration", lo=0, lo_open=True, hint="seconds (e.g. 0.5)")
     with tempfile.TemporaryDirectory() as tmp:
         folder = write_example_recording(Path(tmp) / "synthetic", sensor_size=sensor_size, duration=duration, C=C,
                                          frame_rate=(n_frames - 1) / duration, seed=seed)

@@ -21,26 +21,63 @@ import inspect
 import numpy as np
 from scipy import ndimage
 
-from ..core.checks import ArgumentTypeError, is_real_number
+from ..core.checks import ArgumentTypeError, host_array, is_real_number, real_number
 from ..core.events import EventDataError, check_sensor_size
 from ..core.frames import Frames
+from ..core.guard import dense_array
 
 __all__ = ["Scene", "MovingImageScene", "OscillatingScene", "MovingBarScene", "VaryingSpeedScene", "WarpedImageScene",
-           "ObjectOverBackgroundScene", "LightingScene", "make_scene", "IMAGE_NAMES", "SCENE_NAMES"]
+           "ObjectOverBackgroundScene", "LightingScene", "make_scene", "IMAGE_NAMES", "SCENE_NAMES",
+           "MOTION_PARAMETERS", "check_intensity_range", "real_image"]
 
 # scikit-image sample images that ship with the package (no download needed).
 IMAGE_NAMES = ("camera", "astronaut", "coffee", "chelsea", "cat", "coins", "moon", "rocket", "brick",
                "grass", "gravel", "text", "page", "clock", "hubble_deep_field", "immunohistochemistry")
 SCENE_NAMES = IMAGE_NAMES + ("bar",)
+MOTION_PARAMETERS = ("velocity", "rotation", "zoom", "scale", "blur", "order")   # MovingImageScene's motion keywords
 _RENDER_CHUNK = 1 << 20     # pixels x times computed at once inside log_intensity
 
 
-def _check_range(intensity_range) -> tuple[float, float]:
-    lo, hi = (float(v) for v in intensity_range)
-    if not (0 < lo < hi and np.isfinite(hi)):
-        raise EventDataError(f"intensity_range must be (low, high) with 0 < low < high, got {intensity_range!r}; "
-                             "low > 0 keeps log intensity finite")
+def _pair(value, name: str, what: str) -> tuple[float, float]:
+    """``value`` as two finite floats; else an EventDataError saying ``name`` must be ``what`` (one number for a
+    pair was Python's "not iterable", three numbers numpy's broadcast error, NaN NaN frames)."""
+    try:
+        items = tuple(host_array(value)) if not isinstance(value, (str, bytes)) else ()
+    except TypeError:
+        items = ()
+    if len(items) != 2 or not all(is_real_number(v) and np.isfinite(host_array(v)) for v in items):
+        raise EventDataError(f"{name} must be {what}, got {value!r}")
+    return float(host_array(items[0])), float(host_array(items[1]))
+
+
+def check_intensity_range(intensity_range) -> tuple[float, float]:
+    """(low, high) intensities with 0 < low < high, finite; else an EventDataError (low > 0 keeps the log finite)."""
+    what = "(low, high) with 0 < low < high (low > 0 keeps log intensity finite)"
+    lo, hi = _pair(intensity_range, "intensity_range", what)
+    if not 0 < lo < hi:
+        raise EventDataError(f"intensity_range must be {what}, got {intensity_range!r}")
     return lo, hi
+
+
+
+def real_image(image) -> np.ndarray:
+    """``image`` (an array, a list or a tensor) as a numpy array of real numbers (bool and integers too); complex
+    and non-numeric images are refused by name (a cast to float dropped the imaginary part without a word)."""
+    img = dense_array(image, "image", error=EventDataError, want="an image of one size [h, w] or [h, w, 3]")
+    if img.dtype.kind == "c":
+        raise EventDataError("image is complex; pass a real image (np.abs(image) or np.real(image), whichever you mean)")
+    if img.dtype.kind not in "biuf":
+        raise EventDataError(f"image must be numbers (intensities), got dtype {img.dtype}")
+    return img
+
+
+def _check_base(base, name: str = "base"):
+    """``base`` when it is a scene (sensor_size, duration, log_intensity, max_speed); else an EventDataError."""
+    missing = [a for a in ("sensor_size", "duration", "log_intensity", "max_speed") if not hasattr(base, a)]
+    if missing:
+        raise EventDataError(f"{name}= must be a Scene (it has no {', '.join(missing)}), got {type(base).__name__}; "
+                             "build one with make_scene(name, sensor_size=(H, W), duration=seconds)")
+    return base
 
 
 class Scene:
@@ -66,7 +103,13 @@ class Scene:
 
     def log_intensity(self, t) -> np.ndarray:
         """Log intensity: float64 [H, W] for a scalar t (s), [T, H, W] for t of shape [T]."""
-        t = np.asarray(t, dtype=np.float64)
+        try:
+            arr = np.asarray(host_array(t)) if not isinstance(t, (str, bytes)) else None
+        except (TypeError, ValueError):
+            arr = None
+        if arr is None or arr.dtype.kind not in "iuf":   # "0.1" was read as 0.1 s, a complex time Python's error
+            raise EventDataError(f"t must be seconds (a number or a 1-D array of numbers), got {t!r:.60}")
+        t = arr.astype(np.float64)
         if t.ndim > 1:
             raise EventDataError(f"t must be a scalar or a 1-D array of seconds, got shape {t.shape}")
         if not np.all(np.isfinite(t)):
@@ -114,7 +157,7 @@ def load_image(image="camera") -> np.ndarray:
         import skimage.data
         img = np.asarray(getattr(skimage.data, image)())
     else:
-        img = np.asarray(image)
+        img = real_image(image)
     if img.ndim == 3 and img.shape[-1] in (3, 4):
         from skimage.color import rgb2gray
         img = rgb2gray(img[..., :3])
@@ -164,22 +207,17 @@ class MovingImageScene(Scene):
         super().__init__(sensor_size, duration)
         img = load_image(image)
         H, W = self.sensor_size
-        self.velocity = tuple(float(v) for v in velocity)
-        if len(self.velocity) != 2 or not np.all(np.isfinite(self.velocity)):
-            raise EventDataError(f"velocity must be (vx, vy) in px/s, got {velocity!r}")
-        self.rotation, self.zoom = float(rotation), float(zoom)
-        if not (np.isfinite(self.rotation) and np.isfinite(self.zoom)):
-            raise EventDataError(f"rotation (rad/s) and zoom (1/s) must be finite, got {rotation!r}, {zoom!r}")
-        self.scale = float(min(img.shape[0] / H, img.shape[1] / W) / 1.4 if scale is None else scale)
-        if not (np.isfinite(self.scale) and self.scale > 0):
-            raise EventDataError(f"scale must be positive (source pixels per sensor pixel), got {scale!r}")
-        if not (np.isfinite(blur) and blur >= 0):
-            raise EventDataError(f"blur must be a sigma >= 0 in sensor pixels, got {blur!r}")
+        self.velocity = _pair(velocity, "velocity", "(vx, vy) in px/s")
+        self.rotation = real_number(rotation, "rotation", hint="rad/s")
+        self.zoom = real_number(zoom, "zoom", hint="relative scale rate, 1/s")
+        self.scale = (float(min(img.shape[0] / H, img.shape[1] / W) / 1.4) if scale is None else
+                      real_number(scale, "scale", lo=0, lo_open=True, hint="source pixels per sensor pixel"))
+        blur = real_number(blur, "blur", lo=0, hint="a Gaussian sigma in sensor pixels (0: none)")
         if order not in (1, 3):
             raise EventDataError(f"order must be 1 (bilinear) or 3 (cubic), got {order!r}")
         self.order = order
         self.blur = float(blur)
-        self.intensity_range = _check_range(intensity_range)
+        self.intensity_range = check_intensity_range(intensity_range)
         if blur > 0:
             img = ndimage.gaussian_filter(img, sigma=blur * self.scale, mode="mirror")
         img = (img - img.min()) / max(img.max() - img.min(), 1e-12)
@@ -232,11 +270,15 @@ class OscillatingScene(MovingImageScene):
                  rotation=(0.0, 1.0), scale=None, blur=0.75, intensity_range=(0.05, 1.0), order=3):
         super().__init__(image, sensor_size, duration, velocity=(0.0, 0.0), rotation=0.0, zoom=0.0, scale=scale,
                          blur=blur, intensity_range=intensity_range, order=order)
-        self.path = np.asarray(path, dtype=np.float64).reshape(-1, 4)
-        self.rot_amp, self.rot_period = (float(v) for v in rotation)
-        if self.path.shape[0] < 1 or not np.all(np.isfinite(self.path)) or np.any(self.path[:, 2] <= 0):
-            raise EventDataError(f"path must be ((ax, ay, period > 0, phase), ...) in px, s, rad; got {path!r}")
-        if not (np.isfinite(self.rot_amp) and np.isfinite(self.rot_period) and self.rot_period > 0):
+        path_what = "((ax, ay, period > 0, phase), ...) in px, s, rad"
+        arr = dense_array(path, "path", error=EventDataError, want=path_what)
+        if arr.dtype.kind not in "iuf" or arr.size == 0 or arr.size % 4:   # 3 numbers were numpy's reshape error
+            raise EventDataError(f"path must be {path_what}; got {path!r}")
+        self.path = arr.astype(np.float64).reshape(-1, 4)
+        self.rot_amp, self.rot_period = _pair(rotation, "rotation", "(amplitude rad, period s > 0)")
+        if not np.all(np.isfinite(self.path)) or np.any(self.path[:, 2] <= 0):
+            raise EventDataError(f"path must be {path_what}; got {path!r}")
+        if not self.rot_period > 0:
             raise EventDataError(f"rotation must be (amplitude rad, period s > 0), got {rotation!r}")
 
     def offset(self, t) -> np.ndarray:
@@ -288,19 +330,19 @@ class MovingBarScene(Scene):
     def __init__(self, sensor_size=(120, 160), duration=2.0, *, speed=None, angle=0.3, width=12.0, edge=2.0,
                  intensities=(0.15, 0.9), start=None):
         super().__init__(sensor_size, duration)
-        self.angle, self.width, self.edge = float(angle), float(width), float(edge)
-        if not (self.width > 0 and self.edge > 0):
-            raise EventDataError(f"width and edge must be positive pixels, got {width!r}, {edge!r}")
-        self.intensities = tuple(float(v) for v in intensities)
-        if len(self.intensities) != 2 or min(self.intensities) <= 0:
-            raise EventDataError(f"intensities must be (background, bar), both > 0, got {intensities!r}")
+        # each checked by name: a NaN angle or an infinite width or edge blamed "speed ... got None" (not given)
+        self.angle = real_number(angle, "angle", hint="rad (0 moves right along +x)")
+        self.width = real_number(width, "width", lo=0, lo_open=True, hint="the bar's width in pixels")
+        self.edge = real_number(edge, "edge", lo=0, lo_open=True, hint="the edges' softness in pixels")
+        what = "(background, bar), two finite intensities > 0"
+        self.intensities = _pair(intensities, "intensities", what)
+        if min(self.intensities) <= 0:
+            raise EventDataError(f"intensities must be {what}, got {intensities!r}")
         x, y = self._grid()
         self._u = x * np.cos(self.angle) + y * np.sin(self.angle)
         reach = np.abs(self._u).max() + self.width / 2 + 3 * self.edge   # the bar is off-sensor beyond this
-        self.start = -reach if start is None else float(start)
-        self.speed = 2 * reach / self.duration if speed is None else float(speed)
-        if not np.isfinite(self.speed):
-            raise EventDataError(f"speed must be finite px/s, got {speed!r}")
+        self.start = -reach if start is None else real_number(start, "start", hint="px from the sensor centre at t = 0")
+        self.speed = 2 * reach / self.duration if speed is None else real_number(speed, "speed", hint="px/s")
 
     @property
     def max_speed(self) -> float:
@@ -323,12 +365,13 @@ class VaryingSpeedScene(Scene):
     """
 
     def __init__(self, base: Scene, depth: float = 0.8, period: float = 2.0):
-        super().__init__(base.sensor_size, base.duration)
-        if not 0 <= depth < 1:
-            raise EventDataError(f"depth must be in [0, 1) so that time keeps running forward, got {depth}")
-        if not period > 0:
-            raise EventDataError(f"period must be positive seconds, got {period}")
-        self.base, self.depth, self.period = base, float(depth), float(period)
+        super().__init__(_check_base(base).sensor_size, base.duration)
+        if not (is_real_number(depth) and 0 <= float(host_array(depth)) < 1):
+            raise EventDataError(f"depth= must be a finite number in [0, 1) so that time keeps running forward, got "
+                                 f"{depth!r}")
+        depth = float(host_array(depth))
+        period = real_number(period, "period", lo=0, lo_open=True, hint="seconds (an infinite one gave NaN frames)")
+        self.base, self.depth, self.period = base, depth, period
 
     def warp(self, t) -> np.ndarray:
         """s(t): the base scene's time shown at time t (seconds)."""
@@ -362,10 +405,11 @@ class WarpedImageScene(MovingImageScene):
     def __init__(self, image="camera", sensor_size=(120, 160), duration=2.0, *, shear=(0.15, 0.0),
                  tilt=(0.2, 0.0), **kwargs):
         super().__init__(image, sensor_size, duration, **kwargs)
-        self.shear = tuple(float(v) for v in shear)
-        self.tilt = tuple(float(v) for v in tilt)
-        if len(self.shear) != 2 or len(self.tilt) != 2 or not np.all(np.isfinite(self.shear + self.tilt)):
-            raise EventDataError(f"shear and tilt must be (x, y) pairs of finite rates (1/s), got {shear!r}, {tilt!r}")
+        what = "(x, y) pairs of finite rates (1/s)"
+        try:
+            self.shear, self.tilt = _pair(shear, "shear", what), _pair(tilt, "tilt", what)
+        except EventDataError:
+            raise EventDataError(f"shear and tilt must be {what}, got {shear!r}, {tilt!r}") from None
         self._r = float(np.hypot(*self.sensor_size) / 2)
         if max(abs(v) for v in self.tilt) * self.duration / 2 >= 0.5:
             raise EventDataError(f"tilt {tilt} over {duration} s folds the view; keep |tilt| * duration / 2 below 0.5")
@@ -409,8 +453,12 @@ class ObjectOverBackgroundScene(Scene):
         self.edge = float(edge)
         if not (self.radius > 0 and self.edge > 0):
             raise EventDataError(f"radius and edge must be positive pixels, got {radius!r}, {edge!r}")
-        self.start = np.asarray((-W / 2 + self.radius, -H / 6) if start is None else start, dtype=np.float64)
-        self.end = np.asarray((W / 2 - self.radius, H / 6) if end is None else end, dtype=np.float64)
+        what = "(x, y): finite pixels from the sensor centre"
+        try:   # 3 numbers were numpy's broadcast error, NaN gave NaN frames
+            self.start = np.asarray((-W / 2 + self.radius, -H / 6) if start is None else _pair(start, "start", what))
+            self.end = np.asarray((W / 2 - self.radius, H / 6) if end is None else _pair(end, "end", what))
+        except EventDataError:
+            raise EventDataError(f"start and end must be {what}, got {start!r}, {end!r}") from None
         still = dict(velocity=(0.0, 0.0), rotation=0.0, zoom=0.0, blur=blur, intensity_range=intensity_range)
         self._background = MovingImageScene(background, sensor_size, duration, **still).log_intensity(0.0)
         self._object = MovingImageScene(object_image, sensor_size, duration, **still)
@@ -450,7 +498,7 @@ class LightingScene(Scene):
     """
 
     def __init__(self, base: Scene, global_change: float = 0.4, vignette: float = -0.5):
-        super().__init__(base.sensor_size, base.duration)
+        super().__init__(_check_base(base).sensor_size, base.duration)
         self.base = base
         self.global_change, self.vignette = float(global_change), float(vignette)
         if not (np.isfinite(self.global_change) and np.isfinite(self.vignette)):

@@ -46,7 +46,8 @@ from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, check_seconds_precision, host_array, is_real_number
+from ..core.checks import (ArgumentTypeError, check_seconds_precision, host_array, is_real_number, optional_seconds,
+                           real_number, require, whole_number)
 from ..core.guard import dense_array
 from ..core.events import MAX_SPAN_S, EventDataError, Events
 
@@ -57,6 +58,7 @@ MIN_THRESHOLD_FRACTION = 0.1   # mismatched thresholds are clipped below at this
 MAX_PX_PER_SAMPLE = 0.5        # simulate_scene's default sampling: at most this motion per sample
 MAX_SAMPLE_RATE = 1e6          # samples per second: 1 us, the timestamp resolution of event cameras
 MIN_C = 1e-3                   # log units; sensors have about 0.05 to 1.5, and events grow as 1 / C
+MAX_NOISE_EVENTS = 10**9       # noise events one call may add (about 17 GB of events): beyond, a rate or span is wrong
 N_BISECTION = 50               # halvings when refining a crossing of a callable L
 _REFINE_CHUNK = 1 << 22        # values of L evaluated per call during refinement (bounds memory)
 _SCENE_CHUNK = 1 << 21         # pixels x samples rendered per scene.log_intensity call
@@ -68,12 +70,29 @@ def _as_rng(seed) -> np.random.Generator:
     if isinstance(seed, np.random.Generator):
         return seed
     if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise EventDataError(f"seed must be a whole number >= 0 or a np.random.Generator, got {seed!r}")
+        why = (" (None would draw other events on every call: the simulations are seeded so that they repeat)"
+               if seed is None else "")
+        raise EventDataError(f"seed must be a whole number >= 0 or a np.random.Generator, got {seed!r}{why}")
     return np.random.default_rng(int(seed))
 
 
+def _not_complex(value, name: str):
+    """``value`` as it is, after refusing complex numbers by name (numpy's cast to float drops the imaginary part
+    with only a ComplexWarning, and the events would be those of the real part)."""
+    kind = getattr(getattr(host_array(value), "dtype", None), "kind", None)
+    if kind is None and isinstance(value, (list, tuple)):
+        try:
+            kind = np.asarray(value).dtype.kind
+        except (TypeError, ValueError):
+            kind = None
+    if kind == "c" or isinstance(value, complex):
+        raise EventDataError(f"{name} are complex numbers; pass real values (e.g. np.real({name.split()[0]}) or "
+                             f"np.abs(...), whichever you mean)")
+    return value
+
+
 def _check_times(t) -> np.ndarray:
-    t = host_array(t)
+    t = _not_complex(host_array(t), "t (sample times)")
     check_seconds_precision(t, "t (sample times)")
     t = dense_array(t, "t (sample times)", np.float64, EventDataError)
     if t.ndim != 1 or t.size < 2:
@@ -102,6 +121,28 @@ def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
                                  f"(about 0.05 to 1.5): each pixel would fire |change of log intensity| / C events, "
                                  f"millions of them; use C >= {MIN_C:g} (e.g. C=0.2)")
     return float(C_pos), float(C_neg)
+
+
+def _noise_span(events, t_start, t_end, *, allow_empty: bool = False) -> tuple[float, float]:
+    """(t0, t1) of the noise: ``t_start`` / ``t_end`` (finite seconds) or the events' first / last time; refused
+    when the events are empty and a limit is missing, or the span is reversed (or empty, unless ``allow_empty``)."""
+    t0, t1 = optional_seconds(t_start, "t_start"), optional_seconds(t_end, "t_end")
+    if (t0 is None or t1 is None) and len(events) == 0:
+        raise EventDataError("there are no events, so they give no span for the noise; pass t_start= and t_end= "
+                             "(seconds) for the span to fill")
+    t0 = float(events.t[0]) if t0 is None else t0
+    t1 = float(events.t[-1]) if t1 is None else t1
+    if not (t1 > t0 or (allow_empty and t1 == t0)):
+        raise EventDataError(f"noise span [{t0}, {t1}] s is empty; give t_end > t_start")
+    return t0, t1
+
+
+def _check_noise_count(expected: float, what: str) -> None:
+    """Refuse noise whose expected number of events (a rate x a span x pixels) no memory holds."""
+    if expected > MAX_NOISE_EVENTS:
+        raise EventDataError(f"{what} would add about {expected:,.3g} events (rate x span x pixels), more than "
+                             f"{MAX_NOISE_EVENTS:,} fit in memory; the rate is in events per second (per pixel) and "
+                             "the span in seconds: check both")
 
 
 def _check_nonnegative(**values) -> None:
@@ -362,7 +403,10 @@ def simulate_events_1d(L, t, C=0.2, *, C_pos=None, C_neg=None, threshold_sigma=0
         times in [t[0], t[-1]]. The reference level starts at L(t[0]) per pixel.
     """
     t = _check_times(t)
-    samples = dense_array(L(t) if callable(L) else L, "L(t)" if callable(L) else "L", np.float64, EventDataError,
+    if not isinstance(refine, (bool, np.bool_)):   # "no" is truthy: it would refine
+        raise EventDataError(f"refine must be True or False, got {refine!r}")
+    what = "L(t)" if callable(L) else "L"
+    samples = dense_array(_not_complex(L(t) if callable(L) else L, what), what, np.float64, EventDataError,
                           want="one value per time [T] or [T, P] for P pixels")
     if samples.ndim == 1:
         samples = samples[:, None]
@@ -387,6 +431,7 @@ def pixel_events(events, pixel: int = 0) -> tuple[np.ndarray, np.ndarray]:
     ``(t, p)`` pair of arrays passed through (as float64 [N] each; ``([], [])`` is no events). Anything
     else (None, ``[]``, an [N, 2] array) is an ArgumentTypeError, and a pair whose t and p differ in
     length an EventDataError, each naming the fix."""
+    pixel = whole_number(pixel, "pixel", lo=0)   # 1.5 matched no event, "0" was Python's TypeError
     if isinstance(events, Events):
         H, W = events.sensor_size
         if H != 1:
@@ -402,10 +447,21 @@ def pixel_events(events, pixel: int = 0) -> tuple[np.ndarray, np.ndarray]:
         t, p = events
     except (TypeError, ValueError):   # said "a (t, p) pair" of [], of an [N, 2] array, of (t, p, x): which fix?
         raise ArgumentTypeError(f"events must be {want}, got {_what(events)}") from None
-    t = np.ravel(np.asarray(t, dtype=np.float64))
-    p = np.ravel(np.asarray(p, dtype=np.float64))
+    if pixel != 0:   # a pair is one pixel's events: the pixel would be ignored
+        raise EventDataError(f"pixel={pixel} picks a pixel of an Events with sensor_size (1, P); a (t, p) pair is "
+                             "the events of one pixel already: leave pixel out (or pass the Events)")
+    t = np.ravel(dense_array(t, "events: t", error=EventDataError))
+    p = np.ravel(dense_array(p, "events: p", error=EventDataError))
+    if t.dtype.kind not in "iuf" or p.dtype.kind not in "iufb":
+        raise EventDataError(f"events: t and p must be numbers (seconds and polarities), got dtypes {t.dtype} and "
+                             f"{p.dtype}")
+    t, p = t.astype(np.float64), p.astype(np.float64)
     if t.shape != p.shape:   # plot_signal_and_events stopped on numpy's boolean-index error
         raise EventDataError(f"events: {t.size} event time(s) but {p.size} polarities; pass one polarity per event")
+    finite = np.isfinite(t)
+    if not finite.all():
+        bad = int(np.flatnonzero(~finite)[0])
+        raise EventDataError(f"events: t[{bad}] is {t[bad]}; event times must be finite seconds: drop or repair it")
     return t, p
 
 
@@ -551,20 +607,26 @@ def add_background_noise(events: Events, rate_hz: float, seed=0, t_start: float 
         the input carry over as ``labels_out[~added] = labels_in``); with ``return_labels``,
         ``(events, added)``.
     """
-    if not (np.isscalar(rate_hz) and np.isfinite(rate_hz) and rate_hz >= 0):
-        raise EventDataError(f"rate_hz must be a finite number >= 0 (events per pixel per second), got {rate_hz!r}")
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    t0 = events.t[0] if t_start is None else float(t_start)
-    t1 = events.t[-1] if t_end is None else float(t_end)
-    if not t1 > t0:
-        raise EventDataError(f"noise span [{t0}, {t1}] s is empty; give t_end > t_start")
+    events = require(events, Events, "events")
+    rate_hz = _rate(rate_hz, "rate_hz", "events per pixel per second")
+    rng = _as_rng(seed)
+    t0, t1 = _noise_span(events, t_start, t_end)
     H, W = events.sensor_size
+    _check_noise_count(rate_hz * (t1 - t0) * H * W, "add_background_noise")
     counts = rng.poisson(rate_hz * (t1 - t0), size=H * W)
     pix = np.repeat(np.arange(H * W), counts)
     t = t0 + (t1 - t0) * rng.random(pix.size)
     p = np.where(rng.random(pix.size) < 0.5, -1, 1)
     noise = Events.from_arrays(t, pix % W, pix // W, p, (H, W), sort=True, t_origin=events.t_origin)
     return _merge(events, noise, return_labels)
+
+
+def _rate(value, name: str, unit: str) -> float:
+    """A rate (``unit``) as a float: a finite number >= 0 (a 0-d array or tensor too); else an EventDataError."""
+    value = host_array(value)
+    if not (is_real_number(value) and np.isfinite(value) and value >= 0):
+        raise EventDataError(f"{name} must be a finite number >= 0 ({unit}), got {value!r}")
+    return float(value)
 
 
 def _merge(events: Events, noise: Events, return_labels: bool):
@@ -595,15 +657,14 @@ def add_hot_pixels(events: Events, n_pixels: int, rate_hz: float, seed=0, t_star
         (events, hot): the merged events and the hot pixels' flat indices y * W + x (int64 [n_pixels]);
         with ``return_labels``, (events, hot, added). The input events keep their order (stable merge).
     """
-    if not (np.isscalar(rate_hz) and np.isfinite(rate_hz) and rate_hz >= 0):
-        raise EventDataError(f"rate_hz must be a finite number >= 0 (events per second), got {rate_hz!r}")
-    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    events = require(events, Events, "events")
+    rate_hz = _rate(rate_hz, "rate_hz", "events per second")
+    rng = _as_rng(seed)
     H, W = events.sensor_size
-    if not 0 <= int(n_pixels) <= H * W:
-        raise EventDataError(f"n_pixels must be in [0, {H * W}], got {n_pixels!r}")
-    t0 = events.t[0] if t_start is None else float(t_start)
-    t1 = events.t[-1] if t_end is None else float(t_end)
-    hot = np.sort(rng.choice(H * W, size=int(n_pixels), replace=False)).astype(np.int64)
+    n_pixels = whole_number(n_pixels, "n_pixels", lo=0, hi=H * W)
+    t0, t1 = _noise_span(events, t_start, t_end, allow_empty=True)
+    _check_noise_count(rate_hz * (t1 - t0) * n_pixels, "add_hot_pixels")
+    hot = np.sort(rng.choice(H * W, size=n_pixels, replace=False)).astype(np.int64)
     sign = np.where(rng.random(hot.size) < 0.5, -1, 1)
     counts = rng.poisson(rate_hz * (t1 - t0), size=hot.size)
     pix = np.repeat(hot, counts)
@@ -638,17 +699,23 @@ def add_light_noise(events: Events, scene, rate_hz: float, seed=0, t_start: floa
     Returns:
         The merged events (stable merge), with ``return_labels`` ``(events, added)``.
     """
-    _check_nonnegative(rate_hz=rate_hz)
-    if not (np.isscalar(max_gain) and np.isfinite(max_gain) and max_gain >= 1):
+    events = require(events, Events, "events")
+    rate_hz = _rate(rate_hz, "rate_hz", "events per pixel per second")
+    max_gain = host_array(max_gain)
+    if not (is_real_number(max_gain) and np.isfinite(max_gain) and max_gain >= 1):
         raise EventDataError(f"max_gain must be a number >= 1 (the noise's largest factor), got {max_gain!r}")
+    max_gain = float(max_gain)
+    n_frames_per_s = real_number(n_frames_per_s, "n_frames_per_s", lo=0, lo_open=True,
+                                 hint="the scene's frames per second that set the light (e.g. 20)")
+    if not all(hasattr(scene, a) for a in ("sensor_size", "log_intensity")):
+        raise EventDataError(f"scene= must be a Scene (the one the events came from: its light sets the noise), got "
+                             f"{type(scene).__name__}")
     if tuple(scene.sensor_size) != tuple(events.sensor_size):
         raise EventDataError(f"scene sensor_size {tuple(scene.sensor_size)} != events' {tuple(events.sensor_size)}")
     rng = _as_rng(seed)
-    t0 = events.t[0] if t_start is None else float(t_start)
-    t1 = events.t[-1] if t_end is None else float(t_end)
-    if not t1 > t0:
-        raise EventDataError(f"noise span [{t0}, {t1}] s is empty; give t_end > t_start")
+    t0, t1 = _noise_span(events, t_start, t_end)
     H, W = events.sensor_size
+    _check_noise_count(rate_hz * max_gain * (t1 - t0) * H * W, "add_light_noise")
     counts = rng.poisson(rate_hz * max_gain * (t1 - t0), size=H * W)
     pix = np.repeat(np.arange(H * W), counts)
     t = t0 + (t1 - t0) * rng.random(pix.size)
