@@ -22,6 +22,8 @@ import numpy as np
 import torch
 from torch import nn
 
+from ..core.checks import ArgumentTypeError, real_number, require, seconds_array, whole_number
+from ..core.events import EventDataError
 from ..core.runtime import default_device
 from ..method.siren import Siren, input_gradient
 from ..sim.simulate import pixel_events
@@ -64,10 +66,88 @@ def _window_index(t_events: np.ndarray, boundaries: np.ndarray) -> tuple[np.ndar
 
 def window_sums(t_events, p_events, C, boundaries) -> np.ndarray:
     """Delta L per window (Eq. 2): C times the summed polarities in each window. float64 [B]."""
-    b = np.asarray(boundaries, dtype=np.float64)
-    t = np.asarray(t_events, dtype=np.float64)
+    C = _contrast(C)
+    b = _edges(boundaries)
+    t, p = _pixel_pair(t_events, p_events)
     idx, inside = _window_index(t, b)
-    return C * np.bincount(idx, weights=np.asarray(p_events, dtype=np.float64)[inside], minlength=b.size - 1)
+    return C * np.bincount(idx, weights=p[inside], minlength=b.size - 1)
+
+
+# ---- argument checks of the helpers below (the exercises' reference solutions stay as the notebooks show them) ----
+
+MAX_WINDOWS = 10_000_000   # windows in one call: more is a window length in the wrong unit, not a plan
+
+
+def _contrast(C) -> float:
+    return real_number(C, "C", lo=0.0, lo_open=True, hint="the contrast threshold in log units, e.g. 0.2")
+
+
+def _edges(boundaries, name: str = "boundaries") -> np.ndarray:
+    """Window edges as float64 [B + 1]: numbers, finite, at least two, strictly increasing."""
+    b = seconds_array(boundaries, name)
+    if b.size < 2:
+        raise EventDataError(f"{name}= holds {b.size} edge; windows need at least 2 edges (B + 1 edges make B "
+                             f"windows), e.g. np.linspace(0.0, 1.0, 11)")
+    step = np.diff(b)
+    if not (step > 0).all():
+        k = int(np.flatnonzero(~(step > 0))[0])
+        raise EventDataError(f"{name}= must increase strictly, but {name}[{k + 1}] = {b[k + 1]:g} comes after "
+                             f"{name}[{k}] = {b[k]:g}; sort them (np.sort) and drop repeats (np.unique)")
+    return b
+
+
+def _pixel_pair(t_events, p_events) -> tuple[np.ndarray, np.ndarray]:
+    """One pixel's events as float64 [N] times and polarities: numbers, one polarity per time, finite."""
+    t = seconds_array(t_events, "t_events", allow_empty=True)
+    p = np.asarray(p_events) if not isinstance(p_events, (str, bytes)) else np.asarray([p_events])
+    if p.dtype.kind not in "iufb" or p.ndim > 1:
+        raise EventDataError(f"p_events= must be a 1-D array of polarities (+-1), got "
+                             f"{'shape ' + str(p.shape) if p.dtype.kind in 'iufb' else repr(p_events)[:60]}")
+    p = np.atleast_1d(p).astype(np.float64)
+    if p.shape != t.shape:
+        raise EventDataError(f"{t.size} event time(s) in t_events but {p.size} polarities in p_events; pass one "
+                             f"polarity per event")
+    if not np.isfinite(p).all():
+        raise EventDataError("p_events= holds NaN or inf; polarities are +1 (ON) or -1 (OFF)")
+    return t, p
+
+
+def _span(t_range, name: str = "t_range") -> tuple[float, float]:
+    """(t0, t1) as finite floats, t0 < t1."""
+    try:
+        t0, t1 = t_range
+    except (TypeError, ValueError):
+        raise EventDataError(f"{name}= must be a pair (t0, t1) of seconds, e.g. (0.0, 1.0), got "
+                             f"{repr(t_range)[:60]}") from None
+    t0 = real_number(t0, f"{name}: t0", hint="seconds, e.g. (0.0, 1.0)")
+    t1 = real_number(t1, f"{name}: t1", hint="seconds, e.g. (0.0, 1.0)")
+    if not t1 > t0:
+        raise EventDataError(f"t_range must be increasing, got {t_range}; give (t0, t1) with t0 < t1")
+    return t0, t1
+
+
+def _callable(fn, name: str, *, none_ok: bool = False):
+    if (fn is None and none_ok) or callable(fn):
+        return fn
+    raise ArgumentTypeError(f"{name}= must be a function of time (seconds -> log intensity), e.g. lambda t: "
+                            f"np.sin(t), got {type(fn).__name__}" + (" (or None)" if none_ok else ""))
+
+
+def _window_count(span: float, window: float) -> int:
+    n = span / window
+    if n > MAX_WINDOWS:
+        raise EventDataError(f"window={window:g} s cuts {span:g} s into {n:,.0f} windows (at most "
+                             f"{MAX_WINDOWS:,}); give the window in seconds (e.g. 0.025, not 25 ms as 2.5e-5)")
+    return int(n)
+
+
+FORMS = ("derivative", "difference")
+
+
+def _form(form) -> str:
+    if not isinstance(form, str) or form not in FORMS:
+        raise EventDataError(f"form must be 'derivative' (Eq. 5) or 'difference' (F(t2) - F(t1)), got {form!r}")
+    return form
 
 
 def event_rate_derivative(t_events, p_events, C, boundaries):
@@ -495,6 +575,10 @@ def taylor_error(L: Callable, t_mid, window: float, dLdt: Callable | None = None
     Returns:
         float64 [M], log units per second.
     """
+    _callable(L, "L")
+    _callable(dLdt, "dLdt", none_ok=True)
+    seconds_array(t_mid, "t_mid")
+    window = real_number(window, "window", lo=0.0, lo_open=True, hint="the window length t2 - t1 in seconds")
     t_mid = np.asarray(t_mid, dtype=np.float64)
     slope = (np.asarray(L(t_mid + window / 2)) - np.asarray(L(t_mid - window / 2))) / window
     return np.abs(slope - _derivative(L, t_mid, dLdt))
@@ -514,15 +598,23 @@ def eq4_error_vs_window(L: Callable, windows, t_range, *, t_events=None, p_event
     Returns:
         dict with float64 arrays [K]: ``"window"``, ``"taylor"`` and (with events) ``"events"``.
     """
-    t0, t1 = (float(v) for v in t_range)
-    windows = np.asarray(windows, dtype=np.float64)
+    _callable(L, "L")
+    _callable(dLdt, "dLdt", none_ok=True)
+    t0, t1 = _span(t_range)
+    windows = seconds_array(windows, "windows", allow_empty=True)
+    if (windows <= 0).any():
+        raise EventDataError(f"windows= must be window lengths > 0 s, got {windows[windows <= 0][0]:g}")
     out = {"window": windows, "taylor": np.empty_like(windows)}
     with_events = t_events is not None
-    if with_events:
-        if p_events is None or C is None:
-            raise ValueError("the event estimate needs t_events, p_events and C together")
+    if with_events or p_events is not None or C is not None:
+        if t_events is None or p_events is None or C is None:
+            raise EventDataError("the event estimate needs t_events, p_events and C together (one of them is "
+                                 "None); pass all three, or none for the Taylor error alone")
+        _contrast(C)
+        _pixel_pair(t_events, p_events)
         out["events"] = np.empty_like(windows)
     for k, w in enumerate(windows):
+        _window_count(t1 - t0, w)
         n = int(np.floor((t1 - t0) / w + 1e-9))
         if n < 1:
             raise ValueError(f"window {w} s is longer than t_range {t_range}")
@@ -554,9 +646,7 @@ class TimeSiren1D(nn.Module):
     def __init__(self, t_range, hidden_features: int = 64, hidden_layers: int = 2,
                  omega_0: float = 10.0, first_omega_0: float | None = 5.0):
         super().__init__()
-        t0, t1 = (float(v) for v in t_range)
-        if not t1 > t0:
-            raise ValueError(f"t_range must be increasing, got {t_range}")
+        t0, t1 = _span(t_range)
         self.t_range = (t0, t1)
         self.siren = Siren(1, 1, hidden_features, hidden_layers, omega_0, first_omega_0)
         self.register_buffer("offset", torch.zeros(()))
@@ -569,17 +659,20 @@ class TimeSiren1D(nn.Module):
     def predict(self, t) -> np.ndarray:
         """F at times ``t`` (numpy, seconds) as float64 numpy [N]."""
         p = next(self.parameters())
+        t = seconds_array(t, "t")   # a scalar is one time; text, a 2-D array or NaN are refused here
         with torch.no_grad():
-            return self(torch.as_tensor(np.asarray(t), dtype=p.dtype, device=p.device)).double().cpu().numpy()
+            return self(torch.as_tensor(t, dtype=p.dtype, device=p.device)).double().cpu().numpy()
 
     def derivative(self, t) -> np.ndarray:
         """dF/dt at times ``t`` (numpy, seconds) as float64 numpy [N]."""
         p = next(self.parameters())
-        tt = torch.as_tensor(np.asarray(t), dtype=p.dtype, device=p.device).requires_grad_(True)
+        t = seconds_array(t, "t")
+        tt = torch.as_tensor(t, dtype=p.dtype, device=p.device).requires_grad_(True)
         return time_derivative(self, tt, create_graph=False).detach().double().cpu().numpy()
 
     def shifted(self, c: float) -> "TimeSiren1D":
         """A copy computing F(t) + c: the same derivative everywhere, so the same temporal loss."""
+        c = real_number(c, "c", hint="a constant in log units added to F")
         new = copy.deepcopy(self)
         with torch.no_grad():
             new.offset += c
@@ -589,12 +682,18 @@ class TimeSiren1D(nn.Module):
 def time_derivative(model: nn.Module, t: torch.Tensor, create_graph: bool = True) -> torch.Tensor:
     """dF/dt at times ``t`` [N] (requires_grad) by autograd; ``create_graph=True`` lets a loss
     on it be back-propagated into the weights (double back-propagation, Eq. 5). -> [N]."""
+    if not isinstance(t, torch.Tensor):
+        raise ArgumentTypeError(f"t must be a torch tensor [N] that requires grad, got {type(t).__name__}; "
+                                f"torch.tensor(t, dtype=torch.float32, requires_grad=True)")
     return input_gradient(model(t), t, create_graph=create_graph)
 
 
 def _prepare_windows(events, t_range, C, window, pixel):
+    C = _contrast(C)
+    window = real_number(window, "window", lo=0.0, lo_open=True, hint="the window length in seconds, e.g. 0.025")
+    t0, t1 = _span(t_range)
     t_e, p_e = pixel_events(events, pixel)
-    t0, t1 = (float(v) for v in t_range)
+    _window_count(t1 - t0, window)
     n = max(1, int(round((t1 - t0) / window)))
     b = np.linspace(t0, t1, n + 1)
     return b, window_sums(t_e, p_e, C, b)
@@ -603,7 +702,9 @@ def _prepare_windows(events, t_range, C, window, pixel):
 def evaluate_temporal_loss(model: TimeSiren1D, events, C: float, window: float, t_range=None,
                            pixel: int = 0, form: str = "derivative") -> float:
     """The temporal loss (Eq. 6, mean over windows) of a fitted model, as a float."""
+    require(model, TimeSiren1D, "model")
     t_range = model.t_range if t_range is None else t_range
+    form = _form(form)
     b, dL = _prepare_windows(events, t_range, C, window, pixel)
     p = next(model.parameters())
     kw = dict(dtype=p.dtype, device=p.device)
@@ -638,8 +739,16 @@ def bin_residuals(model: TimeSiren1D, boundaries, delta_L) -> dict:
     Returns:
         dict of floats ``"slope"``, ``"change"``.
     """
-    b = np.asarray(boundaries, dtype=np.float64)
-    dL = np.asarray(delta_L, dtype=np.float64)
+    require(model, TimeSiren1D, "model")
+    b = _edges(boundaries)
+    dL = np.asarray(delta_L) if not isinstance(delta_L, (str, bytes)) else np.asarray([delta_L])
+    if dL.dtype.kind not in "iuf" or dL.ndim != 1 or not np.isfinite(dL).all():
+        raise EventDataError(f"delta_L= must be a 1-D array of finite numbers (log units, one per window), got "
+                             f"{repr(delta_L)[:60]}")
+    dL = dL.astype(np.float64)
+    if dL.size != b.size - 1:
+        raise EventDataError(f"delta_L= holds {dL.size} value(s) but boundaries= make {b.size - 1} window(s); pass "
+                             f"one Delta L per window: window_sums(t_events, p_events, C, boundaries)")
     slope = model.derivative(0.5 * (b[1:] + b[:-1])) * np.diff(b)
     change = np.diff(model.predict(b))
     return {"slope": float(np.sqrt(np.mean((slope - dL) ** 2))),
@@ -680,8 +789,21 @@ def fit_siren_1d(events, t_range, C: float, n_iters: int = 300, window: float = 
         ``"loss"`` (total), ``"temporal"``, ``"anchor"`` and the float ``"seconds"`` spent.
     """
     device = default_device() if device is None else torch.device(device)
-    if n_iters < 0 or window <= 0:
-        raise ValueError(f"need n_iters >= 0 and window > 0, got {n_iters}, {window}")
+    n_iters = whole_number(n_iters, "n_iters", lo=0)
+    seed = whole_number(seed, "seed")   # None would leave the fit unrepeatable
+    form = _form(form)
+    lr = real_number(lr, "lr", lo=0.0, lo_open=True, hint="Adam's learning rate, e.g. 3e-3")
+    lr_decay = real_number(lr_decay, "lr_decay", lo=0.0, lo_open=True, hint="the factor every 10 steps, e.g. 0.98")
+    anchor_weight = real_number(anchor_weight, "anchor_weight", lo=0.0)
+    if anchor is not None:
+        try:
+            t_a, L_a = anchor
+        except (TypeError, ValueError):
+            raise EventDataError(f"anchor= must be a pair (t_a, L_a): a time in seconds and the log intensity "
+                                 f"there, got {repr(anchor)[:60]}") from None
+        anchor = (real_number(t_a, "anchor: t_a"), real_number(L_a, "anchor: L_a"))
+    if prior_mean is not None:
+        prior_mean = real_number(prior_mean, "prior_mean", hint="a mean log intensity, e.g. np.log(0.5)")
     b, dL = _prepare_windows(events, t_range, C, window, pixel)
     torch.manual_seed(seed)
     model = TimeSiren1D(t_range, hidden_features, hidden_layers, omega_0, first_omega_0).to(device)
