@@ -25,7 +25,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import exercises
-from ..core.events import Events
+from ..core.checks import require, whole_number
+from ..core.events import EventDataError, Events
 
 __all__ = ["esim_interval", "events_to_frames_fixed", "interval_imbalance", "pixel_trace", "busiest_pixel"]
 
@@ -656,12 +657,19 @@ exercises.register(
 
 def pixel_trace(events: Events, x: int, y: int) -> tuple[np.ndarray, np.ndarray]:
     """(t float64 [n], p int8 [n]) of the events of the pixel at column ``x``, row ``y``."""
+    require(events, Events, "events")
+    H, W = events.sensor_size
+    x = whole_number(x, "x", lo=0, hi=W - 1)   # outside the sensor matched no event, silently
+    y = whole_number(y, "y", lo=0, hi=H - 1)
     keep = (events.x == x) & (events.y == y)
     return events.t[keep], events.p[keep]
 
 
 def busiest_pixel(events: Events) -> tuple[int, int]:
     """(x, y) of the pixel with the most events (the first in row-major order on a tie)."""
+    require(events, Events, "events")
+    if len(events) == 0:   # was (0, 0), a pixel that never fired
+        raise EventDataError("events hold no event, so no pixel is the busiest; pass events that hold some")
     H, W = events.sensor_size
     counts = np.bincount(events.y.astype(np.int64) * W + events.x, minlength=H * W)
     y, x = divmod(int(np.argmax(counts)), W)
