@@ -28,7 +28,7 @@ ROUND3 = ["test_batch_ownership.py", "test_api_checks.py", "test_signals_edges.p
 LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustness_round6.py", "test_api_bad_inputs.py",
          "test_api_round6.py", "test_ragged_inputs.py", "test_fuzz_readers.py", "test_robustness_round7.py",
          "test_robustness_round8.py", "test_robustness_round9.py", "test_robustness_round10.py",
-         "test_robustness_round11.py"]
+         "test_robustness_round11.py", "test_robustness_round12.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
@@ -51,6 +51,9 @@ CLASSES = [
     ("the simulator (seeds, noise rates and spans, scenes, colour, recordings) and the method's helpers beside "
      "reconstruct (baselines, bins, lam, windows, tone maps, denoiser, enhancement, ablation), round 11",
      "test_robustness_round11.py", r"test_"),
+    ("the teaching helpers readers re-call (pde1d's window sums, Taylor error, one-pixel SIREN, its fit, loss and "
+     "residuals; events2d's pixel trace and busiest pixel): contrasts, edges, windows, spans, seeds, pixels, round 12",
+     "test_robustness_round12.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"
