@@ -74,8 +74,7 @@ def test_window_sums_refuse_a_contrast_that_is_no_threshold(C):
 
 
 @pytest.mark.parametrize("b,pattern", [([], r"boundaries= is empty"), ([0.5], r"at least 2 edges"),
-                                       (B[::-1], r"must increase strictly"),
-                                       ([0.0, 0.5, 0.5, 1.0], r"increase strictly"),
+                                       (B[::-1], r"must increase"),
                                        ([0.0, np.nan, 1.0], r"finite"), (B[None], r"1-D array"),
                                        ])
 def test_window_sums_and_rates_refuse_edges_that_are_no_windows(b, pattern):
@@ -126,7 +125,7 @@ def test_eq4_table_refuses_windows_that_are_no_lengths(windows, pattern):
     _no(lambda: pde1d.eq4_error_vs_window(np.sin, windows, (0, 1)), pattern)
 
 
-@pytest.mark.parametrize("span,pattern", [((1, 0), r"t_range must be increasing"), ((0, np.nan), r"t1= must be a fin"),
+@pytest.mark.parametrize("span,pattern", [((1, 0), r"t_range= must be increasing"), ((0, np.nan), r"t1= must be a fin"),
                                           ((0, 1, 2), r"pair \(t0, t1\)"), (1.0, r"pair \(t0, t1\)"),
                                           (("0", "1"), r"t0= must be a finite number")])
 def test_eq4_table_refuses_a_range_that_is_no_span(span, pattern):
@@ -151,7 +150,7 @@ def test_eq4_table_as_before():
 # ---- 3. the SIREN of one pixel -------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("span,pattern", [((0, np.inf), r"t1= must be a finite"), (("0", "1"), r"t0= must be a fin"),
-                                          (1.0, r"pair \(t0, t1\)"), ((1, 0), r"t_range must be increasing")])
+                                          (1.0, r"pair \(t0, t1\)"), ((1, 0), r"t_range= must be increasing")])
 def test_time_siren_refuses_a_range_that_is_no_span(span, pattern):
     _no(lambda: pde1d.TimeSiren1D(span), pattern)
 
@@ -183,7 +182,7 @@ def test_time_derivative_refuses_numpy_times():
 @pytest.mark.parametrize("kw,pattern", [(dict(C=np.nan), r"C= must be"), (dict(window=0.0), r"window= must be"),
                                         (dict(window=np.nan), r"window= must be"), (dict(window=-0.1), r"window="),
                                         (dict(window=1e-12), r"windows \(at most"),
-                                        (dict(t_range=(1, 0)), r"t_range must be increasing"),
+                                        (dict(t_range=(1, 0)), r"t_range= must be increasing"),
                                         (dict(form="diff"), r"form must be")])
 def test_evaluate_temporal_loss_refuses_bad_settings(kw, pattern):
     args = dict(C=0.2, window=0.1) | kw
@@ -191,8 +190,8 @@ def test_evaluate_temporal_loss_refuses_bad_settings(kw, pattern):
 
 
 def test_loss_and_residuals_refuse_no_model():
-    _no(lambda: pde1d.evaluate_temporal_loss(None, PAIR, 0.2, 0.1), r"model= must be TimeSiren1D")
-    _no(lambda: pde1d.bin_residuals(None, B, np.ones(4)), r"model= must be TimeSiren1D")
+    _no(lambda: pde1d.evaluate_temporal_loss(None, PAIR, 0.2, 0.1), r"model= must be a fitted TimeSiren1D")
+    _no(lambda: pde1d.bin_residuals(None, B, np.ones(4)), r"model= must be a fitted TimeSiren1D")
 
 
 def test_bin_residuals_refuse_sums_that_do_not_fit_the_windows():
@@ -259,3 +258,44 @@ def test_pixel_trace_and_busiest_pixel_as_before():
     keep = (EV2.x == x) & (EV2.y == y)
     assert len(t) and np.array_equal(t, EV2.t[keep]) and np.array_equal(p, EV2.p[keep])
     assert np.array_equal(events2d.pixel_trace(EV2, np.int64(x), float(y))[0], t)
+
+
+# ---- from the review of this round ----------------------------------------------------------------
+
+def test_window_sums_take_a_repeated_edge_as_an_empty_window():
+    """The review: refusing repeated edges cost the exercise check of event_rate_derivative its hint for an input
+    clipped to [0, 1] (the reference answers the clipped input through window_sums). A repeated edge is an empty
+    window again; decreasing edges stay refused."""
+    sums = pde1d.window_sums(T, P, 0.2, [0.0, 0.5, 0.5, 1.0])
+    assert sums.shape == (3,) and sums[1] == 0.0
+    assert np.isclose(sums.sum(), pde1d.window_sums(T, P, 0.2, [0.0, 0.5, 1.0]).sum())
+
+
+def test_no_query_times_give_no_answers():
+    """The review: a zoom range no mid-point falls in (notebook 01) asked predict / derivative / taylor_error for no
+    times, which now was an error; an empty query has the empty answer, as before this round."""
+    assert MODEL.predict(np.zeros(0)).shape == (0,) and MODEL.derivative([]).shape == (0,)
+    assert pde1d.taylor_error(np.sin, [], 0.1, np.cos).shape == (0,)
+
+
+def test_whole_numbers_take_zero_d_arrays_and_tensors():
+    """The review: pixel_trace(E, torch.tensor(2), torch.tensor(1)) said "x= must be a whole number in [0, 2], got
+    tensor(2)"; a 0-d array or tensor holding a whole number is that number (core.checks.whole_number)."""
+    from evinr_lite.core.checks import whole_number
+    assert whole_number(torch.tensor(2), "x") == 2 and whole_number(np.array(3), "x") == 3
+    _no(lambda: whole_number(torch.tensor(2.5), "x"), r"whole number")
+
+
+def test_a_readers_own_model_with_the_same_methods_is_taken():
+    """The review: evaluate_temporal_loss and bin_residuals refused any model but a TimeSiren1D by type."""
+    class Wrap:
+        def __init__(self, m):
+            self.m, self.t_range = m, m.t_range
+
+        def predict(self, t):
+            return self.m.predict(t)
+
+        def derivative(self, t):
+            return self.m.derivative(t)
+    assert np.isclose(pde1d.bin_residuals(Wrap(MODEL), B, np.ones(4))["slope"],
+                      pde1d.bin_residuals(MODEL, B, np.ones(4))["slope"])

@@ -163,7 +163,10 @@ def _short(value) -> str:
 
 
 def whole_number(value, name: str, *, lo: int | None = None, hi: int | None = None) -> int:
-    """``value`` as an int when it is a whole number (not a bool, not 1.5) in [lo, hi]; else an InputError."""
+    """``value`` as an int when it is a whole number (not a bool, not 1.5) in [lo, hi]; else an InputError.
+    A 0-d array or tensor holding one counts as that number (what ``np.argmax`` or ``t.sum()`` give)."""
+    if not isinstance(value, numbers.Real) and is_real_number(value):   # 0-d numeric array or tensor
+        value = host_array(value)[()]
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)) and \
                 math.isfinite(float(value)) and float(value) == int(value):

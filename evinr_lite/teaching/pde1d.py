@@ -67,7 +67,7 @@ def _window_index(t_events: np.ndarray, boundaries: np.ndarray) -> tuple[np.ndar
 def window_sums(t_events, p_events, C, boundaries) -> np.ndarray:
     """Delta L per window (Eq. 2): C times the summed polarities in each window. float64 [B]."""
     C = _contrast(C)
-    b = _edges(boundaries)
+    b = _edges(boundaries, strict=False)   # a repeated edge is an empty window (an input clipped to [0, 1])
     t, p = _pixel_pair(t_events, p_events)
     idx, inside = _window_index(t, b)
     return C * np.bincount(idx, weights=p[inside], minlength=b.size - 1)
@@ -82,17 +82,19 @@ def _contrast(C) -> float:
     return real_number(C, "C", lo=0.0, lo_open=True, hint="the contrast threshold in log units, e.g. 0.2")
 
 
-def _edges(boundaries, name: str = "boundaries") -> np.ndarray:
-    """Window edges as float64 [B + 1]: numbers, finite, at least two, strictly increasing."""
+def _edges(boundaries, name: str = "boundaries", strict: bool = True) -> np.ndarray:
+    """Window edges as float64 [B + 1]: numbers, finite, at least two, increasing (``strict``: no repeats)."""
     b = seconds_array(boundaries, name)
     if b.size < 2:
         raise EventDataError(f"{name}= holds {b.size} edge; windows need at least 2 edges (B + 1 edges make B "
                              f"windows), e.g. np.linspace(0.0, 1.0, 11)")
     step = np.diff(b)
-    if not (step > 0).all():
-        k = int(np.flatnonzero(~(step > 0))[0])
-        raise EventDataError(f"{name}= must increase strictly, but {name}[{k + 1}] = {b[k + 1]:g} comes after "
-                             f"{name}[{k}] = {b[k]:g}; sort them (np.sort) and drop repeats (np.unique)")
+    bad = ~(step > 0) if strict else step < 0
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise EventDataError(f"{name}= must increase{' strictly' if strict else ''}, but {name}[{k + 1}] = "
+                             f"{b[k + 1]:g} comes after {name}[{k}] = {b[k]:g}; sort them (np.sort)"
+                             + (" and drop repeats (np.unique)" if strict else ""))
     return b
 
 
@@ -122,8 +124,16 @@ def _span(t_range, name: str = "t_range") -> tuple[float, float]:
     t0 = real_number(t0, f"{name}: t0", hint="seconds, e.g. (0.0, 1.0)")
     t1 = real_number(t1, f"{name}: t1", hint="seconds, e.g. (0.0, 1.0)")
     if not t1 > t0:
-        raise EventDataError(f"t_range must be increasing, got {t_range}; give (t0, t1) with t0 < t1")
+        raise EventDataError(f"{name}= must be increasing, got ({t0:g}, {t1:g}); give (t0, t1) with t0 < t1")
     return t0, t1
+
+
+def _model(model):
+    """A fitted 1-D model: a TimeSiren1D, or anything with its t_range, predict and derivative (a reader's own)."""
+    if not all(hasattr(model, a) for a in ("t_range", "predict", "derivative")):
+        raise ArgumentTypeError(f"model= must be a fitted TimeSiren1D (fit_siren_1d(...)['model']) or a model with "
+                                f"its t_range, predict and derivative, got {type(model).__name__}")
+    return model
 
 
 def _callable(fn, name: str, *, none_ok: bool = False):
@@ -136,8 +146,9 @@ def _callable(fn, name: str, *, none_ok: bool = False):
 def _window_count(span: float, window: float) -> int:
     n = span / window
     if n > MAX_WINDOWS:
-        raise EventDataError(f"window={window:g} s cuts {span:g} s into {n:,.0f} windows (at most "
-                             f"{MAX_WINDOWS:,}); give the window in seconds (e.g. 0.025, not 25 ms as 2.5e-5)")
+        raise EventDataError(f"window={window:g} s cuts the span of {span:g} s into {n:,.0f} windows (at most "
+                             f"{MAX_WINDOWS:,}): give both in seconds (a span given in microseconds, (0, 1e6), "
+                             f"or a window in ms written as 2.5e-8 s does this)")
     return int(n)
 
 
@@ -577,7 +588,7 @@ def taylor_error(L: Callable, t_mid, window: float, dLdt: Callable | None = None
     """
     _callable(L, "L")
     _callable(dLdt, "dLdt", none_ok=True)
-    seconds_array(t_mid, "t_mid")
+    seconds_array(t_mid, "t_mid", allow_empty=True)
     window = real_number(window, "window", lo=0.0, lo_open=True, hint="the window length t2 - t1 in seconds")
     t_mid = np.asarray(t_mid, dtype=np.float64)
     slope = (np.asarray(L(t_mid + window / 2)) - np.asarray(L(t_mid - window / 2))) / window
@@ -659,14 +670,14 @@ class TimeSiren1D(nn.Module):
     def predict(self, t) -> np.ndarray:
         """F at times ``t`` (numpy, seconds) as float64 numpy [N]."""
         p = next(self.parameters())
-        t = seconds_array(t, "t")   # a scalar is one time; text, a 2-D array or NaN are refused here
+        t = seconds_array(t, "t", allow_empty=True)   # a scalar is one time; text, a 2-D array or NaN are refused here
         with torch.no_grad():
             return self(torch.as_tensor(t, dtype=p.dtype, device=p.device)).double().cpu().numpy()
 
     def derivative(self, t) -> np.ndarray:
         """dF/dt at times ``t`` (numpy, seconds) as float64 numpy [N]."""
         p = next(self.parameters())
-        t = seconds_array(t, "t")
+        t = seconds_array(t, "t", allow_empty=True)
         tt = torch.as_tensor(t, dtype=p.dtype, device=p.device).requires_grad_(True)
         return time_derivative(self, tt, create_graph=False).detach().double().cpu().numpy()
 
@@ -702,7 +713,7 @@ def _prepare_windows(events, t_range, C, window, pixel):
 def evaluate_temporal_loss(model: TimeSiren1D, events, C: float, window: float, t_range=None,
                            pixel: int = 0, form: str = "derivative") -> float:
     """The temporal loss (Eq. 6, mean over windows) of a fitted model, as a float."""
-    require(model, TimeSiren1D, "model")
+    _model(model)
     t_range = model.t_range if t_range is None else t_range
     form = _form(form)
     b, dL = _prepare_windows(events, t_range, C, window, pixel)
@@ -739,7 +750,7 @@ def bin_residuals(model: TimeSiren1D, boundaries, delta_L) -> dict:
     Returns:
         dict of floats ``"slope"``, ``"change"``.
     """
-    require(model, TimeSiren1D, "model")
+    _model(model)
     b = _edges(boundaries)
     dL = np.asarray(delta_L) if not isinstance(delta_L, (str, bytes)) else np.asarray([delta_L])
     if dL.dtype.kind not in "iuf" or dL.ndim != 1 or not np.isfinite(dL).all():
