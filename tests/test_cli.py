@@ -204,7 +204,7 @@ def test_module_entry_point_errors_without_traceback(tmp_path):
 
 def test_ctrl_c_during_training(ijrr_folder, tmp_path):
     """A real SIGINT while training: exit status 130 and no output folder."""
-    env = {**os.environ, "EVINR_FAST": "1"}
+    env = {**os.environ, "EVINR_FAST": "1", "PYTHONFAULTHANDLER": "1"}   # SIGABRT prints every thread's stack
     proc = subprocess.Popen([sys.executable, "-m", "evinr_lite", "reconstruct", str(ijrr_folder), "--out",
                              str(tmp_path / "out"), "--iters", "100000", "--quiet"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
@@ -217,7 +217,12 @@ def test_ctrl_c_during_training(ijrr_folder, tmp_path):
             break
     time.sleep(0.5)
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:   # seen once in a CI run under load (docs/setup.md): say where it stood
+        proc.send_signal(signal.SIGABRT)
+        _, err = proc.communicate(timeout=30)
+        pytest.fail(f"reconstruct still ran 60 s after SIGINT; its threads when aborted:\n{err[-8000:]}")
     assert proc.returncode == 130, err
     assert "interrupted" in err and "Traceback" not in err
     assert list(tmp_path.iterdir()) == []
