@@ -73,7 +73,7 @@ import numpy as np
 from .checking.evaluate import NOT_DONE, evaluate
 
 __all__ = [
-    "Exercise", "ExerciseWarning", "register", "exercise", "get", "names", "reference",
+    "Exercise", "ExerciseWarning", "register", "unregister", "exercise", "get", "names", "reference",
     "check", "use", "solution_or_reference", "show_reference",
 ]
 
@@ -138,6 +138,11 @@ def register(name: str, reference: Callable, make_inputs: Callable, *, hints: di
     ex = Exercise(name, reference, make_inputs, dict(hints or {}), rtol, atol, compare, observe)
     _REGISTRY[name] = ex
     return ex
+
+
+def unregister(name: str) -> None:
+    """Forget exercise ``name`` (a toy exercise a test registered); an unknown name is ignored."""
+    _REGISTRY.pop(name, None)
 
 
 def exercise(name: str, make_inputs: Callable, **kwargs) -> Callable:
