@@ -111,7 +111,7 @@ import torch
 from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
 from evinr_lite.teaching import exercises
 from evinr_lite.teaching.checking.across_calls import shares_output
-from evinr_lite.teaching.checking.calls import run
+from evinr_lite.teaching.checking.learner_calls import run
 from evinr_lite.teaching.checking.global_state import rng_states, same_rng_state
 from evinr_lite.teaching.checking.mistakes import generic_mistakes
 from evinr_lite.teaching.poisson_exercises import _differences

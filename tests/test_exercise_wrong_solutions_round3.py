@@ -23,8 +23,8 @@ import torch
 
 from evinr_lite.core.events import Events
 from evinr_lite.teaching import events2d, exercises, pde1d
-from evinr_lite.teaching.checking.calls import run
-from evinr_lite.teaching.checking.compare import compare
+from evinr_lite.teaching.checking.learner_calls import run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -323,7 +323,7 @@ def test_the_wrong_versions_differ_from_the_reference():
         for args, kwargs in ex.cases():
             got = run(wrong, args, kwargs)
             expected = run(ex.reference, args, kwargs)
-            differs |= compare(got, expected, ex.rtol, ex.atol) is not None
+            differs |= compare_outputs(got, expected, ex.rtol, ex.atol) is not None
         assert differs, name
 
 

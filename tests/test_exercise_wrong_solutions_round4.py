@@ -29,8 +29,8 @@ import pytest
 import torch
 
 from evinr_lite.teaching import exercises
-from evinr_lite.teaching.checking.calls import run
-from evinr_lite.teaching.checking.compare import compare
+from evinr_lite.teaching.checking.learner_calls import run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 
 from test_exercise_wrong_solutions_round3 import _report   # the check's verdict and its printed report
 
@@ -444,7 +444,7 @@ def test_the_wrong_versions_differ_from_the_reference():
                 differs = True
                 continue
             expected = run(ex.reference, args, kwargs)
-            differs |= compare(got, expected, ex.rtol, ex.atol) is not None
+            differs |= compare_outputs(got, expected, ex.rtol, ex.atol) is not None
         differs |= name == "sine_layer_derivative"          # right values, cut off from the graph
         assert differs, name
 

@@ -44,8 +44,8 @@ import torch
 from evinr_lite.core.events import Events
 from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
 from evinr_lite.teaching import events2d, exercises
-from evinr_lite.teaching.checking.calls import changed_inputs, run
-from evinr_lite.teaching.checking.compare import compare
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 from evinr_lite.teaching.poisson_exercises import _differences, _path_integral
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
@@ -862,6 +862,6 @@ def test_the_wrong_versions_differ_from_the_reference():
                 differs = True
                 continue
             expected = run(ex.reference, args, kwargs, ex.observe)
-            differs |= compare(got, expected, ex.rtol, ex.atol) is not None
+            differs |= compare_outputs(got, expected, ex.rtol, ex.atol) is not None
             differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)

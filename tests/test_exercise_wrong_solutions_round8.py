@@ -85,9 +85,9 @@ import torch.nn.functional as TF
 
 from evinr_lite.method.losses import tikhonov
 from evinr_lite.teaching import events2d, exercises
-from evinr_lite.teaching.checking import calls
-from evinr_lite.teaching.checking.calls import changed_inputs, run
-from evinr_lite.teaching.checking.compare import compare
+from evinr_lite.teaching.checking import learner_calls
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 from evinr_lite.teaching.checking.hints import generic_hint, one_based_hint
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
@@ -866,7 +866,7 @@ def test_the_wrong_versions_differ_from_the_reference():
                 differs = True
                 continue
             expected = run(ex.reference, args, kwargs, ex.observe)
-            p = compare(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
+            p = compare_outputs(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
             differs |= p is not None
             differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)
@@ -884,11 +884,11 @@ def test_library_frames_are_told_from_the_kit_and_the_learner(monkeypatch, tmp_p
     site-packages folder that sysconfig does not name (the user's, Debian's dist-packages) is still a library."""
     from evinr_lite.teaching import exercises
 
-    assert calls.library_file(np.__file__)
-    assert not calls.library_file(exercises.__file__) and not calls.library_file(calls.__file__)
+    assert learner_calls.library_file(np.__file__)
+    assert not learner_calls.library_file(exercises.__file__) and not learner_calls.library_file(learner_calls.__file__)
     site_dir = tmp_path / "site-packages"
-    monkeypatch.setattr(calls, "LIBRARY_ROOTS", (str(site_dir),))
-    monkeypatch.setattr(calls, "KIT_ROOT", str(site_dir / "evinr_lite"))
-    assert calls.library_file(str(site_dir / "numpy" / "core.py"))
-    assert not calls.library_file(str(site_dir / "evinr_lite" / "method" / "solver.py"))
-    assert not calls.library_file(str(tmp_path / "notebook.py"))
+    monkeypatch.setattr(learner_calls, "LIBRARY_ROOTS", (str(site_dir),))
+    monkeypatch.setattr(learner_calls, "KIT_ROOT", str(site_dir / "evinr_lite"))
+    assert learner_calls.library_file(str(site_dir / "numpy" / "core.py"))
+    assert not learner_calls.library_file(str(site_dir / "evinr_lite" / "method" / "solver.py"))
+    assert not learner_calls.library_file(str(tmp_path / "notebook.py"))

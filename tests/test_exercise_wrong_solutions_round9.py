@@ -56,8 +56,8 @@ import scipy.special
 import torch
 
 from evinr_lite.teaching import exercises
-from evinr_lite.teaching.checking.calls import changed_inputs, run
-from evinr_lite.teaching.checking.compare import compare
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
 
@@ -625,7 +625,7 @@ def test_the_wrong_versions_differ_from_the_reference():
                 differs = True
                 continue
             expected = run(ex.reference, args, kwargs, ex.observe)
-            p = compare(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
+            p = compare_outputs(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
             differs |= p is not None
             differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)

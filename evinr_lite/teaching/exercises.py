@@ -70,7 +70,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .checking.evaluate import NOT_DONE, evaluate
+from .checking.run_check import NOT_DONE, run_check
 
 __all__ = [
     "Exercise", "ExerciseWarning", "register", "unregister", "exercise", "get", "names", "reference",
@@ -191,7 +191,7 @@ def check(name: str, fn: Callable, *, verbose: bool = True) -> bool:
             print(f"✗ {err.args[0]}")
         return False
     try:
-        ok, headline, details = evaluate(ex, fn)
+        ok, headline, details = run_check(ex, fn)
     except Exception as err:  # never raise from a check
         ok, headline, details = False, f"the check itself failed ({type(err).__name__}: {err})", []
     if verbose:
@@ -209,7 +209,7 @@ def use(name: str, fn: Callable, *, verbose: bool = True) -> Callable:
     """
     ex = get(name)  # an unknown name is a mistake in the notebook itself: raise
     try:
-        ok, headline, _ = evaluate(ex, fn)
+        ok, headline, _ = run_check(ex, fn)
     except Exception as err:
         ok, headline = False, f"the check itself failed ({type(err).__name__}: {err})"
     if ok:

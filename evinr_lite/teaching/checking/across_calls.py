@@ -3,7 +3,8 @@
 One input alone cannot show these: a mutable default argument or a notebook dict that fills up during the check
 (:func:`mutable_default_hint`, :func:`global_cache_hint`), a second call on the same input that answers
 otherwise (:func:`state_hint`), a result that is right for input #1's arguments or sizes, not this input's
-(:func:`stale_argument_hint`, :func:`fixed_size_hint`). And, on the second call of the last input:
+(:func:`stale_argument_hint`, :func:`fixed_size_hint`), one number off by the same factor on every input
+(:func:`scalar_factor_hint`). And, on the second call of the last input:
 :func:`shares_output` (the same array, tensor or dict handed out twice, a buffer or a cached result) and
 :func:`reseed_hint` (a global generator seeded inside the function).
 """
@@ -16,9 +17,11 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .calls import run, same_array
-from .compare import compare, is_tensor, to_numpy
 from .global_state import SEED_CALLS, other_rng_states, reseeded_generators, rng_states, set_rng_states
+from .hints import unit_note
+from .learner_calls import run, same_array
+from .outputs import compare_outputs, is_tensor, to_numpy
+from .protocol import ExerciseLike
 
 
 # ---- mistakes seen only across inputs: state kept between calls, a notebook variable for an argument ------
@@ -66,7 +69,7 @@ def mutable_default_hint(fn: Callable, before: dict[str, Any]) -> str | None:
     return None
 
 
-def state_hint(fn: Callable, before: dict[str, Any], ex: "Exercise", args, kwargs, got,
+def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwargs, got,
                 first: bool = False) -> str | None:
     """A mutable default argument that changed (or holds data) during the check, or a second call on the same
     input that gives another result: the function keeps state between calls, or draws unseeded random numbers.
@@ -76,7 +79,7 @@ def state_hint(fn: Callable, before: dict[str, Any], ex: "Exercise", args, kwarg
         return hint
     try:
         again = run(fn, args, kwargs, ex.observe)
-        if compare(again, got, ex.rtol, ex.atol) is not None:
+        if compare_outputs(again, got, ex.rtol, ex.atol) is not None:
             return ("called again on the same input, your function returns another result: it keeps state between "
                     "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "
                     "from the global generator (np.random.choice, np.random.randn, torch.randn without a seed of "
@@ -103,7 +106,7 @@ def global_containers(fn: Callable) -> dict[str, tuple[int, int]]:
             if isinstance(v := namespace.get(name), (dict, list, set))}
 
 
-def global_cache_hint(fn: Callable, before: dict[str, tuple[int, int]], ex: "Exercise | None" = None,
+def global_cache_hint(fn: Callable, before: dict[str, tuple[int, int]], ex: ExerciseLike | None = None,
                        case: tuple | None = None, got: Any = None, raised: bool = False) -> tuple[str | None, bool]:
     """A notebook dict, list or set named in ``fn``'s code that gained entries during the check: results (or parts
     of them) kept from one call to the next. Returns (hint, proven): with ``ex`` and ``case`` (the failing input's
@@ -124,7 +127,7 @@ def global_cache_hint(fn: Callable, before: dict[str, tuple[int, int]], ex: "Exe
     return None, False
 
 
-def _kept_data_matters(ex: "Exercise", fn: Callable, name: str, case: tuple, got: Any, raised: bool) -> bool:
+def _kept_data_matters(ex: ExerciseLike, fn: Callable, name: str, case: tuple, got: Any, raised: bool) -> bool:
     """``fn`` on ``case`` with the notebook variable ``name`` emptied for the call (a shallow copy, cleared: a
     defaultdict keeps its factory) gives another answer than ``got`` (a result where it raised, or another
     result); the variable is put back whatever happens. Cannot tell (it raises again, or otherwise): False."""
@@ -145,12 +148,12 @@ def _kept_data_matters(ex: "Exercise", fn: Callable, name: str, case: tuple, got
     if raised:
         return True
     try:
-        return compare(fresh, got, ex.rtol, ex.atol) is not None
+        return compare_outputs(fresh, got, ex.rtol, ex.atol) is not None
     except Exception:
         return False
 
 
-def _stale_elsewhere(ex: "Exercise", cases: list, k: int, subset: tuple, fn_outputs) -> bool:
+def _stale_elsewhere(ex: ExerciseLike, cases: list, k: int, subset: tuple, fn_outputs) -> bool:
     """On every other input (but #1) where the learner is wrong, its output is also the reference's with the
     arguments ``subset`` taken from input #1: a coincidence on one input (a phase (0, 0) both times) says nothing."""
     kw0 = cases[0][1]
@@ -159,9 +162,9 @@ def _stale_elsewhere(ex: "Exercise", cases: list, k: int, subset: tuple, fn_outp
             continue
         try:
             g = fn_outputs(j)
-            if compare(g, run(ex.reference, a, kw, ex.observe), ex.rtol, ex.atol) is None:
+            if compare_outputs(g, run(ex.reference, a, kw, ex.observe), ex.rtol, ex.atol) is None:
                 continue
-            if compare(g, run(ex.reference, (), dict(kw, **{name: kw0[name] for name in subset}), ex.observe),
+            if compare_outputs(g, run(ex.reference, (), dict(kw, **{name: kw0[name] for name in subset}), ex.observe),
                         ex.rtol, ex.atol) is not None:
                 return False
         except Exception:
@@ -169,7 +172,7 @@ def _stale_elsewhere(ex: "Exercise", cases: list, k: int, subset: tuple, fn_outp
     return True
 
 
-def stale_argument_hint(ex: "Exercise", fn: Callable, cases: list, k: int, got, expected) -> str | None:
+def stale_argument_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected) -> str | None:
     """The learner's output on input ``k`` equals the reference's with one or two arguments taken from input #1
     (and so on every other input where it is wrong): the function reads a notebook variable (or a value fixed in
     the code) in place of those arguments."""
@@ -194,7 +197,8 @@ def stale_argument_hint(ex: "Exercise", fn: Callable, cases: list, k: int, got, 
         trial = dict(kw, **{name: kw0[name] for name in subset})
         try:
             w = run(ex.reference, (), trial, ex.observe)
-            if compare(w, expected, ex.rtol, ex.atol) is None or compare(got, w, ex.rtol, ex.atol) is not None:
+            if compare_outputs(w, expected, ex.rtol, ex.atol) is None \
+                    or compare_outputs(got, w, ex.rtol, ex.atol) is not None:
                 continue
         except Exception:
             continue
@@ -207,7 +211,7 @@ def stale_argument_hint(ex: "Exercise", fn: Callable, cases: list, k: int, got, 
     return None
 
 
-def fixed_size_hint(ex: "Exercise", cases: list, k: int, got, expected) -> str | None:
+def fixed_size_hint(ex: ExerciseLike, cases: list, k: int, got, expected) -> str | None:
     """A result shaped like input #1's expected result (all of it, or the sizes that differ): a size fixed in the
     code, or read from a notebook variable, instead of from the arguments."""
     if k == 0:
@@ -226,6 +230,34 @@ def fixed_size_hint(ex: "Exercise", cases: list, k: int, got, expected) -> str |
                 f"{e.shape}: a size fixed in the code (np.zeros(3), `H, W = 4, 4`) or taken from a notebook "
                 "variable; read the sizes from the arguments (len(...), .shape, sensor_size)")
     return None
+
+
+def scalar_factor_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected) -> str | None:
+    """One number off by the same factor on every input (a weight such as lam, a 1/2, a sum for a mean)."""
+    if ex.observe is not None:
+        return None
+    try:
+        g, e = float(to_numpy(got)), float(to_numpy(expected))
+        if not (np.isfinite(g) and np.isfinite(e)) or e == 0 or g == 0:
+            return None
+        ratio = g / e
+        seen = 0
+        for j, (a, kw) in enumerate(cases):
+            if j == k:
+                continue
+            ej = float(to_numpy(run(ex.reference, a, kw)))
+            if ej == 0:
+                continue
+            if abs(float(to_numpy(run(fn, a, kw))) / ej - ratio) > 1e-5 * max(1.0, abs(ratio)):
+                return None
+            seen += 1
+    except Exception:
+        return None
+    if seen == 0:
+        return None
+    return (f"off by a constant factor: got {ratio:.4g} x the expected value on every input (a weight such as "
+            f"lam or 1/2 that does not belong here, a sum where a mean is expected, or the other way round?)"
+            + unit_note(ratio))
 
 
 # ---- a second call on the last input: kept results, reseeded generators ----------------------------------------
@@ -266,7 +298,7 @@ def shares_output(first, second) -> str | None:
     return None
 
 
-def reseed_hint(ex: "Exercise", fn: Callable, args, kwargs) -> tuple[str | None, str | None]:
+def reseed_hint(ex: ExerciseLike, fn: Callable, args, kwargs) -> tuple[str | None, str | None]:
     """A function that seeds a global generator (its random numbers the same on every call, but random all the
     same): two runs from different generator states leave the generators in one state. Returns (hint, note): the
     hint when it drew from a generator after seeding it (the generator is not where a seed leaves it), which can

@@ -5,7 +5,7 @@ global random generator. The check reads these before and after each call: :func
 :func:`restore_torch_settings` set torch's settings back (:func:`settings_message` names the change), and
 :func:`rng_states`, :func:`other_rng_states` and :func:`reseeded_generators` tell a function that seeds a generator
 (two runs from different states end in one state) from one that only draws from it. Kept apart from running the
-call (:mod:`.calls`), which uses the settings half, and from the hints built on the generators' states
+call (:mod:`.learner_calls`), which uses the settings half, and from the hints built on the generators' states
 (:mod:`.across_calls`).
 """
 from __future__ import annotations
@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 
-from .compare import is_tensor
+from .outputs import is_tensor
 
 
 def torch_settings() -> dict | None:

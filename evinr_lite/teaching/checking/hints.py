@@ -1,23 +1,21 @@
-"""Hints read off a wrong output: patterns any exercise can show, recognised from the output and the inputs.
+"""Hints read off a wrong output: patterns any exercise can show, recognised from the output and the inputs alone.
 
-Given the learner's output and the expected one on the failing input, each function here returns a sentence
-naming a likely mistake, or None: :func:`generic_hint` (a flipped sign, a constant factor or offset, exp or log
-once too often, a shift by one position, a pair of outputs swapped, a scatter-add that kept one contribution per
-repeated index), :func:`one_based_hint` (indices counted from 1), :func:`wrong_axes_hint` (differences along the
-wrong image axis), :func:`swapped_pair_hint`, :func:`scalar_factor_hint` (one number off by the same factor on
-every input), :func:`size_from_events_hint` (an image sized by the events, not the sensor) and
-:func:`non_square` (for an IndexError on a sensor that is not square). The mistakes recognised by running a
-wrong version of the reference are in :mod:`.mistakes`; those that show only across inputs in
-:mod:`.across_calls`.
+Given the learner's output and the expected one on the failing input, each hint here returns a sentence naming a
+likely mistake, or None, and runs no function: :func:`generic_hint` (a flipped sign, a constant factor or offset,
+exp or log once too often, a shift by one position, a pair of outputs swapped, a scatter-add that kept one
+contribution per repeated index), :func:`one_based_hint` (indices counted from 1), :func:`swapped_pair_hint` and
+:func:`size_from_events_hint` (an image sized by the events, not the sensor). Two conditions read off the inputs
+choose among hints: :func:`has_repeated_index` (a scatter-add is likely) and :func:`non_square` (an IndexError on a
+sensor that is not square). The mistakes recognised by running a wrong version of the reference (the wrong image
+axis among them) are in :mod:`.mistakes`; those that show only across inputs (one number off by the same factor
+on every input among them) in :mod:`.across_calls`.
 """
 from __future__ import annotations
 
-from typing import Callable
-
 import numpy as np
 
-from .calls import run
-from .compare import compare, is_tensor, to_numpy
+from .outputs import compare_outputs, is_tensor, to_numpy
+from .protocol import ExerciseLike
 
 
 def generic_hint(got, expected, indexed: bool = False) -> str | None:
@@ -56,7 +54,7 @@ def generic_hint(got, expected, indexed: bool = False) -> str | None:
         ratios = g[nz] / e[nz]
         if np.ptp(ratios) <= 1e-6 * max(1.0, abs(ratios[0])) and abs(ratios[0] - 1) > 1e-6 \
                 and abs(ratios[0]) > 1e-12:         # a factor 0 is a result of zeros, not a scaling
-            return f"off by a constant factor: got {ratios[0]:.4g} x the expected values" + _unit_note(ratios[0])
+            return f"off by a constant factor: got {ratios[0]:.4g} x the expected values" + unit_note(ratios[0])
     if g.size > 1:
         d = g - e
         if np.ptp(d) <= tol and abs(d[0]) > tol:
@@ -75,7 +73,7 @@ def generic_hint(got, expected, indexed: bool = False) -> str | None:
     return None
 
 
-def _unit_note(ratio: float) -> str:
+def unit_note(ratio: float) -> str:
     """A word on a factor that is a power of 1000: a unit conversion."""
     k = np.log10(abs(ratio)) / 3 if ratio else 0.0
     if ratio > 0 and abs(k - round(k)) < 1e-6 and round(k) != 0:
@@ -96,55 +94,6 @@ def _axes_hint(g: np.ndarray, e: np.ndarray, tol: float) -> str | None:
     return None
 
 
-def _swap_last_axes(v):
-    """``v`` with the last two axes of every array (or tensor) of >= 2 dimensions swapped, recursively."""
-    if is_tensor(v):
-        return v.transpose(-1, -2) if v.dim() >= 2 else v
-    if isinstance(v, np.ndarray):
-        return np.swapaxes(v, -1, -2) if v.ndim >= 2 else v
-    if isinstance(v, tuple):
-        return tuple(_swap_last_axes(x) for x in v)
-    if isinstance(v, list):
-        return [_swap_last_axes(x) for x in v]
-    return v
-
-
-def _has_image(v) -> bool:
-    if is_tensor(v):
-        return v.dim() >= 2 and v.shape[-1] > 1 and v.shape[-2] > 1
-    if isinstance(v, np.ndarray):
-        return v.ndim >= 2 and v.shape[-1] > 1 and v.shape[-2] > 1
-    if isinstance(v, (tuple, list)):
-        return any(_has_image(x) for x in v)
-    return False
-
-
-def wrong_axes_hint(ex: "Exercise", args: tuple, kwargs: dict, got, expected=None) -> str | None:
-    """The learner's output equals the reference run on transposed images, transposed back.
-
-    That is the sign of differences (or sums) taken along the wrong image axis: rows for columns.
-    A candidate that equals the expected output itself (an exercise symmetric under the swap) says nothing.
-    """
-    if not (any(_has_image(a) for a in args) or any(_has_image(v) for v in kwargs.values())):
-        return None
-    try:
-        w = run(ex.reference, _swap_last_axes(args), {k: _swap_last_axes(v) for k, v in kwargs.items()}, ex.observe)
-        w = _swap_last_axes(w)
-    except Exception:
-        return None
-    candidates = [w] + ([type(w)(reversed(w))] if isinstance(w, (tuple, list)) and len(w) == 2 else [])
-    for c in candidates:
-        try:
-            if expected is not None and compare(c, expected, ex.rtol, ex.atol) is None:
-                continue
-            if compare(got, c, ex.rtol, ex.atol) is None:
-                return ("the differences (or sums) run along the wrong image axis: x is the column "
-                        "index (axis -1), y the row index (axis -2)")
-        except Exception:
-            continue
-    return None
-
-
 def one_based_hint(got, expected, rtol: float, atol: float) -> str | None:
     """An image (or a stack of images) rolled by one row and/or one column towards the start: the values of row
     (column) 0 sit in the last one. That is indexing counted from 1, ``a[y - 1, x - 1]``: index -1 wraps round."""
@@ -154,7 +103,7 @@ def one_based_hint(got, expected, rtol: float, atol: float) -> str | None:
             return None
         for shift, axes, what in (((-1, -1), (-2, -1), "one row and one column"), ((-1,), (-2,), "one row"),
                                   ((-1,), (-1,), "one column")):
-            if compare(g, np.roll(e, shift, axis=axes), rtol, atol) is None:
+            if compare_outputs(g, np.roll(e, shift, axis=axes), rtol, atol) is None:
                 return (f"the image is shifted by {what}, and the first one's values sit in the last one: indices "
                         "counted from 1 (`a[y - 1, x - 1]`) put row (column) 0 at index -1, which wraps round to the "
                         "end; numpy counts from 0, so index with y and x as they are")
@@ -229,43 +178,15 @@ def size_from_events_hint(args, kwargs, got, expected) -> str | None:
     return None
 
 
-def swapped_pair_hint(ex: "Exercise", got, expected) -> str | None:
+def swapped_pair_hint(ex: ExerciseLike, got, expected) -> str | None:
     """A pair of outputs returned in the other order."""
     if not (isinstance(expected, (tuple, list)) and len(expected) == 2 and isinstance(got, (tuple, list))
             and len(got) == 2):
         return None
     try:
-        if compare(got[::-1], expected, ex.rtol, ex.atol) is None or (
+        if compare_outputs(got[::-1], expected, ex.rtol, ex.atol) is None or (
                 ex.compare is not None and ex.compare(tuple(got[::-1]), expected) is None):
             return "the two outputs are swapped: return them in the order the docstring gives"
     except Exception:
         return None
     return None
-
-
-def scalar_factor_hint(ex: "Exercise", fn: Callable, cases: list, k: int, got, expected) -> str | None:
-    """One number off by the same factor on every input (a weight such as lam, a 1/2, a sum for a mean)."""
-    if ex.observe is not None:
-        return None
-    try:
-        g, e = float(to_numpy(got)), float(to_numpy(expected))
-        if not (np.isfinite(g) and np.isfinite(e)) or e == 0 or g == 0:
-            return None
-        ratio = g / e
-        seen = 0
-        for j, (a, kw) in enumerate(cases):
-            if j == k:
-                continue
-            ej = float(to_numpy(run(ex.reference, a, kw)))
-            if ej == 0:
-                continue
-            if abs(float(to_numpy(run(fn, a, kw))) / ej - ratio) > 1e-5 * max(1.0, abs(ratio)):
-                return None
-            seen += 1
-    except Exception:
-        return None
-    if seen == 0:
-        return None
-    return (f"off by a constant factor: got {ratio:.4g} x the expected value on every input (a weight such as "
-            f"lam or 1/2 that does not belong here, a sum where a mean is expected, or the other way round?)"
-            + _unit_note(ratio))

@@ -5,7 +5,8 @@ few more from any reference, for mistakes every exercise can show (-1/+1 polarit
 dropped, an input or the result clipped to [0, 1], a result or a float input rounded). The learner's output
 matching a wrong version's on the failing input is not enough: :func:`same_mistake_elsewhere` asks that it also
 match on the other inputs where that mistake shows, so that one input cannot make two different mistakes look
-alike.
+alike. :func:`wrong_axes_hint` makes one more, the reference run on transposed images (differences or sums along
+the wrong image axis), and compares it on the failing input.
 """
 from __future__ import annotations
 
@@ -15,8 +16,9 @@ from typing import Callable
 
 import numpy as np
 
-from .calls import run
-from .compare import compare, is_tensor, to_numpy
+from .learner_calls import run
+from .outputs import compare_outputs, is_tensor, to_numpy
+from .protocol import ExerciseLike
 
 
 _POLARITY_NAMES = ("p", "p_events", "polarity", "polarities")
@@ -90,7 +92,7 @@ def _torch_round(v, d):
     return (v * 10.0 ** d).round() / 10.0 ** d
 
 
-def generic_mistakes(ex: "Exercise", cases: list | None = None) -> list[tuple[str, Callable]]:
+def generic_mistakes(ex: ExerciseLike, cases: list | None = None) -> list[tuple[str, Callable]]:
     """Wrong versions made from the reference, for mistakes that any exercise can show: -1/+1 polarities treated
     as 0/1 (or OFF events dropped), an input or the result clipped to [0, 1], a result rounded for display, one
     float array input rounded (made only for the arguments that are float numpy arrays in some case of
@@ -162,7 +164,7 @@ def _rounded_input(kwargs: dict, only: str, d: int) -> dict | None:
     return dict(kwargs, **{only: np.round(v, d)})
 
 
-def same_mistake_elsewhere(ex: "Exercise", fn: Callable, wrong: Callable, cases: list, skip: int,
+def same_mistake_elsewhere(ex: ExerciseLike, fn: Callable, wrong: Callable, cases: list, skip: int,
                             support: int = 0) -> bool:
     """On every case but ``skip`` where the wrong version ``wrong`` shows its mistake (differs from the
     reference), ``fn`` gives the same output. Cases where either raises say nothing, and so do cases where
@@ -176,15 +178,66 @@ def same_mistake_elsewhere(ex: "Exercise", fn: Callable, wrong: Callable, cases:
             continue
         try:
             w = run(wrong, args, kwargs, ex.observe)
-            if compare(w, run(ex.reference, args, kwargs, ex.observe), ex.rtol, ex.atol) is None:
+            if compare_outputs(w, run(ex.reference, args, kwargs, ex.observe), ex.rtol, ex.atol) is None:
                 continue
             g = run(fn, args, kwargs, ex.observe)
         except Exception:
             continue
         try:
-            if compare(g, w, ex.rtol, ex.atol) is not None:
+            if compare_outputs(g, w, ex.rtol, ex.atol) is not None:
                 return False
         except Exception:
             return False
         shown += 1
     return shown >= support
+
+
+# ---- the reference run on transposed images: differences along the wrong image axis -----------------------
+
+def _swap_last_axes(v):
+    """``v`` with the last two axes of every array (or tensor) of >= 2 dimensions swapped, recursively."""
+    if is_tensor(v):
+        return v.transpose(-1, -2) if v.dim() >= 2 else v
+    if isinstance(v, np.ndarray):
+        return np.swapaxes(v, -1, -2) if v.ndim >= 2 else v
+    if isinstance(v, tuple):
+        return tuple(_swap_last_axes(x) for x in v)
+    if isinstance(v, list):
+        return [_swap_last_axes(x) for x in v]
+    return v
+
+
+def _has_image(v) -> bool:
+    if is_tensor(v):
+        return v.dim() >= 2 and v.shape[-1] > 1 and v.shape[-2] > 1
+    if isinstance(v, np.ndarray):
+        return v.ndim >= 2 and v.shape[-1] > 1 and v.shape[-2] > 1
+    if isinstance(v, (tuple, list)):
+        return any(_has_image(x) for x in v)
+    return False
+
+
+def wrong_axes_hint(ex: ExerciseLike, args: tuple, kwargs: dict, got, expected=None) -> str | None:
+    """The learner's output equals the reference run on transposed images, transposed back.
+
+    That is the sign of differences (or sums) taken along the wrong image axis: rows for columns.
+    A candidate that equals the expected output itself (an exercise symmetric under the swap) says nothing.
+    """
+    if not (any(_has_image(a) for a in args) or any(_has_image(v) for v in kwargs.values())):
+        return None
+    try:
+        w = run(ex.reference, _swap_last_axes(args), {k: _swap_last_axes(v) for k, v in kwargs.items()}, ex.observe)
+        w = _swap_last_axes(w)
+    except Exception:
+        return None
+    candidates = [w] + ([type(w)(reversed(w))] if isinstance(w, (tuple, list)) and len(w) == 2 else [])
+    for c in candidates:
+        try:
+            if expected is not None and compare_outputs(c, expected, ex.rtol, ex.atol) is None:
+                continue
+            if compare_outputs(got, c, ex.rtol, ex.atol) is None:
+                return ("the differences (or sums) run along the wrong image axis: x is the column "
+                        "index (axis -1), y the row index (axis -2)")
+        except Exception:
+            continue
+    return None

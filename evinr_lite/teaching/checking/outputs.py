@@ -1,9 +1,10 @@
 """Comparing a learner's output with the reference's, and describing values in a report.
 
-:func:`compare` walks the two outputs together (tuples, lists, dicts, arrays, tensors, plain values) and returns
-the first :class:`Problem`: a missing ``return``, a wrong type, shape or dtype (with a word on the likely cause),
-or wrong values (how many, where, by how much). It is the one yardstick every other module of the check uses: the
-main run, the hints' wrong versions, the second call. The helpers that read a tensor as numpy live here too,
+:func:`compare_outputs` walks the two outputs together (tuples, lists, dicts, arrays, tensors, plain values) and
+returns the first :class:`Problem`: a missing ``return``, a wrong type, shape or dtype (with a word on the likely
+cause), or wrong values (how many, where, by how much). It is the one built-in yardstick every other module of the
+check uses: the main run, the hints' wrong versions, the second call (an exercise may bring its own ``compare``,
+which the main run and the second call use in its place). The helpers that read a tensor as numpy live here too,
 since every comparison starts with them.
 """
 from __future__ import annotations
@@ -72,7 +73,7 @@ class Problem:
     values: bool = False  # True when shapes/types agree and only the numbers differ
 
 
-def compare(got, expected, rtol: float, atol: float, where: str = "") -> Problem | None:
+def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") -> Problem | None:
     at = f" in output {where}" if where else ""
     if got is None and expected is not None:
         return Problem(f"returned None{at}; did you forget the `return` statement?")
@@ -82,7 +83,7 @@ def compare(got, expected, rtol: float, atol: float, where: str = "") -> Problem
         if len(got) != len(expected):
             return Problem(f"returned {len(got)} items{at}, expected {len(expected)}")
         for k, (g, e) in enumerate(zip(got, expected)):
-            p = compare(g, e, rtol, atol, f"{where}[{k}]")
+            p = compare_outputs(g, e, rtol, atol, f"{where}[{k}]")
             if p is not None:
                 return p
         return None
@@ -95,7 +96,7 @@ def compare(got, expected, rtol: float, atol: float, where: str = "") -> Problem
             return Problem(f"returned a dict{at} with the wrong keys: missing {missing}, not expected {extra}; "
                             "use the input's keys unchanged (the same spelling and case)")
         for k in expected:
-            p = compare(got[k], expected[k], rtol, atol, f"{where}[{k!r}]")
+            p = compare_outputs(got[k], expected[k], rtol, atol, f"{where}[{k!r}]")
             if p is not None:
                 return p
         return None
@@ -210,11 +211,11 @@ def differing_leaf(got, expected, rtol: float, atol: float):
     try:
         if isinstance(expected, (tuple, list)) and isinstance(got, (tuple, list)) and len(got) == len(expected):
             for g, e in zip(got, expected):
-                if compare(g, e, rtol, atol) is not None:
+                if compare_outputs(g, e, rtol, atol) is not None:
                     return differing_leaf(g, e, rtol, atol)
         if isinstance(expected, dict) and isinstance(got, dict) and set(got) == set(expected):
             for k in expected:
-                if compare(got[k], expected[k], rtol, atol) is not None:
+                if compare_outputs(got[k], expected[k], rtol, atol) is not None:
                     return differing_leaf(got[k], expected[k], rtol, atol)
     except Exception:
         pass

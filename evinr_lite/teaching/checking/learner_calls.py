@@ -5,20 +5,22 @@ function cannot change the exercise's data), and sets torch's global settings ba
 raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
 check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
 :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
+Over a whole check, :func:`watching` gathers what the learner's function changed of torch's settings.
 """
 from __future__ import annotations
 
+import contextlib
 import copy
 import os
 import re
 import site
 import sysconfig
 import traceback
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from .compare import is_tensor, to_numpy
+from .outputs import is_tensor, to_numpy
 from .global_state import restore_torch_settings, torch_settings
 
 
@@ -38,7 +40,7 @@ def _site_dirs() -> list:
     return [*getattr(site, "getsitepackages", lambda: [])(), *([user] if user else [])]
 
 
-# evinr_lite/, three folders above this file (evinr_lite/teaching/checking/calls.py)
+# evinr_lite/, three folders above this file (evinr_lite/teaching/checking/learner_calls.py)
 KIT_ROOT = os.path.realpath(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 # Python's own folders and every site-packages folder: a frame in one is a library's, not the learner's
 LIBRARY_ROOTS = tuple(sorted({os.path.realpath(p) for p in
@@ -51,8 +53,10 @@ _EXERCISES_FILE = os.path.join(os.path.dirname(_HERE), "exercises.py")
 
 
 def _check_file(filename: str) -> bool:
-    """A file of the exercise system itself: a module of this package or exercises.py, whose frames (the check's
-    loop, :func:`run`) stand between the report and the learner's code and are never the learner's line."""
+    """A frame never reported as the learner's line: a module of this package (the check's own frames, its loop
+    and :func:`run`, which stand between the report and the learner's code), or exercises.py, because a learner's
+    code may call the registry (``exercises.get``, ``exercises.reference``): an error raised there is reported at
+    the learner's line that called it, as before the check moved out of exercises.py."""
     return os.path.dirname(filename) == _HERE or filename == _EXERCISES_FILE
 
 
@@ -101,7 +105,20 @@ def _deepcopy_with_grads(x):
     return y
 
 
-WATCH: list = []   # (the learner's function, what its calls changed of torch's settings), one per running check
+_WATCHED: list = []   # (the learner's function, what its calls changed of torch's settings), one per running check
+
+
+@contextlib.contextmanager
+def watching(fn: Callable) -> Iterator[dict]:
+    """While the block runs, what any call of ``fn`` through :func:`run` changes of torch's settings (the hints'
+    calls too) is gathered into the dict it yields, {name: (before, after)}, the first change of each name kept.
+    Checks may nest (a check run from inside a learner's function): the innermost one's ``fn`` is watched."""
+    seen: dict = {}
+    _WATCHED.append((fn, seen))
+    try:
+        yield seen
+    finally:
+        _WATCHED.pop()
 
 
 def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None):
@@ -113,7 +130,7 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
     reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
     the call changed ({name: (before, after)}). What the learner's function changed on any call of the check
-    (the hints' calls too) is also kept for the report (see :func:`evinr_lite.teaching.checking.evaluate.evaluate`)."""
+    (the hints' calls too) is also kept for the report (see :func:`watching`)."""
     args, kwargs = _deepcopy_with_grads((args, kwargs))
     settings = torch_settings()
     try:
@@ -122,9 +139,9 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
         changed = restore_torch_settings(settings)
         if settings_changed is not None:
             settings_changed.update(changed)
-        if changed and WATCH and fn is WATCH[-1][0]:
+        if changed and _WATCHED and fn is _WATCHED[-1][0]:
             for name, change in changed.items():
-                WATCH[-1][1].setdefault(name, change)
+                _WATCHED[-1][1].setdefault(name, change)
     if inputs_after is not None:
         inputs_after.append((args, kwargs))
     return result if observe is None else observe(result, args, kwargs)
