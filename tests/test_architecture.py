@@ -145,3 +145,17 @@ def test_public_face():
         module = __import__(f"evinr_lite.{sub}", fromlist=["__all__"])
         assert module.__all__ and all(hasattr(module, n) or (ROOT / "evinr_lite" / sub / f"{n}.py").exists()
                                       for n in module.__all__), sub
+
+
+def test_the_check_may_import_no_other_teaching_module():
+    """The contract that keeps teaching.checking below the registry names every other module of teaching, so that
+    a teaching module added later is not left out of it."""
+    import tomllib
+    contracts = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"]
+    source = ["evinr_lite.teaching.checking"]
+    forbidden = {m for c in contracts if c.get("source_modules") == source for m in c["forbidden_modules"]}
+    teaching = ROOT / "evinr_lite" / "teaching"
+    others = {f"evinr_lite.teaching.{p.stem}" for p in teaching.glob("*.py") if p.name != "__init__.py"}
+    others |= {f"evinr_lite.teaching.{p.name}" for p in teaching.iterdir()
+               if (p / "__init__.py").exists() and p.name != "checking"}
+    assert forbidden == others

@@ -110,6 +110,10 @@ import torch
 
 from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
 from evinr_lite.teaching import exercises
+from evinr_lite.teaching.checking.across_calls import shares_output
+from evinr_lite.teaching.checking.learner_calls import run
+from evinr_lite.teaching.checking.global_state import rng_states, same_rng_state
+from evinr_lite.teaching.checking.mistakes import generic_mistakes
 from evinr_lite.teaching.poisson_exercises import _differences
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
@@ -798,7 +802,7 @@ def test_the_counts_the_notebooks_quote_are_unchanged():
 def test_the_step_observes_the_learning_rates():
     ex = exercises.get("frame_train_step")
     args, kwargs = ex.cases()[0]
-    seen = exercises._run(ex.reference, args, kwargs, ex.observe)
+    seen = run(ex.reference, args, kwargs, ex.observe)
     assert seen["optimizer's learning rates after the step"] == (kwargs["optimizer"].param_groups[0]["lr"],)
 
 
@@ -806,11 +810,11 @@ def test_a_check_leaves_the_generators_and_torch_settings_as_they_were():
     """The second run of the last input starts from other generator states; the check sets them back after it
     (a learner's own reseeding stays, as it would without the check), and it sets torch's settings back."""
     np.random.seed(3); random.seed(3); torch.manual_seed(3)
-    before = exercises._rng_states()
+    before = rng_states()
     for name in ("integrate_gradients", "frame_train_step", "pareto_front"):
         assert exercises.check(name, R(name), verbose=False)
-    after = exercises._rng_states()
-    assert all(exercises._same_rng_state(before[k], after[k]) for k in before)
+    after = rng_states()
+    assert all(same_rng_state(before[k], after[k]) for k in before)
     assert not exercises.check("frame_train_step", step_grad_off_after, verbose=False)
     assert torch.is_grad_enabled()
     assert not exercises.check("sine_layer_derivative", sld_default_double, verbose=False)
@@ -820,15 +824,15 @@ def test_a_check_leaves_the_generators_and_torch_settings_as_they_were():
 def test_a_fresh_result_each_call_is_not_a_shared_one():
     """Copies of a cached result, read-only arrays and empty arrays share nothing a caller could change."""
     a = np.arange(4.0)
-    assert exercises._shares_output(a, a[1:]) == "array"
-    assert exercises._shares_output(a, a.copy()) is None
+    assert shares_output(a, a[1:]) == "array"
+    assert shares_output(a, a.copy()) is None
     ro = np.arange(3.0); ro.setflags(write=False)
-    assert exercises._shares_output(ro, ro) is None
-    assert exercises._shares_output(np.zeros(0), np.zeros(0)) is None
+    assert shares_output(ro, ro) is None
+    assert shares_output(np.zeros(0), np.zeros(0)) is None
     d = {"a": 1.0}
-    assert exercises._shares_output(d, d) == "dict" and exercises._shares_output(d, dict(d)) is None
+    assert shares_output(d, d) == "dict" and shares_output(d, dict(d)) is None
     t = torch.zeros(3)
-    assert exercises._shares_output((t,), (t[1:],)) == "tensor" and exercises._shares_output(t, t.clone()) is None
+    assert shares_output((t,), (t[1:],)) == "tensor" and shares_output(t, t.clone()) is None
 
 
 def test_the_open_holes_are_what_the_docstring_says():
@@ -909,7 +913,7 @@ def test_rounded_input_mistakes_are_made_for_float_array_arguments_only():
     """Built for every argument, each copied its inputs before finding it did not apply (an int, a tensor)."""
     def rounded(name):
         ex = exercises.get(name)
-        return {m.split("`")[1] for m, _ in exercises._generic_mistakes(ex, ex.cases()) if "` was rounded to" in m}
+        return {m.split("`")[1] for m, _ in generic_mistakes(ex, ex.cases()) if "` was rounded to" in m}
     assert rounded("integrate_events_1d") == {"t_events", "t_query"}
     assert rounded("split_index") == set() and rounded("tikhonov_autograd") == set()
     assert rounded("background_activity_filter") == {"t"}

@@ -25,6 +25,7 @@ from evinr_lite.teaching import frame_exercises as fe
 from evinr_lite.teaching import pde1d, poisson_exercises as pe, realdata_exercises as rd
 from evinr_lite.teaching import recording_exercises as rec
 from evinr_lite.teaching import training_exercises as te
+from evinr_lite.teaching.checking import learner_calls
 from evinr_lite.method.coordinate import split_index
 from evinr_lite.method.baselines import highpass_per_event
 
@@ -350,7 +351,8 @@ def _nan_of_reference(name):
 
 GARBAGE = {"None": lambda name: (lambda *a, **k: None), "raises": lambda name: _raises,
            "string": lambda name: (lambda *a, **k: "abc"), "object": lambda name: (lambda *a, **k: object()),
-           "NaN": _nan_of_reference, "ragged": lambda name: (lambda *a, **k: ([1.0], [1.0, 2.0]))}
+           "NaN": _nan_of_reference, "ragged": lambda name: (lambda *a, **k: ([1.0], [1.0, 2.0])),
+           "no_arguments": lambda name: (lambda: None)}     # the stub's signature changed: the call itself fails
 
 
 @pytest.mark.parametrize("kind", list(GARBAGE))
@@ -364,10 +366,40 @@ def test_garbage_fails_every_check_without_a_traceback(name, kind):
     assert ok is False, out
     assert "check itself failed" not in out and "Traceback" not in out, out
     assert "exercises.py" not in out and "_observe_step" not in out, out
+    # a report names a function and a line, never the check's own: its loop and `run` stand between the report
+    # and the learner's code (learner_calls._check_file skips their frames)
+    for own in ("run", "_run_inputs", "_raised_report", "run_check"):
+        assert f"raised in {own}," not in out, out
     if kind == "None":
         assert "None" in out, out
     if kind == "raises":
         assert "raised ValueError" in out, out
+    if kind == "no_arguments":      # no line of the learner's raised: no "raised in", and the hint on the stub
+        assert "raised TypeError" in out and "raised in " not in out, out
+        assert "keep the stub's parameter names and order" in out, out
+
+
+def _raised_through_run(fn, *args):
+    """The error ``fn`` raised when called through the check's ``run``, its traceback starting at ``run``'s frame,
+    as the check's loop (in checking/ too) catches it."""
+    try:
+        learner_calls.run(fn, args, {})
+    except Exception as err:
+        return err.with_traceback(err.__traceback__.tb_next)
+    raise AssertionError(f"{fn.__name__} raised nothing")
+
+
+def test_where_raised_names_the_learners_line_never_the_checks_nor_the_registrys():
+    def no_arguments():                  # the stub's signature changed: the call fails before any learner line
+        return 0
+
+    def asks_the_registry(t):            # a learner's code may call the registry: the error is the learner's
+        return exercises.get("typo")
+
+    assert learner_calls.where_raised(_raised_through_run(no_arguments, 1.0)) == []
+    line = asks_the_registry.__code__.co_firstlineno + 1
+    assert learner_calls.where_raised(_raised_through_run(asks_the_registry, 1.0)) == [
+        f'raised in asks_the_registry, line {line}: `return exercises.get("typo")`']
 
 
 def test_a_step_returning_a_tensor_or_none_is_named_not_blamed_on_the_check():

@@ -23,6 +23,8 @@ import torch
 
 from evinr_lite.core.events import Events
 from evinr_lite.teaching import events2d, exercises, pde1d
+from evinr_lite.teaching.checking.learner_calls import run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -319,9 +321,9 @@ def test_the_wrong_versions_differ_from_the_reference():
         ex = exercises.get(name)
         differs = False
         for args, kwargs in ex.cases():
-            got = exercises._run(wrong, args, kwargs)
-            expected = exercises._run(ex.reference, args, kwargs)
-            differs |= exercises._compare(got, expected, ex.rtol, ex.atol) is not None
+            got = run(wrong, args, kwargs)
+            expected = run(ex.reference, args, kwargs)
+            differs |= compare_outputs(got, expected, ex.rtol, ex.atol) is not None
         assert differs, name
 
 

@@ -29,6 +29,8 @@ import pytest
 import torch
 
 from evinr_lite.teaching import exercises
+from evinr_lite.teaching.checking.learner_calls import run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 
 from test_exercise_wrong_solutions_round3 import _report   # the check's verdict and its printed report
 
@@ -437,12 +439,12 @@ def test_the_wrong_versions_differ_from_the_reference():
         differs = False
         for args, kwargs in ex.cases():
             try:
-                got = exercises._run(wrong, args, kwargs)
+                got = run(wrong, args, kwargs)
             except Exception:
                 differs = True
                 continue
-            expected = exercises._run(ex.reference, args, kwargs)
-            differs |= exercises._compare(got, expected, ex.rtol, ex.atol) is not None
+            expected = run(ex.reference, args, kwargs)
+            differs |= compare_outputs(got, expected, ex.rtol, ex.atol) is not None
         differs |= name == "sine_layer_derivative"          # right values, cut off from the graph
         assert differs, name
 

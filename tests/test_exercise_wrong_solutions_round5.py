@@ -33,6 +33,8 @@ import torch
 from evinr_lite.core.events import Events
 from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
 from evinr_lite.teaching import exercises
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts   # the check's verdict and its report; the notebooks' counts
 
 
@@ -838,11 +840,11 @@ def test_the_wrong_versions_differ_from_the_reference():
         for args, kwargs in ex.cases():
             after = []
             try:
-                got = exercises._run(wrong, args, kwargs, ex.observe, inputs_after=after)
+                got = run(wrong, args, kwargs, ex.observe, inputs_after=after)
             except Exception:
                 differs = True
                 continue
-            expected = exercises._run(ex.reference, args, kwargs, ex.observe)
-            differs |= exercises._compare(got, expected, ex.rtol, ex.atol) is not None
-            differs |= bool(exercises._changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
+            expected = run(ex.reference, args, kwargs, ex.observe)
+            differs |= compare_outputs(got, expected, ex.rtol, ex.atol) is not None
+            differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)

@@ -23,7 +23,7 @@ Holes (these passed a check before this round; each now fails and its report nam
 - highpass_per_event: a notebook dict of per-sensor states that is never reset (every case had its own sensor
   and C); the check now runs its last input a second time and fails a function that answers differently.
 
-Hints added: generic ones (in exercises.py) for state kept between calls (a mutable default argument that holds
+Hints added: generic ones (in checking/) for state kept between calls (a mutable default argument that holds
 data, a second call that differs), a notebook variable or fixed value used in place of an argument (the result is
 the reference's with input #1's argument, confirmed on every other failing input), a shape with input #1's sizes,
 an image smaller than the sensor, two outputs swapped, an inverted mask, np.exp / np.log of the expected values, a
@@ -44,6 +44,8 @@ import torch
 from evinr_lite.core.events import Events
 from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
 from evinr_lite.teaching import events2d, exercises
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 from evinr_lite.teaching.poisson_exercises import _differences, _path_integral
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
@@ -855,11 +857,11 @@ def test_the_wrong_versions_differ_from_the_reference():
         for args, kwargs in ex.cases() + ex.cases()[-1:]:
             after = []
             try:
-                got = exercises._run(wrong, args, kwargs, ex.observe, inputs_after=after)
+                got = run(wrong, args, kwargs, ex.observe, inputs_after=after)
             except Exception:
                 differs = True
                 continue
-            expected = exercises._run(ex.reference, args, kwargs, ex.observe)
-            differs |= exercises._compare(got, expected, ex.rtol, ex.atol) is not None
-            differs |= bool(exercises._changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
+            expected = run(ex.reference, args, kwargs, ex.observe)
+            differs |= compare_outputs(got, expected, ex.rtol, ex.atol) is not None
+            differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)

@@ -29,7 +29,7 @@ case holds int64 coordinates, and round 4's correct loop does not cast); a float
 and a uint8 frame told by `a.max() > 1` (the float frames the contract allows lie in [0, 1]); a step's bin centres
 cast to float32 (the cases' times are below 1 s).
 
-Hints added: generic ones (in exercises.py) built as wrong versions of the reference and confirmed on every input
+Hints added: generic ones (in checking/) built as wrong versions of the reference and confirmed on every input
 like registered hints: polarities read as 0/1 (`2 * p - 1`, or OFF weighted 0), an input (or one named input) or the
 result clipped to [0, 1], a result rounded to 0-6 decimals; a second call on input #1 that differs (unseeded
 randomness now named on the first input too); a plain-number argument fixed to input #1's value in an exercise
@@ -50,6 +50,8 @@ import torch
 
 from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
 from evinr_lite.teaching import events2d, exercises
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 from evinr_lite.teaching.poisson_exercises import _differences
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
@@ -796,12 +798,12 @@ def test_the_wrong_versions_differ_from_the_reference():
         for args, kwargs in ex.cases():
             after = []
             try:
-                got = exercises._run(wrong, args, kwargs, ex.observe, inputs_after=after)
+                got = run(wrong, args, kwargs, ex.observe, inputs_after=after)
             except Exception:
                 differs = True
                 continue
-            expected = exercises._run(ex.reference, args, kwargs, ex.observe)
-            p = exercises._compare(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
+            expected = run(ex.reference, args, kwargs, ex.observe)
+            p = compare_outputs(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
             differs |= p is not None
-            differs |= bool(exercises._changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
+            differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)

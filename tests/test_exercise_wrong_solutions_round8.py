@@ -53,7 +53,7 @@ RuntimeError "does not require grad" gets a hint (torch.no_grad(), .detach(), .d
 everywhere" is said of an array only when at least two entries agree (a single non-zero entry flipped is any mistake
 that lands on minus it: a set of events that drops two of three ON events got it).
 
-Hints added: generic (in exercises.py): an image shifted by one row and/or one column towards the start, its first
+Hints added: generic (in checking/): an image shifted by one row and/or one column towards the start, its first
 row (column) in the last one, is indexing counted from 1. Registered: the built-in sum and len(L) (anchor), len(prev)
 and an exclusive running sum (chain_offsets), `dtype is`, eps as a floor and eps twice (anchor_first_offset), a
 floor added, in milliseconds, pairs across pixels, np.lexsort's key order, x * W + y (interval_imbalance), np.interp
@@ -85,6 +85,10 @@ import torch.nn.functional as TF
 
 from evinr_lite.method.losses import tikhonov
 from evinr_lite.teaching import events2d, exercises
+from evinr_lite.teaching.checking import learner_calls
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
+from evinr_lite.teaching.checking.hints import generic_hint, one_based_hint
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
 
@@ -809,19 +813,19 @@ def test_a_single_flipped_entry_is_not_called_a_flipped_sign():
     ok, report = _report("anchor_first_offset", lambda first_frame, L_t0, eps=1 / 255:
                          -R("anchor_first_offset")(first_frame, L_t0, eps))
     assert not ok and "g = log(I0 + eps) - L(t0), not L(t0) - log(I0 + eps)" in report, report
-    assert exercises._generic_hint(-np.arange(1.0, 4.0), np.arange(1.0, 4.0)) == "the sign is flipped everywhere"
-    assert exercises._generic_hint(np.array([0.0, -2.0]), np.array([0.0, 2.0])) is None
-    assert exercises._generic_hint(np.float64(-2.0), np.float64(2.0)) == "the sign is flipped everywhere"
+    assert generic_hint(-np.arange(1.0, 4.0), np.arange(1.0, 4.0)) == "the sign is flipped everywhere"
+    assert generic_hint(np.array([0.0, -2.0]), np.array([0.0, 2.0])) is None
+    assert generic_hint(np.float64(-2.0), np.float64(2.0)) == "the sign is flipped everywhere"
 
 
 def test_the_one_based_hint_needs_the_roll_itself():
     """The generic hint is said only of an image whose first row or column moved to the end, not of any shift."""
     e = np.arange(12.0).reshape(3, 4)
-    assert "counted from 1" in exercises._one_based_hint(np.roll(e, (-1, -1), axis=(0, 1)), e, 1e-5, 1e-8)
-    assert "one row" in exercises._one_based_hint(np.roll(e, -1, axis=0), e, 1e-5, 1e-8)
-    assert exercises._one_based_hint(np.roll(e, 1, axis=0), e, 1e-5, 1e-8) is None
-    assert exercises._one_based_hint(e[::-1], e, 1e-5, 1e-8) is None
-    assert exercises._one_based_hint(np.arange(4.0), np.roll(np.arange(4.0), 1), 1e-5, 1e-8) is None   # 1-D: no image
+    assert "counted from 1" in one_based_hint(np.roll(e, (-1, -1), axis=(0, 1)), e, 1e-5, 1e-8)
+    assert "one row" in one_based_hint(np.roll(e, -1, axis=0), e, 1e-5, 1e-8)
+    assert one_based_hint(np.roll(e, 1, axis=0), e, 1e-5, 1e-8) is None
+    assert one_based_hint(e[::-1], e, 1e-5, 1e-8) is None
+    assert one_based_hint(np.arange(4.0), np.roll(np.arange(4.0), 1), 1e-5, 1e-8) is None   # 1-D: no image
 
 
 def test_the_changed_cases_hold_what_the_holes_need():
@@ -857,14 +861,14 @@ def test_the_wrong_versions_differ_from_the_reference():
         for args, kwargs in ex.cases():
             after = []
             try:
-                got = exercises._run(wrong, args, kwargs, ex.observe, inputs_after=after)
+                got = run(wrong, args, kwargs, ex.observe, inputs_after=after)
             except Exception:
                 differs = True
                 continue
-            expected = exercises._run(ex.reference, args, kwargs, ex.observe)
-            p = exercises._compare(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
+            expected = run(ex.reference, args, kwargs, ex.observe)
+            p = compare_outputs(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
             differs |= p is not None
-            differs |= bool(exercises._changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
+            differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)
     # the open ones: an event a nanosecond past the window; events microseconds past an edge on a clock at 1000 s
     t, x, y = np.array([0.0, 0.125 + 2 ** -32]), np.array([0, 1]), np.array([0, 0])
@@ -880,11 +884,11 @@ def test_library_frames_are_told_from_the_kit_and_the_learner(monkeypatch, tmp_p
     site-packages folder that sysconfig does not name (the user's, Debian's dist-packages) is still a library."""
     from evinr_lite.teaching import exercises
 
-    assert exercises._library_file(np.__file__)
-    assert not exercises._library_file(exercises.__file__)
+    assert learner_calls.library_file(np.__file__)
+    assert not learner_calls.library_file(exercises.__file__) and not learner_calls.library_file(learner_calls.__file__)
     site_dir = tmp_path / "site-packages"
-    monkeypatch.setattr(exercises, "_LIBRARY_ROOTS", (str(site_dir),))
-    monkeypatch.setattr(exercises, "_KIT_ROOT", str(site_dir / "evinr_lite"))
-    assert exercises._library_file(str(site_dir / "numpy" / "core.py"))
-    assert not exercises._library_file(str(site_dir / "evinr_lite" / "method" / "solver.py"))
-    assert not exercises._library_file(str(tmp_path / "notebook.py"))
+    monkeypatch.setattr(learner_calls, "LIBRARY_ROOTS", (str(site_dir),))
+    monkeypatch.setattr(learner_calls, "KIT_ROOT", str(site_dir / "evinr_lite"))
+    assert learner_calls.library_file(str(site_dir / "numpy" / "core.py"))
+    assert not learner_calls.library_file(str(site_dir / "evinr_lite" / "method" / "solver.py"))
+    assert not learner_calls.library_file(str(tmp_path / "notebook.py"))

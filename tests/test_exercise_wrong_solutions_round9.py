@@ -56,6 +56,8 @@ import scipy.special
 import torch
 
 from evinr_lite.teaching import exercises
+from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
+from evinr_lite.teaching.checking.outputs import compare_outputs
 from test_exercise_wrong_solutions_round3 import _report, quoted_counts
 
 
@@ -618,14 +620,14 @@ def test_the_wrong_versions_differ_from_the_reference():
         for args, kwargs in ex.cases():
             after = []
             try:
-                got = exercises._run(wrong, args, kwargs, ex.observe, inputs_after=after)
+                got = run(wrong, args, kwargs, ex.observe, inputs_after=after)
             except Exception:
                 differs = True
                 continue
-            expected = exercises._run(ex.reference, args, kwargs, ex.observe)
-            p = exercises._compare(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
+            expected = run(ex.reference, args, kwargs, ex.observe)
+            p = compare_outputs(got, expected, ex.rtol, ex.atol) if ex.compare is None else ex.compare(got, expected)
             differs |= p is not None
-            differs |= bool(exercises._changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
+            differs |= bool(changed_inputs((args, kwargs), after[0])) if ex.observe is None else False
         assert differs, (name, wrong.__name__)
     frames = np.random.default_rng(0).normal(size=(5, 3, 4))
     assert og_float32(frames)[0].dtype == np.float32 != R("offset_gradients")(frames)[0].dtype

@@ -24,7 +24,7 @@ def toy():
     exercises.register("toy_cumsum", _ref_scaled_cumsum, _inputs,
                        hints={"did you forget the sign of the polarity?": lambda x, C: C * np.cumsum(np.abs(x))})
     yield "toy_cumsum"
-    exercises._REGISTRY.pop("toy_cumsum", None)
+    exercises.unregister("toy_cumsum")
 
 
 def _solution_with_markers(x, C):
@@ -86,8 +86,8 @@ def test_fancy_index_plus_equals_gets_the_add_at_hint(capsys):
         assert not exercises.check("toy_sum", lambda x, C: C * x)
         assert "np.add.at" not in capsys.readouterr().out
     finally:
-        exercises._REGISTRY.pop("toy_scatter", None)
-        exercises._REGISTRY.pop("toy_sum", None)
+        exercises.unregister("toy_scatter")
+        exercises.unregister("toy_sum")
 
 
 def test_differences_along_the_wrong_axes_get_an_axis_hint(capsys):
@@ -104,8 +104,8 @@ def test_differences_along_the_wrong_axes_get_an_axis_hint(capsys):
         assert not exercises.check("toy_dx", wrong_axis)
         assert "wrong image axis" in capsys.readouterr().out
     finally:
-        exercises._REGISTRY.pop("toy_grad", None)
-        exercises._REGISTRY.pop("toy_dx", None)
+        exercises.unregister("toy_grad")
+        exercises.unregister("toy_dx")
 
 
 def test_wrong_values_name_the_input_the_index_and_the_hint(toy, capsys):
@@ -161,7 +161,7 @@ def test_decorator_registers(capsys):
         assert exercises.reference("toy_square") is square
         assert exercises.check("toy_square", lambda a: a * a)
     finally:
-        exercises._REGISTRY.pop("toy_square")
+        exercises.unregister("toy_square")
 
 
 # ---- notebook 01's exercises --------------------------------------------------------

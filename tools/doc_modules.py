@@ -17,7 +17,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from textfile import write_beside  # noqa: E402  (tools/textfile.py)
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("core", "io", "io/formats", "sim", "method", "evaluation", "viz", "teaching", "apps")   # by layer
+PACKAGES = ("core", "io", "io/formats", "sim", "method", "evaluation", "viz", "teaching", "teaching/checking",
+            "apps")   # by layer
 
 
 def summary(path: Path) -> str:

@@ -1,0 +1,22 @@
+"""The check behind ``exercises.check`` and ``exercises.use``: run a learner's function, say what is wrong.
+
+:mod:`evinr_lite.teaching.exercises` holds the registry and the notebook's entry points; this package is the
+check itself, one job per module, lowest first:
+
+- ``protocol``: what the check uses of an exercise (``ExerciseLike``);
+- ``outputs``: compare an output with the reference's (type, shape, dtype, values) and describe values;
+- ``global_state``: what a call can change for the whole notebook: torch's settings, the global generators;
+- ``learner_calls``: run the learner's function on copied inputs; where it raised; what it changed in place;
+- ``hints``: likely mistakes read off a wrong output (a flipped sign, a factor, indices from 1, ...);
+- ``mistakes``: wrong versions made from the reference (the wrong image axis among them), confirmed on the other
+  inputs;
+- ``across_calls``: mistakes seen only across inputs or on a second call (kept state, a stale argument, the same
+  factor on every input, a shared result, a reseeded generator);
+- ``run_check``: the main loop tying them together, in the order the report relies on.
+
+An exercise is named in annotations by the protocol ``ExerciseLike``, never by the registry's ``Exercise``: this
+package never imports the registry (which imports it), so that the check stays below the registry, with no circle.
+"""
+from . import across_calls, global_state, hints, learner_calls, mistakes, outputs, protocol, run_check
+
+__all__ = ["protocol", "outputs", "global_state", "learner_calls", "hints", "mistakes", "across_calls", "run_check"]

@@ -1,0 +1,218 @@
+"""Running a learner's function, and what the call did besides returning.
+
+:func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's
+function cannot change the exercise's data), and sets torch's global settings back after it, whether it returns or
+raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
+check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
+:func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
+Over a whole check, :func:`watching` gathers what the learner's function changed of torch's settings.
+"""
+from __future__ import annotations
+
+import contextlib
+import copy
+import os
+import re
+import site
+import sysconfig
+import traceback
+from typing import Any, Callable, Iterator
+
+import numpy as np
+
+from .outputs import is_tensor, to_numpy
+from .global_state import restore_torch_settings, torch_settings
+
+
+def library_file(filename: str) -> bool:
+    """A file of an installed library or of Python itself (numpy, torch, the standard library), not the learner's
+    notebook or module (nor this kit, whose frames say which of its functions the learner's call broke)."""
+    path = os.path.realpath(filename)
+    if path.startswith(KIT_ROOT + os.sep):          # the kit itself, installed into site-packages or not
+        return False
+    return any(path.startswith(root + os.sep) for root in LIBRARY_ROOTS)
+
+
+def _site_dirs() -> list:
+    """site-packages folders beyond sysconfig's: the system's (Debian's dist-packages) and the user's (some
+    virtualenvs' site module lacks either function)."""
+    user = getattr(site, "getusersitepackages", lambda: None)()
+    return [*getattr(site, "getsitepackages", lambda: [])(), *([user] if user else [])]
+
+
+# evinr_lite/, three folders above this file (evinr_lite/teaching/checking/learner_calls.py)
+KIT_ROOT = os.path.realpath(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+# Python's own folders and every site-packages folder: a frame in one is a library's, not the learner's
+LIBRARY_ROOTS = tuple(sorted({os.path.realpath(p) for p in
+                               [*(sysconfig.get_paths().get(k) for k in ("stdlib", "platstdlib", "purelib", "platlib")),
+                                *_site_dirs()] if p}))
+
+
+_HERE = os.path.dirname(__file__)
+_EXERCISES_FILE = os.path.join(os.path.dirname(_HERE), "exercises.py")
+
+
+def _check_file(filename: str) -> bool:
+    """A frame never reported as the learner's line: a module of this package (the check's own frames, its loop
+    and :func:`run`, which stand between the report and the learner's code), or exercises.py, because a learner's
+    code may call the registry (``exercises.get``, ``exercises.reference``): an error raised there is reported at
+    the learner's line that called it, as before the check moved out of exercises.py."""
+    return os.path.dirname(filename) == _HERE or filename == _EXERCISES_FILE
+
+
+def cache_raised(fn: Callable, err: BaseException) -> bool:
+    """An "unhashable type" TypeError that a cache raised: ``fn`` is an lru_cache (it has ``cache_info``), the
+    error came from no line of the learner's code (the cache's wrapper, in C, builds the key before the call), or
+    the learner's line that raised calls a notebook function that is an lru_cache (a cached helper)."""
+    if hasattr(fn, "cache_info"):
+        return True
+    frames = [f for f in traceback.extract_tb(err.__traceback__) if not _check_file(f.filename)]
+    own = [f for f in frames if not library_file(f.filename)]
+    if not own:
+        return True
+    namespace = getattr(fn, "__globals__", None)
+    line = own[-1].line or ""
+    if isinstance(namespace, dict) and line:
+        for name in re.findall(r"[A-Za-z_][A-Za-z0-9_]*(?=\s*\()", line):
+            if hasattr(namespace.get(name), "cache_info"):
+                return True
+    return False
+
+
+def where_raised(err: BaseException) -> list[str]:
+    """The line of the learner's code that raised: the last frame outside the check's own files and outside the
+    libraries it called (an error raised deep inside numpy or torch is reported at the learner's line that called
+    them)."""
+    frames = [f for f in traceback.extract_tb(err.__traceback__) if not _check_file(f.filename)]
+    if not frames:
+        return []
+    own = [f for f in frames if not library_file(f.filename)]
+    f = (own or frames)[-1]
+    code = f": `{f.line.strip()}`" if f.line else ""
+    return [f"raised in {f.name}, line {f.lineno}{code}"]
+
+
+def _deepcopy_with_grads(x):
+    """``copy.deepcopy(x)``, also copying the ``.grad`` of torch parameters (which deepcopy drops),
+    so that a case can hold a model with gradients left from an earlier step."""
+    memo: dict = {}
+    y = copy.deepcopy(x, memo)
+    for orig in memo.get(id(memo), []):
+        grad = getattr(orig, "grad", None) if is_tensor(orig) else None
+        new = memo.get(id(orig))
+        if grad is not None and new is not None and new is not orig and getattr(new, "grad", None) is None:
+            new.grad = grad.detach().clone()
+    return y
+
+
+_WATCHED: list = []   # (the learner's function, what its calls changed of torch's settings), one per running check
+
+
+@contextlib.contextmanager
+def watching(fn: Callable) -> Iterator[dict]:
+    """While the block runs, what any call of ``fn`` through :func:`run` changes of torch's settings (the hints'
+    calls too) is gathered into the dict it yields, {name: (before, after)}, the first change of each name kept.
+    Checks may nest (a check run from inside a learner's function): the innermost one's ``fn`` is watched."""
+    seen: dict = {}
+    _WATCHED.append((fn, seen))
+    try:
+        yield seen
+    finally:
+        _WATCHED.pop()
+
+
+def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None):
+    """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
+    e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
+    receives the copied ``(args, kwargs)`` as they are after the call.
+
+    torch's global settings (grad mode, default dtype) are set back after every call, whether it returns or
+    raises, so that a function that changes them on one input changes nothing for the calls after it (the
+    reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
+    the call changed ({name: (before, after)}). What the learner's function changed on any call of the check
+    (the hints' calls too) is also kept for the report (see :func:`watching`)."""
+    args, kwargs = _deepcopy_with_grads((args, kwargs))
+    settings = torch_settings()
+    try:
+        result = fn(*args, **kwargs)
+    finally:
+        changed = restore_torch_settings(settings)
+        if settings_changed is not None:
+            settings_changed.update(changed)
+        if changed and _WATCHED and fn is _WATCHED[-1][0]:
+            for name, change in changed.items():
+                _WATCHED[-1][1].setdefault(name, change)
+    if inputs_after is not None:
+        inputs_after.append((args, kwargs))
+    return result if observe is None else observe(result, args, kwargs)
+
+
+def _arrays_of(v) -> list[tuple[str, Any]]:
+    """The arrays (or tensors) an input holds: itself, or the array fields of an object such as ``Events``."""
+    if isinstance(v, np.ndarray) or is_tensor(v):
+        return [("", v)]
+    fields = getattr(v, "__dict__", None)
+    if isinstance(fields, dict) and not hasattr(v, "parameters"):
+        return [(f".{k}", a) for k, a in fields.items() if isinstance(a, np.ndarray) or is_tensor(a)]
+    return []
+
+
+def same_array(a, b) -> bool:
+    try:
+        a, b = to_numpy(a), to_numpy(b)
+        return a.shape == b.shape and a.dtype == b.dtype and bool(np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"))
+    except Exception:
+        return True          # cannot tell: say nothing
+
+
+def _same_contents(a, b) -> bool:
+    """``a`` and ``b`` hold the same keys, items and values (dicts, lists and tuples compared recursively, arrays
+    entry by entry); an object that cannot be compared counts as the same (say nothing)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_same_contents(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return type(a) is type(b) and len(a) == len(b) and all(_same_contents(x, y) for x, y in zip(a, b))
+    if isinstance(a, np.ndarray) or is_tensor(a) or isinstance(b, np.ndarray) or is_tensor(b):
+        return same_array(a, b)
+    if isinstance(a, (bool, int, float, complex, str, bytes, np.generic, type(None))):
+        try:
+            return type(a) is type(b) and (bool(a == b) or bool(a != a and b != b))
+        except Exception:
+            return True
+    return True
+
+
+def changed_inputs(before: tuple[tuple, dict], after: tuple[tuple, dict]) -> list[str]:
+    """Names of the array inputs (or array fields of an input), and of the dict and list inputs (a key added,
+    removed or changed, an item appended, the list sorted), that the call changed in place."""
+    (args0, kwargs0), (args1, kwargs1) = before, after
+    pairs = [(f"argument {k + 1}", a, b) for k, (a, b) in enumerate(zip(args0, args1))]
+    pairs += [(name, kwargs0[name], kwargs1[name]) for name in kwargs0 if name in kwargs1]
+    changed = []
+    for name, v0, v1 in pairs:
+        if isinstance(v0, (dict, list)):
+            if not _same_contents(v0, v1):
+                changed.append(name)
+            continue
+        for (field_name, a0), (_, a1) in zip(_arrays_of(v0), _arrays_of(v1)):
+            if not same_array(a0, a1):
+                changed.append(f"{name}{field_name}")
+    return changed
+
+
+def in_place_message(changed: list[str], containers: tuple = ()) -> str:
+    names = ", ".join(f"`{n}`" for n in changed)
+    if containers and set(changed) <= set(containers):
+        return (f"changed its input {names} in place (a key added, changed or removed: `row[key] = ...`, "
+                "`row.pop(key)`, `del row[key]`; or a list appended to or sorted): the caller's table must stay "
+                "as it was, so build a new dict (`{name: ... for name, row in table.items()}`) or work on "
+                "`copy.deepcopy(...)` of it")
+    return (f"changed its input {names} in place (`x += ...`, `x[...] = ...`, `np.exp(x, out=x)`; "
+            "`np.asarray(x, dtype=...)` is x itself when the dtype already matches): the caller's data must "
+            "stay as it was, so compute a new array (`x = x + ...`) or work on a copy (`np.array(x, dtype=float)`)")
+
+
+def container_names(args: tuple, kwargs: dict) -> tuple:
+    """The names `changed_inputs` gives the dict and list inputs."""
+    return tuple([f"argument {k + 1}" for k, a in enumerate(args) if isinstance(a, (dict, list))]
+                 + [name for name, v in kwargs.items() if isinstance(v, (dict, list))])

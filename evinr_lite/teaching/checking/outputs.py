@@ -1,0 +1,222 @@
+"""Comparing a learner's output with the reference's, and describing values in a report.
+
+:func:`compare_outputs` walks the two outputs together (tuples, lists, dicts, arrays, tensors, plain values) and
+returns the first :class:`Problem`: a missing ``return``, a wrong type, shape or dtype (with a word on the likely
+cause), or wrong values (how many, where, by how much). It is the one built-in yardstick every other module of the
+check uses: the main run, the hints' wrong versions, the second call (an exercise may bring its own ``compare``,
+which the main run and the second call use in its place). The helpers that read a tensor as numpy live here too,
+since every comparison starts with them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def is_tensor(x) -> bool:
+    return type(x).__module__.startswith("torch") and hasattr(x, "detach")
+
+
+def to_numpy(x):
+    if is_tensor(x):
+        x = x.detach().cpu()
+        return (x.float() if str(x.dtype) == "torch.bfloat16" else x).numpy()   # numpy has no bfloat16
+    return np.asarray(x)
+
+
+def _is_bfloat16(x) -> bool:
+    return is_tensor(x) and str(x.dtype) == "torch.bfloat16"
+
+
+def _fmt(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        return f"{float(v):.4g}"
+    return str(v)
+
+
+def _fmt_pair(a, b) -> tuple[str, str]:
+    """Two numbers formatted so that they read differently when they differ (4 digits, more when needed)."""
+    fa, fb = _fmt(a), _fmt(b)
+    if fa == fb and isinstance(a, (float, np.floating)) and isinstance(b, (float, np.floating)) and a != b:
+        return f"{float(a):.12g}", f"{float(b):.12g}"
+    return fa, fb
+
+
+def _describe_value(v) -> str:
+    if not isinstance(v, (np.ndarray, np.generic, int, float, str, bool, list, tuple, dict)) and not is_tensor(v) \
+            and v is not None and ("\n" in repr(v) or len(repr(v)) > 60):
+        return type(v).__name__          # a model or an optimiser: its repr would fill the report
+    if is_tensor(v):
+        return f"tensor {str(v.dtype).replace('torch.', '')}{list(v.shape)}"
+    if isinstance(v, np.ndarray):
+        return f"{v.dtype}{list(v.shape)}" if v.size > 4 else np.array2string(v, precision=3)
+    if isinstance(v, (list, tuple)) and len(v) > 4:
+        return f"{type(v).__name__} of {len(v)}"
+    if isinstance(v, dict) and len(repr(v)) > 60:          # a table of rows: its repr would fill the headline
+        return f"dict of {len(v)} items ({', '.join(repr(k) for k in list(v)[:4])}{', ...' if len(v) > 4 else ''})"
+    return _fmt(v) if isinstance(v, (int, float, np.number)) else repr(v)
+
+
+def describe_case(args: tuple, kwargs: dict) -> str:
+    parts = [_describe_value(a) for a in args] + [f"{k}={_describe_value(v)}" for k, v in kwargs.items()]
+    return ", ".join(parts)
+
+
+def _kind(a: np.ndarray) -> str:
+    return {"b": "bool", "i": "integer", "u": "integer", "f": "float", "c": "complex"}.get(a.dtype.kind, str(a.dtype))
+
+
+@dataclass
+class Problem:
+    message: str
+    values: bool = False  # True when shapes/types agree and only the numbers differ
+
+
+def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") -> Problem | None:
+    at = f" in output {where}" if where else ""
+    if got is None and expected is not None:
+        return Problem(f"returned None{at}; did you forget the `return` statement?")
+    if isinstance(expected, (tuple, list)):
+        if not isinstance(got, (tuple, list)):
+            return Problem(f"returned a {type(got).__name__}{at}, expected a {type(expected).__name__} of {len(expected)} items")
+        if len(got) != len(expected):
+            return Problem(f"returned {len(got)} items{at}, expected {len(expected)}")
+        for k, (g, e) in enumerate(zip(got, expected)):
+            p = compare_outputs(g, e, rtol, atol, f"{where}[{k}]")
+            if p is not None:
+                return p
+        return None
+    if isinstance(expected, dict):
+        if not isinstance(got, dict):
+            return Problem(f"returned {type(got).__name__}{at}, expected a dict with keys {sorted(expected)}")
+        if set(got) != set(expected):
+            missing = sorted(set(expected) - set(got), key=str)
+            extra = sorted(set(got) - set(expected), key=str)
+            return Problem(f"returned a dict{at} with the wrong keys: missing {missing}, not expected {extra}; "
+                            "use the input's keys unchanged (the same spelling and case)")
+        for k in expected:
+            p = compare_outputs(got[k], expected[k], rtol, atol, f"{where}[{k!r}]")
+            if p is not None:
+                return p
+        return None
+    if is_tensor(expected) and not is_tensor(got):
+        if expected.is_floating_point():
+            return Problem(f"returned a {type(got).__name__}{at}, expected a torch.Tensor: keep the computation "
+                            "in torch so that it can be back-propagated")
+        return Problem(f"returned a {type(got).__name__}{at}, expected a torch.Tensor like the input: use torch "
+                        "operations on the tensor (no .numpy() or Python lists)")
+    if is_tensor(expected) and expected.requires_grad and not got.requires_grad:
+        return Problem(f"the result{at} is cut off from the autograd graph (it does not require grad): keep the "
+                        "computation in torch operations on the inputs, without .item(), float(), .numpy(), "
+                        ".detach() or torch.tensor(...) on an intermediate value, so that it can be back-propagated")
+    if isinstance(expected, np.ndarray) and is_tensor(got):
+        return Problem(f"returned a torch.Tensor{at}, expected a numpy array: compute with numpy, or convert "
+                        "with `.detach().cpu().numpy()`")
+    if isinstance(expected, np.ndarray) and isinstance(got, (list, tuple)):
+        return Problem(f"returned a {type(got).__name__}{at}, expected a numpy array: return "
+                        "`np.asarray(...)` of it (later cells use array methods such as .shape)")
+    if isinstance(expected, (np.ndarray, np.generic, int, float, bool)) or is_tensor(expected):
+        try:
+            g = to_numpy(got)
+        except Exception:
+            return Problem(f"returned a {type(got).__name__}{at}, expected numbers")
+        e = to_numpy(expected)
+        if g.dtype == object or g.dtype.kind not in "biufc":
+            return Problem(f"returned {type(got).__name__} of dtype {g.dtype}{at}, expected numbers")
+        if g.shape != e.shape:
+            return Problem(f"wrong shape{at}: got {g.shape}, expected {e.shape}" + _shape_note(g, e))
+        if _kind(g) != _kind(e):
+            return Problem(f"wrong dtype{at}: got {_kind(g)} ({g.dtype}), expected {_kind(e)} ({e.dtype})"
+                            + _dtype_note(g, e))
+        close = np.isclose(g, e, rtol=rtol, atol=atol, equal_nan=True)
+        if np.all(close):
+            return None
+        if g.dtype.kind == "u" and np.any(e < 0):
+            return Problem(f"wrong values{at}: an unsigned dtype ({g.dtype}) cannot hold the negative values "
+                            "expected (-1 wraps round to the largest value): use a signed integer dtype (np.int64)")
+        if _is_bfloat16(got) and not _is_bfloat16(expected):
+            return Problem(f"wrong values{at}: the result is bfloat16 (about 3 significant digits: `.bfloat16()`, "
+                            "or torch.autocast), too coarse for these values: compute and return float32 like the "
+                            "inputs")
+        if g.dtype == np.float16 and e.dtype != np.float16:
+            return Problem(f"wrong values{at}: the result is float16 (half precision, about 3 significant "
+                            "digits), too coarse for these values: compute and return float64 (or float32)")
+        if g.dtype == np.float32 and e.dtype == np.float64 and np.allclose(g, e, rtol=1e-3, atol=1e-6 + atol):
+            return Problem(f"wrong values{at}: the result is float32 (about 7 significant digits) and differs from "
+                            f"the expected float64 values in the last digits, beyond this exercise's tolerance "
+                            f"(rtol {rtol:g}): compute in float64 (np.asarray(..., dtype=np.float64))")
+        bad = np.flatnonzero(~close.ravel())
+        diff = np.abs(g.astype(np.float64) - e.astype(np.float64)).ravel()
+        diff = np.where(np.isnan(diff), np.inf, diff)
+        worst = int(bad[np.argmax(diff[bad])])
+        if e.ndim == 0:
+            gs, es = _fmt_pair(g.item(), e.item())
+            return Problem(f"wrong value{at}: got {gs}, expected {es}", values=True)
+        idx = np.unravel_index(worst, e.shape)
+        idx_s = str(idx[0]) if len(idx) == 1 else str(tuple(int(i) for i in idx))
+        gs, es = _fmt_pair(g.ravel()[worst], e.ravel()[worst])
+        return Problem(f"wrong values{at}: {bad.size} of {e.size} differ; at index {idx_s}: got {gs}, expected {es}",
+                        values=True)
+    # anything else: plain equality
+    if got != expected:
+        return Problem(f"got {got!r}{at}, expected {expected!r}", values=True)
+    return None
+
+
+def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
+    """A word on a wrong shape that names a common cause: a transposed result, indices for a mask, an array
+    holding one number where a number is expected."""
+    if e.ndim >= 2 and g.ndim == e.ndim and g.shape[:-2] == e.shape[:-2] and g.shape[-2:] == e.shape[-2:][::-1]:
+        return ("; the last two axes are swapped: a transposed result, or (H, W) read as (W, H) (sensor_size and "
+                "images are rows first: `H, W = sensor_size`, `np.zeros((H, W))`, `a[y, x]`)")
+    if e.dtype == bool and g.dtype.kind in "iu" and g.size <= e.size:
+        return ("; that looks like the indices of the True entries (np.flatnonzero, np.where, np.argwhere): "
+                "return the boolean mask itself, one entry per element")
+    if e.ndim == 1 and g.ndim == 1 and abs(g.shape[0] - e.shape[0]) == 1:
+        more = "one entry too many" if g.shape[0] > e.shape[0] else "one entry too few"
+        return f"; {more}: an off-by-one (a loop's range, a slice, or a count rounded the wrong way)?"
+    if e.ndim >= 3 and g.ndim == e.ndim and g.shape[1:] == e.shape[1:] and abs(g.shape[0] - e.shape[0]) == 1:
+        more = "one entry too many" if g.shape[0] > e.shape[0] else "one entry too few"
+        return (f"; {more} along the first axis: an off-by-one (a loop's range, a slice, np.diff's `prepend=` "
+                "that keeps the length: B + 1 boundaries make B bins)?")
+    if e.ndim == 0 and g.size == 1:
+        return ("; that is an array holding one number where the number itself is expected: take it out "
+                "(`x[0]`, `x.squeeze()`, or `float(x)` for a numpy result), e.g. np.linalg.lstsq returns an array")
+    if e.ndim == 0 and g.size > 1:
+        return (f"; one number is expected, not {g.size}: reduce over every entry (np.mean(x) or torch.mean(x) "
+                "without `axis=` / `dim=`), and return that number alone")
+    if g.size == e.size and g.size > 1 and tuple(d for d in g.shape if d != 1) == tuple(d for d in e.shape if d != 1):
+        return ("; the same number of entries with an extra or missing axis of length 1 (a column (N, 1) for a "
+                "1-D (N,), say): drop `[:, None]` / `reshape(-1, 1)` / `keepdims=True`, or `.ravel()` the result")
+    return ""
+
+
+def _dtype_note(g: np.ndarray, e: np.ndarray) -> str:
+    """A word on a wrong dtype that names a common cause."""
+    if e.dtype == bool and g.dtype.kind in "iuf":
+        return ": return the comparison itself (a boolean mask), without .astype(int) or multiplying by 1"
+    if e.dtype.kind in "iu" and g.dtype.kind == "f":
+        return (": `/` (and np.trunc, np.floor, np.round) give floats: use integer division `//` "
+                "(torch.div(..., rounding_mode='floor')), or convert with .astype(np.int64) after rounding; an "
+                "array made without a dtype (np.zeros(n), np.full(n, p)) is float too: give dtype=")
+    if e.dtype.kind == "f" and g.dtype.kind in "iu":
+        return (": the values were made whole numbers: no .astype(int) or int(...) on the result, and no integer "
+                "array to fill (np.zeros(..., dtype=int), or np.zeros_like of an integer input such as x or p)")
+    return ""
+
+
+def differing_leaf(got, expected, rtol: float, atol: float):
+    """The (got, expected) pair, inside nested tuples, lists and dicts, where the two first differ."""
+    try:
+        if isinstance(expected, (tuple, list)) and isinstance(got, (tuple, list)) and len(got) == len(expected):
+            for g, e in zip(got, expected):
+                if compare_outputs(g, e, rtol, atol) is not None:
+                    return differing_leaf(g, e, rtol, atol)
+        if isinstance(expected, dict) and isinstance(got, dict) and set(got) == set(expected):
+            for k in expected:
+                if compare_outputs(got[k], expected[k], rtol, atol) is not None:
+                    return differing_leaf(got[k], expected[k], rtol, atol)
+    except Exception:
+        pass
+    return got, expected

@@ -1,0 +1,295 @@
+"""The check's main loop: every input in turn, the first problem reported with the hint that explains it.
+
+:func:`run_check` runs the learner's function and the reference on each of the exercise's inputs
+(:mod:`.learner_calls`), compares the outputs (:mod:`.outputs`), and at the first difference looks for a hint
+(:func:`_hint_for`), in a fixed order: data kept in a notebook variable (when it made the difference), the
+exercise's own wrong versions, a swapped pair, state kept between calls, an argument taken from input #1, the
+generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
+patterns read off the values (:mod:`.hints`), and last a notebook variable that only grew. After every input
+matched, the last one is run a second time from other states of the global generators (:func:`_second_call`,
+:mod:`.across_calls`, :mod:`.global_state`). The order is the report's: change it and other hints win. Returns
+(passed, headline, detail lines); printing is :func:`evinr_lite.teaching.exercises.check`'s.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+from .across_calls import (fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
+                           mutable_defaults, reseed_hint, scalar_factor_hint, shares_output, stale_argument_hint,
+                           state_hint)
+from .global_state import (other_rng_states, reseeded_generators, restore_torch_settings, rng_states,
+                           set_rng_states, settings_message, torch_settings)
+from .hints import (generic_hint, has_repeated_index, non_square, one_based_hint, size_from_events_hint,
+                    swapped_pair_hint)
+from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, run, watching,
+                            where_raised)
+from .mistakes import generic_mistakes, same_mistake_elsewhere, wrong_axes_hint
+from .outputs import Problem, compare_outputs, describe_case, differing_leaf
+from .protocol import ExerciseLike
+
+NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
+
+Report = tuple[bool, str, list[str]]   # (passed, headline, detail lines)
+
+
+def run_check(ex: ExerciseLike, fn: Callable) -> Report:
+    """(passed, headline, detail lines) without printing.
+
+    torch's global settings are set back after every call of a function (see :func:`run`), and once more, to
+    what they were when the check began, after all of it: a function that changes them only on an input the
+    main run never reaches (a hint's search runs the others), or that raises right after, leaves the notebook as
+    it was. Such a change is named in the report (`also: ...`) when the main run did not name it already."""
+    settings = torch_settings()
+    try:
+        with watching(fn) as seen:
+            ok, headline, details = _run_inputs(ex, fn)
+        if seen and not ok and not headline.startswith("changed torch's global settings"):
+            details = details + ["also: " + settings_message(seen)]
+        return ok, headline, details
+    finally:
+        restore_torch_settings(settings)
+
+
+def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
+    """:func:`run_check`'s work: every input in turn until one fails, then the last input a second time."""
+    if not callable(fn):
+        return False, f"expected a function, got {type(fn).__name__}", []
+    try:
+        cases = ex.cases()
+    except Exception as err:  # a bug in the exercise itself, not the learner's
+        return False, f"could not build the test inputs ({type(err).__name__}: {err})", []
+    n = len(cases)
+    defaults = mutable_defaults(fn)
+    containers = global_containers(fn)
+    for k, (args, kwargs) in enumerate(cases):
+        where = f"input #{k + 1} of {n} ({describe_case(args, kwargs)})"
+        after: list = []
+        if k == n - 1:
+            rng_before = rng_states()       # the last input is run again below, from other generator states
+        changed_settings: dict = {}
+        try:
+            got = run(fn, args, kwargs, ex.observe, inputs_after=after, settings_changed=changed_settings)
+            if k == n - 1:
+                rng_after = rng_states()
+        except NotImplementedError:
+            return False, f"{NOT_DONE}: the function raises NotImplementedError", [
+                "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
+        except Exception as err:
+            return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
+        if changed_settings:
+            return False, f"changed torch's global settings on {where}", [settings_message(changed_settings)]
+        expected = run(ex.reference, args, kwargs, ex.observe)
+        problem = _first_difference(ex, got, expected)
+        # inputs changed in place (a function with side effects says what to compare through `observe`)
+        changed = changed_inputs((args, kwargs), after[0]) if ex.observe is None and after else []
+        if problem is None and not changed:
+            continue
+        if problem is None:
+            return False, f"changed its input on {where}", [in_place_message(changed, container_names(args, kwargs))]
+        details = [problem.message]
+        hint, seed_note = _hint_for(ex, fn, cases, k, got, expected, problem, defaults, containers)
+        if hint:
+            details.append(f"hint: {hint}")
+        if seed_note:
+            details.append(f"also: {seed_note}")
+        if changed:
+            details.append("also: " + in_place_message(changed, container_names(args, kwargs)))
+        return False, f"does not match the reference on {where}", details
+    if n:
+        failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after)
+        if failed is not None:
+            return failed
+    return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
+
+
+def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, k: int, where: str, defaults: dict,
+                   containers: dict) -> Report:
+    """The report for a call of ``fn`` that raised ``err`` on input ``k``: the error, the learner's line that
+    raised it, and a hint where the error names a likely cause (an unhashable argument to a cache or a dict key,
+    the stub's signature changed, a loss without a graph, a sensor that is not square, state kept between calls)."""
+    args, kwargs = cases[k]
+    details = [f"{type(err).__name__}: {err}"] + where_raised(err)
+    if isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
+        details.append("hint: a cache (functools.lru_cache, functools.cache, or a dict keyed by the "
+                       "arguments) needs hashable arguments, and an array, a list or a dict is not one; "
+                       "drop the cache (nothing here is slow enough to need one), or key it by "
+                       "something hashable that holds all of the data (a.tobytes()) and return copies")
+    elif isinstance(err, TypeError) and "unhashable type" in str(err):
+        details.append("hint: an array, a list or a dict cannot be a dict key, a set's member or a "
+                       "Counter's item (it is unhashable: its contents can change); use a tuple of numbers "
+                       "(`tuple(row.tolist())`), one integer made of them (`y * W + x`), or numpy "
+                       "itself (np.unique(..., axis=0, return_counts=True), np.add.at)")
+    elif isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
+        names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
+        details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
+                       "stub's parameter names and order")
+    if isinstance(err, RuntimeError) and "does not require grad" in str(err):
+        details.append("hint: the loss has no autograd graph to back-propagate: it was computed under "
+                       "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
+                       ".item(), .numpy()); compute it with torch operations on the model's outputs, "
+                       "with gradients on")
+    if isinstance(err, IndexError) and non_square(args, kwargs):
+        details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
+                       "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
+                       "`np.zeros((H, W))`, `frame[y, x]`")
+    state = mutable_default_hint(fn, defaults) if k > 0 else None
+    if state is None and k > 0:
+        cache, proven = global_cache_hint(fn, containers, ex, (args, kwargs), raised=True)
+        if proven or not any(d.startswith("hint:") for d in details):
+            state = cache        # a list only logged to, which changes nothing, is a fallback
+    if state:
+        details.append(f"hint: {state}")
+    return False, f"raised {type(err).__name__} on {where}", details
+
+
+def _first_difference(ex: ExerciseLike, got, expected) -> Problem | None:
+    """The first difference between the learner's output and the reference's: by the exercise's own comparison
+    (``ex.compare``) when it has one, else by :func:`compare_outputs` within its tolerances."""
+    if ex.compare is None:
+        return compare_outputs(got, expected, ex.rtol, ex.atol)
+    try:
+        msg = ex.compare(got, expected)
+    except Exception as err:     # a return value the comparison cannot read at all
+        msg = f"returned a {type(got).__name__} that cannot be compared ({type(err).__name__}: {err})"
+    return None if msg is None else Problem(msg, values=True)
+
+
+def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected, problem: Problem, defaults: dict,
+              containers: dict) -> tuple[str | None, str | None]:
+    """(hint, seed note) for a wrong output ``got`` on input ``k``: the first hint that applies, in the report's
+    order. Each step may run the learner's function again (with its side effects), so a step runs only when the
+    ones before it found nothing."""
+    args, kwargs = cases[k]
+    # results kept in a notebook dict (or list) that the function fills: an input that shares an earlier
+    # one's key gets that input's result. Named first when the kept data made the difference (run with the
+    # variable emptied, the function answers otherwise), else only when no other hint applies (below): a list
+    # the function only logs to (`log.append(len(t))`, a common habit) grows just the same and explains nothing
+    cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
+    hint = cache_hint if proven else None
+    if hint is None:
+        hint = _own_hint(ex, fn, cases, k, got)
+    # mistakes that show only across inputs: state kept from an earlier call, a notebook variable or a
+    # fixed size in place of an argument; and a pair returned in the other order
+    if hint is None:
+        hint = swapped_pair_hint(ex, got, expected)
+    if hint is None:
+        hint = state_hint(fn, defaults, ex, args, kwargs, got, first=k == 0)
+    if hint is None:
+        hint = stale_argument_hint(ex, fn, cases, k, got, expected)
+    if hint is None and ex.observe is None:
+        hint = _generic_mistake_hint(ex, fn, cases, k, got, expected)
+    # a global generator seeded inside: random numbers, the same at every call (after the generic mistakes: a
+    # seed that draws nothing explains no value, and is only noted)
+    seed_note = None
+    if hint is None:
+        hint, seed_note = reseed_hint(ex, fn, args, kwargs)
+    if hint is None:
+        hint = size_from_events_hint(args, kwargs, got, expected)
+    if hint is None:
+        hint = fixed_size_hint(ex, cases, k, got, expected)
+    if problem.values:
+        if hint is None:
+            hint = one_based_hint(got, expected, ex.rtol, ex.atol)
+        if hint is None:
+            hint = wrong_axes_hint(ex, args, kwargs, got, expected)
+        if hint is None:
+            indexed = has_repeated_index(args, kwargs)
+            hint = generic_hint(got, expected, indexed=indexed)
+            if hint is None and isinstance(expected, (tuple, list, dict)):
+                hint = generic_hint(*differing_leaf(got, expected, ex.rtol, ex.atol), indexed=indexed)
+        if hint is None:
+            hint = scalar_factor_hint(ex, fn, cases, k, got, expected)
+    if hint is None:
+        hint = cache_hint
+    return hint, seed_note
+
+
+def _own_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got) -> str | None:
+    """The message of the exercise's own wrong version that ``got`` matches on input ``k``.
+
+    A known mistake is recognised by its output, whatever the first difference is (a wrong count of events is a
+    wrong shape, not wrong values), and confirmed on the other inputs where it shows: one input alone can make two
+    different mistakes look alike."""
+    args, kwargs = cases[k]
+    for message, wrong in ex.hints.items():
+        try:
+            w = run(wrong, args, kwargs, ex.observe)
+            if compare_outputs(got, w, ex.rtol, ex.atol) is None and same_mistake_elsewhere(ex, fn, wrong, cases, k):
+                return message
+        except Exception:
+            continue
+    return None
+
+
+def _generic_mistake_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected) -> str | None:
+    """The message of a generic wrong version (:func:`generic_mistakes`) that ``got`` matches on input ``k``.
+
+    Mistakes any exercise can show (polarities read as 0/1, a clip to [0, 1], a rounded result), recognised the
+    same way as the exercise's own, from wrong versions made from the reference."""
+    args, kwargs = cases[k]
+    for message, wrong in generic_mistakes(ex, cases):
+        applies = getattr(wrong, "applies", None)
+        if applies is not None and not applies(args, kwargs):
+            continue
+        try:
+            w = run(wrong, args, kwargs)
+            if compare_outputs(w, expected, ex.rtol, ex.atol) is not None \
+                    and compare_outputs(got, w, ex.rtol, ex.atol) is None \
+                    and same_mistake_elsewhere(ex, fn, wrong, cases, k, getattr(wrong, "support", 0)):
+                return message
+        except Exception:
+            continue
+    return None
+
+
+def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_before: dict,
+                 rng_after: dict) -> Report | None:
+    """The failure seen when the last input, ``case``, is run once more, from other states of the global random
+    generators, or None. From the loop's last pass: ``got``, what the first run returned, and ``rng_before`` and
+    ``rng_after``, the generators' states around it.
+
+    A function that keeps state between calls (a notebook variable it changes, a mutable default argument) gives
+    another result the second time; one that keeps its result (a buffer, a cache) returns the same array again;
+    one that reseeds a global generator leaves it in the same state whatever it held before."""
+    args, kwargs = case
+    rng_now, rng_other = rng_states(), other_rng_states(rng_before)
+    changed_settings: dict = {}
+    try:
+        set_rng_states(rng_other)
+        again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
+        rng_again = rng_states()
+        if ex.observe is not None:
+            problem = None
+        elif ex.compare is None:
+            problem = compare_outputs(again, run(ex.reference, args, kwargs), ex.rtol, ex.atol)
+        else:
+            problem = None if ex.compare(again, run(ex.reference, args, kwargs)) is None else Problem("", True)
+    except Exception as err:
+        again, rng_again, problem = None, None, Problem(f"{type(err).__name__}: {err}")
+    finally:
+        set_rng_states(rng_now)
+    if changed_settings:
+        return False, f"changed torch's global settings on input #{n} of {n}", [settings_message(changed_settings)]
+    if problem is not None:
+        return False, f"gives another result when input #{n} of {n} is run a second time", [
+            "every input matched once, but a second call on the same input does not: your function keeps "
+            "state between calls (a notebook variable it changes, a mutable default argument such as "
+            "`state={}`, or unseeded randomness); compute everything from the arguments, afresh in each call"]
+    shared = shares_output(got, again) if ex.observe is None else None
+    if shared:
+        return False, f"returns the same {shared} again when input #{n} of {n} is run a second time", [
+            "every input matched, but two calls return the same array (or dict) object, or views of one: a "
+            "buffer or a cached result kept between calls (a notebook variable, a dict of results keyed by the "
+            "shape or the arguments, a default argument) is handed out again, so each call changes what the "
+            "earlier ones returned, and a caller that changes a result changes the cache (`frames = [f(...) "
+            "for ...]` would hold one array many times); create the result afresh in each call (np.zeros(...) "
+            "inside the function), or return a copy of a cached one (`.copy()`)"]
+    reseeded = reseeded_generators(rng_before, rng_other, rng_after, rng_again) if rng_again is not None else []
+    if reseeded:
+        return False, f"reseeds the global random generator ({', '.join(reseeded)})", [
+            "every input matched, but after a call the global generator is in the same state whatever it held "
+            "before: your function seeds it (np.random.seed, torch.manual_seed, random.seed), which resets the "
+            "random numbers of the whole notebook at every call (a later cell's random minibatches or noise "
+            "repeat); nothing here asks for randomness: remove the seed, or draw from a generator of your own "
+            "(rng = np.random.default_rng(seed), torch.Generator().manual_seed(seed))"]
+    return None
