@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .checks import is_real_number, real_number, whole_number
 from .events import EventDataError, check_sensor_size
 
 __all__ = ["CHANNELS", "QUAD_BAYER", "BAYER", "TILE_COLOURS", "CFA_NAMES", "check_cfa", "cfa_phase",
@@ -44,6 +45,7 @@ TILE_COLOURS = np.array([[0, 1], [1, 2]], dtype=np.int8)   # R G / G B, one entr
 # 2 x 2 Bayer filters by the colours of photosites (0, 0), (0, 1), (1, 0), (1, 1) -> phase (dy, dx) of
 # the RGGB tile (block = 1)
 CFA_NAMES = {"RGGB": (0, 0), "GRBG": (0, 1), "GBRG": (1, 0), "BGGR": (1, 1)}
+MAX_BLOCK = 8   # photosites per side of one colour block: Quad Bayer 2, "nona" 3, "hexadeca" 4; none larger exists
 
 
 def check_cfa(cfa, error=EventDataError) -> str | None:
@@ -68,20 +70,29 @@ def cfa_phase(cfa) -> tuple[int, int]:
 
 
 def check_block(block) -> int:
-    """``block`` checked: a positive int (2 = Quad Bayer, 1 = plain Bayer)."""
-    if isinstance(block, (bool, np.bool_)) or not isinstance(block, (int, np.integer)) or block < 1:
-        raise EventDataError(f"block must be a positive int (2 = Quad Bayer, 1 = plain Bayer), got {block!r}")
-    return int(block)
+    """``block`` checked: a whole number in [1, MAX_BLOCK] (2 = Quad Bayer, 1 = plain Bayer); a 0-d array or
+    tensor holding one is that number (a block of 10^9 was a tile of 4 * 10^18 photosites)."""
+    try:
+        return whole_number(block, "block", lo=1, hi=MAX_BLOCK)
+    except EventDataError:
+        raise EventDataError(f"block must be a whole number in [1, {MAX_BLOCK}] (2 = Quad Bayer, 1 = plain Bayer), "
+                             f"got {block!r}") from None
 
 
 def check_phase(phase, block: int) -> tuple[int, int]:
-    """``phase = (dy, dx)`` checked (whole numbers) and reduced modulo the period P = 2 * block."""
+    """``phase = (dy, dx)`` checked (whole numbers, not text) and reduced modulo the period P = 2 * block."""
     try:
-        dy, dx = (int(v) for v in phase)
+        dy, dx = phase
+        ok = is_real_number(dy) and is_real_number(dx)
     except (TypeError, ValueError):
-        raise EventDataError(f"phase must be (dy, dx), two ints (row, column offset in the tile), got {phase!r}") from None
-    if not np.allclose(np.asarray(phase, dtype=np.float64), (dy, dx)):
-        raise EventDataError(f"phase must hold whole numbers (row, column offset in the tile), got {phase!r}")
+        ok = False
+    if not ok:
+        raise EventDataError(f"phase must be (dy, dx), two whole numbers (row, column offset in the tile), got "
+                             f"{phase!r}")
+    try:
+        dy, dx = whole_number(dy, "phase: dy"), whole_number(dx, "phase: dx")
+    except EventDataError:
+        raise EventDataError(f"phase must hold whole numbers (row, column offset in the tile), got {phase!r}") from None
     P = 2 * block
     return dy % P, dx % P
 
@@ -111,14 +122,40 @@ def cfa_channel(y, x, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
 
     ``TILE[(y + dy) % P, (x + dx) % P]``: the block row is ``((y + dy) % P) // block``, the block
     column likewise, and the block colour is R G / G B. ``y`` and ``x`` are int arrays of one shape
-    (broadcast); returns int64 of that shape.
+    (broadcast); returns int64 of that shape. Whole numbers given as floats are taken; fractions, NaN and
+    text are refused (a photosite has whole coordinates), and so are shapes that do not broadcast.
     """
     block = check_block(block)
     dy, dx = check_phase(phase, block)
     P = 2 * block
-    y = np.asarray(y, dtype=np.int64)
-    x = np.asarray(x, dtype=np.int64)
+    y = _photosites(y, "y", "rows")
+    x = _photosites(x, "x", "columns")
+    try:
+        np.broadcast_shapes(y.shape, x.shape)
+    except ValueError:
+        raise EventDataError(f"y= (shape {y.shape}) and x= (shape {x.shape}) must have one shape (or broadcast): "
+                             "one row and one column per photosite") from None
     return TILE_COLOURS[((y + dy) % P) // block, ((x + dx) % P) // block].astype(np.int64)
+
+
+def _photosites(a, name: str, what: str) -> np.ndarray:
+    """Photosite coordinates as int64; EventDataError naming ``name`` when they are not whole numbers."""
+    from .guard import host_array
+
+    try:
+        arr = np.asarray(host_array(a))
+    except (TypeError, ValueError):
+        arr = np.asarray([None])
+    if arr.dtype.kind in "iu":
+        return arr.astype(np.int64)
+    if arr.dtype.kind != "f" or not np.all(np.isfinite(arr)) or not np.all(arr == np.round(arr)):
+        raise EventDataError(f"{name}= must be whole photosite {what} (integers), got {_short(a)}")
+    return arr.astype(np.int64)
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else f"{type(value).__name__} {text[:50]}..."
 
 
 def cfa_pattern(sensor_size, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
@@ -134,6 +171,5 @@ def effective_thresholds(C: float, block: int = QUAD_BAYER) -> dict:
     Returns {"grey": C / n, "R": C / n_R, "G": C / n_G, "B": C / n_B}; for Quad Bayer
     C/16, C/4, C/8, C/4 (:mod:`evinr_lite.sim.quadbayer` explains why).
     """
-    if not (np.isscalar(C) and np.isfinite(C) and C > 0):
-        raise EventDataError(f"C must be a positive contrast threshold (log units), got {C!r}")
-    return {name: float(C) / n for name, n in photosites_per_window(block).items()}
+    C = real_number(C, "C", lo=0.0, lo_open=True, hint="a positive contrast threshold in log units (e.g. 0.2)")
+    return {name: C / n for name, n in photosites_per_window(block).items()}

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..core.checks import check_image_values, real_number
 from ..core.events import EventDataError
+from ..core.guard import dense_array
 from ..method.offset import gaussian_lowpass
 
 __all__ = ["match_level", "error_parts", "COARSE_PX"]
@@ -33,7 +34,7 @@ COARSE_PX = 8.0    # the Gaussian's sigma (pixels) above which an error counts a
 
 
 def _frames(a, name: str) -> np.ndarray:
-    a = np.asarray(a)
+    a = dense_array(a, name, error=EventDataError, want="frames of one size [K, H, W] (crop or resize them to one size)")
     if a.ndim != 3 or a.size == 0:
         raise EventDataError(f"{name} must be a stack [K, H, W] of frames, got shape {a.shape}"
                              + ("; one image [H, W] is a stack of one: image[None]" if a.ndim == 2 else

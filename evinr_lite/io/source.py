@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from ..core.checks import host_array, is_real_number
 from ..core.events import EventDataError, Events, InputError
 from ..core.frames import Frames
 from ..core.recording import Recording
@@ -28,11 +29,11 @@ __all__ = ["RecordingSource", "MemorySource", "as_source", "check_window"]
 
 
 def check_window(t0, t1, what: str = "window") -> tuple[float, float]:
-    """(t0, t1) as finite floats with t0 < t1, or an EventDataError naming the problem."""
-    try:
-        t0, t1 = float(t0), float(t1)
-    except (TypeError, ValueError):
-        raise EventDataError(f"the {what} [t0, t1) must be two numbers of seconds, got {t0!r}, {t1!r}") from None
+    """(t0, t1) as finite floats with t0 < t1, or an EventDataError naming the problem. Numbers only: a 0-d
+    array or tensor holding one is that number; text ("0") and booleans are refused, not read as seconds."""
+    if not (is_real_number(t0) and is_real_number(t1)):
+        raise EventDataError(f"the {what} [t0, t1) must be two numbers of seconds, got {t0!r}, {t1!r}")
+    t0, t1 = float(host_array(t0)), float(host_array(t1))
     if not (math.isfinite(t0) and math.isfinite(t1)):
         raise EventDataError(f"the {what} [{t0}, {t1}) must be finite seconds")
     if t1 <= t0:

@@ -12,7 +12,8 @@ import os
 
 import numpy as np
 
-from ..core.events import EventDataError
+from ..core.checks import checked_span, real_number, require, whole_number
+from ..core.events import EventDataError, check_sensor_size
 from .config import EvINRConfig
 from .ensemble import split_windows
 from .coarse import coarse_applies, coarse_times
@@ -104,8 +105,13 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
         "offset_solve_bytes" (the L1 offset solve's work arrays alone), "coarse_bytes" (the static image's
         coarse part's, alone; 0 where it does not run)}.
     """
-    span = max(float(t_end) - float(t_start), 0.0)
-    H, W = sensor_size
+    H, W = check_sensor_size(sensor_size)                   # before any size is multiplied (None, 10.5 or 0 rows)
+    t_start, t_end = checked_span(t_start, t_end, "estimate_memory")   # NaN, inf, text or reversed: no estimate
+    n_events = whole_number(n_events, "n_events", lo=0)
+    n_frames = whole_number(n_frames, "n_frames", lo=0)
+    n_kept = whole_number(n_kept, "n_kept", lo=0)
+    config = require(config, EvINRConfig, "config")
+    span = max(t_end - t_start, 0.0)
     P = float(H) * float(W)
     N = _n_windows(span, config)
     window_s = span if N == 1 else (span + (N - 1) * config.overlap) / N
@@ -179,6 +185,8 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
     ``events_span``: (first, last) event time in seconds, named in the advice (default: the window).
     Returns the estimate.
     """
+    fraction = real_number(fraction, "fraction", lo=0.0, lo_open=True, hi=1.0,
+                           hint="the share of the free memory a run may take (0.8)")
     est = estimate_memory(sensor_size, t_start, t_end, n_events, n_frames, config, streaming=streaming,
                           n_kept=n_kept)
     free = available_bytes(device)
@@ -215,6 +223,9 @@ def check_times_memory(n_times: int, sensor_size, what: str, *, fraction: float 
     """Refuse (EventDataError) ``n_times`` query times before they are allocated, when the times alone
     would not fit in ``fraction`` of the free memory (:func:`check_memory` then counts the frames).
     ``what`` says where the times come from (e.g. "1,000 frames at 30 per second over [0, 1] s")."""
+    n_times = whole_number(n_times, "n_times", lo=0)
+    fraction = real_number(fraction, "fraction", lo=0.0, lo_open=True, hi=1.0,
+                           hint="the share of the free memory a run may take (0.8)")
     need, free = n_times * BYTES_PER_TIME, available_bytes("cpu")
     if need > fraction * free:
         H, W = sensor_size

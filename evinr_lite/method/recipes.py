@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.checks import whole_number
 from ..core.events import EventDataError
 from ..core.recording import Recording
 from .binning import as_thresholds
@@ -35,16 +36,17 @@ def recipe_config(recipe: str = "kit", n_iters: int | None = None, tonemap: str 
     tone map's own level (:data:`~evinr_lite.method.tonemap.DISPLAY_MEANS`) unless ``display_mean`` is
     among ``fields``.
     """
-    if recipe not in RECIPES:
+    if not isinstance(recipe, str) or recipe not in RECIPES:
         raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {recipe!r}")
     make = RECIPES[recipe]
     if n_iters is not None:
-        fields["n_iters"] = int(n_iters)
+        n_iters = whole_number(n_iters, "n_iters", lo=0)   # 2.5 ran 2, "90" and True were taken
+        fields["n_iters"] = n_iters
         if make().coarse_to_fine:
             c2f = (n_iters // 3, 2 * n_iters // 3) if n_iters >= 3 else ()
             fields.update(c2f_iters=c2f, coarse_to_fine=bool(c2f))
     if tonemap is not None:
-        if tonemap not in DISPLAY_MEANS:
+        if not isinstance(tonemap, str) or tonemap not in DISPLAY_MEANS:
             raise EventDataError(f"tonemap= must be one of {tuple(DISPLAY_MEANS)} (or None: the recipe's own), "
                                  f"got {tonemap!r}")
         fields["tonemap"] = tonemap
@@ -66,7 +68,8 @@ def contrast_option(C):
 
 
 def format_contrast(C) -> str:
-    """'0.2' for one threshold, 'C+ 0.22 / C- 0.18' for a pair."""
+    """'0.2' for one threshold, 'C+ 0.22 / C- 0.18' for a pair (a resolved C: not None, not 'auto')."""
+    as_thresholds(C, "C")   # None, 'auto', text, NaN or one value as a pair were Python's format errors or 'nan'
     return f"{C:g}" if np.ndim(C) == 0 else f"C+ {C[0]:.4g} / C- {C[1]:.4g}"
 
 

@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..core.checks import check_reach, optional_seconds, require, seconds_array
 from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
 from .prepare import prepare_source, read_chunks
@@ -226,26 +227,43 @@ def first_window_offset(model: FrameINR, window, config: EvINRConfig, events=Non
 
 
 def _check(source, query_times, config, t_start, t_end, offset_from):
-    cfg = config or EvINRConfig()
-    if not isinstance(cfg, EvINRConfig):
-        raise EventDataError(f"config must be an EvINRConfig, got {type(cfg).__name__}")
+    cfg = EvINRConfig() if config is None else require(config, EvINRConfig, "config")   # {} ran the default
     if cfg.anchor != "none":
         raise EventDataError(f"streaming does not take anchored configs (anchor={cfg.anchor!r}): the APS frames fit "
                              "the offset over the whole span; use reconstruct(...) for them")
     if offset_from not in OFFSET_FROM:
         raise EventDataError(f"offset_from must be one of {OFFSET_FROM}, got {offset_from!r}")
-    q = np.atleast_1d(np.asarray(query_times, dtype=np.float64))
-    if q.ndim != 1 or q.size == 0 or not np.all(np.isfinite(q)):
-        raise EventDataError("query_times must be a non-empty 1-D array of finite seconds")
+    q = seconds_array(query_times, "query_times")     # True, text, ragged or complex times were numpy's errors
     if np.any(np.diff(q) < 0):
         raise EventDataError("query_times must be sorted (increasing seconds) for streaming; pass np.sort(times)")
     first, last = source.t_span
-    t_start = min(first, q.min()) if t_start is None else float(t_start)
-    t_end = max(last, q.max()) if t_end is None else float(t_end)
+    t_start, t_end = optional_seconds(t_start, "t_start"), optional_seconds(t_end, "t_end")
+    t_start = min(first, q.min()) if t_start is None else t_start
+    t_end = max(last, q.max()) if t_end is None else t_end
+    # times in ms or us, or on the absolute clock: a span no recording has, counted for hours before any window
+    check_reach(min(t_start, q.min()), max(t_end, q.max()), np.array(source.t_span if source.n_events != 0 else []),
+                source.t_origin, "query_times and t_start / t_end")
     if q.min() < t_start or q.max() > t_end:
         raise EventDataError(f"query times span [{q.min()}, {q.max()}] s, outside [t_start, t_end] = "
                              f"[{t_start}, {t_end}] s; widen the span or drop those times")
     return cfg, q, t_start, t_end
+
+
+def _check_hooks(progress, on_state, state, workdir) -> None:
+    """The run's switches and hooks, before any pass over the recording (a bad on_state failed after the first
+    window had trained; progress="no" showed the bar)."""
+    if progress is not None and not isinstance(progress, (bool, np.bool_)):
+        raise EventDataError(f"progress= must be True, False or None (the config's), got {progress!r}")
+    if on_state is not None and not callable(on_state):
+        raise EventDataError(f"on_state= must be a function on_state(state) called after each window (or None), got "
+                             f"{type(on_state).__name__}")
+    require(state, StreamState, "state", none_ok=True)
+    if workdir is not None and not isinstance(workdir, (str, Path)):
+        import os
+
+        if not isinstance(workdir, os.PathLike):
+            raise EventDataError(f"workdir= must be a folder (a str or Path) for the spill file, or None for a "
+                                 f"temporary one; got {type(workdir).__name__}")
 
 
 def _check_two_events(source, t_start: float, t_end: float) -> None:
@@ -319,6 +337,7 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
 
     source = as_source(source)
     cfg, q, t_start, t_end = _check(source, query_times, config, t_start, t_end, offset_from)
+    _check_hooks(progress, on_state, state, workdir)
     _check_two_events(source, t_start, t_end)
     show = cfg.progress if progress is None else bool(progress)
     # hot pixels, background, ON/OFF balance, lam (method/prepare.py)

@@ -51,7 +51,7 @@ from scipy import ndimage
 
 from ..core.cfa import (BAYER, CHANNELS, QUAD_BAYER, TILE_COLOURS, cfa_channel, cfa_pattern, cfa_tile,  # noqa: F401
                         check_block, check_phase, effective_thresholds, period, photosites_per_window)
-from ..core.checks import ArgumentTypeError
+from ..core.checks import ArgumentTypeError, whole_number
 from ..core.events import EventDataError, Events, check_sensor_size
 from ..core.guard import dense_array
 from .scenes import MOTION_PARAMETERS, MovingImageScene, check_intensity_range, real_image
@@ -63,6 +63,25 @@ __all__ = ["CHANNELS", "QUAD_BAYER", "BAYER", "TILE_COLOURS", "period", "photosi
            "simulate_colour_video", "reduce_mean", "mosaic_display", "checker_amplitude"]
 
 
+def _image(a, name: str, want: str = "a mosaic [..., H, W]", *, finite: bool = True) -> np.ndarray:
+    """``a`` as an array of 2 or more dimensions of real numbers (and, with ``finite``, no NaN or inf); else an
+    EventDataError naming ``name`` (text, complex numbers, a ragged list, None or one row were numpy's errors,
+    a sensor size's, or NaN results)."""
+    a = dense_array(a, f"{name}=", error=EventDataError, want=f"{want}, all of one size")
+    if a.ndim < 2:
+        raise EventDataError(f"{name}= must be {want}, got shape {a.shape}" +
+                             ("; one row is an image of one row: a[None]" if a.ndim == 1 else ""))
+    if a.dtype.kind not in "biuf":
+        kind = "complex numbers" if a.dtype.kind == "c" else f"dtype {a.dtype}"
+        raise EventDataError(f"{name}= must be numbers (linear intensities), got {kind}")
+    if finite and a.dtype.kind == "f":
+        bad = int(a.size - np.count_nonzero(np.isfinite(a)))
+        if bad:
+            raise EventDataError(f"{name}= holds {bad:,} NaN or infinite value(s) of {a.size:,}; repair or drop them "
+                                 "(they would make every window they fall in NaN)")
+    return a
+
+
 def mosaic(rgb, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
     """What the photosites see: each keeps only its own channel of an RGB image or video.
 
@@ -71,9 +90,12 @@ def mosaic(rgb, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
     Returns:
         [..., H, W] of the same dtype (the raw mosaic).
     """
-    rgb = np.asarray(rgb)
+    rgb = dense_array(rgb, "rgb=", error=EventDataError, want="colour images [..., H, W, 3], all of one size")
     if rgb.ndim < 3 or rgb.shape[-1] != 3:
         raise EventDataError(f"rgb must have shape [..., H, W, 3], got {rgb.shape}")
+    if rgb.dtype.kind not in "biuf":   # complex numbers kept their imaginary part, text was taken
+        kind = "complex numbers" if rgb.dtype.kind == "c" else f"dtype {rgb.dtype}"
+        raise EventDataError(f"rgb= must be numbers (intensities or log intensities), got {kind}")
     pattern = cfa_pattern(rgb.shape[-3:-1], phase, block)
     return np.take_along_axis(rgb, np.broadcast_to(pattern[..., None], rgb.shape[:-1] + (1,)).astype(np.intp),
                               axis=-1)[..., 0]
@@ -82,7 +104,7 @@ def mosaic(rgb, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
 def mosaic_display(raw, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
     """A raw mosaic [..., H, W] as colours for display: each photosite's value in its own channel,
     the other two zero. Returns float64 [..., H, W, 3] (scale ``raw`` to [0, 1] first)."""
-    raw = np.asarray(raw, dtype=np.float64)
+    raw = np.asarray(_image(raw, "raw"), dtype=np.float64)
     pattern = cfa_pattern(raw.shape[-2:], phase, block)
     return np.stack([np.where(pattern == c, raw, 0.0) for c in range(3)], axis=-1)
 
@@ -90,11 +112,12 @@ def mosaic_display(raw, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
 # ---- demosaicing frames ------------------------------------------------------------------
 
 def _check_raw(raw, block: int) -> tuple[np.ndarray, int]:
-    raw = np.asarray(raw)
+    raw = _image(raw, "raw")
     P = period(block)
-    if raw.ndim < 2:
-        raise EventDataError(f"raw must be a mosaic [..., H, W], got shape {raw.shape}")
     H, W = raw.shape[-2:]
+    if not raw.size:
+        raise EventDataError(f"raw= has no photosite (shape {raw.shape}); pass a mosaic of at least one {P} x {P} "
+                             "tile")
     if H % P or W % P:
         raise EventDataError(f"raw mosaic is {H} x {W} (H x W) but both must be multiples of the tile period {P}; "
                              f"crop it to {H - H % P} x {W - W % P} first (cropping from the top/left changes the phase)")
@@ -103,7 +126,8 @@ def _check_raw(raw, block: int) -> tuple[np.ndarray, int]:
 
 def reduce_mean(image, factor: int) -> np.ndarray:
     """Mean over non-overlapping factor x factor windows of [..., H, W] -> float64 [..., H/f, W/f]."""
-    image = np.asarray(image, dtype=np.float64)
+    factor = whole_number(factor, "factor", lo=1)
+    image = np.asarray(_image(image, "image", "an image [..., H, W]", finite=False), dtype=np.float64)
     H, W = image.shape[-2:]
     if H % factor or W % factor:
         raise EventDataError(f"image {H} x {W} is not a multiple of the reduction factor {factor}")
@@ -172,6 +196,13 @@ def debayer_bilinear(raw, phase=(0, 0)) -> np.ndarray:
     of that channel's nearest photosites (kernel 1 2 1 / 2 4 2 / 1 2 1: the 2 or 4 neighbours), as a
     camera driver's debayered topic (DAVIS346 colour, CED). ``phase``: the filter's phase (cfa_tile).
     """
+    raw = _image(raw, "raw", "a mosaic [H, W]")
+    if raw.ndim != 2:
+        raise EventDataError(f"raw= must be one mosaic [H, W], got shape {raw.shape}; debayer one frame at a time "
+                             "(raw[i])")
+    if min(raw.shape) < 2:
+        raise EventDataError(f"raw= must be at least 2 x 2 photosites (one whole Bayer tile), got {raw.shape[0]} x "
+                             f"{raw.shape[1]}: the missing colours of a smaller one have no neighbour to come from")
     values = np.asarray(raw, np.float64)
     pattern = cfa_pattern(values.shape, phase, block=BAYER)
     kernel = np.array([[1.0, 2.0, 1.0], [2.0, 4.0, 2.0], [1.0, 2.0, 1.0]])
@@ -240,8 +271,10 @@ def checker_amplitude(images) -> float:
     image gives about half its gradient per pixel; a channel whose pixels alternate between colours
     gives about half the colour difference.
     """
-    x = np.asarray(images, dtype=np.float64)
+    x = np.asarray(_image(images, "images", "images [..., H, W]"), dtype=np.float64)
     H, W = x.shape[-2:]
+    if H < 2 or W < 2:
+        raise EventDataError(f"images= must be at least 2 x 2 pixels (one period-2 block), got shape {x.shape}")
     if H % 2 or W % 2:
         x = x[..., :H - H % 2, :W - W % 2]
     a, b, c, d = x[..., 0::2, 0::2], x[..., 0::2, 1::2], x[..., 1::2, 0::2], x[..., 1::2, 1::2]

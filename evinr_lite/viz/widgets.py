@@ -24,6 +24,7 @@ handle whose ``fig`` is the figure.
 """
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -61,6 +62,9 @@ def _parse_one(name: str, spec) -> Control:
         if len(spec) not in (3, 4) or not all(_is_number(v) for v in spec):
             raise ValueError(f"control {name!r}: a slider is (min, max, step) or (min, max, step, default) "
                              f"with numbers, got {spec!r}")
+        if not all(math.isfinite(v) for v in spec):   # inf was Python's OverflowError, or a step taken as 0
+            raise ValueError(f"control {name!r}: a slider's numbers must be finite (min, max, step[, default]), "
+                             f"got {spec!r}")
         lo, hi, step = spec[:3]
         if not lo < hi:
             raise ValueError(f"control {name!r}: min must be below max, got min={lo}, max={hi}")
@@ -167,6 +171,24 @@ def _make_widget(c: Control):
     return w.Checkbox(value=c.default, description=c.name, style=style)
 
 
+MAX_FIGSIZE = 100.0   # inches per side: wider than any screen at matplotlib's 100 dpi
+
+
+def _figsize(figsize):
+    """(width, height) in inches, each a finite number in (0, MAX_FIGSIZE]; None: matplotlib's default."""
+    if figsize is None:
+        return None
+    try:
+        w, h = figsize
+        ok = all(_is_number(v) and math.isfinite(v) and 0 < v <= MAX_FIGSIZE for v in (w, h))
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f"figsize= must be (width, height) in inches, two numbers in (0, {MAX_FIGSIZE:g}] "
+                         f"(e.g. (8, 4)), or None for matplotlib's default; got {figsize!r}")
+    return figsize
+
+
 def interact(draw: Callable, *, figsize=(8, 4), **controls) -> Interactive:
     """Draw ``draw(fig, **values)`` with controls; see the module docstring.
 
@@ -181,6 +203,7 @@ def interact(draw: Callable, *, figsize=(8, 4), **controls) -> Interactive:
     """
     if not callable(draw):
         raise TypeError(f"draw must be a function draw(fig, **values), got {type(draw).__name__}")
+    figsize = _figsize(figsize)
     parsed = parse_controls(**controls)
     import matplotlib.pyplot as plt
 
