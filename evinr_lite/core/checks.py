@@ -86,6 +86,7 @@ TypeFix = {
     ("Frames", "Recording"): "pass recording.frames",
     ("Frames", "list"): "wrap the images with their timestamps: Frames(images, t)",
     ("EvINRConfig", "dict"): "pass EvINRConfig(**that_dict) (or EvINRConfig.paper(**changes))",
+    ("EvINRConfig", "NoneType"): "pass EvINRConfig() for the kit's defaults (or EvINRConfig.paper())",
     ("Events", "str"): "read the file first: read_recording(path).events",
     ("Events", "PosixPath"): "read the file first: read_recording(path).events",
 }

@@ -68,7 +68,8 @@ def contrast_option(C):
 
 
 def format_contrast(C) -> str:
-    """'0.2' for one threshold, 'C+ 0.22 / C- 0.18' for a pair (a resolved C: not None, not 'auto')."""
+    """'0.2' for one threshold, 'C+ 0.22 / C- 0.18' for a pair (a resolved C: not None, not 'auto', and one
+    that EvINRConfig accepts: each threshold in (0, MAX_C])."""
     as_thresholds(C, "C")   # None, 'auto', text, NaN or one value as a pair were Python's format errors or 'nan'
     return f"{C:g}" if np.ndim(C) == 0 else f"C+ {C[0]:.4g} / C- {C[1]:.4g}"
 

@@ -78,7 +78,7 @@ def _image(a, name: str, want: str = "a mosaic [..., H, W]", *, finite: bool = T
         bad = int(a.size - np.count_nonzero(np.isfinite(a)))
         if bad:
             raise EventDataError(f"{name}= holds {bad:,} NaN or infinite value(s) of {a.size:,}; repair or drop them "
-                                 "(they would make every window they fall in NaN)")
+                                 "(NaN or inf has no colour to show, average or demosaic)")
     return a
 
 
@@ -115,7 +115,7 @@ def _check_raw(raw, block: int) -> tuple[np.ndarray, int]:
     raw = _image(raw, "raw")
     P = period(block)
     H, W = raw.shape[-2:]
-    if not raw.size:
+    if not (H and W):   # an empty stack of frames [0, H, W] is a valid video of no frames; a frame of no photosite is not
         raise EventDataError(f"raw= has no photosite (shape {raw.shape}); pass a mosaic of at least one {P} x {P} "
                              "tile")
     if H % P or W % P:
