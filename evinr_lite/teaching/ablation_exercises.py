@@ -67,6 +67,8 @@ def _inputs_front(rng):
              dict(cost=np.array([1.0, 1.0, 2.0]), quality=np.array([0.3, 0.6, 0.6]))]             # ties in one
     for k in (5, 8):
         cases.append(dict(cost=rng.integers(1, 5, k).astype(np.float64), quality=rng.integers(1, 5, k) / 5))
+    # costs counted in weights (a million, a few apart): unequal, though np.isclose (rtol 1e-5) calls them equal
+    cases[4]["cost"] += 1e6
     return cases
 
 
@@ -135,6 +137,26 @@ def _sweep_ties_kept(cost, quality):
     return _sweep(cost, quality, True)
 
 
+def _qualities_sorted_alone(cost, quality):
+    """A sweep in order of cost over np.sort(quality), best first: the qualities sorted on their own, so each
+    variant is paired with another one's quality."""
+    c = np.asarray(cost, dtype=np.float64)
+    keep, best = np.zeros(len(c), dtype=bool), -np.inf
+    for i, q in zip(np.argsort(c, kind="stable"), np.sort(np.asarray(quality, dtype=np.float64))[::-1]):
+        if q > best:
+            keep[i], best = True, q
+    return keep
+
+
+def _ties_within_tolerance(cost, quality):
+    """Equal costs and qualities told by np.isclose (rtol 1e-5): a million weights and a million and three tie."""
+    c, q = np.asarray(cost, float), np.asarray(quality, float)
+    same_c, same_q = np.isclose(c[None, :], c[:, None]), np.isclose(q[None, :], q[:, None])
+    no_more = (c[None, :] <= c[:, None]) | same_c
+    no_worse = (q[None, :] >= q[:, None]) | same_q
+    return ~(no_more & no_worse & ~(same_c & same_q)).any(axis=1)
+
+
 exercises.register(
     "pareto_front", pareto_front, _inputs_front,
     hints={"two variants tied in both cost and quality do not dominate each other: j dominates i only if it "
@@ -159,4 +181,10 @@ exercises.register(
            "sorted by cost alone, variants of equal cost stay in the order given, and a worse one met before a "
            "better one of the same cost is kept (that one dominates it): sort by cost and then by quality, best "
            "first (np.lexsort((-quality, cost))), or compare every pair":
-           _sweep_by_cost_alone})
+           _sweep_by_cost_alone,
+           "np.sort(quality) sorts the qualities on their own, so they no longer belong to the variants that "
+           "np.argsort(cost) lists: take both in one order (order = np.argsort(cost), then quality[order])":
+           _qualities_sorted_alone,
+           "compare costs and qualities exactly (<=, >=, <, >): np.isclose (or any tolerance) calls costs of "
+           "1000003 and 1000004 weights equal, so a variant that costs more for the same quality stays on the "
+           "front": _ties_within_tolerance})

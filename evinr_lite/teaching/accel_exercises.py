@@ -393,9 +393,19 @@ def _normalised_over_times(windows, times):
     return w / w.sum(axis=1, keepdims=True)
 
 
+def _crossfade_over_max(windows, times):
+    """A wrong version (for the hint): the ramps divided by their column's largest weight, not its sum (a column's
+    scale cancels, so the reference's weights over their maximum are the ramps over theirs)."""
+    w = crossfade_weights(windows, times)
+    return w / w.max(axis=0, keepdims=True)
+
+
 exercises.register(
     "crossfade_weights", crossfade_weights, _inputs_crossfade, atol=1e-5,
     hints={
+        "the weights of a column sum to 1: divide by the column's sum (w / w.sum(axis=0)), not by its largest "
+        "weight":
+            _crossfade_over_max,
         "these are hard switches (0 or 1); ramp the weights linearly across each overlap": _hard_switch_weights,
         "the first window must not fade in at the start of the sequence, nor the last fade out at its end "
         "(there is no neighbour to hand over to)": _fades_at_both_ends,

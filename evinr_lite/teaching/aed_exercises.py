@@ -140,9 +140,11 @@ def _inputs_grey(rng):
     # and fancy-index `+=` keeps one event per pixel
     cases = [dict(x=np.array([4, 4, 4, 7, 6]), y=np.array([1, 1, 1, 3, 0]), p=np.array([1, 1, 1, -1, -1], np.int8),
                   C=0.25, raw_size=(8, 8))]
-    for H, W, n, C in ((4, 8, 12, 0.2), (8, 12, 60, 0.25), (12, 8, 200, 0.1)):
-        cases.append(dict(x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=rng.choice([-1, 1], n).astype(np.int8),
-                          C=C, raw_size=(H, W)))
+    # the last is a flash: 1200 events, nine in ten ON, some 160 net on each of its six grey pixels, past what int8
+    # (the polarities' dtype) holds: net counts summed in it wrap round
+    for H, W, n, C, on in ((4, 8, 12, 0.2, None), (8, 12, 60, 0.25, None), (12, 8, 1200, 0.1, 0.9)):
+        p = rng.choice([-1, 1], n, p=None if on is None else [1 - on, on]).astype(np.int8)
+        cases.append(dict(x=rng.integers(0, W, n), y=rng.integers(0, H, n), p=p, C=C, raw_size=(H, W)))
     return cases
 
 
@@ -206,6 +208,14 @@ def _grey_rows_columns_swapped(x, y, p, C, raw_size):
     return grey_event_frame(x, y, p, C, raw_size).T
 
 
+def _grey_int8_counts(x, y, p, C, raw_size):
+    """Net counts summed in the polarities' int8 (np.zeros(..., p.dtype)): past 127 they wrap round."""
+    H, W = raw_size
+    n = np.zeros((H // 4, W // 4), np.int8)
+    np.add.at(n, (np.asarray(y) // 4, np.asarray(x) // 4), np.asarray(p).astype(np.int8))
+    return C * n / 16
+
+
 exercises.register(
     "grey_event_frame", grey_event_frame, _inputs_grey,
     hints={
@@ -234,4 +244,7 @@ exercises.register(
         "every event counts, repeated ones too: a set (or np.unique) of the (y, x, p) triples keeps one of several "
         "identical events (a photosite that fired again); add up all of them with np.add.at":
             _grey_one_per_distinct_event,
+        "a grey pixel gathers the events of 16 photosites, and a flash makes hundreds: a net count summed in int8 "
+        "(the polarities' dtype, np.zeros(..., dtype=p.dtype)) wraps past 127; sum C * p / 16 in float64":
+            _grey_int8_counts,
     })

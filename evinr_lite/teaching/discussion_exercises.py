@@ -136,9 +136,25 @@ def _t_last_set_first(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     return state * np.exp(-alpha * (t_end - t_last))
 
 
+def _highpass_split_exponentials(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
+    """A wrong version (for the hint): exp(-alpha t) / exp(-alpha t_last), each factor from the clock's zero:
+    both underflow to 0 on a clock at 1000 s (0 / 0 is NaN)."""
+    H, W = sensor_size
+    state = np.zeros((H, W))
+    t_last = np.full((H, W), float(t_start))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        for ti, xi, yi, pi in zip(t, x, y, p):
+            state[yi, xi] = np.exp(-alpha * ti) / np.exp(-alpha * t_last[yi, xi]) * state[yi, xi] + C * pi
+            t_last[yi, xi] = ti
+        return state * np.exp(-alpha * t_end) / np.exp(-alpha * t_last)
+
+
 exercises.register(
     "highpass_per_event", highpass_per_event, _inputs_highpass, rtol=1e-6, atol=1e-10,
     hints={
+        "exp(-alpha t) / exp(-alpha t_last) underflows: on a clock at 1000 s both factors are 0 (and 0 / 0 is "
+        "NaN); decay by the time since the pixel's last event, np.exp(-alpha * (t - t_last))":
+            _highpass_split_exponentials,
         "images are indexed [y, x] (row, column): the state is np.zeros((H, W)) with H, W = sensor_size, "
         "updated at state[y, x]": _state_transposed,
         "after the last event, decay every pixel to t_end (exp(-alpha (t_end - t_last)))": _no_final_decay,

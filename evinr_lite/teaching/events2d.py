@@ -232,6 +232,12 @@ def _random_events(rng, n, sensor_size, t0=0.0, t1=1.0) -> Events:
 def _inputs_frames(rng):
     cases = []
     ev = _random_events(rng, 40, (4, 4))
+    # and a hot pixel (x 3, y 0) that fires 130 ON events in the second bin: more than int8, the polarities' dtype,
+    # holds, so frames summed in it wrap round
+    t = np.concatenate([ev.t, np.linspace(0.3, 0.45, 130)])
+    order = np.argsort(t, kind="stable")
+    x, y = np.concatenate([ev.x, np.full(130, 3)]), np.concatenate([ev.y, np.zeros(130, int)])
+    ev = Events(t[order], x[order], y[order], np.concatenate([ev.p, np.ones(130, int)])[order], (4, 4))
     cases.append(dict(events=ev, boundaries=np.array([0.0, 0.25, 0.5, 0.75, 1.0]), C=0.2))
     # events exactly on the edges, at the first edge and outside the range
     t = np.array([0.0, 0.1, 0.25, 0.25, 0.3, 0.5, 0.6, 0.9])
@@ -336,9 +342,24 @@ def _frames_last_edge_open(events, boundaries, C):
                                          events.sensor_size), boundaries, C)
 
 
+def _frames_int8_sums(events: Events, boundaries, C):
+    """A wrong version (for the hint): the polarities summed per bin and pixel in their own int8."""
+    b = np.asarray(boundaries, dtype=np.float64)
+    H, W = events.sensor_size
+    i = np.searchsorted(b, events.t, side="left") - 1
+    i[events.t == b[0]] = 0
+    keep = (i >= 0) & (i < b.size - 1)
+    sums = np.zeros((b.size - 1, H, W), np.int8)
+    np.add.at(sums, (i[keep], events.y[keep], events.x[keep]), events.p[keep].astype(np.int8))
+    return (C * sums).astype(np.float32)
+
+
 exercises.register(
     "events_to_frames_fixed", events_to_frames_fixed, _inputs_frames,
     hints={
+        "a hot pixel fires hundreds of times in one bin: polarities summed in their own int8 (np.zeros(..., "
+        "dtype=p.dtype)) wrap past 127; sum them in float64 (or int64)":
+            _frames_int8_sums,
         "an event exactly on an edge b_{i+1} belongs to bin i, (b_i, b_{i+1}]: use "
         "np.searchsorted(boundaries, t, side='left') - 1":
             _frames_right,
@@ -597,9 +618,26 @@ def _intervals_log_ratio(events):
     return float(2 * np.arctanh(interval_imbalance(events)))
 
 
+def _imbalance_pixels_sorted_alone(events: Events) -> float:
+    """A wrong version (for the hint): np.sort of the pixel numbers, the times and polarities left in time order."""
+    H, W = events.sensor_size
+    pix = np.sort(events.y.astype(np.int64) * W + events.x)
+    t, p = np.asarray(events.t, np.float64), events.p
+    pair = (pix[1:] == pix[:-1]) & (p[1:] == p[:-1])
+    log_dt = np.log(np.maximum(np.diff(t), MIN_INTERVAL))
+    on = p[1:] > 0
+    if not (pair & on).any() or not (pair & ~on).any():
+        return float("nan")
+    return float(np.tanh((log_dt[pair & on].mean() - log_dt[pair & ~on].mean()) / 2))
+
+
 exercises.register(
     "interval_imbalance", interval_imbalance, _inputs_intervals, rtol=1e-6, atol=1e-9,
     hints={
+        "np.sort(pix) sorts the pixel numbers alone: the times and polarities stay in time order, so the pairs "
+        "mix pixels; sort all three by one order (order = np.argsort(pix, kind=\"stable\"), then pix[order], "
+        "t[order], p[order])":
+            _imbalance_pixels_sorted_alone,
         "take the pairs per pixel: sort the events by pixel first (a stable sort keeps their time order), "
         "then pair each event with the one before it at the same pixel":
             _intervals_unsorted,

@@ -311,9 +311,18 @@ def _tv_central_differences(F):
     return torch.gradient(F, dim=-1)[0].abs().mean() + torch.gradient(F, dim=-2)[0].abs().mean()
 
 
+def _tv_pooled_mean(F):
+    """A wrong version (for the hint): one mean over the x and y differences together (times 2)."""
+    dx, dy = F[..., :, 1:] - F[..., :, :-1], F[..., 1:, :] - F[..., :-1, :]
+    return 2 * (dx.abs().sum() + dy.abs().sum()) / (dx.numel() + dy.numel())
+
+
 exercises.register(
     "total_variation", total_variation, _inputs_tv, rtol=1e-5, atol=1e-7,
     hints={
+        "average each direction over its own differences (H (W - 1) along x, (H - 1) W along y), then add the two "
+        "means: one mean over both together weighs the longer direction more":
+            _tv_pooled_mean,
         "total variation takes absolute values; squares give Tikhonov (Eq. 9)":
             lambda F: torch.mean((F[..., :, 1:] - F[..., :, :-1]) ** 2) + torch.mean((F[..., 1:, :] - F[..., :-1, :]) ** 2),
         "use means, not sums":

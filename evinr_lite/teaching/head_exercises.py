@@ -108,9 +108,20 @@ def _ridge_over_bins(A, E, ridge):
     return head_closed_form(A, E, ridge / np.asarray(A).shape[0])
 
 
+def _head_diagonal_set(A, E, ridge):
+    """A wrong version (for the hint): np.fill_diagonal(A^T A, ridge), which sets the diagonal, not adds to it."""
+    A = np.asarray(A, dtype=np.float64)
+    M = A.T @ A
+    np.fill_diagonal(M, ridge)
+    return np.linalg.solve(M, A.T @ np.asarray(E, dtype=np.float64))
+
+
 exercises.register(
     "head_closed_form", head_closed_form, _inputs, rtol=1e-6, atol=1e-9,
     hints={
+        "np.fill_diagonal(M, ridge) replaces the diagonal of A^T A by ridge (its squared column norms are lost): "
+        "add to it, A.T @ A + ridge * np.eye(d)":
+            _head_diagonal_set,
         "the penalty is ridge |W|^2: add ridge * I to A^T A, not ridge ** 2 * I":
             lambda A, E, ridge: head_closed_form(A, E, ridge ** 2),
         "add ridge times the identity to A^T A (the ridge term is part of the loss being minimised)":

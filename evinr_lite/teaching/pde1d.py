@@ -371,9 +371,21 @@ def _integrate_events_before(t_events, p_events, C, t_query):
     return C * np.where(n >= 0, before[np.maximum(n, 0)] if p.size else 0.0, 0.0)
 
 
+def _integrate_isclose(t_events, p_events, C, t_query):
+    """A wrong version (for the hint): t_event < t_q or np.isclose(t_event, t_q), a tolerance for the equal case
+    (rtol 1e-5 of 1000 s is 10 ms)."""
+    t, q = np.asarray(t_events, np.float64), np.asarray(t_query, np.float64)
+    before = (t[None, :] < q[:, None]) | np.isclose(t[None, :], q[:, None])
+    return C * (before * np.asarray(p_events, np.float64)).sum(axis=1)
+
+
 exercises.register(
     "integrate_events_1d", integrate_events_1d, _inputs_integrate,
     hints={
+        "an event counts when t_event <= t_q exactly: a tolerance for the equal case (np.isclose, whose rtol 1e-5 "
+        "of a clock at 1000 s is 10 ms) counts events after the query; compare with `<=` (np.searchsorted(..., "
+        "side=\"right\"))":
+            _integrate_isclose,
         "did you forget the sign of the polarity? ON events add C, OFF events subtract C":
             lambda t_events, p_events, C, t_query: integrate_events_1d(t_events, np.abs(p_events), C, t_query),
         "did you forget to multiply by the contrast threshold C?":
@@ -534,9 +546,17 @@ def _loss_durations_on_events(dF_dt, delta_L, durations):
     return torch.mean((delta_L * durations - dF_dt) ** 2)
 
 
+def _loss_mean_duration(dF_dt, delta_L, durations):
+    """A wrong version (for the hint): every window's dF/dt times the mean window length."""
+    return torch.mean((delta_L - dF_dt * durations.mean()) ** 2)
+
+
 exercises.register(
     "temporal_loss", temporal_loss, _inputs_loss,
     hints={
+        "multiply each window's dF/dt by its own length (durations, elementwise), not by their mean: the windows "
+        "differ in length":
+            _loss_mean_duration,
         "use the mean over windows, not the sum":
             lambda dF_dt, delta_L, durations: torch.sum((delta_L - dF_dt * durations) ** 2),
         "Eq. 6 is the plain mean of the squared differences: no factor 1/2 in front":

@@ -81,9 +81,10 @@ def _inputs_hot(rng):
         counts[r, c] = n
     x, y = _events_from_counts(counts, rng)
     cases.append(dict(x=x, y=y, sensor_size=(5, 5), factor=5.0))
-    # a sensor with Poisson activity, a third of it silent, and three hot pixels
+    # a sensor with Poisson activity, a third of it silent, and three hot pixels; one fired 260 times, past what
+    # uint8 holds: counts kept in uint8 (or in the int8 of the polarities) wrap it round to 4, not hot
     counts = rng.poisson(3.0, (6, 9)) * (rng.uniform(size=(6, 9)) > 0.33)
-    counts.ravel()[rng.choice(54, 3, replace=False)] = (150, 400, 31)
+    counts.ravel()[rng.choice(54, 3, replace=False)] = (150, 260, 31)
     x, y = _events_from_counts(counts, rng)
     cases.append(dict(x=x, y=y, sensor_size=(6, 9), factor=10.0))
     # an even number of firing pixels (8), counts 1 1 2 2 | 5 10 11 20: the median is (2 + 5) / 2 = 3.5 (np.median
@@ -177,6 +178,14 @@ def _hot_sorted_through_a_view(x, y, sensor_size, factor=10.0):
     return counts > factor * np.median(flat[flat > 0])
 
 
+def _hot_uint8_counts(x, y, sensor_size, factor=10.0):
+    """Counts kept in uint8: a pixel that fired 256 times or more wraps round to a few."""
+    H, W = sensor_size
+    counts = np.zeros((H, W), np.uint8)
+    np.add.at(counts, (np.asarray(y), np.asarray(x)), 1)
+    return counts > factor * np.median(counts[counts > 0])
+
+
 exercises.register(
     "hot_pixel_mask", hot_pixel_mask, _inputs_hot,
     hints={
@@ -208,6 +217,9 @@ exercises.register(
         "(.sort()) sorts the counts image too, so the mask marks the pixels at the end of the sensor instead of the "
         "hot ones; take the median of a copy (np.sort(...), .flatten()), or just np.median(counts[counts > 0])":
             _hot_sorted_through_a_view,
+        "a hot pixel fires hundreds of times: counts in uint8 (or int8) wrap past 255 (127), so "
+        "its 260 events count as 4; count in int64 (np.zeros((H, W), np.int64), np.bincount)":
+            _hot_uint8_counts,
     })
 
 
@@ -227,9 +239,11 @@ def event_count_windows(n_events: int, max_events: int) -> np.ndarray:
 
 
 def _inputs_windows(rng):
-    # 122 events in 14 windows: k * N / w computed in floating point truncates 61 to 60 (np.linspace)
+    # 122 events in 14 windows: k * N / w computed in floating point truncates 61 to 60 (np.linspace). A recording
+    # of three million events in windows of at most 2000 (1501 windows of 1998 or 1999): k * N passes 2 ** 31, where
+    # int32 wraps, and is not exact in float32
     return [dict(n_events=122, max_events=9), dict(n_events=12, max_events=4), dict(n_events=7, max_events=100),
-            dict(n_events=int(rng.integers(5000, 9000)), max_events=1000), dict(n_events=1, max_events=1)]
+            dict(n_events=3_000_000 + int(rng.integers(0, 400)), max_events=2000), dict(n_events=1, max_events=1)]
 
 
 def _compare_windows(got, expected) -> str | None:
@@ -278,6 +292,26 @@ def _windows_ceil_positions(n_events, max_events):
     return -(-(np.arange(w + 1, dtype=np.int64) * n_events) // w)
 
 
+def _windows_floor_step(n_events, max_events):
+    """Windows of N // w events each, the remainder all in the last one."""
+    w = max(1, math.ceil(n_events / max_events))
+    idx = np.arange(w + 1, dtype=np.int64) * (n_events // w)
+    idx[-1] = n_events
+    return idx
+
+
+def _windows_int32(n_events, max_events):
+    """(k * N) // w in int32: k * N wraps past 2 ** 31 on a long recording."""
+    w = max(1, math.ceil(n_events / max_events))
+    return ((np.arange(w + 1, dtype=np.int32) * np.int32(n_events)) // np.int32(w)).astype(np.int64)
+
+
+def _windows_float32(n_events, max_events):
+    """floor(k * N / w) in float32: 24 bits of mantissa, not enough for k * N past 2 ** 24."""
+    w = max(1, math.ceil(n_events / max_events))
+    return np.floor(np.arange(w + 1, dtype=np.float32) * np.float32(n_events) / np.float32(w)).astype(np.int64)
+
+
 exercises.register(
     "event_count_windows", event_count_windows, _inputs_windows, compare=_compare_windows,
     hints={
@@ -305,6 +339,15 @@ exercises.register(
         "idx[k] = floor(k N / w) rounds down, (k * N) // w: rounded up (-(-(k * N) // w), np.ceil) the longer "
         "windows come first":
             _windows_ceil_positions,
+        "windows of N // w events each leave the whole remainder to the last window (which can then hold more "
+        "than max_events): idx[k] = (k * N) // w spreads it, so that the sizes differ by at most one":
+            _windows_floor_step,
+        "k * N passes 2 ** 31 on a recording of millions of events: int32 wraps round to negative numbers; compute "
+        "(k * N) // w in int64 (np.arange(w + 1, dtype=np.int64))":
+            _windows_int32,
+        "float32 holds whole numbers exactly only up to 2 ** 24 (16.7 million): k * N / w in float32 misses by one "
+        "or more; compute (k * N) // w in int64":
+            _windows_float32,
     })
 
 

@@ -1,12 +1,12 @@
 """Wrong versions of a reference: mistakes recognised by making them, and confirmed on the other inputs.
 
 An exercise's own hints map a message to a wrong version of its reference; :func:`generic_mistakes` makes a
-few more from any reference, for mistakes every exercise can show (-1/+1 polarities read as 0/1 or OFF events
-dropped, an input or the result clipped to [0, 1], a result or a float input rounded). The learner's output
-matching a wrong version's on the failing input is not enough: :func:`same_mistake_elsewhere` asks that it also
-match on the other inputs where that mistake shows, so that one input cannot make two different mistakes look
-alike. :func:`wrong_axes_hint` makes one more, the reference run on transposed images (differences or sums along
-the wrong image axis), and compares it on the failing input.
+few more from any reference, for mistakes every exercise can show (-1/+1 polarities read as 0/1, OFF events
+dropped or polarities made unsigned, an input or the result clipped to [0, 1], a result or a float input
+rounded). The learner's output matching a wrong version's on the failing input is not enough:
+:func:`same_mistake_elsewhere` asks that it also match on the other inputs where that mistake shows, so that one
+input cannot make two different mistakes look alike. :func:`wrong_axes_hint` makes one more, the reference run on
+transposed images (differences or sums along the wrong image axis), and compares it on the failing input.
 """
 from __future__ import annotations
 
@@ -121,6 +121,10 @@ def generic_mistakes(ex: ExerciseLike, cases: list | None = None) -> list[tuple[
         ("the OFF events count as 0: the polarities are -1 and +1 and an OFF event subtracts; weights such as "
          "`p > 0`, `p == 1` or `(p + 1) // 2` (a 0/1 encoding) drop them: use p itself",
          on_inputs(lambda kw: _with_polarities(kw, lambda p: (p > 0).astype(p.dtype)))),
+        ("the polarities were made unsigned (np.uint8, or a difference of unsigned arrays such as "
+         "`(p > 0).astype(np.uint8) - (p < 0).astype(np.uint8)`), where -1 wraps round to 255: keep p signed "
+         "(int8, int64) or make it float",
+         on_inputs(lambda kw: _with_polarities(kw, lambda p: p.astype(np.uint8)))),
     ]
     try:
         params = list(inspect.signature(ref).parameters)

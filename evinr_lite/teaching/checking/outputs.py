@@ -25,6 +25,20 @@ def to_numpy(x):
     return np.asarray(x)
 
 
+def not_finite(v) -> bool:
+    """Some NaN or infinity in an output (in a tuple, list or dict of them too). A wrong version's NaN that meets
+    the learner's NaN says little: many mistakes overflow alike."""
+    if isinstance(v, dict):
+        return any(not_finite(x) for x in v.values())
+    if isinstance(v, (tuple, list)):
+        return any(not_finite(x) for x in v)
+    try:
+        a = to_numpy(v)
+        return a.dtype.kind in "fc" and not bool(np.all(np.isfinite(a)))
+    except Exception:
+        return False
+
+
 def _is_bfloat16(x) -> bool:
     return is_tensor(x) and str(x.dtype) == "torch.bfloat16"
 

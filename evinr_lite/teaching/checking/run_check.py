@@ -24,7 +24,7 @@ from .hints import (generic_hint, has_repeated_index, non_square, one_based_hint
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, run, watching,
                             where_raised)
 from .mistakes import generic_mistakes, same_mistake_elsewhere, wrong_axes_hint
-from .outputs import Problem, compare_outputs, describe_case, differing_leaf
+from .outputs import Problem, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
 
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
@@ -106,7 +106,8 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
                    containers: dict) -> Report:
     """The report for a call of ``fn`` that raised ``err`` on input ``k``: the error, the learner's line that
     raised it, and a hint where the error names a likely cause (an unhashable argument to a cache or a dict key,
-    the stub's signature changed, a loss without a graph, a sensor that is not square, state kept between calls)."""
+    the stub's signature changed, `-` on bool arrays, a loss without a graph, a sensor that is not square, state
+    kept between calls)."""
     args, kwargs = cases[k]
     details = [f"{type(err).__name__}: {err}"] + where_raised(err)
     if isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
@@ -123,6 +124,11 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
         names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
         details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
                        "stub's parameter names and order")
+    if "boolean subtract" in str(err) or "with two bool tensors" in str(err):      # numpy's and torch's words
+        details.append("hint: `-` on two bool arrays or tensors (a sign as `(p > 0) - (p < 0)`) is refused, and "
+                       "the `^` suggested is no sign (it is True for ON and OFF alike): make them integers first, "
+                       "`(p > 0).astype(int) - (p < 0).astype(int)` (`.long()` for tensors), or use np.sign(p), "
+                       "or p itself")
     if isinstance(err, RuntimeError) and "does not require grad" in str(err):
         details.append("hint: the loss has no autograd graph to back-propagate: it was computed under "
                        "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
@@ -234,6 +240,7 @@ def _generic_mistake_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, g
         try:
             w = run(wrong, args, kwargs)
             if compare_outputs(w, expected, ex.rtol, ex.atol) is not None \
+                    and not (not_finite(w) and not not_finite(expected)) \
                     and compare_outputs(got, w, ex.rtol, ex.atol) is None \
                     and same_mistake_elsewhere(ex, fn, wrong, cases, k, getattr(wrong, "support", 0)):
                 return message
