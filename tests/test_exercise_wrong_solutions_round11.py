@@ -36,9 +36,9 @@ Holes (these passed a check before this round; each now fails and its report nam
   case's costs are now counted in weights, a million and a few apart (np.isclose calls them equal).
 For mistakes the check saw only as wrong values: a generic mistake for -1/+1 polarities made unsigned (-1 is 255);
 a TypeError or RuntimeError for `-` on bool arrays or tensors gets a hint (numpy and torch suggest `^`, which is no
-sign); a generic mistake (or an argument from input #1) whose NaN meets the learner's NaN is no longer named where
+sign; since the round's review the sign's wording only where an input holds polarities, a neutral one elsewhere); a generic mistake (or an argument from input #1) whose NaN meets the learner's NaN is no longer named where
 the expected values are finite (exp(-alpha t) on a clock at 1000 s was called "an input was clipped to [0, 1]" and
-"the right result for input #1's t"). Registered hints: uint8 counts (hot_pixel_mask), int32, float32 and a whole
+"the right result for input #1's t"). Registered hints: uint8 and int8 counts (hot_pixel_mask), int32, float32 and a whole
 step N // w (event_count_windows), int8 sums (grey_event_frame, events_to_frames_fixed), np.isclose and qualities
 sorted alone (pareto_front), np.isclose at a query (integrate_events_1d), the mean duration (temporal_loss), one
 mean over both directions (total_variation), the column's maximum (crossfade_weights), pixel numbers sorted alone
@@ -320,7 +320,7 @@ HOLES = [
     ("event_count_windows", ecw_float32, "float32 holds whole numbers exactly only up to 2 ** 24"),
     ("events_to_frames_fixed", ef_int8_frames, "wrap past 127"),
     ("grey_event_frame", gf_int8_counts, "wraps past 127"),
-    ("hot_pixel_mask", hpm_uint8_counts, "wrap past 255 (127)"),
+    ("hot_pixel_mask", hpm_uint8_counts, "uint8 wrap past 255"),
     ("pareto_front", pf_isclose_ties, "np.isclose (or any tolerance)"),
 ]
 
@@ -439,6 +439,30 @@ def test_bool_subtraction_gets_a_hint_in_torch_too():
         return torch.mean((delta_L - sign * dF_dt * durations) ** 2)
     ok, report = _report("temporal_loss", tl_sign)
     assert not ok and "`-` on two bool arrays or tensors" in report, report
+
+
+def test_the_sign_hint_only_where_there_are_polarities():
+    """Review: the bool-subtraction hint spoke of p and of `^` as no sign for any `-` on bools; a mask difference in
+    an exercise without polarities gets the neutral hint (and `^`, right there, is not called wrong)."""
+    ok, report = _report("grey_event_frame", gf_bool_subtract)
+    assert not ok and "np.sign(p)" in report, report
+
+    def hot_mask_difference(x, y, sensor_size, factor=10.0):
+        H, W = sensor_size
+        counts = np.zeros((H, W), np.int64)
+        np.add.at(counts, (np.asarray(y), np.asarray(x)), 1)
+        return (counts > factor * np.median(counts[counts > 0])) - (counts == 0)
+    ok, report = _report("hot_pixel_mask", hot_mask_difference)
+    assert not ok and "`-` on two bool arrays or tensors is refused" in report, report
+    assert "np.sign(p)" not in report and "p itself" not in report, report
+
+
+def test_int8_hot_pixel_counts_get_their_own_hint():
+    def hpm_int8_counts(x, y, sensor_size, factor=10.0):
+        H, W = sensor_size; c = np.zeros((H, W), np.int8); np.add.at(c, (np.asarray(y), np.asarray(x)), 1)
+        return c > factor * np.median(c[c > 0])
+    ok, report = _report("hot_pixel_mask", hpm_int8_counts)
+    assert not ok and "int8 wrap past 127" in report, report
 
 
 def test_a_nan_alike_is_no_evidence_for_a_generic_hint():

@@ -186,6 +186,14 @@ def _hot_uint8_counts(x, y, sensor_size, factor=10.0):
     return counts > factor * np.median(counts[counts > 0])
 
 
+def _hot_int8_counts(x, y, sensor_size, factor=10.0):
+    """Counts kept in int8: a pixel that fired 128 times or more wraps round to negative counts."""
+    H, W = sensor_size
+    counts = np.zeros((H, W), np.int8)
+    np.add.at(counts, (np.asarray(y), np.asarray(x)), 1)
+    return counts > factor * np.median(counts[counts > 0])
+
+
 exercises.register(
     "hot_pixel_mask", hot_pixel_mask, _inputs_hot,
     hints={
@@ -217,9 +225,12 @@ exercises.register(
         "(.sort()) sorts the counts image too, so the mask marks the pixels at the end of the sensor instead of the "
         "hot ones; take the median of a copy (np.sort(...), .flatten()), or just np.median(counts[counts > 0])":
             _hot_sorted_through_a_view,
-        "a hot pixel fires hundreds of times: counts in uint8 (or int8) wrap past 255 (127), so "
+        "a hot pixel fires hundreds of times: counts in uint8 wrap past 255, so "
         "its 260 events count as 4; count in int64 (np.zeros((H, W), np.int64), np.bincount)":
             _hot_uint8_counts,
+        "a hot pixel fires hundreds of times: counts in int8 wrap past 127 to negative numbers; count in int64 "
+        "(np.zeros((H, W), np.int64), np.bincount)":
+            _hot_int8_counts,
     })
 
 

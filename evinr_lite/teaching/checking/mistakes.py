@@ -30,6 +30,11 @@ def _is_pm1(v) -> bool:
         and bool(np.any(v < 0))
 
 
+def has_polarities(kwargs: dict) -> bool:
+    """Whether an input holds -1/+1 polarities (an argument named p or p_events, or the ``p`` of events)."""
+    return _with_polarities(kwargs, lambda v: v) is not None
+
+
 def _with_polarities(kwargs: dict, f: Callable) -> dict | None:
     """``kwargs`` with ``f`` applied to every -1/+1 polarity input (an argument named p or p_events, or the ``p``
     of events); None when there is none."""

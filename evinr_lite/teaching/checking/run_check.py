@@ -23,7 +23,7 @@ from .hints import (generic_hint, has_repeated_index, non_square, one_based_hint
                     swapped_pair_hint)
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, run, watching,
                             where_raised)
-from .mistakes import generic_mistakes, same_mistake_elsewhere, wrong_axes_hint
+from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import Problem, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
 
@@ -124,11 +124,16 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
         names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
         details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
                        "stub's parameter names and order")
-    if "boolean subtract" in str(err) or "with two bool tensors" in str(err):      # numpy's and torch's words
+    if ("boolean subtract" in str(err) or "with two bool tensors" in str(err)) and has_polarities(kwargs):
+        # numpy's and torch's words; with polarities at hand the likely aim is a sign, which `^` is not
         details.append("hint: `-` on two bool arrays or tensors (a sign as `(p > 0) - (p < 0)`) is refused, and "
                        "the `^` suggested is no sign (it is True for ON and OFF alike): make them integers first, "
                        "`(p > 0).astype(int) - (p < 0).astype(int)` (`.long()` for tensors), or use np.sign(p), "
                        "or p itself")
+    elif "boolean subtract" in str(err) or "with two bool tensors" in str(err):
+        details.append("hint: `-` on two bool arrays or tensors is refused: make them integers first "
+                       "(`.astype(int)`, `.long()` for tensors) for a difference of counts or a sign; for masks "
+                       "use `&`, `|`, `~` (a and not b: `a & ~b`)")
     if isinstance(err, RuntimeError) and "does not require grad" in str(err):
         details.append("hint: the loss has no autograd graph to back-propagate: it was computed under "
                        "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
