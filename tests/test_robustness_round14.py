@@ -162,7 +162,7 @@ def test_at_as_before():
 
 @pytest.mark.parametrize("max_points", [1.5, "5", np.nan, None, True])
 def test_subsample_index_refuses_a_count_that_is_no_count(max_points):
-    _no(lambda: ve.subsample_index(10, max_points), r"max_points= must be a whole number >= 1")
+    _no(lambda: ve.subsample_index(10, max_points), r"max_points= must be a whole number, got")
 
 
 @pytest.mark.parametrize("n", [-1, 1.5, "10", np.nan, None])

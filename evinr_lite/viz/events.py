@@ -53,7 +53,9 @@ def subsample_index(n: int, max_points: int, seed: int = 0) -> np.ndarray:
     the same indices. Returns int64 [min(n, max_points)].
     """
     n = whole_number(n, "n", lo=0)
-    max_points = whole_number(max_points, "max_points", lo=1)
+    max_points = whole_number(max_points, "max_points")
+    if max_points < 1:
+        raise EventDataError(f"max_points must be at least 1, got {max_points}")
     seed = whole_number(seed, "seed", lo=0)
     if n <= max_points:
         return np.arange(n, dtype=np.int64)
