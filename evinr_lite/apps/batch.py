@@ -145,6 +145,20 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
     """
     if isinstance(inputs, (str, os.PathLike)):
         inputs = [inputs]
+    if inputs is None or isinstance(inputs, (bytes, dict)) or not hasattr(inputs, "__iter__"):
+        raise EventDataError(f"inputs= must be a recording, a folder or a data_fetch name (a str or Path), or a list "
+                             f"of them, got {type(inputs).__name__}")
+    inputs = list(inputs)
+    for k, spec in enumerate(inputs):   # all of them, before any is looked at
+        if not isinstance(spec, (str, os.PathLike)) or isinstance(os.fspath(spec), bytes):
+            raise EventDataError(f"inputs[{k}] must be a path or a data_fetch name (a str or Path), got "
+                                 f"{type(spec).__name__} {spec!r:.60}")
+        if isinstance(spec, str) and not spec.strip():   # Path("") is the current folder
+            raise EventDataError(f"inputs[{k}] is {spec!r}, an empty name (it would read the current folder); pass "
+                                 "recordings, folders of recordings or data_fetch names")
+    if cache is not None and not isinstance(cache, (str, os.PathLike)):
+        raise EventDataError(f"cache= must be a folder (a str or Path) or None (the data_fetch cache), got "
+                             f"{type(cache).__name__}")
     cache = Path(cache) if cache is not None else cache_dir()
     items = []
     for spec in inputs:
@@ -328,6 +342,19 @@ def summarize(rows, settings: dict | None = None) -> dict:
     "n_sequences", "protocol"}], "protocols": {eq: text}, "recordings": rows (sorted by name),
     "failed": [{"name", "input", "error"}], "settings"}.
     """
+    if rows is None or isinstance(rows, (str, bytes, dict)) or not hasattr(rows, "__iter__"):
+        raise EventDataError(f"rows= must be a list of the per-recording rows a batch makes (dicts), got "
+                             f"{type(rows).__name__}")
+    if settings is not None and not isinstance(settings, dict):
+        raise EventDataError(f"settings= must be a dict (the batch's settings) or None, got {type(settings).__name__}")
+    rows = list(rows)
+    for k, r in enumerate(rows):
+        if not isinstance(r, dict):
+            raise EventDataError(f"rows[{k}] must be a dict (a batch's per-recording row), got {type(r).__name__}")
+        missing = [key for key in ("name", "dataset", "status") if key not in r]
+        if missing:
+            raise EventDataError(f"rows[{k}] has no {missing[0]!r}; pass the rows a batch makes (they hold 'name', "
+                                 "'dataset' and 'status')")
     rows = sorted(rows, key=lambda r: (r["dataset"], r["name"]))
     pooled, protocols = [], {}
     for dataset in sorted({r["dataset"] for r in rows}):
@@ -552,7 +579,15 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
 
     from ..io.output import given_output_path
 
+    if not isinstance(out_dir, (str, bytes, os.PathLike)):
+        raise EventDataError(f"out_dir= must be a folder (a str or Path), got {type(out_dir).__name__}")
     out_dir = given_output_path(out_dir)   # "" is refused, not taken as the current folder
+    if not isinstance(sequential, (bool, np.bool_)):
+        raise EventDataError(f"sequential= must be True or False, got {sequential!r}")
+    if not callable(log):   # it is called after the batch has run
+        raise EventDataError(f"log= must be a function log(text) (e.g. print), got {type(log).__name__}")
+    if client is not None and not callable(getattr(client, "submit", None)):
+        raise EventDataError(f"client= must be a distributed.Client (or None), got {type(client).__name__}")
     # every option checked, once; a batch writes no video unless asked
     options = RunOptions.of(options, **fields) if options is not None else RunOptions(**{"video": False, **fields})
     options.check_batch()

@@ -68,7 +68,17 @@ def render_counts(L_boundaries, C, whole_steps=np.trunc):
 
 def signed_to_polarity_counts(signed) -> np.ndarray:
     """Signed counts [B, H, W] -> non-negative [2, B, H, W] (ON counts, OFF counts)."""
-    s = np.asarray(signed)
+    try:
+        s = None if isinstance(signed, (str, bytes)) or signed is None else np.asarray(signed)
+    except (TypeError, ValueError):   # a ragged list
+        s = None
+    ok = s is not None and s.dtype.kind in "iuf"
+    if ok and s.dtype.kind == "f":   # NaN became an arbitrary integer, 0.5 became 0
+        ok = bool(np.all(np.isfinite(s))) and bool(np.all(s == np.round(s)))
+    if not ok:
+        raise EventDataError("signed: counts must be whole numbers (ON minus OFF events per cell, [B, H, W]); got "
+                             + (f"dtype {s.dtype}" if s is not None and s.dtype.kind not in "iuf" else
+                                "NaN, infinite or fractional values" if s is not None else repr(signed)[:60]))
     return np.stack([np.maximum(s, 0), np.maximum(-s, 0)]).astype(np.int64)
 
 

@@ -49,7 +49,11 @@ PROTOCOLS = {
 
 def protocol_description(equalization: str = "none") -> str:
     """The full scoring protocol (equalisation and metric parameters) as one line of text."""
-    if equalization not in PROTOCOLS:
+    try:
+        known = equalization in PROTOCOLS
+    except TypeError:   # a list or a set: unhashable, so no key
+        known = False
+    if not known:
         raise EventDataError(f"equalization must be one of {EQUALIZATIONS}, got {equalization!r}")
     return PROTOCOLS[equalization]
 

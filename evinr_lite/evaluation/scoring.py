@@ -356,6 +356,13 @@ def measure_inference_fps(model, n_frames: int = 64, batch_size: int = 32, repea
     """
     import torch
 
+    from ..method.models import FrameINR
+
+    require(model, FrameINR, "model")
+    reported = {"n_frames": n_frames, "batch_size": batch_size}   # as given (np.int64 stays np.int64)
+    n_frames = whole_number(n_frames, "n_frames", lo=1)        # 0 timed nothing and reported 0 fps
+    batch_size = whole_number(batch_size, "batch_size", lo=1)
+    repeats = whole_number(repeats, "repeats", lo=1)           # 0 or -1 timed once without a word
     device = model.head_weight.device
     lo, hi = (float(v) for v in model.windows[0])
     times = torch.linspace(lo, hi, n_frames, dtype=torch.float64, device=device)
@@ -370,13 +377,13 @@ def measure_inference_fps(model, n_frames: int = 64, batch_size: int = 32, repea
 
     run()  # warm-up (allocations, kernels)
     seconds = []
-    for _ in range(max(1, repeats)):
+    for _ in range(repeats):
         t0 = time.perf_counter()
         run()
         seconds.append(time.perf_counter() - t0)
     best = min(seconds)
     return {"fps": n_frames / best, "seconds": best, "all_seconds": seconds, "device": str(device),
-            "sensor_size": tuple(model.sensor_size), "n_frames": n_frames, "batch_size": batch_size}
+            "sensor_size": tuple(model.sensor_size), **reported}
 
 
 def frames_to_score(frame_t, events: Events, margin: float = 0.005) -> np.ndarray:

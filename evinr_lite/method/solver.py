@@ -43,7 +43,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..core.checks import (check_reach, check_result_frames, check_seconds_precision, host_array, optional_seconds,
+from ..core.checks import (check_reach, check_result_frames, host_array, optional_seconds,
                            require, seconds_array, whole_number)
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
@@ -99,18 +99,28 @@ class Reconstruction:
         """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W].
         ``chunk``: frames computed at once (a whole number >= 1)."""
         chunk = whole_number(chunk, "chunk", lo=1)
-        times = host_array(times)
-        check_seconds_precision(times, "times")
-        try:
-            t = np.atleast_1d(np.asarray(times, np.float64))
-        except (TypeError, ValueError):
-            raise EventDataError(f"times= must be seconds (a number or an array of numbers), got {times!r}") from None
-        if t.ndim != 1 or not np.all(np.isfinite(t)):
-            raise EventDataError(f"times= must be finite seconds in a 1-D array, got shape {t.shape}")
+        self._check_count(times)
+        t = seconds_array(times, "times", allow_empty=True)   # text, None, booleans, NaN, 2-D refused; [] stays empty
         L = blend_networks(self.model, self.windows, t, self.offsets, chunk)
         if self.trend is not None:
             self.trend.add_to(L, t)
         return L if self.anchor is None else L + self.anchor.offset_at(t)
+
+    def _check_count(self, times) -> None:
+        """Refuse, before any time is converted, more query times than the frames of :meth:`at` (every network at
+        every time, then the blend) can fit in 80 % of the free memory (10^9 times of a view cost nothing to pass)."""
+        from .memory import _gib, available_bytes
+
+        try:
+            n = int(np.size(host_array(times))) if not isinstance(times, (str, bytes)) else 1
+        except (TypeError, ValueError):   # a ragged list: seconds_array names it
+            return
+        H, W = self.log_intensity.shape[1:]
+        need, free = n * (40.0 + 4.0 * H * W * (len(self.windows) + 2)), available_bytes("cpu")
+        if need > 0.8 * free:
+            raise EventDataError(f"times= holds {n:,} query times: their frames of {H}x{W} pixels need about "
+                                 f"{_gib(need)} of memory but about {_gib(free)} is free; ask for fewer times (or "
+                                 "call at() on parts of them and keep what you need)")
 
     def frames_at(self, times) -> np.ndarray:
         """Frames in [0, 1] at any times: float32 [Q, H, W]; tone-mapped, or the APS frames' linear

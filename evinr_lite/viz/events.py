@@ -23,7 +23,8 @@ from matplotlib.animation import FuncAnimation
 from matplotlib.colors import to_rgb
 from matplotlib.transforms import blended_transform_factory
 
-from ..core.checks import ArgumentTypeError
+from ..core.checks import (ArgumentTypeError, host_array, is_real_number, optional_seconds, real_number, require,
+                           whole_number)
 from ..core.events import EventDataError, Events
 from ..method.binning import EventFrames, event_rate
 from .signals import OFF_COLOR, ON_COLOR
@@ -51,8 +52,11 @@ def subsample_index(n: int, max_points: int, seed: int = 0) -> np.ndarray:
     All of ``range(n)`` when ``n <= max_points``. The same (n, max_points, seed) always gives
     the same indices. Returns int64 [min(n, max_points)].
     """
+    n = whole_number(n, "n", lo=0)
+    max_points = whole_number(max_points, "max_points")
     if max_points < 1:
         raise EventDataError(f"max_points must be at least 1, got {max_points}")
+    seed = whole_number(seed, "seed", lo=0)
     if n <= max_points:
         return np.arange(n, dtype=np.int64)
     idx = np.random.default_rng(seed).choice(n, size=max_points, replace=False)
@@ -61,11 +65,12 @@ def subsample_index(n: int, max_points: int, seed: int = 0) -> np.ndarray:
 
 def subsample(events: Events, max_points: int, seed: int = 0) -> Events:
     """At most ``max_points`` events, chosen uniformly at random (seeded), still in time order."""
-    return events.take(subsample_index(len(events), max_points, seed))
+    return require(events, Events, "events").take(subsample_index(len(events), max_points, seed))
 
 
 def _window(events: Events, t0, t1) -> Events:
-    """Events with t0 < t <= t1; None means from the first / to the last event."""
+    """Events with t0 < t <= t1; None means from the first / to the last event (inf and -inf are open ends)."""
+    t0, t1 = _open_end(t0, "t0"), _open_end(t1, "t1")
     lo = 0 if t0 is None else int(np.searchsorted(events.t, t0, side="right"))
     hi = len(events) if t1 is None else int(np.searchsorted(events.t, t1, side="right"))
     if t0 is not None and t1 is not None and not t1 > t0:
@@ -73,8 +78,17 @@ def _window(events: Events, t0, t1) -> Events:
     return events.take(slice(lo, max(lo, hi)))
 
 
+def _open_end(t, name: str):
+    """``t`` (seconds) as given when None or infinite (an open end, as before), else a finite float; NaN and text
+    are refused naming ``name``."""
+    if t is None or (is_real_number(t) and np.isinf(float(host_array(t)))):
+        return t
+    return optional_seconds(t, name)
+
+
 def count_map(events: Events, polarity: int | None = None) -> np.ndarray:
     """Events per pixel: int64 [H, W]. ``polarity`` +1 or -1 counts only ON or only OFF events."""
+    require(events, Events, "events")
     if polarity not in (None, 1, -1):
         raise EventDataError(f"polarity must be None (all), +1 (ON) or -1 (OFF), got {polarity!r}")
     H, W = events.sensor_size
@@ -92,13 +106,28 @@ def polarity_image(events: Events, t0: float | None = None, t1: float | None = N
     ``background`` when it had no events (or as many ON as OFF). ``t0 = None`` starts at the
     first event (included), ``t1 = None`` ends at the last.
     """
-    win = _window(events, t0, t1)
+    win = _window(require(events, Events, "events"), t0, t1)
+    colour = _colour(background, "background")
     net = count_map(win, 1) - count_map(win, -1)
     img = np.empty(net.shape + (3,))
-    img[:] = np.asarray(background, dtype=np.float64)
+    img[:] = colour
     img[net > 0] = ON_RGB
     img[net < 0] = OFF_RGB
     return img
+
+
+def _colour(value, name: str) -> np.ndarray:
+    """An RGB colour: 3 finite numbers in [0, 1] (one number is that grey), as float64 [3] or a 0-d grey."""
+    try:
+        arr = None if isinstance(value, (str, bytes)) or value is None else np.asarray(host_array(value))
+    except (TypeError, ValueError):
+        arr = None
+    ok = (arr is not None and arr.dtype.kind in "iuf" and arr.shape in ((), (3,)) and bool(np.all(np.isfinite(arr)))
+          and bool(np.all((arr >= 0) & (arr <= 1))))
+    if not ok:
+        raise EventDataError(f"{name}= must be a colour: (r, g, b) in [0, 1] (or one grey level), got {value!r}; "
+                             "e.g. (1.0, 1.0, 1.0) for white (255 is 1.0 here)")
+    return arr.astype(np.float64)
 
 
 def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, size: float = 1.0,
@@ -110,6 +139,11 @@ def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, siz
     vertical, pointing down as in an image. ``ax`` must be a 3-D axes (``projection='3d'``)
     if given; ``view`` is the (elevation, azimuth) in degrees.
     """
+    require(events, Events, "events")
+    size = real_number(size, "size", lo=0, hint="the points' area in points^2 (e.g. 1.0)")
+    if isinstance(view, (str, bytes)) or not (np.ndim(view) == 1 and np.size(view) == 2 and
+                                               all(is_real_number(v) and np.isfinite(float(v)) for v in view)):
+        raise EventDataError(f"view= must be (elevation, azimuth), two finite angles in degrees, got {view!r}")
     if len(events) == 0:   # empty 3-D axes titled "0 of 0 events"
         raise EventDataError("plot_xyt: no events to draw; pick a time window or a recording that holds some")
     sub = subsample(events, max_points, seed)
@@ -130,8 +164,8 @@ def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, siz
 
 def plot_count_map(events: Events, ax=None, polarity: int | None = None, title: str | None = None):
     """Events per pixel as an image (with a colour bar)."""
+    counts = count_map(events, polarity)   # checked before a figure is made
     ax = _axes(ax)
-    counts = count_map(events, polarity)
     im = ax.imshow(counts, cmap="magma", interpolation="nearest")
     ax.figure.colorbar(im, ax=ax, fraction=0.046, pad=0.04, label="events")
     which = {None: "", 1: "ON ", -1: "OFF "}[polarity]
