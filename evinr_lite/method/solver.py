@@ -116,7 +116,7 @@ class Reconstruction:
         :func:`~evinr_lite.method.ensemble.blend_networks` holds every network's frame (N, the offsets added in
         place), the float64 blend (2) and its float32 copy (1): N + 3 frames, plus the blend's weights (16 bytes per
         network) and 64 bytes (measured peaks: 3.99, 5.00, 7.02 and 10.99 frames for N = 1, 2, 4, 8 at 24x32)."""
-        from .memory import _gib, available_bytes
+        from .memory import gib, available_bytes
 
         try:
             n = int(np.size(host_array(times))) if not isinstance(times, (str, bytes)) else 1
@@ -127,7 +127,7 @@ class Reconstruction:
         need, free = n * (64.0 + 16.0 * N + 4.0 * H * W * (N + 3)), available_bytes("cpu")
         if need > 0.8 * free:
             raise EventDataError(f"times= holds {n:,} query times: their frames of {H}x{W} pixels need about "
-                                 f"{_gib(need)} of memory but about {_gib(free)} is free; ask for fewer times (or "
+                                 f"{gib(need)} of memory but about {gib(free)} is free; ask for fewer times (or "
                                  f"call {caller}() on parts of them and keep what you need)")
 
     def frames_at(self, times) -> np.ndarray:
