@@ -21,13 +21,36 @@ and text or None were numpy's errors. ``protocol_description(["none"])`` was "un
 ``measure_inference_fps`` of None was an AttributeError, n_frames -1, 1.5 or "4", batch_size 0 or 1.5 and
 repeats 1.5 were torch's or Python's errors, and repeats 0 or -1 timed once without a word.
 
-Refused on purpose where they were taken before: ``measure_inference_fps(n_frames=0)`` (an fps of 0 from no frame)
-and repeats < 1, a background outside [0, 1] (255 drew as white), ``plot_xyt(size=-1)``, and ``resolve_inputs("")``.
+Review fixes (section 5; each test failed before its fix): ``run_batch`` checked its out_dir against the raw inputs,
+so a generator of inputs (used up by resolve_inputs) let a batch write into its input folder and a single str input
+(read char by char, "/" an input folder) was always refused; ``run_batch(sequential=0 / 1)`` (np.int64 too) was
+refused, and out_dir as bytes passed the check and was Python's TypeError; ``summarize(settings=MappingProxyType)``
+was refused (any Mapping is taken, stored as a dict); " " as an input was said to read the current folder (a blank
+name now). ``Reconstruction.at`` / ``frames_at`` estimated N + 2 frames per query time while blend_networks held 2N
+(the networks' frames and their sum with the offsets) or N + 3 (the float64 blend and its float32 copy): the offsets
+are now added in place (the same values, bit for bit) and the estimate is N + 3 frames plus the weights (measured
+peaks 3.99, 5.00, 7.02, 10.99 frames for N = 1, 2, 4, 8); the memory message of ``frames_at`` told its caller to
+call at(). ``subsample_index`` / ``subsample`` / ``plot_xyt`` refused seed=None, a Generator, a SeedSequence and a
+list of seed words (default_rng takes them), max_points=np.inf (all events) and ``plot_xyt(view=(elev, azim,
+roll))``. ``signed_to_polarity_counts`` of a tensor requiring grad was torch's RuntimeError; ``measure_inference_fps
+(n_frames=4.0)`` reported 4.0, not the int it used. ``LogIntensityWriter`` took any tonemap, gamma and display
+(tonemap np.str_ was h5py's TypeError) and wrote NaN frames, which read as never written; ``save_log_intensity``
+now checks every frame (finite as float32, the first bad index named) before any file is made, and ``write``
+refuses a non-finite frame. ``BaselineReconstruction.at`` / ``CoordinateReconstruction.at`` read "0.1" and True
+as seconds: they take times through the same seconds_array check as ``Reconstruction.at`` (57 valid calls give the
+same bytes); the colour result's ``at`` already did, through its channels' ``Reconstruction.at``.
 
-Left as they are: the file writers (save_frames_png, save_gif, save_mp4, save_timestamps, save_csv,
-save_log_intensity: rounds 4 to 8 already refuse their frames, fps and paths), the other figures (plot_results,
+Refused on purpose where they were taken before: ``measure_inference_fps(n_frames=0)`` (an fps of 0 from no frame)
+and repeats < 1, a background outside [0, 1] (255 drew as white), ``plot_xyt(size=-1)``, ``resolve_inputs("")``, and,
+kept refused after the review, a background that only broadcasts to a colour (np.array([[1, 1, 1]])),
+``resolve_inputs`` of a dict and times as Fraction or Decimal (section 5's last test).
+
+Left as they are: the file writers (save_frames_png, save_gif, save_mp4, save_timestamps, save_csv: rounds 4 to 8
+already refuse their frames, fps and paths; save_log_intensity's values and display are section 5's), the other figures (plot_results,
 show_frames, show_images, plot_event_rate, the scorer: rounds 10 and 13), ``render_event_counts`` of a 1-D signal
 (one pixel's boundaries: valid) and ``run_batch``'s unknown keywords (Python's TypeError names the keyword).
+Left after the review: ``BaselineReconstruction.at`` of no time ([]) is still integrate_events' "non-empty 1-D
+array" refusal, as before.
 
 Guards: odd inputs next to these that already behave and must keep their outcome (np.int64 and 0-d tensor times,
 float32 times, an empty list of times, numpy / float counts and seeds, a whole float n, a grey background given as
@@ -99,7 +122,7 @@ def test_summarize_refuses_settings_that_are_no_dict(settings):
 
 
 @pytest.mark.parametrize("kw,pattern", [(dict(sequential="yes"), r"sequential= must be True or False"),
-                                        (dict(sequential=1), r"sequential= must be True or False"),
+                                        (dict(sequential=2), r"sequential= must be True or False"),
                                         (dict(log=5), r"log= must be a function"),
                                         (dict(client=5, sequential=False), r"client= must be a distributed.Client"),
                                         (dict(cache=5), r"cache= must be a folder")])
@@ -265,3 +288,184 @@ def test_scoring_helpers_as_before():
     r = scoring.measure_inference_fps(MODEL, n_frames=np.int64(4), batch_size=np.int64(4), repeats=np.int64(2))
     assert r["n_frames"] == 4 and len(r["all_seconds"]) == 2 and r["sensor_size"] == (4, 4)
     assert scoring.measure_inference_fps(MODEL, n_frames=5, batch_size=100, repeats=1)["batch_size"] == 100
+
+
+# ---- 5. the review's fixes -------------------------------------------------------------------------------------------
+
+@pytest.fixture
+def recs(tmp_path):
+    """A folder holding one tiny recording (as tests/test_batch.py writes them)."""
+    from evinr_lite.sim.recordings import write_example_recording
+
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    write_example_recording(folder / "rec_camera", scene="camera", sensor_size=(12, 16), duration=0.2,
+                            frame_rate=10.0, seed=0)
+    return folder
+
+
+def test_run_batch_refuses_a_generator_of_inputs_around_its_out_dir(recs):
+    out = recs / "out_gen"   # inside the input folder: the generator was used up before the ownership rule looked
+    _no(lambda: batch.run_batch((p for p in [recs]), out, sequential=True, n_iters=2, progress=False, log=QUIET),
+        r"is, or lies inside, the input folder")
+    assert not out.exists() and sorted(p.name for p in recs.iterdir()) == ["rec_camera"]
+
+
+def test_run_batch_takes_one_str_or_path_as_its_inputs(recs, tmp_path):
+    out = tmp_path / "out"   # a str was read char by char: "/" counted as an input folder, so always refused
+    summary = batch.run_batch(str(recs), out, sequential=1, n_iters=2, progress=False, log=QUIET)
+    assert [r["name"] for r in summary["recordings"]] == ["rec_camera"] and not summary["failed"]
+    again = batch.run_batch(recs, out, sequential=np.int64(1), n_iters=2, progress=False, log=QUIET)   # resumes
+    assert [r["name"] for r in again["recordings"]] == ["rec_camera"]
+
+
+def test_run_batch_takes_sequential_as_0_or_1(npy, tmp_path):
+    out = tmp_path / "out"   # 0 is False: refused for the client, not for sequential=
+    _no(lambda: batch.run_batch([str(npy)], out, sequential=np.int64(0), client=5, log=QUIET), r"client= must be")
+    _no(lambda: batch.run_batch([str(npy)], out, sequential=0, client=5, log=QUIET), r"client= must be")
+    assert not out.exists()
+
+
+def test_run_batch_refuses_an_out_dir_of_bytes_by_name(npy, tmp_path):
+    _no(lambda: batch.run_batch([str(npy)], os.fsencode(tmp_path / "o"), sequential=True, log=QUIET),
+        r"out_dir= must be a folder \(a str or Path\), got bytes")
+    assert not (tmp_path / "o").exists()
+
+
+def test_summarize_takes_any_mapping_as_settings():
+    from types import MappingProxyType
+
+    s = batch.summarize([], MappingProxyType({"C": 0.2}))
+    assert s["settings"] == {"C": 0.2} and type(s["settings"]) is dict
+
+
+def test_resolve_inputs_names_a_blank_input_as_blank():
+    _no(lambda: batch.resolve_inputs([" "], log=QUIET), r"inputs\[0\] is ' ', a blank name")
+
+
+def _tight_memory(monkeypatch, n_times):
+    """Free memory just under what n_times query times of REC need at max(2N, N + 3) frames each (N + 3 measured
+    after the in-place offsets; 2N before them), and above the old estimate of N + 2 frames."""
+    from evinr_lite.method import memory
+
+    N, (H, W) = len(REC.windows), REC.log_intensity.shape[1:]
+    need = n_times * (64.0 + 16.0 * N + 4.0 * H * W * (N + 3))
+    assert n_times * (40.0 + 4.0 * H * W * (N + 2)) < 0.8 * (need / 0.8 - 1.0)   # the old estimate let them through
+    monkeypatch.setattr(memory, "available_bytes", lambda device="cpu": need / 0.8 - 1.0)
+
+
+def test_at_counts_every_frame_the_blend_holds(monkeypatch):
+    times = np.full(50_000, 0.1)
+    _tight_memory(monkeypatch, times.size)
+    _no(lambda: REC.at(times), r"times= holds 50,000 query times.*call at\(\) on parts")
+
+
+def test_frames_at_names_itself_in_the_memory_message(monkeypatch):
+    times = np.full(50_000, 0.1)
+    _tight_memory(monkeypatch, times.size)
+    _no(lambda: REC.frames_at(times), r"call frames_at\(\) on parts")
+
+
+def test_blend_networks_as_before():
+    from evinr_lite.method.ensemble import blend_networks, blend_weights, predict_networks
+
+    t = np.linspace(0.03, 0.19, 7)
+    F = predict_networks(REC.model, t) + REC.offsets[:, None]    # the earlier formula, two arrays
+    ref = np.einsum("nq,nqhw->qhw", blend_weights(REC.windows, t), F).astype(np.float32)
+    assert np.array_equal(blend_networks(REC.model, REC.windows, t, REC.offsets), ref)
+
+
+@pytest.mark.parametrize("seed", [None, "generator", "seedsequence", [1, 2]])
+def test_subsample_index_takes_what_default_rng_takes(seed):
+    seed = {"generator": np.random.default_rng(3), "seedsequence": np.random.SeedSequence(3)}.get(
+        seed if isinstance(seed, str) else "", seed)
+    idx = ve.subsample_index(100, 10, seed)
+    assert idx.shape == (10,) and np.all(np.diff(idx) > 0)
+    if isinstance(seed, (np.random.Generator, np.random.SeedSequence)):
+        assert idx.tolist() == ve.subsample_index(100, 10, 3).tolist()   # default_rng(3)'s draw, as before
+
+
+def test_plot_xyt_takes_seed_none_all_points_and_a_roll():
+    ax = ve.plot_xyt(EV, seed=None, max_points=np.inf, view=(20, -60, 10))
+    assert ax.get_title() == f"{len(EV)} of {len(EV)} events" and ax.roll == 10
+    plt.close("all")
+    assert ve.subsample_index(10, np.inf).tolist() == list(range(10)) and ve.subsample(EV, float("inf")).t.size == len(EV)
+    _no(lambda: ve.subsample_index(10, -np.inf), r"max_points")
+
+
+def test_signed_counts_take_a_tensor_that_requires_grad():
+    t = torch.tensor([1.0, -2.0], requires_grad=True)
+    assert enhance.signed_to_polarity_counts(t).tolist() == [[1, 0], [0, 2]]
+
+
+def test_measure_inference_fps_reports_the_count_it_used():
+    r = scoring.measure_inference_fps(MODEL, n_frames=4.0, batch_size=2.0, repeats=1)
+    assert type(r["n_frames"]) is int and type(r["batch_size"]) is int and r["n_frames"] == 4
+
+
+@pytest.mark.parametrize("kw,pattern", [(dict(tonemap="nope"), r"tonemap must be one of \('linear', 'reinhard'\)"),
+                                        (dict(tonemap=None), r"tonemap must be one of"),
+                                        (dict(gamma=0), r"gamma= must be a finite number > 0"),
+                                        (dict(gamma=np.nan), r"gamma= must be a finite number > 0"),
+                                        (dict(gamma="0.6"), r"gamma= must be a finite number > 0"),
+                                        (dict(display=5), r"display= must be a str")])
+def test_log_intensity_writer_refuses_a_display_that_is_none(tmp_path, kw, pattern):
+    from evinr_lite.io.export import LogIntensityWriter, save_log_intensity
+
+    _no(lambda: LogIntensityWriter(tmp_path / "w.h5", [0.0], (2, 2), **kw), pattern)
+    _no(lambda: save_log_intensity(tmp_path / "s.h5", np.zeros((1, 2, 2)), [0.0], **kw), pattern)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, 1e39])   # 1e39 is inf as float32
+def test_save_log_intensity_refuses_non_finite_frames_before_the_file(tmp_path, bad):
+    from evinr_lite.io.export import save_log_intensity
+
+    L = np.zeros((4, 2, 3))
+    L[2, 1, 0] = bad
+    _no(lambda: save_log_intensity(tmp_path / "l.h5", L, [0.0, 0.1, 0.2, 0.3]), r"log_intensity\[2\] holds NaN or inf")
+    assert list(tmp_path.iterdir()) == []   # no file, no partial beside it
+
+
+def test_log_intensity_writer_refuses_a_nan_frame(tmp_path):
+    from evinr_lite.io.export import LogIntensityWriter
+
+    w = LogIntensityWriter(tmp_path / "w.h5", [0.0, 0.1], (2, 2))
+    _no(lambda: w.write(1, np.full((2, 2), np.nan)), r"frame 1 holds NaN or infinite")
+    w.abort()
+
+
+def test_log_intensity_export_stores_a_numpy_str_tonemap(tmp_path):
+    from evinr_lite.io import export
+    from evinr_lite.method.tonemap import TONEMAPS
+
+    assert export.TONEMAPS == TONEMAPS   # io sits below method: the list is kept twice
+    L = np.random.default_rng(0).normal(size=(2, 3, 4)).astype(np.float32)
+    p = export.save_log_intensity(tmp_path / "a.h5", L, [0.1, 0.2], tonemap=np.str_("reinhard"), gamma=np.float32(0.5),
+                                  display="sigmoid")
+    back, t, attrs = export.read_log_intensity(p)
+    assert np.array_equal(back, L) and attrs["tonemap"] == "reinhard" and attrs["gamma"] == 0.5
+    assert export.save_log_intensity(tmp_path / "i.h5", np.ones((1, 2, 2), np.int64), [0.0]).exists()
+
+
+def test_baseline_and_coordinate_at_take_times_as_reconstruction_at_does():
+    from evinr_lite.method.baselines import reconstruct_baseline
+    from evinr_lite.method.coordinate import CoordinateConfig, reconstruct_coordinate
+
+    base = reconstruct_baseline(EV, [0.05, 0.1])
+    coord = reconstruct_coordinate(EV, [0.05, 0.1], CoordinateConfig(n_iters=2, hidden_features=8, hidden_layers=1,
+                                                                     progress=False, device="cpu"))
+    for rec in (base, coord):
+        _none_of([lambda: rec.at("0.1"), lambda: rec.at(["0.1"]), lambda: rec.at([True]), lambda: rec.frames_at(None)],
+                 r"times= must be seconds")
+        assert np.array_equal(rec.at(np.float32(0.1)), rec.at([np.float32(0.1)]))
+    assert coord.at([]).shape == (0, 8, 10)
+
+
+def test_refused_on_purpose_stay_refused(tmp_path):
+    from decimal import Decimal
+    from fractions import Fraction
+
+    _no(lambda: ve.polarity_image(EV, background=np.array([[1, 1, 1]])), r"background= must be a colour")
+    _no(lambda: batch.resolve_inputs({"a": 1}, log=QUIET), r"inputs= must be")
+    _none_of([lambda: REC.at([Fraction(1, 10)]), lambda: REC.frames_at([Decimal("0.1")])], r"times= must be seconds")

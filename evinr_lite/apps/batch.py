@@ -33,6 +33,7 @@ import os
 import re
 import shutil
 import time
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -153,9 +154,10 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
         if not isinstance(spec, (str, os.PathLike)) or isinstance(os.fspath(spec), bytes):
             raise EventDataError(f"inputs[{k}] must be a path or a data_fetch name (a str or Path), got "
                                  f"{type(spec).__name__} {spec!r:.60}")
-        if isinstance(spec, str) and not spec.strip():   # Path("") is the current folder
-            raise EventDataError(f"inputs[{k}] is {spec!r}, an empty name (it would read the current folder); pass "
-                                 "recordings, folders of recordings or data_fetch names")
+        if isinstance(spec, str) and not spec.strip():   # Path("") is the current folder, Path(" ") a folder " "
+            raise EventDataError(f"inputs[{k}] is {spec!r}, a blank name (no recording, folder or data_fetch name; "
+                                 "\"\" would read the current folder); pass recordings, folders of recordings or "
+                                 "data_fetch names")
     if cache is not None and not isinstance(cache, (str, os.PathLike)):
         raise EventDataError(f"cache= must be a folder (a str or Path) or None (the data_fetch cache), got "
                              f"{type(cache).__name__}")
@@ -345,8 +347,11 @@ def summarize(rows, settings: dict | None = None) -> dict:
     if rows is None or isinstance(rows, (str, bytes, dict)) or not hasattr(rows, "__iter__"):
         raise EventDataError(f"rows= must be a list of the per-recording rows a batch makes (dicts), got "
                              f"{type(rows).__name__}")
-    if settings is not None and not isinstance(settings, dict):
-        raise EventDataError(f"settings= must be a dict (the batch's settings) or None, got {type(settings).__name__}")
+    if settings is not None and not isinstance(settings, Mapping):
+        raise EventDataError(f"settings= must be a dict (the batch's settings, or another Mapping) or None, got "
+                             f"{type(settings).__name__}")
+    if settings is not None and not isinstance(settings, dict):   # a MappingProxyType: stored as a plain dict
+        settings = dict(settings)
     rows = list(rows)
     for k, r in enumerate(rows):
         if not isinstance(r, dict):
@@ -579,11 +584,13 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
 
     from ..io.output import given_output_path
 
-    if not isinstance(out_dir, (str, bytes, os.PathLike)):
+    if not isinstance(out_dir, (str, os.PathLike)) or isinstance(os.fspath(out_dir), bytes):   # bytes: TypeError later
         raise EventDataError(f"out_dir= must be a folder (a str or Path), got {type(out_dir).__name__}")
     out_dir = given_output_path(out_dir)   # "" is refused, not taken as the current folder
-    if not isinstance(sequential, (bool, np.bool_)):
-        raise EventDataError(f"sequential= must be True or False, got {sequential!r}")
+    if not isinstance(sequential, (bool, np.bool_)) and not (isinstance(sequential, (int, np.integer))
+                                                             and sequential in (0, 1)):
+        raise EventDataError(f"sequential= must be True or False (or 0 / 1), got {sequential!r}")
+    sequential = bool(sequential)
     if not callable(log):   # it is called after the batch has run
         raise EventDataError(f"log= must be a function log(text) (e.g. print), got {type(log).__name__}")
     if client is not None and not callable(getattr(client, "submit", None)):
@@ -597,6 +604,10 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
         raise EventDataError(f"torch_threads= must be a whole number of at least 1, got {torch_threads!r}")
     if sum(x is not None for x in (scheduler, workers, client)) + bool(sequential) > 1:
         raise EventDataError("give at most one of scheduler=, workers=, client= and sequential=True")
+    if isinstance(inputs, (str, os.PathLike)):   # once: a generator is used up by resolve_inputs, a str is no list
+        inputs = [inputs]
+    elif inputs is not None and not isinstance(inputs, (bytes, dict)) and hasattr(inputs, "__iter__"):
+        inputs = list(inputs)
     items = resolve_inputs(inputs, cache=cache, log=log)
     # as batch.json stores them (pairs and sizes as lists), so a resume compares equal
     settings = {**options.to_dict(BATCH_FIELDS), "torch_threads": int(torch_threads)}

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import real_number, require
+from ..core.checks import host_array, real_number, require
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 from ..method.binning import check_boundaries
@@ -69,7 +69,7 @@ def render_counts(L_boundaries, C, whole_steps=np.trunc):
 def signed_to_polarity_counts(signed) -> np.ndarray:
     """Signed counts [B, H, W] -> non-negative [2, B, H, W] (ON counts, OFF counts)."""
     try:
-        s = None if isinstance(signed, (str, bytes)) or signed is None else np.asarray(signed)
+        s = None if isinstance(signed, (str, bytes)) or signed is None else np.asarray(host_array(signed))
     except (TypeError, ValueError):   # a ragged list
         s = None
     ok = s is not None and s.dtype.kind in "iuf"

@@ -359,9 +359,12 @@ def measure_inference_fps(model, n_frames: int = 64, batch_size: int = 32, repea
     from ..method.models import FrameINR
 
     require(model, FrameINR, "model")
-    reported = {"n_frames": n_frames, "batch_size": batch_size}   # as given (np.int64 stays np.int64)
+    given = {"n_frames": n_frames, "batch_size": batch_size}
     n_frames = whole_number(n_frames, "n_frames", lo=1)        # 0 timed nothing and reported 0 fps
     batch_size = whole_number(batch_size, "batch_size", lo=1)
+    # an integer as given (np.int64 stays np.int64), a whole float (4.0) as the int used
+    reported = {k: v if isinstance(v, (int, np.integer)) else used for (k, v), used in zip(given.items(),
+                                                                                            (n_frames, batch_size))}
     repeats = whole_number(repeats, "repeats", lo=1)           # 0 or -1 timed once without a word
     device = model.head_weight.device
     lo, hi = (float(v) for v in model.windows[0])

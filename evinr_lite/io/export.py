@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from ..core.checks import check_image_values, real_number, seconds_array
+from ..core.checks import check_image_values, choice, host_array, real_number, seconds_array
 from ..core.events import EventDataError
 from ..core.frames import Frames, to_uint8
 from .output import CloseOrAbort, PngWriter, written_beside
@@ -204,6 +204,9 @@ def save_csv(path, rows: list[dict]) -> Path:
 # above the display's white clipped. The HDF5 file keeps the float32 values, so a user can tone-map
 # them again (another level, another curve) or feed them to their own pipeline.
 
+TONEMAPS = ("linear", "reinhard")   # evinr_lite.method.tonemap.TONEMAPS (io sits below method; a test keeps them equal)
+
+
 class LogIntensityWriter(CloseOrAbort):
     """An HDF5 file of log intensities written frame by frame (a streamed run's frames arrive in parts).
 
@@ -212,14 +215,16 @@ class LogIntensityWriter(CloseOrAbort):
     ``t`` float64 [F], seconds relative to the attribute ``t_origin``; attributes saying what the
     values are (``units``) and how the run's frames were drawn from them (``display``, ``tonemap``,
     ``gamma``). Rows not yet written read as NaN, so a file closed early cannot pass for complete;
-    :meth:`close` refuses one with rows missing.
+    :meth:`close` refuses one with rows missing, and :meth:`write` refuses NaN or infinite values (a written
+    NaN frame would read as a missing one).
 
     Args:
         path: the file to create (inside a staging folder: the caller renames the folder into place).
         times: float64 [F] the frames' times (seconds on the events' clock, relative to ``t_origin``).
         frame_shape: (H, W) or (H, W, 3).
         t_origin: seconds, the absolute time of t = 0 (0 when relative).
-        tonemap, gamma, display: the display the run used (``display``: its formula in words).
+        tonemap, gamma, display: the display the run used: ``tonemap`` one of :data:`TONEMAPS`, ``gamma`` a
+            finite number > 0, ``display`` its formula in words (a str).
     """
 
     def __init__(self, path, times, frame_shape, *, t_origin: float = 0.0, tonemap: str = "linear",
@@ -228,6 +233,11 @@ class LogIntensityWriter(CloseOrAbort):
 
         times = seconds_array(times, "times")
         t_origin = real_number(t_origin, "t_origin", hint="seconds: the absolute time of t = 0 (0 when relative)")
+        tonemap = str(choice(tonemap, TONEMAPS, "tonemap"))   # np.str_ too (h5py stores no numpy text)
+        gamma = real_number(gamma, "gamma", lo=0, lo_open=True, hint="the display's gamma (e.g. 0.6)")
+        if not isinstance(display, str):
+            raise EventDataError(f"display= must be a str (the display's formula in words), got "
+                                 f"{type(display).__name__}")
         frame_shape = tuple(int(v) for v in frame_shape)
         if len(frame_shape) not in (2, 3) or min(frame_shape) < 1 or (len(frame_shape) == 3 and frame_shape[2] != 3):
             raise EventDataError(f"frame_shape must be (H, W) or (H, W, 3), got {frame_shape}")
@@ -250,9 +260,13 @@ class LogIntensityWriter(CloseOrAbort):
 
     def write(self, i: int, image) -> None:
         """Frame ``i`` (0-based, in the order of ``times``): an array of ``frame_shape``."""
-        image = np.asarray(image, np.float32)
+        with np.errstate(over="ignore"):   # past float32's range: inf, refused below
+            image = np.asarray(host_array(image), np.float32)
         if image.shape != self.shape[1:]:
             raise EventDataError(f"frame {i} has shape {image.shape}, expected {self.shape[1:]}")
+        if not np.isfinite(image).all():   # unwritten rows read as NaN: a NaN frame would pass for a missing one
+            raise EventDataError(f"frame {i} holds NaN or infinite log intensities (as float32); a log intensity "
+                                 "must be finite: repair or drop that frame")
         self.data[i] = image
         self.done[i] = True
 
@@ -273,11 +287,20 @@ class LogIntensityWriter(CloseOrAbort):
 
 def save_log_intensity(path, log_intensity, times, **kw) -> Path:
     """Write log intensities [F, H, W] (or [F, H, W, 3]) at ``times`` [F] (s) as one HDF5 file
-    (:class:`LogIntensityWriter`'s layout; keywords: its t_origin, tonemap, gamma, display)."""
-    L = np.asarray(log_intensity)
+    (:class:`LogIntensityWriter`'s layout; keywords: its t_origin, tonemap, gamma, display). The values must be
+    finite numbers (as float32): all are checked before the file is created."""
+    L = np.asarray(host_array(log_intensity))
     if L.ndim not in (3, 4) or L.shape[0] != len(np.atleast_1d(times)):
         raise EventDataError(f"log_intensity must be [F, H, W] or [F, H, W, 3] with one frame per time, got shape "
                              f"{L.shape} for {len(np.atleast_1d(times))} time(s)")
+    if L.dtype.kind not in "iuf":
+        raise EventDataError(f"log_intensity must be numbers (float32 log intensities), got dtype {L.dtype}")
+    for i, img in enumerate(L):   # a frame at a time: no float32 copy of the whole stack
+        with np.errstate(over="ignore"):   # 1e39 becomes inf as float32: refused below
+            finite = np.isfinite(img.astype(np.float32, copy=False)).all()
+        if not finite:
+            raise EventDataError(f"log_intensity[{i}] holds NaN or infinite values (as float32); a log intensity "
+                                 "must be finite: repair or drop that frame (nothing was written)")
     path = _output_file(path, ".h5", "save_log_intensity", any_suffix=True)
     with written_beside(path) as tmp, LogIntensityWriter(tmp, times, L.shape[1:], **kw) as out:
         for i, img in enumerate(L):

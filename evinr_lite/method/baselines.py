@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.checks import (ArgumentTypeError, check_reach, check_seconds_precision, choice, host_array, is_real_number,
-                           optional_seconds, real_number, require)
+                           optional_seconds, real_number, require, seconds_array)
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 from ..core.frames import Frames
@@ -370,7 +370,7 @@ class BaselineReconstruction:
 
     def at(self, times) -> np.ndarray:
         """Anchored log intensity at other times: float64 [Q, H, W] (recomputed from the events)."""
-        return self._fn(np.atleast_1d(np.asarray(times, np.float64))) + self.offset
+        return self._fn(seconds_array(times, "times", allow_empty=True)) + self.offset   # "0.1", True refused
 
     def frames_at(self, times) -> np.ndarray:
         if self.method in FRAME_BASELINES:     # in the APS frames' own intensity space

@@ -48,6 +48,7 @@ import torch
 from torch import nn
 
 from .binning import events_to_frames, fixed_duration_boundaries
+from ..core.checks import seconds_array
 from ..core.runtime import default_device
 from ..core.events import EventDataError, Events, check_sensor_size, check_time_range
 from .siren import Siren
@@ -417,7 +418,7 @@ class CoordinateReconstruction:
 
     def at(self, times) -> np.ndarray:
         """Anchored log intensity at any times (s): float32 [Q, H, W]."""
-        return (self.model.render(np.atleast_1d(np.asarray(times, np.float64))) + np.float32(self.offset))
+        return (self.model.render(seconds_array(times, "times", allow_empty=True)) + np.float32(self.offset))
 
     def frames_at(self, times) -> np.ndarray:
         """Tone-mapped frames in [0, 1] at any times: float32 [Q, H, W]."""

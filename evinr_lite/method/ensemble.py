@@ -88,7 +88,8 @@ def blend_weights(windows: np.ndarray, times: np.ndarray) -> np.ndarray:
 def blend_networks(model, windows, times, offsets, chunk=256) -> np.ndarray:
     """The ensemble's log intensity at times [Q]: each network plus its offset [N, H, W], blended
     with :func:`blend_weights`. Returns float32 [Q, H, W]."""
-    F = predict_networks(model, times, chunk) + offsets[:, None]
+    F = predict_networks(model, times, chunk)
+    F += offsets[:, None]   # in place: one [N, Q, H, W] array, not two
     w = blend_weights(windows, times)
     return np.einsum("nq,nqhw->qhw", w, F).astype(np.float32)
 

@@ -172,7 +172,8 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
             "span_s": span, "streaming": bool(streaming), "offset_solve_bytes": offset_work, "coarse_bytes": coarse}
 
 
-def _gib(n_bytes: float) -> str:
+def gib(n_bytes: float) -> str:
+    """``n_bytes`` as text in GiB (one decimal), as the memory messages print it."""
     return f"{n_bytes / 2**30:,.1f} GiB"
 
 
@@ -215,7 +216,7 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
         fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.bin_duration:g} s, "
                f"{config.hidden_features} hidden features); use a longer bin_duration, a shorter tau or fewer "
                "hidden_features, or check the sensor size (sensor_size=(H, W))")
-    raise EventDataError(f"this reconstruction needs about {_gib(est['total'])} of memory but about {_gib(free)} is "
+    raise EventDataError(f"this reconstruction needs about {gib(est['total'])} of memory but about {gib(free)} is "
                          f"free on {device}: most of it for {fix}")
 
 
@@ -229,6 +230,6 @@ def check_times_memory(n_times: int, sensor_size, what: str, *, fraction: float 
     need, free = n_times * BYTES_PER_TIME, available_bytes("cpu")
     if need > fraction * free:
         H, W = sensor_size
-        raise EventDataError(f"{what}: this reconstruction needs about {_gib(need)} of memory but about {_gib(free)} "
+        raise EventDataError(f"{what}: this reconstruction needs about {gib(need)} of memory but about {gib(free)} "
                              f"is free: most of it for {n_times:,} output frames of {H}x{W} pixels; ask for fewer "
                              "frames with fps= or at=, or shorten the window with t_start=/t_end=")

@@ -98,36 +98,44 @@ class Reconstruction:
     def at(self, times, chunk: int = 256) -> np.ndarray:
         """Anchored log intensity at any times (seconds) inside the windows: float32 [Q, H, W].
         ``chunk``: frames computed at once (a whole number >= 1)."""
+        return self._at(times, chunk, "at")
+
+    def _at(self, times, chunk: int, caller: str) -> np.ndarray:
+        """:meth:`at`, its memory message naming ``caller`` (the method the user called)."""
         chunk = whole_number(chunk, "chunk", lo=1)
-        self._check_count(times)
+        self._check_count(times, caller)
         t = seconds_array(times, "times", allow_empty=True)   # text, None, booleans, NaN, 2-D refused; [] stays empty
         L = blend_networks(self.model, self.windows, t, self.offsets, chunk)
         if self.trend is not None:
             self.trend.add_to(L, t)
         return L if self.anchor is None else L + self.anchor.offset_at(t)
 
-    def _check_count(self, times) -> None:
-        """Refuse, before any time is converted, more query times than the frames of :meth:`at` (every network at
-        every time, then the blend) can fit in 80 % of the free memory (10^9 times of a view cost nothing to pass)."""
-        from .memory import _gib, available_bytes
+    def _check_count(self, times, caller: str = "at") -> None:
+        """Refuse, before any time is converted, more query times than the frames of :meth:`at` can fit in 80 % of
+        the free memory (10^9 times of a view cost nothing to pass). Per time, float32 H x W frames:
+        :func:`~evinr_lite.method.ensemble.blend_networks` holds every network's frame (N, the offsets added in
+        place), the float64 blend (2) and its float32 copy (1): N + 3 frames, plus the blend's weights (16 bytes per
+        network) and 64 bytes (measured peaks: 3.99, 5.00, 7.02 and 10.99 frames for N = 1, 2, 4, 8 at 24x32)."""
+        from .memory import gib, available_bytes
 
         try:
             n = int(np.size(host_array(times))) if not isinstance(times, (str, bytes)) else 1
         except (TypeError, ValueError):   # a ragged list: seconds_array names it
             return
         H, W = self.log_intensity.shape[1:]
-        need, free = n * (40.0 + 4.0 * H * W * (len(self.windows) + 2)), available_bytes("cpu")
+        N = len(self.windows)
+        need, free = n * (64.0 + 16.0 * N + 4.0 * H * W * (N + 3)), available_bytes("cpu")
         if need > 0.8 * free:
             raise EventDataError(f"times= holds {n:,} query times: their frames of {H}x{W} pixels need about "
-                                 f"{_gib(need)} of memory but about {_gib(free)} is free; ask for fewer times (or "
-                                 "call at() on parts of them and keep what you need)")
+                                 f"{gib(need)} of memory but about {gib(free)} is free; ask for fewer times (or "
+                                 f"call {caller}() on parts of them and keep what you need)")
 
     def frames_at(self, times) -> np.ndarray:
         """Frames in [0, 1] at any times: float32 [Q, H, W]; tone-mapped, or the APS frames' linear
         intensity when anchored (:func:`evinr_lite.method.anchor.linear_frames`)."""
         if self.anchor is not None:
-            return linear_frames(self.at(times))
-        return to_display(self.at(times), self.config.tonemap, self.config.gamma).astype(np.float32)
+            return linear_frames(self._at(times, 256, "frames_at"))
+        return to_display(self._at(times, 256, "frames_at"), self.config.tonemap, self.config.gamma).astype(np.float32)
 
 
 def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, *,

@@ -49,18 +49,36 @@ def _axes(ax, figsize=(6, 4)):
 def subsample_index(n: int, max_points: int, seed: int = 0) -> np.ndarray:
     """Indices of at most ``max_points`` of ``n`` items, drawn without replacement, sorted.
 
-    All of ``range(n)`` when ``n <= max_points``. The same (n, max_points, seed) always gives
-    the same indices. Returns int64 [min(n, max_points)].
+    All of ``range(n)`` when ``n <= max_points`` (``max_points=np.inf``: all). The same (n, max_points, seed)
+    always gives the same indices; ``seed`` is what ``np.random.default_rng`` takes (a whole number >= 0, None for
+    fresh entropy, a Generator or a SeedSequence). Returns int64 [min(n, max_points)].
     """
     n = whole_number(n, "n", lo=0)
+    if is_real_number(max_points) and float(host_array(max_points)) == np.inf:   # all of them
+        max_points = max(n, 1)
     max_points = whole_number(max_points, "max_points")
     if max_points < 1:
         raise EventDataError(f"max_points must be at least 1, got {max_points}")
-    seed = whole_number(seed, "seed", lo=0)
+    seed = _seed(seed)
     if n <= max_points:
         return np.arange(n, dtype=np.int64)
     idx = np.random.default_rng(seed).choice(n, size=max_points, replace=False)
     return np.sort(idx).astype(np.int64)
+
+
+def _seed(seed):
+    """``seed`` as ``np.random.default_rng`` takes it: None, a Generator, BitGenerator or SeedSequence as given, a
+    whole number >= 0 (or a list of them) checked; text, 1.5, NaN and negative numbers refused."""
+    if seed is None or isinstance(seed, (np.random.Generator, np.random.BitGenerator, np.random.SeedSequence)):
+        return seed
+    if isinstance(seed, (list, tuple, np.ndarray)):   # entropy words, e.g. [1, 2]
+        try:
+            arr = np.asarray(seed)
+        except (TypeError, ValueError):   # ragged
+            arr = np.zeros(0)
+        if arr.ndim == 1 and arr.dtype.kind in "iu" and arr.size and bool(np.all(arr >= 0)):
+            return seed
+    return whole_number(seed, "seed", lo=0)
 
 
 def subsample(events: Events, max_points: int, seed: int = 0) -> Events:
@@ -137,13 +155,14 @@ def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, siz
     At most ``max_points`` events are drawn, a seeded random subset (see :func:`subsample`).
     Time runs along the long horizontal axis, x (column) along the other, and y (row) is
     vertical, pointing down as in an image. ``ax`` must be a 3-D axes (``projection='3d'``)
-    if given; ``view`` is the (elevation, azimuth) in degrees.
+    if given; ``view`` is the (elevation, azimuth) in degrees, or (elevation, azimuth, roll).
     """
     require(events, Events, "events")
     size = real_number(size, "size", lo=0, hint="the points' area in points^2 (e.g. 1.0)")
-    if isinstance(view, (str, bytes)) or not (np.ndim(view) == 1 and np.size(view) == 2 and
+    if isinstance(view, (str, bytes)) or not (np.ndim(view) == 1 and np.size(view) in (2, 3) and
                                                all(is_real_number(v) and np.isfinite(float(v)) for v in view)):
-        raise EventDataError(f"view= must be (elevation, azimuth), two finite angles in degrees, got {view!r}")
+        raise EventDataError(f"view= must be (elevation, azimuth) or (elevation, azimuth, roll), finite angles in "
+                             f"degrees, got {view!r}")
     if len(events) == 0:   # empty 3-D axes titled "0 of 0 events"
         raise EventDataError("plot_xyt: no events to draw; pick a time window or a recording that holds some")
     sub = subsample(events, max_points, seed)
