@@ -358,6 +358,21 @@ def test_frames_at_names_itself_in_the_memory_message(monkeypatch):
     _no(lambda: REC.frames_at(times), r"call frames_at\(\) on parts")
 
 
+def test_frames_at_counts_the_display_frames_too(monkeypatch):
+    """Final review: frames_at tone-maps in float64 (7 frames at its peak), more than the blend's N + 3 when N < 4;
+    memory that fits at()'s frames but not frames_at()'s refuses frames_at() alone."""
+    from evinr_lite.method import memory
+
+    N, (H, W) = len(REC.windows), REC.log_intensity.shape[1:]
+    assert N + 3 < 7
+    n = 50_000
+    between = n * (64.0 + 16.0 * N + 4.0 * H * W * (N + 3 + 7) / 2)   # above at()'s need, below frames_at()'s
+    monkeypatch.setattr(memory, "available_bytes", lambda device="cpu": between / 0.8)
+    times = np.full(n, 0.1)
+    assert REC.at(times).shape == (n, H, W)
+    _no(lambda: REC.frames_at(times), r"call frames_at\(\) on parts")
+
+
 def test_blend_networks_as_before():
     from evinr_lite.method.ensemble import blend_networks, blend_weights, predict_networks
 

@@ -130,6 +130,16 @@ def _from_cache(spec: str, cache: Path) -> list[dict]:
     return [{"path": str(path), "dataset": dataset, "name": sequence}]
 
 
+def _input_list(inputs) -> list:
+    """``inputs`` (one path or name, or an iterable of them) as a list; EventDataError for what is neither."""
+    if isinstance(inputs, (str, os.PathLike)):
+        return [inputs]
+    if inputs is None or isinstance(inputs, (bytes, dict)) or not hasattr(inputs, "__iter__"):
+        raise EventDataError(f"inputs= must be a recording, a folder or a data_fetch name (a str or Path), or a list "
+                             f"of them, got {type(inputs).__name__}")
+    return list(inputs)
+
+
 def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
     """The recordings that INPUTS name, each {"name", "dataset", "path"} (names unique, order kept).
 
@@ -144,12 +154,7 @@ def resolve_inputs(inputs, *, cache=None, log=print) -> list[dict]:
         EventDataError: an input that is neither an existing path nor a converted sequence (the
             message says how to fetch it), or inputs that name no recording at all.
     """
-    if isinstance(inputs, (str, os.PathLike)):
-        inputs = [inputs]
-    if inputs is None or isinstance(inputs, (bytes, dict)) or not hasattr(inputs, "__iter__"):
-        raise EventDataError(f"inputs= must be a recording, a folder or a data_fetch name (a str or Path), or a list "
-                             f"of them, got {type(inputs).__name__}")
-    inputs = list(inputs)
+    inputs = _input_list(inputs)
     for k, spec in enumerate(inputs):   # all of them, before any is looked at
         if not isinstance(spec, (str, os.PathLike)) or isinstance(os.fspath(spec), bytes):
             raise EventDataError(f"inputs[{k}] must be a path or a data_fetch name (a str or Path), got "
@@ -604,10 +609,7 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
         raise EventDataError(f"torch_threads= must be a whole number of at least 1, got {torch_threads!r}")
     if sum(x is not None for x in (scheduler, workers, client)) + bool(sequential) > 1:
         raise EventDataError("give at most one of scheduler=, workers=, client= and sequential=True")
-    if isinstance(inputs, (str, os.PathLike)):   # once: a generator is used up by resolve_inputs, a str is no list
-        inputs = [inputs]
-    elif inputs is not None and not isinstance(inputs, (bytes, dict)) and hasattr(inputs, "__iter__"):
-        inputs = list(inputs)
+    inputs = _input_list(inputs)   # once: a generator is used up by resolve_inputs, a str is no list
     items = resolve_inputs(inputs, cache=cache, log=log)
     # as batch.json stores them (pairs and sizes as lists), so a resume compares equal
     settings = {**options.to_dict(BATCH_FIELDS), "torch_threads": int(torch_threads)}

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .checks import is_real_number, real_number, whole_number
+from .checks import host_array, is_real_number, real_number, short_repr, whole_number
 from .events import EventDataError, check_sensor_size
 
 __all__ = ["CHANNELS", "QUAD_BAYER", "BAYER", "TILE_COLOURS", "CFA_NAMES", "check_cfa", "cfa_phase",
@@ -140,8 +140,6 @@ def cfa_channel(y, x, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:
 
 def _photosites(a, name: str, what: str) -> np.ndarray:
     """Photosite coordinates as int64; EventDataError naming ``name`` when they are not whole numbers."""
-    from .guard import host_array
-
     try:
         arr = np.asarray(host_array(a))
     except (TypeError, ValueError):
@@ -149,13 +147,8 @@ def _photosites(a, name: str, what: str) -> np.ndarray:
     if arr.dtype.kind in "iu":
         return arr.astype(np.int64)
     if arr.dtype.kind != "f" or not np.all(np.isfinite(arr)) or not np.all(arr == np.round(arr)):
-        raise EventDataError(f"{name}= must be whole photosite {what} (integers), got {_short(a)}")
+        raise EventDataError(f"{name}= must be whole photosite {what} (integers), got {short_repr(a)}")
     return arr.astype(np.int64)
-
-
-def _short(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else f"{type(value).__name__} {text[:50]}..."
 
 
 def cfa_pattern(sensor_size, phase=(0, 0), block: int = QUAD_BAYER) -> np.ndarray:

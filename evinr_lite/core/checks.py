@@ -18,7 +18,7 @@ from .guard import InputError, check_unmasked, dense_array, host_array
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
-           "host_array", "check_seconds_precision", "check_reach", "image_stack", "checked_span"]
+           "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -124,7 +124,7 @@ def seconds_array(value, name: str, *, allow_empty: bool = False) -> np.ndarray:
         arr = np.asarray([None])
     if arr.dtype.kind not in "iuf" or arr.dtype == bool:
         raise EventDataError(f"{name}= must be seconds (a number, a list or a 1-D array of numbers), got "
-                             f"{_short(value)}")
+                             f"{short_repr(value)}")
     check_seconds_precision(arr, name)
     arr = np.atleast_1d(arr.astype(np.float64))
     if arr.size == 0 and not allow_empty:
@@ -154,11 +154,12 @@ def choice(value, allowed, name: str):
     except TypeError:   # an unhashable value (a list) against a set
         ok = False
     if not ok:
-        raise EventDataError(f"{name} must be one of {tuple(allowed)}, got {_short(value)}")
+        raise EventDataError(f"{name} must be one of {tuple(allowed)}, got {short_repr(value)}")
     return value
 
 
-def _short(value) -> str:
+def short_repr(value) -> str:
+    """``repr(value)`` for a message, cut to about 60 characters (a long array names its type instead)."""
     text = repr(value)
     return text if len(text) <= 60 else f"{type(value).__name__} {text[:50]}..."
 

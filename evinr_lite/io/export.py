@@ -237,7 +237,8 @@ class LogIntensityWriter(CloseOrAbort):
         gamma = real_number(gamma, "gamma", lo=0, lo_open=True, hint="the display's gamma (e.g. 0.6)")
         if not isinstance(display, str):
             raise EventDataError(f"display= must be a str (the display's formula in words), got "
-                                 f"{type(display).__name__}")
+                                 f"{type(display).__name__}; pass the formula as text, e.g. "
+                                 "evinr_lite.method.tonemap.display_formula(tonemap, gamma)")
         frame_shape = tuple(int(v) for v in frame_shape)
         if len(frame_shape) not in (2, 3) or min(frame_shape) < 1 or (len(frame_shape) == 3 and frame_shape[2] != 3):
             raise EventDataError(f"frame_shape must be (H, W) or (H, W, 3), got {frame_shape}")

@@ -115,7 +115,9 @@ class Reconstruction:
         the free memory (10^9 times of a view cost nothing to pass). Per time, float32 H x W frames:
         :func:`~evinr_lite.method.ensemble.blend_networks` holds every network's frame (N, the offsets added in
         place), the float64 blend (2) and its float32 copy (1): N + 3 frames, plus the blend's weights (16 bytes per
-        network) and 64 bytes (measured peaks: 3.99, 5.00, 7.02 and 10.99 frames for N = 1, 2, 4, 8 at 24x32)."""
+        network) and 64 bytes (measured peaks: 3.99, 5.00, 7.02 and 10.99 frames for N = 1, 2, 4, 8 at 24x32).
+        :meth:`frames_at` then tone-maps in float64 (a copy, a clip, an exp): 7 frames at its peak (tracemalloc), so
+        it needs max(N + 3, 7)."""
         from .memory import gib, available_bytes
 
         try:
@@ -124,7 +126,8 @@ class Reconstruction:
             return
         H, W = self.log_intensity.shape[1:]
         N = len(self.windows)
-        need, free = n * (64.0 + 16.0 * N + 4.0 * H * W * (N + 3)), available_bytes("cpu")
+        frames = N + 3 if caller == "at" else max(N + 3, 7)
+        need, free = n * (64.0 + 16.0 * N + 4.0 * H * W * frames), available_bytes("cpu")
         if need > 0.8 * free:
             raise EventDataError(f"times= holds {n:,} query times: their frames of {H}x{W} pixels need about "
                                  f"{gib(need)} of memory but about {gib(free)} is free; ask for fewer times (or "

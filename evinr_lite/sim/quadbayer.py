@@ -202,7 +202,8 @@ def debayer_bilinear(raw, phase=(0, 0)) -> np.ndarray:
                              "(raw[i])")
     if min(raw.shape) < 2:
         raise EventDataError(f"raw= must be at least 2 x 2 photosites (one whole Bayer tile), got {raw.shape[0]} x "
-                             f"{raw.shape[1]}: the missing colours of a smaller one have no neighbour to come from")
+                             f"{raw.shape[1]}: the missing colours of a smaller one have no neighbour to come from; pass a mosaic of "
+                             "at least one 2 x 2 tile")
     values = np.asarray(raw, np.float64)
     pattern = cfa_pattern(values.shape, phase, block=BAYER)
     kernel = np.array([[1.0, 2.0, 1.0], [2.0, 4.0, 2.0], [1.0, 2.0, 1.0]])
@@ -274,7 +275,8 @@ def checker_amplitude(images) -> float:
     x = np.asarray(_image(images, "images", "images [..., H, W]"), dtype=np.float64)
     H, W = x.shape[-2:]
     if H < 2 or W < 2:
-        raise EventDataError(f"images= must be at least 2 x 2 pixels (one period-2 block), got shape {x.shape}")
+        raise EventDataError(f"images= must be at least 2 x 2 pixels (one period-2 block), got shape {x.shape}; "
+                             "pass images of at least 2 x 2 pixels")
     if H % 2 or W % 2:
         x = x[..., :H - H % 2, :W - W % 2]
     a, b, c, d = x[..., 0::2, 0::2], x[..., 0::2, 1::2], x[..., 1::2, 0::2], x[..., 1::2, 1::2]
