@@ -115,7 +115,7 @@ from evinr_lite.teaching.checking.learner_calls import run
 from evinr_lite.teaching.checking.global_state import rng_states, same_rng_state
 from evinr_lite.teaching.checking.mistakes import generic_mistakes
 from evinr_lite.teaching.poisson_exercises import _differences
-from test_exercise_wrong_solutions_round3 import _report, quoted_counts
+from exercise_reports import quoted_counts, report as _report
 
 
 def R(n): return exercises.reference(n)
@@ -735,8 +735,7 @@ def _fresh_state():
     torch.set_grad_enabled(grad); torch.set_default_dtype(dtype)
 
 
-def _id(rows):
-    return [f"{r[0]}-{k}-{r[1].__name__}" for k, r in enumerate(rows)]
+from exercise_reports import case_ids as _id   # noqa: E402
 
 
 @pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))

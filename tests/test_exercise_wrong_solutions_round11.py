@@ -55,7 +55,7 @@ import pytest
 import torch
 
 from evinr_lite.teaching import exercises
-from test_exercise_wrong_solutions_round3 import _report, quoted_counts
+from exercise_reports import quoted_counts, report as _report
 
 
 def R(n): return exercises.reference(n)
@@ -371,8 +371,7 @@ def _seeded():
     np.random.set_state(state)
 
 
-def _id(rows):
-    return [f"{r[0]}-{k}-{r[1].__name__}" for k, r in enumerate(rows)]
+from exercise_reports import case_ids as _id   # noqa: E402
 
 
 @pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))

@@ -10,11 +10,7 @@ updated, a reference never moved, a bin change measured from the first boundary.
 names the mistake; the references, the notebooks' own solutions and correct alternatives still pass, and the
 counts of inputs that the notebooks quote ("matches the reference on N inputs") are unchanged.
 """
-import contextlib
-import io
 import json
-import re
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -25,16 +21,9 @@ from evinr_lite.core.events import Events
 from evinr_lite.teaching import events2d, exercises, pde1d
 from evinr_lite.teaching.checking.learner_calls import run
 from evinr_lite.teaching.checking.outputs import compare_outputs
+from exercise_reports import quoted_counts, report as _report   # shared by rounds 3-11
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _report(name, fn):
-    buf = io.StringIO()
-    with contextlib.redirect_stdout(buf), warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        ok = exercises.check(name, fn)
-    return ok, buf.getvalue()
 
 
 # ---- wrong solutions -------------------------------------------------------------------------------------
@@ -221,16 +210,6 @@ def test_events_outside_the_windows_do_not_cancel():
         if np.any(t < b[0]) and np.any(t > b[-1]):
             ok = p[t < b[0]].sum() != 0 and p[t > b[-1]].sum() != 0
     assert ok
-
-
-def quoted_counts() -> dict:
-    """{check name: N} from every notebook's "✓ NAME: matches the reference on N inputs"."""
-    quoted = {}
-    for path in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")):
-        text = "".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"])
-        for name, n in re.findall(r"✓ (\w+): matches the reference on (\d+) input", text):
-            quoted[name] = int(n)
-    return quoted
 
 
 def test_the_counts_the_notebooks_quote_are_unchanged():

@@ -35,7 +35,7 @@ from evinr_lite.method.losses import temporal_loss_derivative, tikhonov
 from evinr_lite.teaching import exercises
 from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
 from evinr_lite.teaching.checking.outputs import compare_outputs
-from test_exercise_wrong_solutions_round3 import _report, quoted_counts   # the check's verdict and its report; the notebooks' counts
+from exercise_reports import quoted_counts, report as _report   # the check's verdict and its report; the notebooks' counts
 
 
 def R(n): return exercises.reference(n)

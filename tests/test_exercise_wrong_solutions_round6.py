@@ -47,7 +47,7 @@ from evinr_lite.teaching import events2d, exercises
 from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
 from evinr_lite.teaching.checking.outputs import compare_outputs
 from evinr_lite.teaching.poisson_exercises import _differences, _path_integral
-from test_exercise_wrong_solutions_round3 import _report, quoted_counts
+from exercise_reports import quoted_counts, report as _report
 
 
 def R(n): return exercises.reference(n)

@@ -53,7 +53,7 @@ from evinr_lite.teaching import events2d, exercises
 from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
 from evinr_lite.teaching.checking.outputs import compare_outputs
 from evinr_lite.teaching.poisson_exercises import _differences
-from test_exercise_wrong_solutions_round3 import _report, quoted_counts
+from exercise_reports import quoted_counts, report as _report
 
 
 def R(n): return exercises.reference(n)
@@ -714,8 +714,7 @@ CORRECT = [
 ]
 
 
-def _id(rows):
-    return [f"{r[0]}-{k}-{r[1].__name__}" for k, r in enumerate(rows)]
+from exercise_reports import case_ids as _id   # noqa: E402
 
 
 @pytest.fixture(autouse=True)

@@ -89,7 +89,7 @@ from evinr_lite.teaching.checking import learner_calls
 from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
 from evinr_lite.teaching.checking.outputs import compare_outputs
 from evinr_lite.teaching.checking.hints import generic_hint, one_based_hint
-from test_exercise_wrong_solutions_round3 import _report, quoted_counts
+from exercise_reports import quoted_counts, report as _report
 
 
 def R(n): return exercises.reference(n)
@@ -750,8 +750,7 @@ CORRECT = [
 ]
 
 
-def _id(rows):
-    return [f"{r[0]}-{k}-{r[1].__name__}" for k, r in enumerate(rows)]
+from exercise_reports import case_ids as _id   # noqa: E402
 
 
 @pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))

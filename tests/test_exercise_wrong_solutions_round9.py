@@ -58,7 +58,7 @@ import torch
 from evinr_lite.teaching import exercises
 from evinr_lite.teaching.checking.learner_calls import changed_inputs, run
 from evinr_lite.teaching.checking.outputs import compare_outputs
-from test_exercise_wrong_solutions_round3 import _report, quoted_counts
+from exercise_reports import quoted_counts, report as _report
 
 
 def R(n): return exercises.reference(n)
@@ -555,8 +555,7 @@ CORRECT = [
 ]
 
 
-def _id(rows):
-    return [f"{r[0]}-{k}-{r[1].__name__}" for k, r in enumerate(rows)]
+from exercise_reports import case_ids as _id   # noqa: E402
 
 
 @pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))

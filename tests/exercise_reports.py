@@ -1,0 +1,35 @@
+"""Helpers the rounds of wrong exercise solutions share (tests/test_exercise_wrong_solutions_round3.py and later)."""
+import contextlib
+import io
+import json
+import re
+import warnings
+from pathlib import Path
+
+from evinr_lite.teaching import exercises
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def report(name, fn):
+    """(the check's verdict, the report it prints) for ``fn`` as exercise ``name``; warnings silenced."""
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ok = exercises.check(name, fn)
+    return ok, buf.getvalue()
+
+
+def quoted_counts() -> dict:
+    """{check name: N} from every notebook's "✓ NAME: matches the reference on N inputs"."""
+    quoted = {}
+    for path in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")):
+        text = "".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"])
+        for name, n in re.findall(r"✓ (\w+): matches the reference on (\d+) input", text):
+            quoted[name] = int(n)
+    return quoted
+
+
+def case_ids(rows):
+    """pytest ids "exercise-k-function" for rows (exercise name, function, ...)."""
+    return [f"{r[0]}-{k}-{r[1].__name__}" for k, r in enumerate(rows)]
