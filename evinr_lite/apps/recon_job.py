@@ -32,7 +32,7 @@ from ..method.solver import Reconstruction, reconstruct
 from .options import DEFAULT_FPS, RunOptions, check_run_options, choose_times, parse_times  # noqa: F401
 from .results import EQUALIZATIONS, score_predictions, score_recording, write_results  # noqa: F401
 from .stream_job import (check_disk, display_attrs, report_background, report_balance, report_lam, report_level,
-                         report_reach, run_streaming, streamable, video_fps)
+                         report_reach, report_temporal_scale, run_streaming, streamable, video_fps)
 
 __all__ = ["read_any", "load_recording", "describe_recording", "format_info", "choose_times", "reconstruct_recording",
            "score_predictions", "score_recording", "export_reconstruction", "run_reconstruct",
@@ -217,6 +217,7 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
         if not colour:
             report_balance(C, result.config.C, settings, log)
             report_lam(config.lam, result.config.lam, settings, log)
+            report_temporal_scale(config.temporal_scale, result.config.scale(), config.bin_duration, settings, log)
             report_background(config.background, result.config.background, result.config.background_dt, settings, log)
         report_level(options, config, log)
         if C_fit is not None:   # --C auto: the fit, its uncertainty and what it used

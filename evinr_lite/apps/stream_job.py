@@ -85,6 +85,18 @@ def report_lam(lam, used, settings: dict, log) -> None:
         "smooths more, e.g. 0.03-0.1 under heavy background activity)")
 
 
+def report_temporal_scale(scale, used, bin_duration: float, settings: dict, log) -> None:
+    """When the temporal scale was read from the events (``temporal_scale="auto"``, method/tempo.py): record it
+    in ``settings["temporal_scale_used"]`` and, when it is above 1 (fast motion), log the bins it gave (the
+    in-memory and the streamed job both)."""
+    if scale != "auto" or used is None:
+        return
+    settings["temporal_scale_used"] = float(used)
+    if used > 1:
+        log(f"fast changes: the pixels reverse polarity often, so the bins are {1000 * bin_duration / used:.3g} ms "
+            f"(not {1000 * bin_duration:.3g}) and the temporal prior {float(used):.3g}x faster")
+
+
 def report_background(background, used, dt, settings: dict, log) -> None:
     """When the background filter's window was chosen from the events (``background="auto"``): log the choice
     and record it in ``settings["background_used"]`` (the in-memory and the streamed job both)."""
@@ -282,6 +294,7 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
                 "seed": options.seed, "memory_estimate_bytes": est["total"]}
     report_balance(C, used, settings, log)
     report_lam(config.lam, history.get("lam_used"), settings, log)
+    report_temporal_scale(config.temporal_scale, history.get("temporal_scale_used"), config.bin_duration, settings, log)
     report_background(config.background, history.get("background_used"), history.get("background_dt_used"),
                       settings, log)
     report_level(options, config, log)

@@ -220,7 +220,7 @@ def interval_stride(sensor_size) -> int:
     return s
 
 
-def interval_sums(events: Events, last=None) -> tuple:
+def interval_sums(events: Events, last=None, with_flips: bool = False) -> tuple:
     """Per-pixel sums of the log intervals between consecutive events of the same polarity.
 
     Within a run of ON events a pixel's log intensity rises by C+ between two events, so the interval is
@@ -231,11 +231,14 @@ def interval_sums(events: Events, last=None) -> tuple:
         events: one span, time-ordered (as :class:`~evinr_lite.core.events.Events` always is).
         last: (last_t, last_p) float64 [H, W] and int8 [H, W]: each pixel's event before this span
             (NaN and 0 where none), so a streamed recording's chunks give the sums of the whole span.
+        with_flips: also return each pixel's polarity reversals (an event whose polarity differs from
+            the pixel's event before it): float64 [H, W], on the same grid, appended last.
 
     Returns:
         (log_on, k_on, log_off, k_off, last_t, last_p): [H, W] sums of log(interval / 1 s) and their
         counts for ON-ON and OFF-OFF pairs, and each pixel's last event after the span. Intervals are
-        floored at MIN_INTERVAL (1 us, the timestamp resolution of event cameras).
+        floored at MIN_INTERVAL (1 us, the timestamp resolution of event cameras). With ``with_flips``,
+        (..., last_t, last_p, flips).
     """
     H, W = events.sensor_size
     s = interval_stride((H, W))
@@ -268,11 +271,14 @@ def interval_sums(events: Events, last=None) -> tuple:
             full = np.zeros((H, W))
             full[::s, ::s] = np.bincount(fp[sel], w, minlength=Hs * Ws).reshape(Hs, Ws)
             sums.append(full)
+    if with_flips:   # a reversal: the pixel's event before had the other polarity (0: there was none)
+        flips = np.zeros((H, W))
+        flips[::s, ::s] = np.bincount(f[(prev_p != p) & (prev_p != 0)], minlength=Hs * Ws).reshape(Hs, Ws)
     end = np.ones(len(f), bool)
     end[:-1] = f[1:] != f[:-1]
     grid_t[f[end]], grid_p[f[end]] = t[end], p[end]
     last_t[::s, ::s], last_p[::s, ::s] = grid_t.reshape(Hs, Ws), grid_p.reshape(Hs, Ws)
-    return (*sums, last_t, last_p)
+    return (*sums, last_t, last_p, flips) if with_flips else (*sums, last_t, last_p)
 
 
 @dataclass
@@ -287,8 +293,9 @@ class PolarityCounts:
 
     ``decay`` in (0, 1]: the counts so far are multiplied by it before each update (1: all windows
     count alike; < 1 follows a balance that changes over the recording). The interval sums
-    (:func:`interval_sums`) follow the last event of each pixel across updates, so chunks give the
-    sums of the whole span. ``slices``: the boundaries (float64 [K + 1], s) of the span's time slices
+    (:func:`interval_sums`) and the polarity reversals (``flips``, for the temporal scale,
+    :mod:`~evinr_lite.method.tempo`) follow the last event of each pixel across updates, so chunks give
+    the sums of the whole span. ``slices``: the boundaries (float64 [K + 1], s) of the span's time slices
     for the edges' estimate (:func:`slice_counts`; None: not counted, and the pooled counts stand in
     for it); they take 8 K bytes per pixel (59 MB at 1280 x 720 with K = 8). ``counts_only``: the ON /
     OFF counts alone (the intervals and slices stay zero), for a pass that only finds hot pixels.
@@ -299,6 +306,7 @@ class PolarityCounts:
     n_on: np.ndarray = field(default=None, repr=False)
     n_off: np.ndarray = field(default=None, repr=False)
     intervals: tuple = field(default=None, repr=False)     # (log_on, k_on, log_off, k_off), [H, W] each
+    flips: np.ndarray = field(default=None, repr=False)    # polarity reversals per pixel, [H, W] (interval grid)
     last: tuple = field(default=None, repr=False)          # (last_t, last_p), [H, W] each
     slices: object = None                                   # float64 [K + 1] slice boundaries (s), or None
     sliced: tuple = field(default=None, repr=False)        # (on, off), float32 [K, H, W] each
@@ -312,6 +320,7 @@ class PolarityCounts:
         self.n_off = np.zeros((H, W)) if self.n_off is None else np.asarray(self.n_off, np.float64)
         if self.intervals is None:
             self.intervals = tuple(np.zeros((H, W)) for _ in range(4))
+        self.flips = np.zeros((H, W)) if self.flips is None else np.asarray(self.flips, np.float64)
         if self.slices is not None:
             self.slices = np.asarray(self.slices, np.float64)
             if self.slices.ndim != 1 or len(self.slices) < 2 or not np.all(np.diff(self.slices) > 0):
@@ -329,8 +338,9 @@ class PolarityCounts:
         self.n_off = self.n_off * self.decay + off
         if self.counts_only:
             return self
-        *new, last_t, last_p = interval_sums(events, self.last)
+        *new, last_t, last_p, flips = interval_sums(events, self.last, with_flips=True)
         self.intervals = tuple(old * self.decay + add for old, add in zip(self.intervals, new))
+        self.flips = self.flips * self.decay + flips
         self.last = (last_t, last_p)
         if self.slices is not None:
             self.sliced = tuple(old * np.float32(self.decay) + add

@@ -18,6 +18,7 @@ from .config import EvINRConfig
 from .ensemble import split_windows
 from .coarse import coarse_applies, coarse_times
 from .offset import MIN_TREND_FRAMES, offset_grid, trend_intervals
+from .stream_sizes import MIN_BATCH, PREDICT_CELLS, TONEMAP_CELLS
 
 __all__ = ["estimate_memory", "check_memory", "check_times_memory", "available_bytes"]
 
@@ -67,7 +68,7 @@ def _n_windows(span: float, config: EvINRConfig) -> int:
 def _final_bins(window_s: float, n_window_events: float, config: EvINRConfig) -> int:
     """Final bins of one network window (as training.initial boundaries and the bisections give them)."""
     if config.binning == "fixed":
-        n = max(2 ** config.n_bisections, config.min_bins, int(round(window_s / config.bin_duration)))
+        n = max(2 ** config.n_bisections, config.min_bins, int(round(window_s / config.final_bin_duration())))
     else:
         n = math.ceil(n_window_events / config.events_per_bin)
     return max(int(n), 1)
@@ -88,7 +89,7 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
       plus the fused training step's three B x P work arrays when n_iters > 0;
     - ``frames``: whole solve: every network at every query time [N, Q, P], its offset copy, the
       float64 blend and the float64 tone map [Q, P]; streaming: one prediction batch
-      (streaming.PREDICT_CELLS frames x pixels, at least MIN_BATCH frames) with its tone-mapped and
+      (stream_sizes.PREDICT_CELLS frames x pixels, at least MIN_BATCH frames) with its tone-mapped and
       uint8 copies and the tone map's float64 work arrays (TONEMAP_CELLS); the events and bins are
       freed before it, so the larger of the two phases counts; beside them, all run long: the offset
       grid (max(64, 8 N) frames), the overlap's partial blends and ``n_kept`` frames kept in memory
@@ -123,8 +124,6 @@ def estimate_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_
     bins = 4.0 * B * P * (2 + (3 if config.n_iters > 0 else 0))
     Q = float(n_frames)
     if streaming:
-        from .streaming import MIN_BATCH, PREDICT_CELLS, TONEMAP_CELLS
-
         batch = min(Q, max(MIN_BATCH, PREDICT_CELLS // P)) * P
         grid = float(max(64, 8 * N)) * P
         overlap_frames = Q * min(1.0, config.overlap / span) if span > 0 and N > 1 else 0.0
@@ -201,7 +200,7 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
                      f"over {est['span_s']:.6g} s); shorten the window with t_start=/t_end= (the events cover "
                      f"[{ev_lo:.6f}, {ev_hi:.6f}] s) or check the sensor size (sensor_size=(H, W))"),
         "bins": (f"{est['n_bins']:,} event bins of {H}x{W} pixels ({est['span_s']:.6g} s in bins of "
-                 f"{config.bin_duration:g} s); shorten the window with t_start=/t_end= (the events cover "
+                 f"{config.final_bin_duration():g} s); shorten the window with t_start=/t_end= (the events cover "
                  f"[{ev_lo:.6f}, {ev_hi:.6f}] s) or use a longer bin_duration"),
         "frames": (f"{est['n_frames']:,} output frames of {H}x{W} pixels; ask for fewer frames with fps= or at=, "
                    "or shorten the window with t_start=/t_end="),
@@ -213,7 +212,7 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
                    "or offset_solve=\"median_gradient\""),
     }[worst]
     if est.get("streaming") and worst in ("networks", "bins"):   # one window at a time: the window sets it
-        fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.bin_duration:g} s, "
+        fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.final_bin_duration():g} s, "
                f"{config.hidden_features} hidden features); use a longer bin_duration, a shorter tau or fewer "
                "hidden_features, or check the sensor size (sensor_size=(H, W))")
     raise EventDataError(f"this reconstruction needs about {gib(est['total'])} of memory but about {gib(free)} is "

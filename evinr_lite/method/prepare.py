@@ -39,6 +39,7 @@ from .balance import PolarityCounts, balance_from_counts, span_slices
 from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, fit_background, sample_spans, tile_counts
 from .denoise import DEFAULT_DT, denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
+from .tempo import temporal_scale
 
 __all__ = ["prepare_events", "prepare_source", "plan_from_counts", "drop_pixels", "filter_background",
            "choose_background", "reach", "BACKGROUND_MODES"]
@@ -78,13 +79,17 @@ def choose_background(cfg, read, t_start: float, t_end: float, hot=None, tiles=N
     return replace(cfg, background="keep") if fit.dt is None else replace(cfg, background="filter", background_dt=fit.dt)
 
 
-def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sliced=None):
+def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sliced=None, flips=None,
+                     span_s: float | None = None):
     """(cfg, hot): the config with C replaced by the estimated pair when ``cfg.balance`` is not "none" and
     C is one number (``intervals``: the span's :attr:`~evinr_lite.method.balance.PolarityCounts.intervals`,
     which the "events" rule needs; without them it falls back to the "counts" rule; ``sliced``: its
     :attr:`~evinr_lite.method.balance.PolarityCounts.sliced`, for the edges' estimate), ``lam="auto"``
     replaced by its value (:func:`~evinr_lite.method.smoothing.auto_lam`
-    for windows covering ``fraction`` of the span), and the hot pixels to drop (bool [H, W], all False
+    for windows covering ``fraction`` of the span), ``temporal_scale="auto"`` by its value
+    (:func:`~evinr_lite.method.tempo.temporal_scale`, from ``flips``, the span's
+    :attr:`~evinr_lite.method.balance.PolarityCounts.flips`, over ``span_s`` seconds; without them it stays
+    "auto", which trains as 1), and the hot pixels to drop (bool [H, W], all False
     unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
     changed (a copy)."""
     n_on = np.asarray(n_on, np.float64)
@@ -101,6 +106,8 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sl
             cfg = replace(cfg, C=fit.C)
     if cfg.lam == "auto":
         cfg = replace(cfg, lam=auto_lam(np.where(hot, 0, n_on), np.where(hot, 0, n_off), fraction))
+    if cfg.temporal_scale == "auto" and flips is not None and span_s is not None and span_s > 0:
+        cfg = replace(cfg, temporal_scale=temporal_scale(np.where(hot, 0, flips), np.where(hot, 0, n), span_s))
     return cfg, hot
 
 
@@ -159,7 +166,7 @@ def prepare_events(events: Events, cfg, span: tuple | None = None):
             _check_left(len(events), n_in, cfg.background_dt, events.sensor_size)
     counts = PolarityCounts(tuple(events.sensor_size), slices=span_slices(t0, t1)).update(events)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t0, t1, cfg.tau, cfg.overlap),
-                                counts.intervals, counts.sliced)
+                                counts.intervals, counts.sliced, counts.flips, t1 - t0)
     return drop_pixels(events, hot), cfg
 
 
@@ -231,7 +238,8 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
     read in between to choose the window). So every window is trained with the same C pair, lam
     and events as the whole-span solve. ``progress``: a bar for each pass over the recording."""
     t_start, t_end = checked_span(t_start, t_end, "prepare_source")
-    if cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto" and cfg.background == "keep":
+    if (cfg.balance == "none" and cfg.hot_pixels == "keep" and cfg.lam != "auto" and cfg.background == "keep"
+            and cfg.temporal_scale != "auto"):
         return cfg, source
     chunk_s = chunk_s or cfg.tau or (t_end - t_start)
     span, first, filtered = (t_start, t_end), None, cfg.background != "keep"
@@ -258,7 +266,7 @@ def prepare_source(source, t_start: float, t_end: float, cfg, chunk_s: float | N
         if dt:
             _check_left(int((counts.n_on + counts.n_off).sum()), n_in, dt, source.sensor_size)
     cfg, hot = plan_from_counts(counts.n_on, counts.n_off, cfg, window_fraction(t_start, t_end, cfg.tau, cfg.overlap),
-                                counts.intervals, counts.sliced)
+                                counts.intervals, counts.sliced, counts.flips, t_end - t_start)
     if cfg.background == "keep" and first is None and not hot.any():
         return cfg, source
     return cfg, _Prepared(source, span, first, dt=cfg.background_dt if cfg.background == "filter" else None, then=hot)

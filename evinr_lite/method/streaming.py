@@ -44,7 +44,9 @@ import torch
 from ..core.checks import check_reach, optional_seconds, require, seconds_array
 from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
+from .memory import check_memory
 from .prepare import prepare_source, read_chunks
+from .stream_sizes import MIN_BATCH, PREDICT_CELLS, TONEMAP_CELLS
 from .config import EvINRConfig
 from .ensemble import blend_weights, predict_networks, split_windows
 from .models import FrameINR
@@ -57,9 +59,6 @@ __all__ = ["stream_reconstruct", "StreamPart", "StreamState", "train_window", "n
            "alignment_times", "first_window_offset", "offset_grid", "span_offset", "tonemap",
            "OFFSET_FROM", "PREDICT_CELLS", "MIN_BATCH", "N_ALIGN_SAMPLES"]
 
-PREDICT_CELLS = 1 << 23     # frames x pixels per prediction batch (32 MB of float32) ...
-MIN_BATCH = 32              # ... but at least this many frames: each batch reads the d x H*W head once
-TONEMAP_CELLS = 1 << 21     # frames x pixels tone-mapped at once (its float64 work arrays stay ~50 MB)
 N_ALIGN_SAMPLES = 8         # times at which neighbouring networks are compared (as ensemble.alignment_offsets)
 _EDGE = 1e-9                # seconds: a time this close to a window belongs to it (as ensemble.blend_weights)
 OFFSET_FROM = ("span", "first_window")
@@ -74,7 +73,8 @@ class StreamPart:
     C_used: [C] or [C+, C-], the thresholds the events were integrated with, after the ON/OFF balance;
     lam_used: the regularizer's weight trained with, ``lam="auto"`` resolved; background_used and
     background_dt_used: the background filter applied, ``background="auto"`` resolved to "filter" with its
-    window in seconds, or "keep")."""
+    window in seconds, or "keep"; temporal_scale_used: the bins' and the temporal prior's scale,
+    ``temporal_scale="auto"`` resolved, :mod:`~evinr_lite.method.tempo`)."""
 
     times: np.ndarray
     indices: np.ndarray
@@ -294,9 +294,10 @@ def _count_up_to_two(source, t_start: float, t_end: float) -> int:
 
 
 def _resolved(cfg, used) -> dict:
-    """What the events chose, for a part's history: the thresholds, lam and the background filter."""
+    """What the events chose, for a part's history: the thresholds, lam, the background filter and the
+    temporal scale."""
     return {"C_used": used, "lam_used": float(cfg.lam), "background_used": cfg.background,
-            "background_dt_used": float(cfg.background_dt)}
+            "background_dt_used": float(cfg.background_dt), "temporal_scale_used": cfg.scale()}
 
 
 def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *, t_start: float | None = None,
@@ -342,6 +343,9 @@ def stream_reconstruct(source, query_times, config: EvINRConfig | None = None, *
     show = cfg.progress if progress is None else bool(progress)
     # hot pixels, background, ON/OFF balance, lam (method/prepare.py)
     cfg, source = prepare_source(source, t_start, t_end, cfg, progress=show)
+    if cfg.scale() > 1:   # the events asked for shorter bins (method/tempo.py): a window's bins grow; check again
+        check_memory(tuple(source.sensor_size), t_start, t_end, source.n_events or 0, len(q), cfg,
+                     str(default_device(cfg.device)), streaming=True)
     windows = split_windows(t_start, t_end, cfg.tau, cfg.overlap)
     if state is None:
         state = StreamState.start(windows, source.sensor_size)

@@ -30,7 +30,7 @@ def _initial_boundaries(events: Events, windows: np.ndarray, cfg: EvINRConfig) -
     factor = 2 ** cfg.n_bisections
     out = []
     if cfg.binning == "fixed":
-        n_final = max(factor, cfg.min_bins, int(round((windows[0, 1] - windows[0, 0]) / cfg.bin_duration)))
+        n_final = max(factor, cfg.min_bins, int(round((windows[0, 1] - windows[0, 0]) / cfg.final_bin_duration())))
         n0 = max(1, int(round(n_final / factor)))
         for lo, hi in windows:
             out.append(np.linspace(lo, hi, n0 + 1))
