@@ -138,3 +138,38 @@ def test_a_stream_checks_its_memory_again_when_the_events_shorten_its_bins(shake
     # a scale given as 1 (and a slow scene's "auto") adds no check: the caller's stands
     parts = list(stream_reconstruct(MemorySource(shaken), q, EvINRConfig(C=0.2, temporal_scale=1, progress=False)))
     assert sum(len(p.times) for p in parts) == len(q)
+
+
+def test_the_command_line_takes_the_scale():
+    from evinr_lite.apps.cli import build_parser, _message
+    from evinr_lite.apps.options import BATCH_FIELDS, RunOptions
+
+    assert RunOptions().config(0.2).temporal_scale == "auto"
+    assert RunOptions(temporal_scale=2).config(0.2).temporal_scale == 2.0
+    assert RunOptions(temporal_scale=" AUTO ").config(0.2).temporal_scale == "auto"
+    assert RunOptions(recipe="v0_1").config(0.2).temporal_scale == 1.0      # the recipe's own
+    assert "temporal_scale" in BATCH_FIELDS
+    for bad in ("fast", 0, -1.0, float("nan"), True, [2]):
+        with pytest.raises(EventDataError, match="temporal_scale= must be 'auto'"):
+            RunOptions(temporal_scale=bad)
+    parser = build_parser()
+    assert parser.parse_args(["reconstruct", "x.h5", "--out", "o", "--temporal-scale", "2.5"]).temporal_scale == 2.5
+    assert parser.parse_args(["batch", "x.h5", "--out", "o", "--temporal-scale", "auto"]).temporal_scale == "auto"
+    for bad in ("0", "-1", "nan", "fast"):
+        with pytest.raises(SystemExit):
+            parser.parse_args(["reconstruct", "x.h5", "--out", "o", "--temporal-scale", bad])
+    # the memory check's advice, as the command line words it
+    message = _message(EventDataError("... or use a longer bin_duration; or temporal_scale=1 (the events' fast "
+                                      "changes set 4)"))
+    assert "--temporal-scale 1" in message and "bin_duration" not in message
+
+
+def test_too_little_memory_for_the_scaled_bins_names_the_scale(shaken, monkeypatch):
+    from evinr_lite.method import memory
+    from evinr_lite.method.solver import reconstruct
+
+    est = memory.estimate_memory(SIZE, 0.0, 2.0, len(shaken), 4, EvINRConfig(C=0.2, temporal_scale=4.0))
+    monkeypatch.setattr(memory, "available_bytes", lambda device="cpu": est["total"] / 0.8 / 1.5)
+    monkeypatch.setattr(memory, "estimate_memory", lambda *a, **k: {**est, "parts": {"bins": 1.0}})
+    with pytest.raises(EventDataError, match=r"temporal_scale=1 \(the events' fast changes set"):
+        reconstruct(shaken, np.linspace(0.1, 1.9, 4), EvINRConfig(C=0.2, progress=False))

@@ -155,8 +155,25 @@ CAMERA_HELP = ("which camera of an MVSEC stereo file (davis/left or davis/right;
 LAM_HELP = ("the spatial regularizer's weight lambda: auto (the kit's: chosen from the events' activity) or a "
             "number >= 0; more smooths more (e.g. 0.03-0.1 for a recording with heavy background activity); "
             "default: the recipe's own (auto for kit, 0.05 for paper and v0_1)")
+SCALE_HELP = ("how much shorter the event bins are, and faster the temporal prior, than the recipe's: auto (the "
+              "kit's: 1 unless the pixels reverse polarity more than 2.5 times a second, as under a fast shake; at "
+              "most 4) or a number > 0 (1: the recipe's 1/32 s bins as they are); default: the recipe's own (auto "
+              "for kit, 1 for paper and v0_1)")
 ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose output layer is solved in closed "
               "form; 300 for paper and v0_1, with coarse-to-fine at a third and two thirds)")
+
+
+def _scale(text: str):
+    """--temporal-scale: "auto" or a number > 0."""
+    if text.strip().lower() == "auto":
+        return "auto"
+    try:
+        value = _finite(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected auto or a number > 0, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be auto or a number > 0, got {text!r}")
+    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -208,6 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     rec.add_argument("--display-mean", type=_level, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
     rec.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     rec.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
+    rec.add_argument("--temporal-scale", type=_scale, default=None, metavar="S", help=SCALE_HELP)
     rec.add_argument("--seed", type=_seed, default=0)
     rec.add_argument("--colour", action="store_true",
                      help="reconstruct in colour from a colour event camera (a recording with a 2x2 colour filter, "
@@ -280,6 +298,7 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--display-mean", type=_level, default=None, metavar="M", help=DISPLAY_MEAN_HELP)
     batch.add_argument("--iters", type=_count, default=None, help=ITERS_HELP)
     batch.add_argument("--lam", type=_lam, default=None, help=LAM_HELP)
+    batch.add_argument("--temporal-scale", type=_scale, default=None, metavar="S", help=SCALE_HELP)
     batch.add_argument("--seed", type=_seed, default=0)
     batch.add_argument("--video", action="store_true", help="also write MP4 / GIF per recording")
     batch.add_argument("--save-log", action="store_true", help=SAVE_LOG_HELP)
@@ -306,7 +325,8 @@ def _run_options(args):
                       device=args.device, recipe=args.recipe,
                       n_iters=args.iters, seed=args.seed, anchor=args.anchor, denoise=args.denoise,
                       keep_background=args.keep_background, static_camera=args.static_camera,
-                      colour=getattr(args, "colour", False), lam=args.lam, tonemap=args.tonemap,
+                      colour=getattr(args, "colour", False), lam=args.lam, temporal_scale=args.temporal_scale,
+                      tonemap=args.tonemap,
                       display_mean=args.display_mean, video=video,
                       progress=not args.quiet, save_log=args.save_log)
 
@@ -366,6 +386,7 @@ FLAG_FOR = [
     (re.compile(r",? or pass offset_coarse_px=None or offset_solve=\"median_gradient\""), ""),
     (re.compile(r"use a longer bin_duration, a shorter tau or fewer hidden_features, or "), ""),
     (re.compile(r" or use a longer bin_duration"), ""),
+    (re.compile(r"\btemporal_scale=1\b"), "--temporal-scale 1"),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)=(?=[\w'\"(.+-])"),
      lambda m: FLAGS[m.group(1)] + " "),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)="), lambda m: FLAGS[m.group(1)]),

@@ -28,7 +28,8 @@ from ..method.memory import check_times_memory
 from ..method.recipes import RECIPES, contrast_option, recipe_config
 from ..method.tonemap import TONEMAPS
 
-__all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "lam_option", "BATCH_FIELDS", "DEFAULT_FPS"]
+__all__ = ["RunOptions", "parse_times", "choose_times", "check_run_options", "lam_option", "temporal_scale_option",
+           "BATCH_FIELDS", "DEFAULT_FPS"]
 
 DEFAULT_FPS = 30.0      # frames per second when neither times nor ground-truth frames are given
 DISPLAY_MEAN_RANGE = (0.01, 0.99)   # --display-mean: beyond it the frames clip to black or white (a mean of
@@ -36,7 +37,7 @@ DISPLAY_MEAN_RANGE = (0.01, 0.99)   # --display-mean: beyond it the frames clip 
 
 # the options a batch takes (each recording's window and times are its own), as batch.json stores them
 BATCH_FIELDS = ("C", "fps", "n_iters", "recipe", "seed", "device", "video", "sensor_size", "denoise", "anchor", "tonemap",
-                "keep_background", "static_camera", "lam", "save_log", "display_mean")
+                "keep_background", "static_camera", "lam", "temporal_scale", "save_log", "display_mean")
 MAX_PATH_CHARS = 255   # longer text is never a file name (most file systems' limit for one name)
 _INDEX_TIME = re.compile(r"\s*(\d+)\s+(\S+)\s*")   # one line of timestamps.txt: `index time`
 
@@ -136,6 +137,17 @@ def lam_option(value) -> float | str:
     return float(value)
 
 
+def temporal_scale_option(value) -> float | str:
+    """``temporal_scale=`` checked: "auto" or a finite number > 0 (as a float); EventDataError naming the fix."""
+    if isinstance(value, str) and value.strip().lower() == "auto":
+        return "auto"
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(value) or value <= 0:
+        raise EventDataError(f"temporal_scale= must be 'auto' (read from the events) or a number > 0 (1: the recipe's "
+                             f"bins and temporal prior as they are; 2: bins half as long), got {value!r}")
+    return float(value)
+
+
 def _finite(name: str, value) -> float | None:
     if value is None:
         return None
@@ -179,6 +191,9 @@ class RunOptions:
             chosen from the events' activity; 0.05 for paper and v0_1), "auto", or a number >= 0. More
             smoothing for a recording with heavy background activity (docs/defaults.md, "Stress scenes": 2 Hz of
             background activity wants about 0.1), less for a busy, clean one.
+        temporal_scale: the bins' and the temporal prior's scale (``EvINRConfig.temporal_scale``): None (the
+            recipe's own: "auto" for kit, read from how often the pixels reverse polarity, 1 unless the scene moves
+            fast; 1 for paper and v0_1), "auto", or a number > 0 (bins bin_duration / s, a prior s times faster).
         tonemap: how the frames are shown: None (the recipe's own: linear for kit, the paper's Eq. 12 for
             paper and v0_1), "linear" or "reinhard", each at its own level (:mod:`evinr_lite.method.tonemap`).
         display_mean: the frames' mean brightness over the window, in [0.01, 0.99]: the level events never give
@@ -207,6 +222,7 @@ class RunOptions:
     static_camera: bool = False
     colour: bool = False
     lam: float | str | None = None
+    temporal_scale: float | str | None = None
     tonemap: str | None = None
     display_mean: float | None = None
     video: bool = True
@@ -268,6 +284,8 @@ class RunOptions:
             raise EventDataError("anchored colour reconstruction is not supported; pass anchor='none' with colour")
         if self.lam is not None:
             checked["lam"] = lam_option(self.lam)
+        if self.temporal_scale is not None:
+            checked["temporal_scale"] = temporal_scale_option(self.temporal_scale)
         if self.display_mean is not None:
             level = _finite("display_mean=", self.display_mean)
             if not DISPLAY_MEAN_RANGE[0] <= level <= DISPLAY_MEAN_RANGE[1]:
@@ -318,6 +336,8 @@ class RunOptions:
             extra["camera"] = "static"
         if self.lam is not None:
             extra["lam"] = self.lam
+        if self.temporal_scale is not None:
+            extra["temporal_scale"] = self.temporal_scale
         if self.display_mean is not None:
             extra["display_mean"] = self.display_mean
         return recipe_config(self.recipe, self.n_iters, self.tonemap, C=C, seed=self.seed, device=self.device,

@@ -211,10 +211,14 @@ def check_memory(sensor_size, t_start: float, t_end: float, n_events: int, n_fra
                    "events beside it); check the sensor size (sensor_size=(H, W)), or pass offset_coarse_px=None "
                    "or offset_solve=\"median_gradient\""),
     }[worst]
+    if worst == "bins" and config.scale() > 1:   # the events shortened the bins (method/tempo.py)
+        fix += (f"; or temporal_scale=1 (the events' fast changes set {config.scale():.3g}, for bins of "
+                f"{config.final_bin_duration():g} s instead of {config.bin_duration:g} s)")
     if est.get("streaming") and worst in ("networks", "bins"):   # one window at a time: the window sets it
         fix = (f"one window's network and bins at {H}x{W} pixels ({est['n_bins']:,} bins of {config.final_bin_duration():g} s, "
                f"{config.hidden_features} hidden features); use a longer bin_duration, a shorter tau or fewer "
-               "hidden_features, or check the sensor size (sensor_size=(H, W))")
+               "hidden_features, or check the sensor size (sensor_size=(H, W))"
+               + (f"; or temporal_scale=1 (the events' fast changes set {config.scale():.3g})" if config.scale() > 1 else ""))
     raise EventDataError(f"this reconstruction needs about {gib(est['total'])} of memory but about {gib(free)} is "
                          f"free on {device}: most of it for {fix}")
 
