@@ -72,17 +72,23 @@ def _contrast(text: str):
                                          f"0.22,0.18) or auto, got {text!r}") from None
 
 
-def _lam(text: str):
-    """--lam: "auto" or a number >= 0."""
+def _auto_or(text: str, positive: bool):
+    """"auto", or a finite number >= 0 (> 0 when ``positive``): --lam and --temporal-scale."""
+    bound = "> 0" if positive else ">= 0"
     if text.strip().lower() == "auto":
         return "auto"
     try:
         value = _finite(text)
     except argparse.ArgumentTypeError:
-        raise argparse.ArgumentTypeError(f"expected auto or a number >= 0, got {text!r}") from None
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f"must be auto or a number >= 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected auto or a number {bound}, got {text!r}") from None
+    if not (value > 0 if positive else value >= 0):
+        raise argparse.ArgumentTypeError(f"must be auto or a number {bound}, got {text!r}")
     return value
+
+
+def _lam(text: str):
+    """--lam: "auto" or a number >= 0."""
+    return _auto_or(text, positive=False)
 
 
 def _count(text: str) -> int:
@@ -165,15 +171,7 @@ ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose o
 
 def _scale(text: str):
     """--temporal-scale: "auto" or a number > 0."""
-    if text.strip().lower() == "auto":
-        return "auto"
-    try:
-        value = _finite(text)
-    except argparse.ArgumentTypeError:
-        raise argparse.ArgumentTypeError(f"expected auto or a number > 0, got {text!r}") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be auto or a number > 0, got {text!r}")
-    return value
+    return _auto_or(text, positive=True)
 
 
 def build_parser() -> argparse.ArgumentParser:
