@@ -1,43 +1,57 @@
-"""What a learner's call can change for the whole notebook: torch's global settings and the global generators.
+"""What a learner's call can change for the whole notebook: torch's, numpy's and the warnings' global settings, and
+the global generators.
 
-A function may switch gradients off (or on), change torch's default dtype, or seed numpy's, Python's or torch's
-global random generator. The check reads these before and after each call: :func:`torch_settings` and
-:func:`restore_torch_settings` set torch's settings back (:func:`settings_message` names the change), and
-:func:`rng_states`, :func:`other_rng_states` and :func:`reseeded_generators` tell a function that seeds a generator
-(two runs from different states end in one state) from one that only draws from it. Kept apart from running the
-call (:mod:`.learner_calls`), which uses the settings half, and from the hints built on the generators' states
-(:mod:`.across_calls`).
+A function may switch gradients off (or on), change torch's default dtype, change numpy's floating-point error
+handling (np.seterr) or the warning filters (warnings.filterwarnings, warnings.simplefilter), or seed numpy's,
+Python's or torch's global random generator. The check reads these before and after each call:
+:func:`global_settings` and :func:`restore_settings` set the settings back (:func:`settings_message` names the
+change), and :func:`rng_states`, :func:`other_rng_states` and :func:`reseeded_generators` tell a function that seeds a
+generator (two runs from different states end in one state) from one that only draws from it. Kept apart from
+running the call (:mod:`.learner_calls`), which uses the settings half, and from the hints built on the generators'
+states (:mod:`.across_calls`).
 """
 from __future__ import annotations
 
 import random
 import sys
+import warnings
 
 import numpy as np
 
 from .outputs import is_tensor
 
 
-def torch_settings() -> dict | None:
-    """torch's global settings a function may change for the whole notebook: gradients on or off, the default
-    float dtype; None when torch is not imported."""
+def global_settings() -> dict:
+    """The global settings a function may change for the whole notebook: numpy's floating-point error handling,
+    the warning filters, and (once torch is imported) torch's gradients on or off and default float dtype. Under
+    "modules", how many modules are imported: a call that imports one may add that module's own warning filters,
+    which are no learner's doing."""
+    out = {"numpy errors": np.geterr(), "warning filters": tuple(warnings.filters), "modules": len(sys.modules)}
     torch = sys.modules.get("torch")
-    if torch is None:
-        return None
-    return {"grad": torch.is_grad_enabled(), "dtype": torch.get_default_dtype()}
+    if torch is not None:
+        out.update(grad=torch.is_grad_enabled(), dtype=torch.get_default_dtype())
+    return out
 
 
-def restore_torch_settings(before: dict | None) -> dict:
-    """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was."""
-    torch = sys.modules.get("torch")
-    if before is None or torch is None:
+def restore_settings(before: dict | None) -> dict:
+    """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was. Warning filters
+    added while a module was imported for the first time are the module's, and stay."""
+    if before is None:
         return {}
-    now = torch_settings()
-    changed = {k: (before[k], now[k]) for k in before if now[k] != before[k]}
-    if "grad" in changed:
+    now = global_settings()
+    changed = {k: (before[k], now[k]) for k in before if k in now and k != "modules" and now[k] != before[k]}
+    if "warning filters" in changed and now["modules"] != before["modules"]:
+        del changed["warning filters"]
+    torch = sys.modules.get("torch")
+    if "grad" in changed and torch is not None:
         torch.set_grad_enabled(before["grad"])
-    if "dtype" in changed:
+    if "dtype" in changed and torch is not None:
         torch.set_default_dtype(before["dtype"])
+    if "numpy errors" in changed:
+        np.seterr(**before["numpy errors"])
+    if "warning filters" in changed:
+        warnings.filters[:] = list(before["warning filters"])
+        getattr(warnings, "_filters_mutated", lambda: None)()      # the C side caches the filters' version
     return changed
 
 
@@ -58,6 +72,19 @@ def settings_message(changed: dict) -> str:
                      "(torch.set_default_dtype) for the whole notebook, so every tensor made later (a model's "
                      "weights, torch.zeros, torch.tensor of floats) has the new dtype; give the dtype where you need "
                      "it (x.double(), torch.zeros(..., dtype=torch.float64)) and leave the default alone")
+    if "numpy errors" in changed:
+        old, new = changed["numpy errors"]
+        diff = ", ".join(f"{k}={new[k]!r}" for k in new if new[k] != old.get(k))
+        parts.append(f"it changed numpy's floating-point error handling for the whole notebook (np.seterr({diff})), "
+                     "so every later cell's divisions by zero, logs of 0 and overflows are handled that way too "
+                     "(silently ignored, or raised as errors); use `with np.errstate(divide='ignore'):` around the "
+                     "line that needs it, which sets the handling back at its end")
+    if "warning filters" in changed:
+        parts.append("it changed the warning filters for the whole notebook (warnings.filterwarnings or "
+                     "warnings.simplefilter), so later cells' warnings (the kit's own \"the cells below use the "
+                     "reference solution\" among them) are hidden or changed too; put the filter inside `with "
+                     "warnings.catch_warnings():`, which sets the filters back at its end (or, for numpy's own "
+                     "warnings, use `with np.errstate(...):`)")
     return "; and ".join(parts) + " (the check has set it back)"
 
 

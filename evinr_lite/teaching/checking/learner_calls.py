@@ -1,11 +1,11 @@
 """Running a learner's function, and what the call did besides returning.
 
 :func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's
-function cannot change the exercise's data), and sets torch's global settings back after it, whether it returns or
-raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
+function cannot change the exercise's data), and sets the notebook's global settings (torch's, numpy's error handling, the
+warning filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
 check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
 :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
-Over a whole check, :func:`watching` gathers what the learner's function changed of torch's settings.
+Over a whole check, :func:`watching` gathers what the learner's function changed of those settings.
 """
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from typing import Any, Callable, Iterator
 import numpy as np
 
 from .outputs import is_tensor, to_numpy
-from .global_state import restore_torch_settings, torch_settings
+from .global_state import global_settings, restore_settings
 
 
 def library_file(filename: str) -> bool:
@@ -105,12 +105,12 @@ def _deepcopy_with_grads(x):
     return y
 
 
-_WATCHED: list = []   # (the learner's function, what its calls changed of torch's settings), one per running check
+_WATCHED: list = []   # (the learner's function, what its calls changed of the settings), one per running check
 
 
 @contextlib.contextmanager
 def watching(fn: Callable) -> Iterator[dict]:
-    """While the block runs, what any call of ``fn`` through :func:`run` changes of torch's settings (the hints'
+    """While the block runs, what any call of ``fn`` through :func:`run` changes of the global settings (the hints'
     calls too) is gathered into the dict it yields, {name: (before, after)}, the first change of each name kept.
     Checks may nest (a check run from inside a learner's function): the innermost one's ``fn`` is watched."""
     seen: dict = {}
@@ -126,17 +126,18 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
     receives the copied ``(args, kwargs)`` as they are after the call.
 
-    torch's global settings (grad mode, default dtype) are set back after every call, whether it returns or
+    The global settings (torch's grad mode and default dtype, numpy's error handling, the warning filters) are set
+    back after every call, whether it returns or
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
     reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
     the call changed ({name: (before, after)}). What the learner's function changed on any call of the check
     (the hints' calls too) is also kept for the report (see :func:`watching`)."""
     args, kwargs = _deepcopy_with_grads((args, kwargs))
-    settings = torch_settings()
+    settings = global_settings()
     try:
         result = fn(*args, **kwargs)
     finally:
-        changed = restore_torch_settings(settings)
+        changed = restore_settings(settings)
         if settings_changed is not None:
             settings_changed.update(changed)
         if changed and _WATCHED and fn is _WATCHED[-1][0]:

@@ -17,8 +17,8 @@ from typing import Callable
 from .across_calls import (fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
                            mutable_defaults, reseed_hint, scalar_factor_hint, shares_output, stale_argument_hint,
                            state_hint)
-from .global_state import (other_rng_states, reseeded_generators, restore_torch_settings, rng_states,
-                           set_rng_states, settings_message, torch_settings)
+from .global_state import (global_settings, other_rng_states, reseeded_generators, restore_settings, rng_states,
+                           set_rng_states, settings_message)
 from .hints import (generic_hint, has_repeated_index, non_square, one_based_hint, size_from_events_hint,
                     swapped_pair_hint)
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, run, watching,
@@ -35,19 +35,20 @@ Report = tuple[bool, str, list[str]]   # (passed, headline, detail lines)
 def run_check(ex: ExerciseLike, fn: Callable) -> Report:
     """(passed, headline, detail lines) without printing.
 
-    torch's global settings are set back after every call of a function (see :func:`run`), and once more, to
+    The global settings (torch's, numpy's error handling, the warning filters) are set back after every call of a
+    function (see :func:`run`), and once more, to
     what they were when the check began, after all of it: a function that changes them only on an input the
     main run never reaches (a hint's search runs the others), or that raises right after, leaves the notebook as
     it was. Such a change is named in the report (`also: ...`) when the main run did not name it already."""
-    settings = torch_settings()
+    settings = global_settings()
     try:
         with watching(fn) as seen:
             ok, headline, details = _run_inputs(ex, fn)
-        if seen and not ok and not headline.startswith("changed torch's global settings"):
+        if seen and not ok and not headline.startswith("changed the notebook's global settings"):
             details = details + ["also: " + settings_message(seen)]
         return ok, headline, details
     finally:
-        restore_torch_settings(settings)
+        restore_settings(settings)
 
 
 def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
@@ -77,7 +78,7 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         except Exception as err:
             return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
         if changed_settings:
-            return False, f"changed torch's global settings on {where}", [settings_message(changed_settings)]
+            return False, f"changed the notebook's global settings on {where}", [settings_message(changed_settings)]
         expected = run(ex.reference, args, kwargs, ex.observe)
         problem = _first_difference(ex, got, expected)
         # inputs changed in place (a function with side effects says what to compare through `observe`)
@@ -281,7 +282,7 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
     finally:
         set_rng_states(rng_now)
     if changed_settings:
-        return False, f"changed torch's global settings on input #{n} of {n}", [settings_message(changed_settings)]
+        return False, f"changed the notebook's global settings on input #{n} of {n}", [settings_message(changed_settings)]
     if problem is not None:
         return False, f"gives another result when input #{n} of {n} is run a second time", [
             "every input matched once, but a second call on the same input does not: your function keeps "
