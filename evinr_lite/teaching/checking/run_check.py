@@ -24,7 +24,7 @@ from .hints import (generic_hint, has_repeated_index, non_square, one_based_hint
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, run, watching,
                             where_raised)
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
-from .outputs import Problem, compare_outputs, describe_case, differing_leaf, not_finite
+from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
 
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
@@ -79,10 +79,19 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
         if changed_settings:
             return False, f"changed the notebook's global settings on {where}", [settings_message(changed_settings)]
-        expected = run(ex.reference, args, kwargs, ex.observe)
+        ref_after: list = []
+        expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after)
         problem = _first_difference(ex, got, expected)
         # inputs changed in place (a function with side effects says what to compare through `observe`)
         changed = changed_inputs((args, kwargs), after[0]) if ex.observe is None and after else []
+        # the right values, but not what back-propagation from them reaches (a differentiable result)
+        grads = compare_gradients(got, after[0], expected, ref_after[0]) \
+            if problem is None and ex.observe is None and ex.compare is None and after and ref_after else None
+        if grads is not None:
+            extra = ["also: " + in_place_message(changed, container_names(args, kwargs))] if changed else []
+            what = "back-propagates inside the function" if grads.message == BACKWARD_CALLED \
+                else "gives the right values, but not the reference's gradients,"
+            return False, f"{what} on {where}", [grads.message] + extra
         if problem is None and not changed:
             continue
         if problem is None:
