@@ -19,7 +19,7 @@ import numpy as np
 
 from .global_state import SEED_CALLS, other_rng_states, reseeded_generators, rng_states, set_rng_states
 from .hints import unit_note
-from .learner_calls import run, same_array
+from .learner_calls import poison_freed_memory, run, same_array, uses_uninitialised
 from .outputs import compare_outputs, is_tensor, not_finite, to_numpy
 from .protocol import ExerciseLike
 
@@ -69,6 +69,26 @@ def mutable_default_hint(fn: Callable, before: dict[str, Any]) -> str | None:
     return None
 
 
+UNINITIALISED = (
+    "your function starts an array with np.empty (np.empty_like, torch.empty), which leaves in it whatever an "
+    "earlier array held in that memory, another garbage at every call: a sum, a count or a state must start from "
+    "np.zeros(...) (np.empty only suits an array whose every entry is written before it is read)")
+
+
+def uninitialised_hint(fn: Callable, ex: ExerciseLike, args, kwargs, got) -> str | None:
+    """A function that names np.empty (or np.empty_like, torch.empty) and answers otherwise when the freed memory
+    it may be handed holds zeros instead of the check's pattern: it reads entries it never wrote."""
+    if ex.observe is not None or not uses_uninitialised(fn):
+        return None
+    try:
+        poison_freed_memory(got, 0x00)             # zeros: the lucky memory that lets np.empty pass
+        if compare_outputs(run(fn, args, kwargs), got, ex.rtol, ex.atol) is not None:
+            return UNINITIALISED
+    except Exception:
+        return None
+    return None
+
+
 def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwargs, got,
                 first: bool = False) -> str | None:
     """A mutable default argument that changed (or holds data) during the check, or a second call on the same
@@ -78,7 +98,10 @@ def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwa
     if hint is not None or ex.observe is not None:
         return hint
     try:
+        poison_freed_memory(got)
         again = run(fn, args, kwargs, ex.observe)
+        if compare_outputs(again, got, ex.rtol, ex.atol) is not None and uses_uninitialised(fn):
+            return UNINITIALISED
         if compare_outputs(again, got, ex.rtol, ex.atol) is not None:
             return ("called again on the same input, your function returns another result: it keeps state between "
                     "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "

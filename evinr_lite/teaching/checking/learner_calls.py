@@ -5,7 +5,9 @@ function cannot change the exercise's data), and sets the notebook's global sett
 warning filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
 check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
 :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
-Over a whole check, :func:`watching` gathers what the learner's function changed of those settings.
+Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a call,
+:func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with np.empty
+(:func:`uses_uninitialised`) holds that pattern rather than zeros by chance.
 """
 from __future__ import annotations
 
@@ -217,3 +219,39 @@ def container_names(args: tuple, kwargs: dict) -> tuple:
     """The names `changed_inputs` gives the dict and list inputs."""
     return tuple([f"argument {k + 1}" for k, a in enumerate(args) if isinstance(a, (dict, list))]
                  + [name for name, v in kwargs.items() if isinstance(v, (dict, list))])
+
+
+def poison_freed_memory(like, byte: int = 0x7F) -> None:
+    """Fill memory in the sizes of the arrays in ``like`` (their bytes, and 2, 4, 8 times more or fewer: a float64
+    buffer for a float32 result, int64 counts for a bool mask) with ``byte`` (0x7f), and free it again. numpy and the
+    C library hand freed blocks of one size out again, last freed first, so a learner's np.empty of such a size
+    then starts from 0x7f bytes (1.4e306 as float64, 127 as int8) instead of whatever the last array left there,
+    which may be zeros and pass by chance."""
+    sizes = set()
+    stack = [like]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, dict):
+            stack.extend(v.values())
+        elif isinstance(v, (tuple, list)):
+            stack.extend(v)
+        elif isinstance(v, np.ndarray) or is_tensor(v):
+            n = int(to_numpy(v).nbytes)
+            sizes.update(n * f for f in (1, 2, 4, 8))
+            sizes.update(n // f for f in (2, 4, 8) if n % f == 0)
+    for size in sorted(s for s in sizes if 0 < s <= 1 << 20):
+        blocks = [np.full(size, byte, np.uint8) for _ in range(8)]
+        del blocks
+
+
+def uses_uninitialised(fn) -> bool:
+    """Whether the code of ``fn`` (its nested functions too) names np.empty, np.empty_like or torch.empty."""
+    codes = [getattr(fn, "__code__", None)]
+    while codes:
+        code = codes.pop()
+        if code is None:
+            continue
+        if {"empty", "empty_like"} & set(code.co_names):
+            return True
+        codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
+    return False
