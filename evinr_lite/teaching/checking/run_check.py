@@ -1,14 +1,17 @@
 """The check's main loop: every input in turn, the first problem reported with the hint that explains it.
 
 :func:`run_check` runs the learner's function and the reference on each of the exercise's inputs
-(:mod:`.learner_calls`), compares the outputs (:mod:`.outputs`), and at the first difference looks for a hint
-(:func:`_hint_for`), in a fixed order: data kept in a notebook variable (when it made the difference), the
+(:mod:`.learner_calls`; the reference first, and memory of its result's sizes filled with a pattern before the
+learner's call), compares the outputs (:mod:`.outputs`; where the values match, the gradients of a differentiable
+result too), and at the first difference looks for a hint (:func:`_hint_for`), in a fixed order: data kept in a
+notebook variable (when it made the difference), np.empty (a rerun on zeroed memory answers otherwise), the
 exercise's own wrong versions, a swapped pair, state kept between calls, an argument taken from input #1, the
 generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
-patterns read off the values (:mod:`.hints`), and last a notebook variable that only grew. After every input
-matched, the last one is run a second time from other states of the global generators (:func:`_second_call`,
-:mod:`.across_calls`, :mod:`.global_state`). The order is the report's: change it and other hints win. Returns
-(passed, headline, detail lines); printing is :func:`evinr_lite.teaching.exercises.check`'s.
+patterns read off the values (:mod:`.hints`: indices from 1, rows aliased by one list, then the rest), and last a
+notebook variable that only grew. After every input matched, the last one is run a second time from other states of
+the global generators (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`). The order is the report's:
+change it and other hints win. Returns (passed, headline, detail lines); printing is
+:func:`evinr_lite.teaching.exercises.check`'s.
 """
 from __future__ import annotations
 
