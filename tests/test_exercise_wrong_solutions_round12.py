@@ -441,3 +441,86 @@ def test_the_notebooks_own_cases_are_unchanged():
     from exercise_reports import quoted_counts
     for name, n in quoted_counts().items():
         assert len(exercises.get(name).cases()) == n, name
+
+
+# ---- review of round 12: a filter set beside a first import, np.empty named for other mistakes, gradients of an
+# input handed back and of a dict in another key order, the aliased-rows wording without lists, the fill's limit
+def _report_and_filters(name, fn):
+    """(verdict, report, the warning filters before the check, the filters after it)."""
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        before = list(warnings.filters)
+        ok = exercises.check(name, fn)
+        after = list(warnings.filters)
+    return ok, buf.getvalue(), before, after
+
+
+def _fresh_module(tmp_path, monkeypatch, name, body):
+    (tmp_path / f"{name}.py").write_text(body)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    sys.modules.pop(name, None)
+
+
+def test_a_filter_set_beside_a_first_import_is_named_and_set_back(tmp_path, monkeypatch):
+    """An import of a module not yet loaded (which adds no filter) no longer excuses the learner's own filter."""
+    _fresh_module(tmp_path, monkeypatch, "r12_review_plain", "X = 1\n")
+
+    def tm_import_then_filter(L, gamma):
+        import r12_review_plain  # noqa: F401
+        warnings.filterwarnings("ignore", category=RuntimeWarning)
+        return R("reinhard_tonemap")(L, gamma)
+    try:
+        ok, report, before, after = _report_and_filters("reinhard_tonemap", tm_import_then_filter)
+        assert not ok and "changed the warning filters for the whole notebook" in report, report
+        assert after == before
+    finally:
+        sys.modules.pop("r12_review_plain", None)
+
+
+def test_filters_added_by_an_import_stay_and_a_filter_beside_them_is_named(tmp_path, monkeypatch):
+    """A module imported for the first time (by an import statement or importlib.import_module, as torch's lazy
+    submodules are) keeps the filters it adds; the learner's own filter in the same call is named and removed."""
+    import importlib
+    _fresh_module(tmp_path, monkeypatch, "r12_review_filtered",
+                  "import warnings\nwarnings.filterwarnings('ignore', message='r12 review module filter')\n")
+
+    def tm_lazy_import_and_filter(L, gamma):
+        importlib.import_module("r12_review_filtered")
+        warnings.simplefilter("ignore")
+        return R("reinhard_tonemap")(L, gamma)
+    try:
+        ok, report, before, after = _report_and_filters("reinhard_tonemap", tm_lazy_import_and_filter)
+        assert not ok and "changed the warning filters for the whole notebook" in report, report
+        assert after[1:] == before and after[0][1].pattern == "r12 review module filter"
+        sys.modules.pop("r12_review_filtered", None)
+
+        def tm_lazy_import(L, gamma):
+            importlib.import_module("r12_review_filtered")
+            return R("reinhard_tonemap")(L, gamma)
+        ok, report = _report("reinhard_tonemap", tm_lazy_import)
+        assert ok, report
+    finally:
+        sys.modules.pop("r12_review_filtered", None)
+
+
+def test_the_check_s_final_restore_names_only_what_imports_did_not_add(tmp_path, monkeypatch):
+    import importlib
+    from evinr_lite.teaching.checking.global_state import global_settings, imports_watched, restore_settings
+    _fresh_module(tmp_path, monkeypatch, "r12_review_final",
+                  "import warnings\nwarnings.filterwarnings('ignore', message='r12 review final')\n")
+    try:
+        with warnings.catch_warnings():
+            settings = global_settings()
+            with imports_watched() as imported:
+                importlib.import_module("r12_review_final")
+                warnings.filterwarnings("ignore", message="r12 review learner")
+                changed = restore_settings(settings, imported)
+            assert "warning filters" in changed
+            patterns = [f[1].pattern for f in warnings.filters if f[1] is not None]
+            assert "r12 review final" in patterns and "r12 review learner" not in patterns
+            assert warnings.filters[1:] == list(settings["warning filters"])
+    finally:
+        sys.modules.pop("r12_review_final", None)

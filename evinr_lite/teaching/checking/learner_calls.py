@@ -23,7 +23,7 @@ from typing import Any, Callable, Iterator
 import numpy as np
 
 from .outputs import is_tensor, to_numpy
-from .global_state import global_settings, restore_settings
+from .global_state import global_settings, imports_watched, restore_settings
 
 
 def library_file(filename: str) -> bool:
@@ -132,19 +132,21 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     back after every call, whether it returns or
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
     reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
-    the call changed ({name: (before, after)}). What the learner's function changed on any call of the check
-    (the hints' calls too) is also kept for the report (see :func:`watching`)."""
+    the call changed ({name: (before, after)}); warning filters that a module imported for the first time during
+    the call adds are the module's, and stay (:func:`.global_state.imports_watched`). What the learner's function
+    changed on any call of the check (the hints' calls too) is also kept for the report (see :func:`watching`)."""
     args, kwargs = _deepcopy_with_grads((args, kwargs))
     settings = global_settings()
-    try:
-        result = fn(*args, **kwargs)
-    finally:
-        changed = restore_settings(settings)
-        if settings_changed is not None:
-            settings_changed.update(changed)
-        if changed and _WATCHED and fn is _WATCHED[-1][0]:
-            for name, change in changed.items():
-                _WATCHED[-1][1].setdefault(name, change)
+    with imports_watched() as imported:
+        try:
+            result = fn(*args, **kwargs)
+        finally:
+            changed = restore_settings(settings, imported)
+            if settings_changed is not None:
+                settings_changed.update(changed)
+            if changed and _WATCHED and fn is _WATCHED[-1][0]:
+                for name, change in changed.items():
+                    _WATCHED[-1][1].setdefault(name, change)
     if inputs_after is not None:
         inputs_after.append((args, kwargs))
     return result if observe is None else observe(result, args, kwargs)

@@ -20,8 +20,8 @@ from typing import Callable
 from .across_calls import (UNINITIALISED, fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
                            mutable_defaults, reseed_hint, scalar_factor_hint, shares_output, stale_argument_hint,
                            state_hint, uninitialised_hint)
-from .global_state import (global_settings, other_rng_states, reseeded_generators, restore_settings, rng_states,
-                           set_rng_states, settings_message)
+from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
+                           rng_states, set_rng_states, settings_message)
 from .hints import (aliased_rows_hint, generic_hint, has_repeated_index, non_square, one_based_hint,
                     size_from_events_hint, swapped_pair_hint)
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, poison_freed_memory,
@@ -44,14 +44,15 @@ def run_check(ex: ExerciseLike, fn: Callable) -> Report:
     main run never reaches (a hint's search runs the others), or that raises right after, leaves the notebook as
     it was. Such a change is named in the report (`also: ...`) when the main run did not name it already."""
     settings = global_settings()
-    try:
-        with watching(fn) as seen:
-            ok, headline, details = _run_inputs(ex, fn)
-        if seen and not ok and not headline.startswith("changed the notebook's global settings"):
-            details = details + ["also: " + settings_message(seen)]
-        return ok, headline, details
-    finally:
-        restore_settings(settings)
+    with imports_watched() as imported:
+        try:
+            with watching(fn) as seen:
+                ok, headline, details = _run_inputs(ex, fn)
+            if seen and not ok and not headline.startswith("changed the notebook's global settings"):
+                details = details + ["also: " + settings_message(seen)]
+            return ok, headline, details
+        finally:
+            restore_settings(settings, imported)
 
 
 def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
