@@ -524,3 +524,48 @@ def test_the_check_s_final_restore_names_only_what_imports_did_not_add(tmp_path,
             assert warnings.filters[1:] == list(settings["warning filters"])
     finally:
         sys.modules.pop("r12_review_final", None)
+
+
+def gf_empty_ok_but_random(x, y, p, C, raw_size):          # np.empty used right; random jitter is the mistake
+    H, W = raw_size; fr = np.empty((H // 4, W // 4)); fr.fill(0.0)
+    np.add.at(fr, (np.asarray(y) // 4, np.asarray(x) // 4), C * np.asarray(p, float) / 16)
+    return fr + 1e-3 * np.random.rand()
+_CALLS = [0]
+def gf_empty_ok_counter(x, y, p, C, raw_size):             # np.empty used right; a notebook counter is the mistake
+    _CALLS[0] += 1
+    H, W = raw_size; fr = np.empty((H // 4, W // 4)); fr[:] = 0
+    np.add.at(fr, (np.asarray(y) // 4, np.asarray(x) // 4), C * np.asarray(p, float) / 16)
+    return fr + (0.01 if _CALLS[0] > 4 else 0.0)
+def ie_queue_random(t_events, p_events, C, t_query):       # `empty` as a queue's method: no np.empty at all
+    import queue
+    q = queue.Queue()
+    if q.empty():
+        pass
+    return R("integrate_events_1d")(t_events, p_events, C, t_query) + 1e-3 * np.random.rand()
+
+
+@pytest.mark.parametrize("name, wrong, words", [
+    ("grey_event_frame", gf_empty_ok_but_random, "draws random numbers"),
+    ("grey_event_frame", gf_empty_ok_counter, "keeps state between calls"),
+    ("integrate_events_1d", ie_queue_random, "draws random numbers"),
+], ids=["gf_empty_ok_but_random", "gf_empty_ok_counter", "ie_queue_random"])
+def test_np_empty_is_named_only_where_the_memory_explains_the_difference(name, wrong, words):
+    _CALLS[0] = 0
+    ok, report = _report(name, wrong)
+    assert not ok and words in report, report
+    assert "np.empty" not in report, report
+
+
+def test_uses_uninitialised_needs_numpy_or_torch_as_the_owner():
+    from evinr_lite.teaching.checking.learner_calls import uses_uninitialised
+
+    def local_from_import(n):
+        from numpy import empty
+        return empty(n)
+
+    def local_alias(n):
+        import numpy as onp
+        return onp.empty_like(np.zeros(n))
+    assert uses_uninitialised(gf_empty) and uses_uninitialised(local_from_import) and uses_uninitialised(local_alias)
+    assert uses_uninitialised(lambda n: torch.empty(n))
+    assert not uses_uninitialised(ie_queue_random) and not uses_uninitialised(lambda d: d.empty)

@@ -13,11 +13,14 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import dis
 import os
 import re
 import site
+import sys
 import sysconfig
 import traceback
+import types
 from typing import Any, Callable, Iterator
 
 import numpy as np
@@ -246,14 +249,49 @@ def poison_freed_memory(like, byte: int = 0x7F) -> None:
         del blocks
 
 
+_ARRAY_MODULES = ("numpy", "torch")
+_EMPTY = ("empty", "empty_like")
+_LOADS = ("LOAD_GLOBAL", "LOAD_NAME", "LOAD_FAST", "LOAD_DEREF", "LOAD_CLASSDEREF")
+
+
+def _array_module(value) -> bool:
+    return isinstance(value, types.ModuleType) and value.__name__.split(".")[0] in _ARRAY_MODULES
+
+
+def _empty_function(value) -> bool:
+    """``value`` is np.empty, np.empty_like, torch.empty or torch.empty_like (a name imported from the module)."""
+    for module in map(sys.modules.get, _ARRAY_MODULES):
+        if module is not None and any(value is getattr(module, name, None) for name in _EMPTY):
+            return True
+    return False
+
+
 def uses_uninitialised(fn) -> bool:
-    """Whether the code of ``fn`` (its nested functions too) names np.empty, np.empty_like or torch.empty."""
+    """Whether the code of ``fn`` (its nested functions too) calls np.empty, np.empty_like, torch.empty or
+    torch.empty_like: ``empty`` read off np, numpy or torch (or another name for either module, in the notebook or
+    imported in the function), or a name imported from them (``from numpy import empty``). Another object's
+    ``empty`` (a queue's ``q.empty()``, a DataFrame's ``.empty``) is not one."""
+    namespace = getattr(fn, "__globals__", None)
+    namespace = namespace if isinstance(namespace, dict) else {}
+    modules = {"np", "numpy", "torch"} | {k for k, v in namespace.items() if _array_module(v)}
     codes = [getattr(fn, "__code__", None)]
     while codes:
         code = codes.pop()
         if code is None:
             continue
-        if {"empty", "empty_like"} & set(code.co_names):
-            return True
+        prev = None
+        for ins in dis.get_instructions(code):
+            if ins.opname in ("LOAD_ATTR", "LOAD_METHOD") and ins.argval in _EMPTY and prev is not None \
+                    and prev.opname in _LOADS and prev.argval in modules:
+                return True
+            if ins.opname == "IMPORT_FROM" and ins.argval in _EMPTY and prev is not None \
+                    and prev.opname in ("IMPORT_NAME", "IMPORT_FROM") and str(prev.argval).split(".")[0] in _ARRAY_MODULES:
+                return True
+            if ins.opname in ("LOAD_GLOBAL", "LOAD_NAME") and _empty_function(namespace.get(ins.argval)):
+                return True
+            if ins.opname.startswith("STORE_") and prev is not None and prev.opname == "IMPORT_NAME" \
+                    and str(prev.argval).split(".")[0] in _ARRAY_MODULES:
+                modules.add(ins.argval)          # `import numpy as onp` inside the function
+            prev = ins
         codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
     return False

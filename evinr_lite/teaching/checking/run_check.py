@@ -18,14 +18,14 @@ from __future__ import annotations
 from typing import Callable
 
 from .across_calls import (UNINITIALISED, fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
-                           mutable_defaults, reseed_hint, scalar_factor_hint, shares_output, stale_argument_hint,
-                           state_hint, uninitialised_hint)
+                           memory_explains, mutable_defaults, reseed_hint, scalar_factor_hint, shares_output,
+                           stale_argument_hint, state_hint, uninitialised_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
                            rng_states, set_rng_states, settings_message)
 from .hints import (aliased_rows_hint, generic_hint, has_repeated_index, non_square, one_based_hint,
                     size_from_events_hint, swapped_pair_hint)
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, poison_freed_memory,
-                            run, uses_uninitialised, watching, where_raised)
+                            run, watching, where_raised)
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
@@ -335,7 +335,7 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
         set_rng_states(rng_now)
     if changed_settings:
         return False, f"changed the notebook's global settings on input #{n} of {n}", [settings_message(changed_settings)]
-    if problem is not None and uses_uninitialised(fn):
+    if problem is not None and memory_explains(fn, ex, args, kwargs, got):
         return False, f"gives another result when input #{n} of {n} is run a second time", [UNINITIALISED]
     if problem is not None:
         return False, f"gives another result when input #{n} of {n} is run a second time", [
