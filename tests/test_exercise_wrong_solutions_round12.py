@@ -569,3 +569,37 @@ def test_uses_uninitialised_needs_numpy_or_torch_as_the_owner():
     assert uses_uninitialised(gf_empty) and uses_uninitialised(local_from_import) and uses_uninitialised(local_alias)
     assert uses_uninitialised(lambda n: torch.empty(n))
     assert not uses_uninitialised(ie_queue_random) and not uses_uninitialised(lambda d: d.empty)
+
+
+def _toy(name, reference, cases):
+    exercises.register(name, reference, cases)
+    return name
+
+
+def clip_reference(F, lo, hi):
+    return F.clamp(lo, hi)
+def clip_early_return(F, lo, hi):                           # nothing to clip: F itself, gradient 1 everywhere
+    if bool(((F >= lo) & (F <= hi)).all()):
+        return F
+    return F.clamp(lo, hi)
+def through_positive_reference(F, lo, hi):                  # F's values, the gradient only where F > 0
+    return F.clamp(min=0) + (F - F.clamp(min=0)).detach()
+def through_positive_as_input(F, lo, hi):                   # F itself: the values, not the gradient
+    return F
+
+
+def test_a_result_that_is_an_input_is_compared_by_its_gradients():
+    def cases(rng):
+        g = torch.Generator().manual_seed(0)
+        return [dict(F=torch.rand(3, 4, generator=g).requires_grad_(True), lo=-1.0, hi=2.0),
+                dict(F=(torch.randn(3, 4, generator=g) * 3).requires_grad_(True), lo=-1.0, hi=2.0)]
+    names = [_toy("r12_review_clip", clip_reference, cases),
+             _toy("r12_review_positive", through_positive_reference, cases)]
+    try:
+        ok, report = _report(names[0], clip_early_return)
+        assert ok, report
+        ok, report = _report(names[1], through_positive_as_input)
+        assert not ok and "its gradient with respect to `F` is not the reference's" in report, report
+    finally:
+        for name in names:
+            exercises.unregister(name)

@@ -280,7 +280,10 @@ def compare_gradients(got, got_inputs: tuple, expected, expected_inputs: tuple) 
     if any(g.grad is not None and e.grad is None for (_, g), (_, e) in zip(named_got, named_exp)):
         return Problem(BACKWARD_CALLED)
     pairs = [(g, e) for g, e in zip(got_leaves, exp_leaves) if e.requires_grad]
-    if any(e.grad_fn is not None and g.requires_grad and g.grad_fn is None for g, e in pairs):
+    inputs = [v for _, v in named_got]
+    # a leaf that requires grad and is none of the inputs (an input handed back is compared by its gradients below)
+    if any(e.grad_fn is not None and g.requires_grad and g.grad_fn is None and not any(g is v for v in inputs)
+           for g, e in pairs):
         return Problem("the value is right, but the result is a new tensor with no autograd history "
                        "(torch.tensor(..., requires_grad=True), or .requires_grad_() on a value taken out of the "
                        "graph): it requires grad, yet back-propagation from it reaches none of the inputs, so "
