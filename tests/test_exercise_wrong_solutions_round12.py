@@ -603,3 +603,31 @@ def test_a_result_that_is_an_input_is_compared_by_its_gradients():
     finally:
         for name in names:
             exercises.unregister(name)
+
+
+def tv_parts_reference(F):
+    return {"tv_x": F.diff(dim=-1).abs().mean(), "tv_y": F.diff(dim=-2).abs().mean()}
+def tv_parts_y_first(F):                                    # the same dict, built y first
+    return {"tv_y": F.diff(dim=-2).abs().mean(), "tv_x": F.diff(dim=-1).abs().mean()}
+def diffs_reference(F):
+    return {"dx": F.diff(dim=-1), "dy": F.diff(dim=-2)}
+def diffs_y_first(F):
+    return {"dy": F.diff(dim=-2), "dx": F.diff(dim=-1)}
+def diffs_y_first_detached(F):
+    return {"dy": F.diff(dim=-2), "dx": F.detach().diff(dim=-1).requires_grad_()}
+
+
+def test_dict_results_are_paired_by_key_for_the_gradients():
+    def cases(rng):
+        g = torch.Generator().manual_seed(0)
+        return [dict(F=torch.randn(3, 4, generator=g).requires_grad_(True))]
+    names = [_toy("r12_review_tv_parts", tv_parts_reference, cases), _toy("r12_review_diffs", diffs_reference, cases)]
+    try:
+        for name, fn in zip(names, (tv_parts_y_first, diffs_y_first)):
+            ok, report = _report(name, fn)
+            assert ok, report
+        ok, report = _report(names[1], diffs_y_first_detached)
+        assert not ok and "no autograd history" in report, report
+    finally:
+        for name in names:
+            exercises.unregister(name)

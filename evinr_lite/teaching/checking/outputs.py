@@ -247,13 +247,25 @@ BACKWARD_CALLED = (
     "time; return the loss and leave back-propagation to the caller (the training step)")
 
 
-def _tensor_leaves(v) -> list:
-    """The tensors inside ``v`` (tuples, lists and dict values, in order)."""
-    if isinstance(v, dict):
-        return [t for x in v.values() for t in _tensor_leaves(x)]
-    if isinstance(v, (tuple, list)):
-        return [t for x in v for t in _tensor_leaves(x)]
-    return [v] if is_tensor(v) else []
+def _tensor_pairs(got, expected) -> list | None:
+    """(got, expected) for the tensors inside ``expected``, walking its structure: dict values by key, tuples and
+    lists by position; None where ``got`` has another structure (another key set, another length, no tensor where
+    ``expected`` holds one), so that nothing is compared out of place."""
+    if isinstance(expected, dict):
+        if not isinstance(got, dict) or set(got) != set(expected):
+            return None
+        parts = [_tensor_pairs(got[k], expected[k]) for k in expected]
+    elif isinstance(expected, (tuple, list)):
+        if not isinstance(got, (tuple, list)) or len(got) != len(expected):
+            return None
+        parts = [_tensor_pairs(g, e) for g, e in zip(got, expected)]
+    elif is_tensor(expected):
+        return [(got, expected)] if is_tensor(got) else None
+    else:
+        return []
+    if any(p is None for p in parts):
+        return None
+    return [pair for p in parts for pair in p]
 
 
 def _grad_inputs(inputs: tuple) -> list:
@@ -271,15 +283,15 @@ def compare_gradients(got, got_inputs: tuple, expected, expected_inputs: tuple) 
     are compared (loosely: float32 sums in another order differ in their last digits). None when nothing is
     differentiable or all agree."""
     torch = sys.modules.get("torch")
-    exp_leaves, got_leaves = _tensor_leaves(expected), _tensor_leaves(got)
-    if torch is None or len(exp_leaves) != len(got_leaves) or not any(e.requires_grad for e in exp_leaves):
+    leaves = _tensor_pairs(got, expected)
+    if torch is None or leaves is None or not any(e.requires_grad for _, e in leaves):
         return None
     named_got, named_exp = _grad_inputs(got_inputs), _grad_inputs(expected_inputs)
     if not named_exp or [n for n, _ in named_got] != [n for n, _ in named_exp]:
         return None
     if any(g.grad is not None and e.grad is None for (_, g), (_, e) in zip(named_got, named_exp)):
         return Problem(BACKWARD_CALLED)
-    pairs = [(g, e) for g, e in zip(got_leaves, exp_leaves) if e.requires_grad]
+    pairs = [(g, e) for g, e in leaves if e.requires_grad]
     inputs = [v for _, v in named_got]
     # a leaf that requires grad and is none of the inputs (an input handed back is compared by its gradients below)
     if any(e.grad_fn is not None and g.requires_grad and g.grad_fn is None and not any(g is v for v in inputs)
