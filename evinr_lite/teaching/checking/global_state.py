@@ -6,10 +6,10 @@ handling (np.seterr) or the warning filters (warnings.filterwarnings, warnings.s
 Python's or torch's global random generator. The check reads these before and after each call:
 :func:`global_settings` and :func:`restore_settings` set the settings back (:func:`settings_message` names the
 change; the warning filters a module adds while it is imported for the first time, which :func:`imports_watched`
-gathers, are the module's and stay), and :func:`rng_states`, :func:`other_rng_states` and :func:`reseeded_generators` tell a function that seeds a
-generator (two runs from different states end in one state) from one that only draws from it. Kept apart from
-running the call (:mod:`.learner_calls`), which uses the settings half, and from the hints built on the generators'
-states (:mod:`.across_calls`).
+gathers, are the module's and stay), and :func:`rng_states`, :func:`other_rng_states` and
+:func:`reseeded_generators` tell a function that seeds a generator (two runs from different states end in one
+state) from one that only draws from it. Kept apart from running the call (:mod:`.learner_calls`), which uses the
+settings half, and from the hints built on the generators' states (:mod:`.across_calls`).
 """
 from __future__ import annotations
 

@@ -279,14 +279,15 @@ def uses_uninitialised(fn) -> bool:
         code = codes.pop()
         if code is None:
             continue
-        prev = None
+        prev = importing = None
         for ins in dis.get_instructions(code):
             if ins.opname in ("LOAD_ATTR", "LOAD_METHOD") and ins.argval in _EMPTY and prev is not None \
                     and prev.opname in _LOADS and prev.argval in modules:
                 return True
-            if ins.opname == "IMPORT_FROM" and ins.argval in _EMPTY and prev is not None \
-                    and prev.opname in ("IMPORT_NAME", "IMPORT_FROM") and str(prev.argval).split(".")[0] in _ARRAY_MODULES:
-                return True
+            if ins.opname == "IMPORT_NAME":
+                importing = str(ins.argval).split(".")[0]
+            if ins.opname == "IMPORT_FROM" and ins.argval in _EMPTY and importing in _ARRAY_MODULES:
+                return True             # `from numpy import zeros, empty` inside the function
             if ins.opname in ("LOAD_GLOBAL", "LOAD_NAME") and _empty_function(namespace.get(ins.argval)):
                 return True
             if ins.opname.startswith("STORE_") and prev is not None and prev.opname == "IMPORT_NAME" \
