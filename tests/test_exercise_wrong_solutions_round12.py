@@ -560,8 +560,8 @@ def test_uses_uninitialised_needs_numpy_or_torch_as_the_owner():
     from evinr_lite.teaching.checking.learner_calls import uses_uninitialised
 
     def local_from_import(n):
-        from numpy import empty
-        return empty(n)
+        from numpy import empty, zeros
+        return empty(n) + zeros(n)
 
     def local_alias(n):
         import numpy as onp
@@ -631,3 +631,22 @@ def test_dict_results_are_paired_by_key_for_the_gradients():
     finally:
         for name in names:
             exercises.unregister(name)
+
+
+def gf_forgot_row(x, y, p, C, raw_size):                    # numpy, no lists: the row index left out
+    H, W = raw_size; fr = np.zeros((H // 4, W // 4))
+    for xi, pi in zip(x, p):
+        fr[:, xi // 4] += C * pi / 16
+    return fr
+
+
+def test_every_row_the_same_names_lists_only_where_the_function_multiplies_one():
+    ok, report = _report("grey_event_frame", gf_forgot_row)
+    assert not ok and "every row of the result is the same" in report and "the row index is not used" in report, report
+    assert "[[0.0] * W] * H" not in report, report
+    ok, report = _report("grey_event_frame", gf_list_rows)
+    assert ok, report
+    e = np.array([[1.0, 0.0], [0.0, 2.0]])
+    assert "[[0.0] * W] * H" in aliased_rows_hint(np.array([[1.0, 2.0], [1.0, 2.0]]), e, 1e-5, 1e-8, gf_list_alias)
+    assert "[[0.0] * W] * H" not in aliased_rows_hint(np.array([[1.0, 2.0], [1.0, 2.0]]), e, 1e-5, 1e-8,
+                                                       gf_list_rows)

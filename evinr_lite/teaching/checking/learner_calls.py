@@ -7,7 +7,9 @@ check's), and :func:`cache_raised` tells an unhashable argument given to a cache
 :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
 Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a call,
 :func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with np.empty
-(:func:`uses_uninitialised`) holds that pattern rather than zeros by chance.
+(:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern rather than
+zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that holds a list
+(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint.
 """
 from __future__ import annotations
 
@@ -294,5 +296,57 @@ def uses_uninitialised(fn) -> bool:
                     and str(prev.argval).split(".")[0] in _ARRAY_MODULES:
                 modules.add(ins.argval)          # `import numpy as onp` inside the function
             prev = ins
+        codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
+    return False
+
+
+_NAME_LOADS = ("LOAD_FAST", "LOAD_NAME", "LOAD_DEREF", "LOAD_GLOBAL", "LOAD_CLASSDEREF", "LOAD_CLOSURE")
+_NAME_STORES = ("STORE_FAST", "STORE_NAME", "STORE_DEREF", "STORE_GLOBAL")
+
+
+def multiplies_rows(fn) -> bool:
+    """Whether the code of ``fn`` (its nested functions and comprehensions too) multiplies a list that holds a list:
+    ``[[0.0] * W] * H``, or ``[row] * H`` where ``row = [0.0] * W``, H references to one row list. Read off the
+    bytecode by following what each value on the stack is (a list of numbers, a list holding a list, anything
+    else) through list displays, ``*`` and the names they are stored in; runs nothing."""
+    codes = [getattr(fn, "__code__", None)]
+    while codes:
+        code = codes.pop()
+        if code is None:
+            continue
+        stack: list[str] = []
+        names: dict[str, str] = {}
+
+        def pop() -> str:
+            return stack.pop() if stack else "other"
+        for ins in dis.get_instructions(code):
+            op = ins.opname
+            if op == "BUILD_LIST":
+                items = [pop() for _ in range(ins.arg or 0)]
+                stack.append("rows" if any(t in ("list", "rows") for t in items) else "list")
+            elif op == "BINARY_OP" and ins.argrepr in ("*", "*="):
+                kinds = (pop(), pop())
+                if "rows" in kinds:
+                    return True
+                stack.append("list" if "list" in kinds else "other")
+            elif op in _NAME_STORES:
+                names[ins.argval] = pop()
+            elif op in _NAME_LOADS or op == "LOAD_CONST":
+                try:
+                    pushed = dis.stack_effect(ins.opcode, ins.arg)
+                except (ValueError, TypeError):
+                    pushed = 1
+                stack.extend(["other"] * (pushed - 1))             # the NULL that LOAD_GLOBAL may push first
+                stack.append("const" if op == "LOAD_CONST" else names.get(ins.argval, "other"))
+            else:
+                try:
+                    effect = dis.stack_effect(ins.opcode, ins.arg if ins.opcode >= dis.HAVE_ARGUMENT else None)
+                except (ValueError, TypeError):
+                    effect = 0
+                for _ in range(-effect):
+                    pop()
+                if effect >= 0 and stack:
+                    stack[-1] = "other"                             # an operation on the value on top
+                stack.extend(["other"] * max(effect, 0))
         codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
     return False

@@ -252,7 +252,7 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
         if hint is None:
             hint = one_based_hint(got, expected, ex.rtol, ex.atol)
         if hint is None:
-            hint = aliased_rows_hint(got, expected, ex.rtol, ex.atol)
+            hint = aliased_rows_hint(got, expected, ex.rtol, ex.atol, fn)
         if hint is None:
             hint = wrong_axes_hint(ex, args, kwargs, got, expected)
         if hint is None:
