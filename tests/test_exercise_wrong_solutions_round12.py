@@ -650,3 +650,9 @@ def test_every_row_the_same_names_lists_only_where_the_function_multiplies_one()
     assert "[[0.0] * W] * H" in aliased_rows_hint(np.array([[1.0, 2.0], [1.0, 2.0]]), e, 1e-5, 1e-8, gf_list_alias)
     assert "[[0.0] * W] * H" not in aliased_rows_hint(np.array([[1.0, 2.0], [1.0, 2.0]]), e, 1e-5, 1e-8,
                                                        gf_list_rows)
+
+
+def test_the_exercises_docstring_states_the_fill_s_limit():
+    from evinr_lite.teaching.checking.learner_calls import POISON_LIMIT
+    assert POISON_LIMIT == 1 << 20
+    assert "up to 1 MiB" in " ".join(exercises.__doc__.split())

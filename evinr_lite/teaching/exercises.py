@@ -47,7 +47,8 @@ a tensor result cut off from the autograd graph where the reference's is differe
 inputs with ``requires_grad``), or whose gradients with respect to those inputs differ from the reference's (a new
 leaf made with ``requires_grad=True``, a term taken out of the graph, ``.backward()`` called inside), and a list or
 a tensor where the reference returns a numpy array. Memory freed in the sizes of the reference's result is filled
-with a pattern before each call, so that an array started with np.empty does not pass by holding zeros. An
+with a pattern before each call (blocks of up to 1 MiB; a larger result's memory is not filled), so that an array
+started with np.empty does not pass by holding zeros. An
 exception is reported at the learner's own line, even when numpy or torch raised it deeper down. The last input
 is run a second time, from other states of the global random generators: a function fails that then answers
 differently (state kept between calls), that hands out the same array, tensor or dict again (a buffer or a cached

@@ -228,12 +228,16 @@ def container_names(args: tuple, kwargs: dict) -> tuple:
                  + [name for name, v in kwargs.items() if isinstance(v, (dict, list))])
 
 
+POISON_LIMIT = 1 << 20     # the largest block poison_freed_memory fills (1 MiB): eight of each size are made
+
+
 def poison_freed_memory(like, byte: int = 0x7F) -> None:
     """Fill memory in the sizes of the arrays in ``like`` (their bytes, and 2, 4, 8 times more or fewer: a float64
     buffer for a float32 result, int64 counts for a bool mask) with ``byte`` (0x7f), and free it again. numpy and the
     C library hand freed blocks of one size out again, last freed first, so a learner's np.empty of such a size
     then starts from 0x7f bytes (1.4e306 as float64, 127 as int8) instead of whatever the last array left there,
-    which may be zeros and pass by chance."""
+    which may be zeros and pass by chance. Only blocks of up to :data:`POISON_LIMIT` (1 MiB) are filled: memory
+    for a larger array is not, and np.empty there may hold zeros by chance."""
     sizes = set()
     stack = [like]
     while stack:
@@ -246,7 +250,7 @@ def poison_freed_memory(like, byte: int = 0x7F) -> None:
             n = int(to_numpy(v).nbytes)
             sizes.update(n * f for f in (1, 2, 4, 8))
             sizes.update(n // f for f in (2, 4, 8) if n % f == 0)
-    for size in sorted(s for s in sizes if 0 < s <= 1 << 20):
+    for size in sorted(s for s in sizes if 0 < s <= POISON_LIMIT):
         blocks = [np.full(size, byte, np.uint8) for _ in range(8)]
         del blocks
 
