@@ -44,14 +44,19 @@ A hint is shown only when the learner's output also matches the wrong version on
 where that mistake shows, so that one input cannot make two different mistakes look alike. Beyond the
 values, a check fails a function that changes an input array in place (even when its result is right),
 a tensor result cut off from the autograd graph where the reference's is differentiable (cases mark such
-inputs with ``requires_grad``), and a list or a tensor where the reference returns a numpy array. An
+inputs with ``requires_grad``), or whose gradients with respect to those inputs differ from the reference's (a new
+leaf made with ``requires_grad=True``, a term taken out of the graph, ``.backward()`` called inside), and a list or
+a tensor where the reference returns a numpy array. Memory freed in the sizes of the reference's result is filled
+with a pattern before each call (blocks of up to 1 MiB; a larger result's memory is not filled), so that an array
+started with np.empty does not pass by holding zeros. An
 exception is reported at the learner's own line, even when numpy or torch raised it deeper down. The last input
 is run a second time, from other states of the global random generators: a function fails that then answers
 differently (state kept between calls), that hands out the same array, tensor or dict again (a buffer or a cached
 result, which the next call or the caller changes), or that reseeds a global generator (np.random.seed,
 torch.manual_seed, random.seed); so does one that changes torch's settings for the whole notebook (gradients
-switched off, or on where the notebook had them off; the default dtype), which the check sets back after every call
-(the hints' calls too) and once more at its end.
+switched off, or on where the notebook had them off; the default dtype), numpy's error handling (np.seterr) or the
+warning filters (warnings.filterwarnings), which the check sets back after every call (the hints' calls too) and
+once more at its end.
 
 ``use`` says "not finished" for a stub that still raises ``NotImplementedError`` and "does not
 pass the check yet" for a finished function that gives wrong results. For a function with side

@@ -4,8 +4,10 @@
 check itself, one job per module, lowest first:
 
 - ``protocol``: what the check uses of an exercise (``ExerciseLike``);
-- ``outputs``: compare an output with the reference's (type, shape, dtype, values) and describe values;
-- ``global_state``: what a call can change for the whole notebook: torch's settings, the global generators;
+- ``outputs``: compare an output with the reference's (type, shape, dtype, values, and the gradients of a
+  differentiable one) and describe values;
+- ``global_state``: what a call can change for the whole notebook: torch's settings, numpy's error handling, the
+  warning filters, the global generators;
 - ``learner_calls``: run the learner's function on copied inputs; where it raised; what it changed in place;
 - ``hints``: likely mistakes read off a wrong output (a flipped sign, a factor, indices from 1, ...);
 - ``mistakes``: wrong versions made from the reference (the wrong image axis among them), confirmed on the other

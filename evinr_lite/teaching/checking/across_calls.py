@@ -2,7 +2,8 @@
 
 One input alone cannot show these: a mutable default argument or a notebook dict that fills up during the check
 (:func:`mutable_default_hint`, :func:`global_cache_hint`), a second call on the same input that answers
-otherwise (:func:`state_hint`), a result that is right for input #1's arguments or sizes, not this input's
+otherwise (:func:`state_hint`) or answers otherwise on freed memory filled with zeros than with the check's pattern
+(np.empty, :func:`memory_explains`), a result that is right for input #1's arguments or sizes, not this input's
 (:func:`stale_argument_hint`, :func:`fixed_size_hint`), one number off by the same factor on every input
 (:func:`scalar_factor_hint`). And, on the second call of the last input:
 :func:`shares_output` (the same array, tensor or dict handed out twice, a buffer or a cached result) and
@@ -19,7 +20,7 @@ import numpy as np
 
 from .global_state import SEED_CALLS, other_rng_states, reseeded_generators, rng_states, set_rng_states
 from .hints import unit_note
-from .learner_calls import run, same_array
+from .learner_calls import poison_freed_memory, run, same_array, uses_uninitialised
 from .outputs import compare_outputs, is_tensor, not_finite, to_numpy
 from .protocol import ExerciseLike
 
@@ -69,25 +70,67 @@ def mutable_default_hint(fn: Callable, before: dict[str, Any]) -> str | None:
     return None
 
 
+UNINITIALISED = (
+    "your function starts an array with np.empty (np.empty_like, torch.empty), which leaves in it whatever an "
+    "earlier array held in that memory, another garbage at every call: a sum, a count or a state must start from "
+    "np.zeros(...) (np.empty only suits an array whose every entry is written before it is read)")
+
+
+def memory_explains(fn: Callable, ex: ExerciseLike, args, kwargs, like) -> bool:
+    """Whether what np.empty is handed explains ``fn``'s answers on this input: a function that calls np.empty (or
+    np.empty_like, torch.empty; :func:`uses_uninitialised`) is run four times, the global generators set to one
+    state before each, on freed memory (in the sizes of ``like``) filled with zeros, then the check's pattern, then
+    zeros and the pattern again: the two runs on each fill agree, and the fills answer differently. A function that
+    draws random numbers, keeps state between calls or counts its calls answers otherwise for its own reasons, and
+    is not blamed on np.empty. The generators are set back to their state before."""
+    if ex.observe is not None or not uses_uninitialised(fn):
+        return False
+    states = rng_states()
+    try:
+        outs = []
+        for byte in (0x00, 0x7F, 0x00, 0x7F):
+            set_rng_states(states)
+            poison_freed_memory(like, byte)
+            outs.append(run(fn, args, kwargs))
+        zeros, pattern, zeros_again, pattern_again = outs
+        return (compare_outputs(zeros_again, zeros, ex.rtol, ex.atol) is None
+                and compare_outputs(pattern_again, pattern, ex.rtol, ex.atol) is None
+                and compare_outputs(pattern, zeros, ex.rtol, ex.atol) is not None)
+    except Exception:
+        return False
+    finally:
+        set_rng_states(states)
+
+
+def uninitialised_hint(fn: Callable, ex: ExerciseLike, args, kwargs, got) -> str | None:
+    """A function that calls np.empty (or np.empty_like, torch.empty) and whose answer depends on what the freed
+    memory it is handed holds (:func:`memory_explains`): it reads entries it never wrote."""
+    return UNINITIALISED if memory_explains(fn, ex, args, kwargs, got) else None
+
+
 def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwargs, got,
                 first: bool = False) -> str | None:
     """A mutable default argument that changed (or holds data) during the check, or a second call on the same
-    input that gives another result: the function keeps state between calls, or draws unseeded random numbers.
+    input that gives another result: the function keeps state between calls, or draws unseeded random numbers
+    (np.empty only where the memory it is handed explains the difference, :func:`memory_explains`).
     ``first``: the failing input is the first one, where a default cannot hold an earlier call's data yet."""
     hint = None if first else mutable_default_hint(fn, before)
     if hint is not None or ex.observe is not None:
         return hint
     try:
+        poison_freed_memory(got)
         again = run(fn, args, kwargs, ex.observe)
-        if compare_outputs(again, got, ex.rtol, ex.atol) is not None:
-            return ("called again on the same input, your function returns another result: it keeps state between "
-                    "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "
-                    "from the global generator (np.random.choice, np.random.randn, torch.randn without a seed of "
-                    "its own); compute everything from the arguments, starting afresh in each call, with no "
-                    "randomness (nothing here asks for a random sample)")
+        if compare_outputs(again, got, ex.rtol, ex.atol) is None:
+            return None
+        if memory_explains(fn, ex, args, kwargs, got):
+            return UNINITIALISED
+        return ("called again on the same input, your function returns another result: it keeps state between "
+                "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "
+                "from the global generator (np.random.choice, np.random.randn, torch.randn without a seed of "
+                "its own); compute everything from the arguments, starting afresh in each call, with no "
+                "randomness (nothing here asks for a random sample)")
     except Exception:
         return None
-    return None
 
 
 def global_containers(fn: Callable) -> dict[str, tuple[int, int]]:

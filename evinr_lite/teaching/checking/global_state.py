@@ -1,43 +1,128 @@
-"""What a learner's call can change for the whole notebook: torch's global settings and the global generators.
+"""What a learner's call can change for the whole notebook: torch's, numpy's and the warnings' global settings, and
+the global generators.
 
-A function may switch gradients off (or on), change torch's default dtype, or seed numpy's, Python's or torch's
-global random generator. The check reads these before and after each call: :func:`torch_settings` and
-:func:`restore_torch_settings` set torch's settings back (:func:`settings_message` names the change), and
-:func:`rng_states`, :func:`other_rng_states` and :func:`reseeded_generators` tell a function that seeds a generator
-(two runs from different states end in one state) from one that only draws from it. Kept apart from running the
-call (:mod:`.learner_calls`), which uses the settings half, and from the hints built on the generators' states
-(:mod:`.across_calls`).
+A function may switch gradients off (or on), change torch's default dtype, change numpy's floating-point error
+handling (np.seterr) or the warning filters (warnings.filterwarnings, warnings.simplefilter), or seed numpy's,
+Python's or torch's global random generator. The check reads these before and after each call:
+:func:`global_settings` and :func:`restore_settings` set the settings back (:func:`settings_message` names the
+change; the warning filters a module adds while it is imported for the first time, which :func:`imports_watched`
+gathers, are the module's and stay), and :func:`rng_states`, :func:`other_rng_states` and
+:func:`reseeded_generators` tell a function that seeds a generator (two runs from different states end in one
+state) from one that only draws from it. Kept apart from running the call (:mod:`.learner_calls`), which uses the
+settings half, and from the hints built on the generators' states (:mod:`.across_calls`).
 """
 from __future__ import annotations
 
+import builtins
+import contextlib
+import functools
+import importlib
 import random
 import sys
+import warnings
+from typing import Callable, Iterator
 
 import numpy as np
 
 from .outputs import is_tensor
 
 
-def torch_settings() -> dict | None:
-    """torch's global settings a function may change for the whole notebook: gradients on or off, the default
-    float dtype; None when torch is not imported."""
+def global_settings() -> dict:
+    """The global settings a function may change for the whole notebook: numpy's floating-point error handling,
+    the warning filters, and (once torch is imported) torch's gradients on or off and default float dtype."""
+    out = {"numpy errors": np.geterr(), "warning filters": tuple(warnings.filters)}
     torch = sys.modules.get("torch")
-    if torch is None:
-        return None
-    return {"grad": torch.is_grad_enabled(), "dtype": torch.get_default_dtype()}
+    if torch is not None:
+        out.update(grad=torch.is_grad_enabled(), dtype=torch.get_default_dtype())
+    return out
 
 
-def restore_torch_settings(before: dict | None) -> dict:
-    """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was."""
-    torch = sys.modules.get("torch")
-    if before is None or torch is None:
+_IMPORT_WATCHES: list[list] = []    # one list per open :func:`imports_watched`, innermost last
+
+
+def _watched(original: Callable) -> Callable:
+    """``original`` (builtins.__import__ or importlib.import_module), noting the warning filters added while it ran
+    in every open watch: a module imported for the first time runs its own code then, and its filters are its
+    own."""
+    @functools.wraps(original)
+    def importing(*args, **kwargs):
+        before = list(warnings.filters)          # kept alive, so that no new entry can share an id with one of them
+        seen = {id(f) for f in before}
+        try:
+            return original(*args, **kwargs)
+        finally:
+            added = [f for f in warnings.filters if id(f) not in seen]
+            for watch in _IMPORT_WATCHES:
+                watch.extend(added)
+    return importing
+
+
+@contextlib.contextmanager
+def imports_watched() -> Iterator[list]:
+    """While the block runs, the warning filters added while a module was being imported (an import statement,
+    __import__ or importlib.import_module; numpy's and torch's submodules load lazily, and some add filters) are
+    gathered into the list it yields, for :func:`restore_settings` to keep: they are the module's, not the
+    caller's. A filter set beside the import, by the caller, is not among them. Watches may nest."""
+    added: list = []
+    first = not _IMPORT_WATCHES
+    if first:
+        originals = builtins.__import__, importlib.import_module
+        wrappers = _watched(originals[0]), _watched(originals[1])
+        builtins.__import__, importlib.import_module = wrappers
+    _IMPORT_WATCHES.append(added)
+    try:
+        yield added
+    finally:
+        _IMPORT_WATCHES.pop()
+        if first:
+            if builtins.__import__ is wrappers[0]:
+                builtins.__import__ = originals[0]
+            if importlib.import_module is wrappers[1]:
+                importlib.import_module = originals[1]
+
+
+def _same_entries(a: list, b: list) -> bool:
+    return len(a) == len(b) and all(x is y for x, y in zip(a, b))
+
+
+def _filters_to_keep(before: list, now: list, imported: list) -> list:
+    """The warning filters to set back: ``before``'s, with those of ``now`` that an import added (``imported``), in
+    the places they hold now (in front, unless added with append=True) where the caller left ``before``'s own
+    entries in order, else in front."""
+    ours = {id(f) for f in imported}
+    added = [f for f in now if id(f) in ours]
+    if not added:
+        return list(before)
+    old = {id(f) for f in before}
+    kept = [f for f in now if id(f) in ours or id(f) in old]
+    if _same_entries([f for f in kept if id(f) in old], list(before)):
+        return kept
+    return added + list(before)
+
+
+def restore_settings(before: dict | None, imported: list = ()) -> dict:
+    """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was. Warning filters
+    added while a module was imported for the first time are the module's, and stay: ``imported``, the filters
+    that :func:`imports_watched` gathered while the call ran; any other change of the filters is named."""
+    if before is None:
         return {}
-    now = torch_settings()
-    changed = {k: (before[k], now[k]) for k in before if now[k] != before[k]}
-    if "grad" in changed:
+    now = global_settings()
+    changed = {k: (before[k], now[k]) for k in before if k in now and now[k] != before[k]}
+    filters = None
+    if "warning filters" in changed:
+        filters = _filters_to_keep(list(before["warning filters"]), list(now["warning filters"]), list(imported))
+        if filters == list(now["warning filters"]):
+            del changed["warning filters"]     # only the modules' own filters were added
+    torch = sys.modules.get("torch")
+    if "grad" in changed and torch is not None:
         torch.set_grad_enabled(before["grad"])
-    if "dtype" in changed:
+    if "dtype" in changed and torch is not None:
         torch.set_default_dtype(before["dtype"])
+    if "numpy errors" in changed:
+        np.seterr(**before["numpy errors"])
+    if "warning filters" in changed:
+        warnings.filters[:] = filters
+        getattr(warnings, "_filters_mutated", lambda: None)()      # the C side caches the filters' version
     return changed
 
 
@@ -58,6 +143,19 @@ def settings_message(changed: dict) -> str:
                      "(torch.set_default_dtype) for the whole notebook, so every tensor made later (a model's "
                      "weights, torch.zeros, torch.tensor of floats) has the new dtype; give the dtype where you need "
                      "it (x.double(), torch.zeros(..., dtype=torch.float64)) and leave the default alone")
+    if "numpy errors" in changed:
+        old, new = changed["numpy errors"]
+        diff = ", ".join(f"{k}={new[k]!r}" for k in new if new[k] != old.get(k))
+        parts.append(f"it changed numpy's floating-point error handling for the whole notebook (np.seterr({diff})), "
+                     "so every later cell's divisions by zero, logs of 0 and overflows are handled that way too "
+                     "(silently ignored, or raised as errors); use `with np.errstate(divide='ignore'):` around the "
+                     "line that needs it, which sets the handling back at its end")
+    if "warning filters" in changed:
+        parts.append("it changed the warning filters for the whole notebook (warnings.filterwarnings or "
+                     "warnings.simplefilter), so later cells' warnings (the kit's own \"the cells below use the "
+                     "reference solution\" among them) are hidden or changed too; put the filter inside `with "
+                     "warnings.catch_warnings():`, which sets the filters back at its end (or, for numpy's own "
+                     "warnings, use `with np.errstate(...):`)")
     return "; and ".join(parts) + " (the check has set it back)"
 
 

@@ -4,7 +4,9 @@ Given the learner's output and the expected one on the failing input, each hint 
 likely mistake, or None, and runs no function: :func:`generic_hint` (a flipped sign, a constant factor or offset,
 exp or log once too often, a shift by one position, a pair of outputs swapped, a scatter-add that kept one
 contribution per repeated index), :func:`one_based_hint` (indices counted from 1), :func:`swapped_pair_hint` and
-:func:`size_from_events_hint` (an image sized by the events, not the sensor). Two conditions read off the inputs
+:func:`size_from_events_hint` (an image sized by the events, not the sensor) and :func:`aliased_rows_hint` (every row
+the same: the row index not used, or, where the function's code multiplies a list of lists, a nested list made with
+``[[0.0] * W] * H``). Two conditions read off the inputs
 choose among hints: :func:`has_repeated_index` (a scatter-add is likely) and :func:`non_square` (an IndexError on a
 sensor that is not square). The mistakes recognised by running a wrong version of the reference (the wrong image
 axis among them) are in :mod:`.mistakes`; those that show only across inputs (one number off by the same factor
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .learner_calls import multiplies_rows
 from .outputs import compare_outputs, is_tensor, to_numpy
 from .protocol import ExerciseLike
 
@@ -190,3 +193,30 @@ def swapped_pair_hint(ex: ExerciseLike, got, expected) -> str | None:
     except Exception:
         return None
     return None
+
+
+def aliased_rows_hint(got, expected, rtol: float, atol: float, fn=None) -> str | None:
+    """Every row of an image (axis -2) the same, where the expected rows differ (a sum then holds the column sums of
+    the expected image in every row). Where ``fn``'s code multiplies a list that holds a list
+    (:func:`.learner_calls.multiplies_rows`), a nested list made as ``[[0.0] * W] * H`` holds H references to one
+    row list, so each write lands in every row; otherwise (numpy, say) the row index is not used."""
+    try:
+        g, e = to_numpy(got).astype(np.float64), to_numpy(expected).astype(np.float64)
+    except Exception:
+        return None
+    if g.shape != e.shape or g.ndim < 2 or g.shape[-2] < 2 or g.shape[-1] < 1 or not np.all(np.isfinite(g)):
+        return None
+    same = np.broadcast_to(g[..., :1, :], g.shape)
+    if not np.allclose(g, same, rtol=rtol, atol=atol) or np.allclose(e, e[..., :1, :], rtol=rtol, atol=atol) \
+            or np.allclose(g, np.broadcast_to(g[..., :1, :1], g.shape), rtol=rtol, atol=atol):
+        return None                         # (a result constant everywhere is some other mistake)
+    summed = np.allclose(g, np.broadcast_to(e.sum(axis=-2, keepdims=True), e.shape), rtol=rtol, atol=atol)
+    what = " (each holds the sums of the expected columns)" if summed else ""
+    if fn is not None and multiplies_rows(fn):
+        return (f"every row of the result is the same{what}, where the expected rows differ: a nested list made as "
+                "`[[0.0] * W] * H` holds H references to one row, so `frame[y][x] += ...` writes column x of every "
+                "row; make each row its own list (`[[0.0] * W for _ in range(H)]`), or use np.zeros((H, W)) and "
+                "index `frame[y, x]`")
+    return (f"every row of the result is the same{what}, where the expected rows differ: the row index is not "
+            "used (a write to `frame[:, x]`, or a value that does not depend on y); index the row too, "
+            "`frame[y, x]` (rows first: y is the row)")

@@ -1,27 +1,34 @@
 """Running a learner's function, and what the call did besides returning.
 
 :func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's
-function cannot change the exercise's data), and sets torch's global settings back after it, whether it returns or
-raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
+function cannot change the exercise's data), and sets the notebook's global settings (torch's, numpy's error handling, the
+warning filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
 check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
 :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
-Over a whole check, :func:`watching` gathers what the learner's function changed of torch's settings.
+Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a call,
+:func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with np.empty
+(:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern rather than
+zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that holds a list
+(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint.
 """
 from __future__ import annotations
 
 import contextlib
 import copy
+import dis
 import os
 import re
 import site
+import sys
 import sysconfig
 import traceback
+import types
 from typing import Any, Callable, Iterator
 
 import numpy as np
 
 from .outputs import is_tensor, to_numpy
-from .global_state import restore_torch_settings, torch_settings
+from .global_state import global_settings, imports_watched, restore_settings
 
 
 def library_file(filename: str) -> bool:
@@ -105,12 +112,12 @@ def _deepcopy_with_grads(x):
     return y
 
 
-_WATCHED: list = []   # (the learner's function, what its calls changed of torch's settings), one per running check
+_WATCHED: list = []   # (the learner's function, what its calls changed of the settings), one per running check
 
 
 @contextlib.contextmanager
 def watching(fn: Callable) -> Iterator[dict]:
-    """While the block runs, what any call of ``fn`` through :func:`run` changes of torch's settings (the hints'
+    """While the block runs, what any call of ``fn`` through :func:`run` changes of the global settings (the hints'
     calls too) is gathered into the dict it yields, {name: (before, after)}, the first change of each name kept.
     Checks may nest (a check run from inside a learner's function): the innermost one's ``fn`` is watched."""
     seen: dict = {}
@@ -126,22 +133,25 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
     receives the copied ``(args, kwargs)`` as they are after the call.
 
-    torch's global settings (grad mode, default dtype) are set back after every call, whether it returns or
+    The global settings (torch's grad mode and default dtype, numpy's error handling, the warning filters) are set
+    back after every call, whether it returns or
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
     reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
-    the call changed ({name: (before, after)}). What the learner's function changed on any call of the check
-    (the hints' calls too) is also kept for the report (see :func:`watching`)."""
+    the call changed ({name: (before, after)}); warning filters that a module imported for the first time during
+    the call adds are the module's, and stay (:func:`.global_state.imports_watched`). What the learner's function
+    changed on any call of the check (the hints' calls too) is also kept for the report (see :func:`watching`)."""
     args, kwargs = _deepcopy_with_grads((args, kwargs))
-    settings = torch_settings()
-    try:
-        result = fn(*args, **kwargs)
-    finally:
-        changed = restore_torch_settings(settings)
-        if settings_changed is not None:
-            settings_changed.update(changed)
-        if changed and _WATCHED and fn is _WATCHED[-1][0]:
-            for name, change in changed.items():
-                _WATCHED[-1][1].setdefault(name, change)
+    settings = global_settings()
+    with imports_watched() as imported:
+        try:
+            result = fn(*args, **kwargs)
+        finally:
+            changed = restore_settings(settings, imported)
+            if settings_changed is not None:
+                settings_changed.update(changed)
+            if changed and _WATCHED and fn is _WATCHED[-1][0]:
+                for name, change in changed.items():
+                    _WATCHED[-1][1].setdefault(name, change)
     if inputs_after is not None:
         inputs_after.append((args, kwargs))
     return result if observe is None else observe(result, args, kwargs)
@@ -216,3 +226,131 @@ def container_names(args: tuple, kwargs: dict) -> tuple:
     """The names `changed_inputs` gives the dict and list inputs."""
     return tuple([f"argument {k + 1}" for k, a in enumerate(args) if isinstance(a, (dict, list))]
                  + [name for name, v in kwargs.items() if isinstance(v, (dict, list))])
+
+
+POISON_LIMIT = 1 << 20     # the largest block poison_freed_memory fills (1 MiB): eight of each size are made
+
+
+def poison_freed_memory(like, byte: int = 0x7F) -> None:
+    """Fill memory in the sizes of the arrays in ``like`` (their bytes, and 2, 4, 8 times more or fewer: a float64
+    buffer for a float32 result, int64 counts for a bool mask) with ``byte`` (0x7f), and free it again. numpy and the
+    C library hand freed blocks of one size out again, last freed first, so a learner's np.empty of such a size
+    then starts from 0x7f bytes (1.4e306 as float64, 127 as int8) instead of whatever the last array left there,
+    which may be zeros and pass by chance. Only blocks of up to :data:`POISON_LIMIT` (1 MiB) are filled: memory
+    for a larger array is not, and np.empty there may hold zeros by chance."""
+    sizes = set()
+    stack = [like]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, dict):
+            stack.extend(v.values())
+        elif isinstance(v, (tuple, list)):
+            stack.extend(v)
+        elif isinstance(v, np.ndarray) or is_tensor(v):
+            n = int(to_numpy(v).nbytes)
+            sizes.update(n * f for f in (1, 2, 4, 8))
+            sizes.update(n // f for f in (2, 4, 8) if n % f == 0)
+    for size in sorted(s for s in sizes if 0 < s <= POISON_LIMIT):
+        blocks = [np.full(size, byte, np.uint8) for _ in range(8)]
+        del blocks
+
+
+_ARRAY_MODULES = ("numpy", "torch")
+_EMPTY = ("empty", "empty_like")
+_LOADS = ("LOAD_GLOBAL", "LOAD_NAME", "LOAD_FAST", "LOAD_DEREF", "LOAD_CLASSDEREF")
+
+
+def _array_module(value) -> bool:
+    return isinstance(value, types.ModuleType) and value.__name__.split(".")[0] in _ARRAY_MODULES
+
+
+def _empty_function(value) -> bool:
+    """``value`` is np.empty, np.empty_like, torch.empty or torch.empty_like (a name imported from the module)."""
+    for module in map(sys.modules.get, _ARRAY_MODULES):
+        if module is not None and any(value is getattr(module, name, None) for name in _EMPTY):
+            return True
+    return False
+
+
+def uses_uninitialised(fn) -> bool:
+    """Whether the code of ``fn`` (its nested functions too) calls np.empty, np.empty_like, torch.empty or
+    torch.empty_like: ``empty`` read off np, numpy or torch (or another name for either module, in the notebook or
+    imported in the function), or a name imported from them (``from numpy import empty``). Another object's
+    ``empty`` (a queue's ``q.empty()``, a DataFrame's ``.empty``) is not one."""
+    namespace = getattr(fn, "__globals__", None)
+    namespace = namespace if isinstance(namespace, dict) else {}
+    modules = {"np", "numpy", "torch"} | {k for k, v in namespace.items() if _array_module(v)}
+    codes = [getattr(fn, "__code__", None)]
+    while codes:
+        code = codes.pop()
+        if code is None:
+            continue
+        prev = importing = None
+        for ins in dis.get_instructions(code):
+            if ins.opname in ("LOAD_ATTR", "LOAD_METHOD") and ins.argval in _EMPTY and prev is not None \
+                    and prev.opname in _LOADS and prev.argval in modules:
+                return True
+            if ins.opname == "IMPORT_NAME":
+                importing = str(ins.argval).split(".")[0]
+            if ins.opname == "IMPORT_FROM" and ins.argval in _EMPTY and importing in _ARRAY_MODULES:
+                return True             # `from numpy import zeros, empty` inside the function
+            if ins.opname in ("LOAD_GLOBAL", "LOAD_NAME") and _empty_function(namespace.get(ins.argval)):
+                return True
+            if ins.opname.startswith("STORE_") and prev is not None and prev.opname == "IMPORT_NAME" \
+                    and str(prev.argval).split(".")[0] in _ARRAY_MODULES:
+                modules.add(ins.argval)          # `import numpy as onp` inside the function
+            prev = ins
+        codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
+    return False
+
+
+_NAME_LOADS = ("LOAD_FAST", "LOAD_NAME", "LOAD_DEREF", "LOAD_GLOBAL", "LOAD_CLASSDEREF", "LOAD_CLOSURE")
+_NAME_STORES = ("STORE_FAST", "STORE_NAME", "STORE_DEREF", "STORE_GLOBAL")
+
+
+def multiplies_rows(fn) -> bool:
+    """Whether the code of ``fn`` (its nested functions and comprehensions too) multiplies a list that holds a list:
+    ``[[0.0] * W] * H``, or ``[row] * H`` where ``row = [0.0] * W``, H references to one row list. Read off the
+    bytecode by following what each value on the stack is (a list of numbers, a list holding a list, anything
+    else) through list displays, ``*`` and the names they are stored in; runs nothing."""
+    codes = [getattr(fn, "__code__", None)]
+    while codes:
+        code = codes.pop()
+        if code is None:
+            continue
+        stack: list[str] = []
+        names: dict[str, str] = {}
+
+        def pop() -> str:
+            return stack.pop() if stack else "other"
+        for ins in dis.get_instructions(code):
+            op = ins.opname
+            if op == "BUILD_LIST":
+                items = [pop() for _ in range(ins.arg or 0)]
+                stack.append("rows" if any(t in ("list", "rows") for t in items) else "list")
+            elif op == "BINARY_OP" and ins.argrepr in ("*", "*="):
+                kinds = (pop(), pop())
+                if "rows" in kinds:
+                    return True
+                stack.append("list" if "list" in kinds else "other")
+            elif op in _NAME_STORES:
+                names[ins.argval] = pop()
+            elif op in _NAME_LOADS or op == "LOAD_CONST":
+                try:
+                    pushed = dis.stack_effect(ins.opcode, ins.arg)
+                except (ValueError, TypeError):
+                    pushed = 1
+                stack.extend(["other"] * (pushed - 1))             # the NULL that LOAD_GLOBAL may push first
+                stack.append("const" if op == "LOAD_CONST" else names.get(ins.argval, "other"))
+            else:
+                try:
+                    effect = dis.stack_effect(ins.opcode, ins.arg if ins.opcode >= dis.HAVE_ARGUMENT else None)
+                except (ValueError, TypeError):
+                    effect = 0
+                for _ in range(-effect):
+                    pop()
+                if effect >= 0 and stack:
+                    stack[-1] = "other"                             # an operation on the value on top
+                stack.extend(["other"] * max(effect, 0))
+        codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
+    return False

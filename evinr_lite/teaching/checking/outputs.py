@@ -4,11 +4,14 @@
 returns the first :class:`Problem`: a missing ``return``, a wrong type, shape or dtype (with a word on the likely
 cause), or wrong values (how many, where, by how much). It is the one built-in yardstick every other module of the
 check uses: the main run, the hints' wrong versions, the second call (an exercise may bring its own ``compare``,
-which the main run and the second call use in its place). The helpers that read a tensor as numpy live here too,
-since every comparison starts with them.
+which the main run and the second call use in its place). Where the values match and the reference's result is a
+differentiable tensor, :func:`compare_gradients` compares what back-propagation from it reaches: a result rebuilt
+as a new leaf, a term taken out of the graph, or a function that calls .backward() itself has the right values and
+the wrong gradients. The helpers that read a tensor as numpy live here too, since every comparison starts with them.
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -234,3 +237,102 @@ def differing_leaf(got, expected, rtol: float, atol: float):
     except Exception:
         pass
     return got, expected
+
+
+# ---- gradients: what back-propagation from a differentiable result reaches ----------------------------------
+
+BACKWARD_CALLED = (
+    "your function calls .backward() itself: the gradients land in the inputs' .grad at every call, and the "
+    "caller's own loss.backward() then fails (the graph is freed) or, with retain_graph=True, adds them a second "
+    "time; return the loss and leave back-propagation to the caller (the training step)")
+
+
+def _tensor_pairs(got, expected) -> list | None:
+    """(got, expected) for the tensors inside ``expected``, walking its structure: dict values by key, tuples and
+    lists by position; None where ``got`` has another structure (another key set, another length, no tensor where
+    ``expected`` holds one), so that nothing is compared out of place."""
+    if isinstance(expected, dict):
+        if not isinstance(got, dict) or set(got) != set(expected):
+            return None
+        parts = [_tensor_pairs(got[k], expected[k]) for k in expected]
+    elif isinstance(expected, (tuple, list)):
+        if not isinstance(got, (tuple, list)) or len(got) != len(expected):
+            return None
+        parts = [_tensor_pairs(g, e) for g, e in zip(got, expected)]
+    elif is_tensor(expected):
+        return [(got, expected)] if is_tensor(got) else None
+    else:
+        return []
+    if any(p is None for p in parts):
+        return None
+    return [pair for p in parts for pair in p]
+
+
+def _grad_inputs(inputs: tuple) -> list:
+    """(name, tensor) for the inputs (args, kwargs) that are leaf tensors requiring grad."""
+    args, kwargs = inputs
+    named = [(f"argument {k + 1}", a) for k, a in enumerate(args)] + list(kwargs.items())
+    return [(n, v) for n, v in named if is_tensor(v) and v.requires_grad and v.is_leaf]
+
+
+def compare_gradients(got, got_inputs: tuple, expected, expected_inputs: tuple) -> Problem | None:
+    """Whether back-propagation from ``got`` reaches the inputs as it does from ``expected`` (their values already
+    match). ``got_inputs`` and ``expected_inputs``: the (args, kwargs) each run was given, as they are after it (the
+    result's graph ends there). The outputs are weighted by fixed random numbers (a generator of its own: the global
+    one is not touched) and summed, and the gradients of that sum with respect to every input that requires grad
+    are compared (loosely: float32 sums in another order differ in their last digits). None when nothing is
+    differentiable or all agree."""
+    torch = sys.modules.get("torch")
+    leaves = _tensor_pairs(got, expected)
+    if torch is None or leaves is None or not any(e.requires_grad for _, e in leaves):
+        return None
+    named_got, named_exp = _grad_inputs(got_inputs), _grad_inputs(expected_inputs)
+    if not named_exp or [n for n, _ in named_got] != [n for n, _ in named_exp]:
+        return None
+    if any(g.grad is not None and e.grad is None for (_, g), (_, e) in zip(named_got, named_exp)):
+        return Problem(BACKWARD_CALLED)
+    pairs = [(g, e) for g, e in leaves if e.requires_grad]
+    inputs = [v for _, v in named_got]
+    # a leaf that requires grad and is none of the inputs (an input handed back is compared by its gradients below)
+    if any(e.grad_fn is not None and g.requires_grad and g.grad_fn is None and not any(g is v for v in inputs)
+           for g, e in pairs):
+        return Problem("the value is right, but the result is a new tensor with no autograd history "
+                       "(torch.tensor(..., requires_grad=True), or .requires_grad_() on a value taken out of the "
+                       "graph): it requires grad, yet back-propagation from it reaches none of the inputs, so "
+                       "training would update nothing; compute it with torch operations on the inputs themselves "
+                       "(no .item(), .numpy(), .detach() or torch.tensor(...) on the way)")
+    gen = torch.Generator().manual_seed(0)
+    weights = [torch.rand(e.shape, generator=gen, dtype=torch.float64) for _, e in pairs]
+
+    def grads(leaves, inputs):
+        total = sum((t * w.to(t.dtype)).sum() for t, w in zip(leaves, weights) if t.requires_grad)
+        return torch.autograd.grad(total, [v for _, v in inputs], allow_unused=True)
+    try:
+        want = grads([e for _, e in pairs], named_exp)
+    except Exception:            # the reference's own graph cannot say: say nothing
+        return None
+    try:
+        have = grads([g for g, _ in pairs], named_got)
+    except RuntimeError as err:
+        if "second time" in str(err) or "freed" in str(err):
+            return Problem(BACKWARD_CALLED)
+        return Problem(f"the value is right, but it cannot be back-propagated ({err})")
+    for (name, v), a, b in zip(named_got, have, want):
+        a = np.zeros(tuple(v.shape)) if a is None else to_numpy(a).astype(np.float64)
+        b = np.zeros(tuple(v.shape)) if b is None else to_numpy(b).astype(np.float64)
+        scale = float(np.abs(b).max()) if b.size else 0.0
+        close = np.isclose(a, b, rtol=1e-4, atol=1e-6 * scale + 1e-8)
+        if np.all(close):
+            continue
+        out_of_graph = ("part of the computation uses a value taken out of the autograd graph (.detach(), .data, "
+                        ".item(), .numpy(), torch.tensor(...)), so training would not update what "
+                        f"`{name}` feeds; use the tensors themselves in every term")
+        if not np.any(a) and np.any(b):
+            return Problem(f"the value is right, but back-propagation from it does not reach `{name}`: "
+                           + out_of_graph)
+        worst = int(np.argmax(np.where(close, 0.0, np.abs(a - b)).ravel()))
+        ga, gb = _fmt_pair(a.ravel()[worst], b.ravel()[worst])
+        return Problem(f"the value is right, but its gradient with respect to `{name}` is not the reference's "
+                       f"({int((~close).sum())} of {close.size} entries differ; at index {worst}: got {ga}, expected "
+                       f"{gb}): " + out_of_graph)
+    return None

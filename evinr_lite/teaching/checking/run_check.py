@@ -1,30 +1,33 @@
 """The check's main loop: every input in turn, the first problem reported with the hint that explains it.
 
 :func:`run_check` runs the learner's function and the reference on each of the exercise's inputs
-(:mod:`.learner_calls`), compares the outputs (:mod:`.outputs`), and at the first difference looks for a hint
-(:func:`_hint_for`), in a fixed order: data kept in a notebook variable (when it made the difference), the
+(:mod:`.learner_calls`; the reference first, and memory of its result's sizes filled with a pattern before the
+learner's call), compares the outputs (:mod:`.outputs`; where the values match, the gradients of a differentiable
+result too), and at the first difference looks for a hint (:func:`_hint_for`), in a fixed order: data kept in a
+notebook variable (when it made the difference), np.empty (a rerun on zeroed memory answers otherwise), the
 exercise's own wrong versions, a swapped pair, state kept between calls, an argument taken from input #1, the
 generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
-patterns read off the values (:mod:`.hints`), and last a notebook variable that only grew. After every input
-matched, the last one is run a second time from other states of the global generators (:func:`_second_call`,
-:mod:`.across_calls`, :mod:`.global_state`). The order is the report's: change it and other hints win. Returns
-(passed, headline, detail lines); printing is :func:`evinr_lite.teaching.exercises.check`'s.
+patterns read off the values (:mod:`.hints`: indices from 1, rows aliased by one list, then the rest), and last a
+notebook variable that only grew. After every input matched, the last one is run a second time from other states of
+the global generators (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`). The order is the report's:
+change it and other hints win. Returns (passed, headline, detail lines); printing is
+:func:`evinr_lite.teaching.exercises.check`'s.
 """
 from __future__ import annotations
 
 from typing import Callable
 
-from .across_calls import (fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
-                           mutable_defaults, reseed_hint, scalar_factor_hint, shares_output, stale_argument_hint,
-                           state_hint)
-from .global_state import (other_rng_states, reseeded_generators, restore_torch_settings, rng_states,
-                           set_rng_states, settings_message, torch_settings)
-from .hints import (generic_hint, has_repeated_index, non_square, one_based_hint, size_from_events_hint,
-                    swapped_pair_hint)
-from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, run, watching,
-                            where_raised)
+from .across_calls import (UNINITIALISED, fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
+                           memory_explains, mutable_defaults, reseed_hint, scalar_factor_hint, shares_output,
+                           stale_argument_hint, state_hint, uninitialised_hint)
+from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
+                           rng_states, set_rng_states, settings_message)
+from .hints import (aliased_rows_hint, generic_hint, has_repeated_index, non_square, one_based_hint,
+                    size_from_events_hint, swapped_pair_hint)
+from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, poison_freed_memory,
+                            run, watching, where_raised)
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
-from .outputs import Problem, compare_outputs, describe_case, differing_leaf, not_finite
+from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
 
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
@@ -35,19 +38,21 @@ Report = tuple[bool, str, list[str]]   # (passed, headline, detail lines)
 def run_check(ex: ExerciseLike, fn: Callable) -> Report:
     """(passed, headline, detail lines) without printing.
 
-    torch's global settings are set back after every call of a function (see :func:`run`), and once more, to
+    The global settings (torch's, numpy's error handling, the warning filters) are set back after every call of a
+    function (see :func:`run`), and once more, to
     what they were when the check began, after all of it: a function that changes them only on an input the
     main run never reaches (a hint's search runs the others), or that raises right after, leaves the notebook as
     it was. Such a change is named in the report (`also: ...`) when the main run did not name it already."""
-    settings = torch_settings()
-    try:
-        with watching(fn) as seen:
-            ok, headline, details = _run_inputs(ex, fn)
-        if seen and not ok and not headline.startswith("changed torch's global settings"):
-            details = details + ["also: " + settings_message(seen)]
-        return ok, headline, details
-    finally:
-        restore_torch_settings(settings)
+    settings = global_settings()
+    with imports_watched() as imported:
+        try:
+            with watching(fn) as seen:
+                ok, headline, details = _run_inputs(ex, fn)
+            if seen and not ok and not headline.startswith("changed the notebook's global settings"):
+                details = details + ["also: " + settings_message(seen)]
+            return ok, headline, details
+        finally:
+            restore_settings(settings, imported)
 
 
 def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
@@ -67,6 +72,14 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         if k == n - 1:
             rng_before = rng_states()       # the last input is run again below, from other generator states
         changed_settings: dict = {}
+        # the reference first, so that memory freed in the sizes of its result can be filled with a pattern before
+        # the learner's call: an array started with np.empty then holds that pattern, not zeros by chance
+        ref_after: list = []
+        try:
+            expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after)
+            poison_freed_memory(expected)
+        except Exception:                   # run again below, where its error stops the check as it did before
+            ref_after = []
         try:
             got = run(fn, args, kwargs, ex.observe, inputs_after=after, settings_changed=changed_settings)
             if k == n - 1:
@@ -77,11 +90,20 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         except Exception as err:
             return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
         if changed_settings:
-            return False, f"changed torch's global settings on {where}", [settings_message(changed_settings)]
-        expected = run(ex.reference, args, kwargs, ex.observe)
+            return False, f"changed the notebook's global settings on {where}", [settings_message(changed_settings)]
+        if not ref_after:
+            expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after)
         problem = _first_difference(ex, got, expected)
         # inputs changed in place (a function with side effects says what to compare through `observe`)
         changed = changed_inputs((args, kwargs), after[0]) if ex.observe is None and after else []
+        # the right values, but not what back-propagation from them reaches (a differentiable result)
+        grads = compare_gradients(got, after[0], expected, ref_after[0]) \
+            if problem is None and ex.observe is None and ex.compare is None and after and ref_after else None
+        if grads is not None:
+            extra = ["also: " + in_place_message(changed, container_names(args, kwargs))] if changed else []
+            what = "back-propagates inside the function" if grads.message == BACKWARD_CALLED \
+                else "gives the right values, but not the reference's gradients,"
+            return False, f"{what} on {where}", [grads.message] + extra
         if problem is None and not changed:
             continue
         if problem is None:
@@ -134,6 +156,7 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
         details.append("hint: `-` on two bool arrays or tensors is refused: make them integers first "
                        "(`.astype(int)`, `.long()` for tensors) for a difference of counts or a sign; for masks "
                        "use `&`, `|`, `~` (a and not b: `a & ~b`)")
+    details += _python_on_arrays_hints(err, " ".join(details[1:]))
     if isinstance(err, RuntimeError) and "does not require grad" in str(err):
         details.append("hint: the loss has no autograd graph to back-propagate: it was computed under "
                        "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
@@ -151,6 +174,31 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     if state:
         details.append(f"hint: {state}")
     return False, f"raised {type(err).__name__} on {where}", details
+
+
+def _python_on_arrays_hints(err: Exception, line: str) -> list[str]:
+    """Hints for Python's one-value tools used on whole arrays or tensors, from the error numpy or torch raised:
+    `and` / `or` / `if` / a chained comparison (one truth value), `&` read before a comparison, the math module (one
+    number), numpy on a tensor that requires grad (whose error suggests .detach(), which cuts the graph). ``line``:
+    the learner's line that raised, as the report quotes it."""
+    msg = str(err)
+    if isinstance(err, (ValueError, RuntimeError)) and "ambiguous" in msg and ("truth value" in msg
+                                                                            or "Boolean value" in msg):
+        return ["hint: `and`, `or`, `not`, `if` and a chained comparison such as `a < t <= b` (which Python reads "
+                "as `a < t and t <= b`) each need one True or False, and an array holds many: combine element-wise "
+                "comparisons with `&`, `|` and `~`, each comparison in its own brackets: `(a < t) & (t <= b)`"]
+    if isinstance(err, TypeError) and "ufunc 'bitwise_" in msg:
+        return ["hint: `&` and `|` bind more tightly than comparisons: `t > a & t <= b` reads `t > (a & t) <= b`, "
+                "and `&` of floats is refused; put each comparison in brackets: `(t > a) & (t <= b)`"]
+    if isinstance(err, TypeError) and "converted to Python scalars" in msg and "math." in line:
+        return ["hint: the math module works on one number at a time (math.exp, math.log, math.sqrt, math.floor): "
+                "on an array use numpy's element-wise functions (np.exp, np.log, ...), on a tensor torch's"]
+    if isinstance(err, RuntimeError) and "numpy() on Tensor that requires grad" in msg:
+        return ["hint: a numpy function (np.mean, np.square, np.exp, ...) on a tensor that requires grad turns it "
+                "into a numpy array, which torch refuses; the error's own suggestion, .detach().numpy(), would cut "
+                "the result off from the autograd graph, so nothing could be trained through it: use torch's "
+                "functions (torch.mean, torch.square, torch.exp) or the tensor's own methods (x.pow(2).mean())"]
+    return []
 
 
 def _first_difference(ex: ExerciseLike, got, expected) -> Problem | None:
@@ -178,6 +226,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
     hint = cache_hint if proven else None
     if hint is None:
+        hint = uninitialised_hint(fn, ex, args, kwargs, got)
+    if hint is None:
         hint = _own_hint(ex, fn, cases, k, got)
     # mistakes that show only across inputs: state kept from an earlier call, a notebook variable or a
     # fixed size in place of an argument; and a pair returned in the other order
@@ -201,6 +251,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     if problem.values:
         if hint is None:
             hint = one_based_hint(got, expected, ex.rtol, ex.atol)
+        if hint is None:
+            hint = aliased_rows_hint(got, expected, ex.rtol, ex.atol, fn)
         if hint is None:
             hint = wrong_axes_hint(ex, args, kwargs, got, expected)
         if hint is None:
@@ -268,6 +320,7 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
     changed_settings: dict = {}
     try:
         set_rng_states(rng_other)
+        poison_freed_memory(got)
         again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
         rng_again = rng_states()
         if ex.observe is not None:
@@ -281,7 +334,9 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
     finally:
         set_rng_states(rng_now)
     if changed_settings:
-        return False, f"changed torch's global settings on input #{n} of {n}", [settings_message(changed_settings)]
+        return False, f"changed the notebook's global settings on input #{n} of {n}", [settings_message(changed_settings)]
+    if problem is not None and memory_explains(fn, ex, args, kwargs, got):
+        return False, f"gives another result when input #{n} of {n} is run a second time", [UNINITIALISED]
     if problem is not None:
         return False, f"gives another result when input #{n} of {n} is run a second time", [
             "every input matched once, but a second call on the same input does not: your function keeps "
