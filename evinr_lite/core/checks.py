@@ -18,7 +18,8 @@ from .guard import InputError, check_unmasked, dense_array, host_array
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
-           "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span"]
+           "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
+           "true_or_false"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -179,6 +180,14 @@ def whole_number(value, name: str, *, lo: int | None = None, hi: int | None = No
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         raise EventDataError(f"{name}= must be a whole number{_range(lo, hi)}, got {value}")
     return value
+
+
+def true_or_false(value, name: str) -> bool:
+    """``value`` as a bool when it is True or False (numpy's too) or the whole number 0 or 1; else an InputError.
+    Text ("no" is a true value), None and other numbers are refused, not read as their truth."""
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, np.integer)) and value in (0, 1)):
+        return bool(value)
+    raise EventDataError(f"{name}= must be True or False, got {short_repr(value)}")
 
 
 def is_real_number(value) -> bool:

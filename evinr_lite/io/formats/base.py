@@ -265,8 +265,8 @@ def check_reader_window(t_start, t_end) -> None:
     import math
 
     for name, value in (("t_start", t_start), ("t_end", t_end)):
-        if value is not None and (not isinstance(value, (int, float, np.integer, np.floating))
-                                  or not math.isfinite(value)):
+        if value is not None and (not isinstance(value, (int, float, np.integer, np.floating)) or isinstance(value, bool)
+                                  or not math.isfinite(value)):   # True was read as 1 s
             raise EventDataError(f"{name}= must be a finite number of seconds, got {value!r}")
     if t_start is not None and t_end is not None and t_end <= t_start:
         raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
