@@ -162,7 +162,7 @@ def resolve_time_unit(t, time_unit: str | None, source, *, flag: str = "time_uni
     (nanoseconds: ESIM); floating-point timestamps are seconds.
     """
     if time_unit not in (None, "auto"):
-        if time_unit not in TIME_UNITS:
+        if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):   # a list was "unhashable type"
             raise EventDataError(f"unknown {flag}={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
         return time_unit
     kind = np.asarray(t).dtype.kind if not isinstance(t, str) else t
@@ -242,7 +242,7 @@ def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
     Integer timestamps (us, ns) are shifted in integer arithmetic and then divided (correctly
     rounded), so no precision is lost; float timestamps are shifted in float64 (exact for large values).
     """
-    if time_unit not in TIME_UNITS:
+    if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):
         raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
     per_s = round(1 / TIME_UNITS[time_unit])  # 1, 1000, 10**6, 10**9 units per second
     t = np.asarray(t)
@@ -460,7 +460,7 @@ class Events:
             sort: sort by time (stable) instead of raising on unsorted input.
             t_origin: seconds to add to ``t`` to get the absolute clock.
         """
-        if time_unit not in TIME_UNITS:
+        if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):   # a list was "unhashable type"
             raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
         t, x, y, p = (host_array(a) for a in (t, x, y, p))
         t = dense_array(t, "Events.t", error=EventDataError)   # a ragged nest: named, not numpy's ValueError

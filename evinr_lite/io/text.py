@@ -24,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.events import (LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit,
-                           wrap_hint)
+from ..core.events import (LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, check_t_origin,
+                           resolve_time_unit, wrap_hint)
 
 __all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "blank_leading_comments",
            "parse_frame_list", "line_blocks", "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
@@ -63,8 +63,7 @@ TXT_LAYOUT = TextLayout()   # `t x y p` (IJRR events.txt, rpg_e2vid)
 
 def origin_to_ns(t_origin) -> int:
     """Seconds (float or int) -> exact integer nanoseconds of that float value."""
-    if not math.isfinite(t_origin):
-        raise EventDataError(f"t_origin must be a finite number of seconds, got {t_origin!r}")
+    check_t_origin(t_origin)   # text or a list were Python's "must be real number", True was 1 s
     return round(Fraction(t_origin) * NS)
 
 
@@ -414,7 +413,7 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}{names_hint(i)}"
                 f"{_count_hint(_line_text(buf, newlines, i), opens, layout)}")
     empty = np.zeros(0, dtype=np.int64)
-    if time_unit not in TIME_UNITS and time_unit != "auto":
+    if time_unit != "auto" and not (isinstance(time_unit, str) and time_unit in TIME_UNITS):
         raise EventDataError(f"unknown time_unit={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
     if len(starts) == 0:
         return EventBlock(np.zeros(0), empty, empty, empty.astype(np.int8), header, origin_ns, n_lines,
