@@ -19,7 +19,9 @@ import numpy as np
 
 from ..method.integration import integrate_events
 from ..evaluation.metrics import SCORE_PROTOCOLS, score_frames
-from ..io.output import atomic_output_dir, save_json, save_png
+from ..core.checks import ArgumentTypeError, require, true_or_false, whole_number
+from ..core.events import EventDataError, check_sensor_size
+from ..io.output import atomic_output_dir, check_output_path, save_json, save_png
 from ..sim.scenes import make_scene
 from ..sim.simulate import simulate_scene
 from ..method.solver import EvINRConfig, reconstruct
@@ -67,11 +69,13 @@ def labelled_grid(rows, row_labels, column_labels, *, title: str = "") -> np.nda
     return np.asarray(canvas)
 
 
+SSIM_MIN_SIDE = 11   # pixels: SSIM's gaussian window (sigma 1.5, truncated at 3.5 sigma) is 11 x 11
+
+
 def _check_demo_memory(sensor_size, duration, n_frames, cfg, *, fraction: float = 0.8) -> None:
     """Refuse (EventDataError, before anything is simulated) a demo whose reconstruction (the solver's estimate,
     :func:`~evinr_lite.method.memory.estimate_memory`) and ground-truth frames would not fit in ``fraction`` of
     the free memory, naming the demo's own settings (its command has no --start/--end or --fps/--at)."""
-    from ..core.events import EventDataError, check_sensor_size
     from ..method.memory import available_bytes, estimate_memory
 
     H, W = check_sensor_size(sensor_size)
@@ -98,6 +102,18 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
         "ssim_clahe", "time_s", "folder"}}, "n_events": int, ...}.
     """
     t0 = time.perf_counter()
+    # before any work (the simulation and the training): the output folder was checked after the training
+    overwrite = true_or_false(overwrite, "overwrite")
+    check_output_path(out_dir, overwrite=overwrite)
+    n_frames = whole_number(n_frames, "n_frames", lo=1)   # 2.5 was numpy's error, True one frame, 0 no query time
+    require(config, EvINRConfig, "config", none_ok=True)   # {} ran the default recipe
+    if not callable(log):
+        raise ArgumentTypeError(f"log= must be a function log(text) (e.g. print), got {type(log).__name__}")
+    H, W = check_sensor_size(sensor_size)
+    if min(H, W) < SSIM_MIN_SIDE:   # the scores' SSIM refused it after the training
+        raise EventDataError(f"the demo scores its frames with SSIM, whose window needs at least {SSIM_MIN_SIDE} x "
+                             f"{SSIM_MIN_SIDE} pixels; sensor_size=({H}, {W}) is smaller: choose at least "
+                             f"({SSIM_MIN_SIDE}, {SSIM_MIN_SIDE}) (the default is (120, 160))")
     cfg = config or EvINRConfig(C=C, seed=seed)
     _check_demo_memory(sensor_size, duration, n_frames, cfg)   # before the scene and its frames are allocated
     sc = make_scene(scene, sensor_size=sensor_size, duration=duration)

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from ..core.checks import ArgumentTypeError, true_or_false
 from ..core.events import InputError
 from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, termination_signals  # re-exported
 
@@ -103,7 +104,10 @@ def _inside(a: Path, b: Path) -> bool:
 
 def given_output_path(out_dir) -> Path:
     """``out_dir`` as a Path (``~`` expanded); an empty or blank name is an OutputError, not the current folder
-    (``Path("")`` is ".") nor a folder named by spaces."""
+    (``Path("")`` is ".") nor a folder named by spaces; None or a number is refused naming out_dir= (Python's
+    "expected str, bytes or os.PathLike object" named nothing)."""
+    if not isinstance(out_dir, (str, os.PathLike)):
+        raise ArgumentTypeError(f"out_dir= must be a folder (a str or Path), got {type(out_dir).__name__}")
     if isinstance(out_dir, (str, bytes)) and not out_dir.strip():
         raise OutputError(f"out_dir={out_dir!r} is empty or blank (an empty path would be the current folder); pass "
                           "the folder to write, e.g. out_dir=rec")
@@ -232,7 +236,11 @@ class OutputDir:
 
     def __init__(self, out_dir, *, overwrite: bool = False, inputs=(), log=None, command: str = ""):
         self.given = given_output_path(out_dir)
-        self.overwrite = overwrite
+        self.overwrite = true_or_false(overwrite, "overwrite")   # "no" is a true value: it replaced the folder
+        if log is not None and not callable(log):
+            raise ArgumentTypeError(f"log= must be a function log(text) (e.g. print) or None, got {type(log).__name__}")
+        if not isinstance(command, str):   # it is written into the lock for a second run to read
+            raise ArgumentTypeError(f"command= must be text (the command line, recorded in the lock), got {command!r}")
         self.inputs = tuple(inputs)
         self.log = log or (lambda message: None)
         self.command = command
