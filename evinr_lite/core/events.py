@@ -15,7 +15,9 @@ Conventions (every module relies on them):
 """
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
+from decimal import Decimal
 
 import numpy as np
 
@@ -269,8 +271,17 @@ def _is_number(value) -> bool:
 
 
 def check_t_origin(t_origin) -> float:
-    """``t_origin`` (seconds, the absolute time of t = 0) as a finite float, or an EventDataError."""
-    if not _is_number(t_origin) or not math.isfinite(float(t_origin)):
+    """``t_origin`` (seconds, the absolute time of t = 0) as a finite float, or an EventDataError.
+
+    A number: a Python or numpy int or float, a 0-d array or tensor holding one, a Fraction or a Decimal (the
+    text readers turn it into nanoseconds exactly, through Fraction). Text, None, lists and bools are refused:
+    True is no 1 s and False no 0 s (a flag given where a time belongs)."""
+    exact = isinstance(t_origin, (numbers.Rational, Decimal)) and not isinstance(t_origin, (bool, np.bool_))
+    try:
+        finite = (exact or _is_number(t_origin)) and math.isfinite(float(t_origin))
+    except (OverflowError, ValueError):   # 10**400; Decimal("sNaN")
+        finite = False
+    if not finite:
         raise EventDataError(f"t_origin must be a finite number of seconds (the absolute time of t = 0; 0 when the "
                              f"times are already relative), got {t_origin!r}")
     return float(t_origin)

@@ -56,7 +56,8 @@ from pathlib import Path
 import numpy as np
 
 from ..core.cfa import CFA_NAMES, cfa_phase, check_cfa  # the colour filter's one home (names kept here)
-from ..core.checks import ArgumentTypeError, is_real_number, real_number, true_or_false, whole_number
+from ..core.checks import (check_path_type, check_reader_window, decimal_as_float, host_array, is_real_number,
+                           real_number, true_or_false, whole_number)
 from ..core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_sensor_size, check_t_origin,
                            check_time_range)
 from ..core.frames import Frames, to_grey_uint8
@@ -90,21 +91,12 @@ COMPRESSION = dict(compression="gzip", compression_opts=4, shuffle=True)
 DTYPES = {"t": np.float64, "x": np.uint16, "y": np.uint16, "p": np.int8}
 log = logging.getLogger("evinr_lite")
 EVENT_FIELDS = ("t", "x", "y", "p")
+
+
 def _file_path(path) -> Path:
-    """``path`` as a Path; None, a number or a list are refused naming the argument (Python's "expected str, bytes
-    or os.PathLike object" named none)."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise ArgumentTypeError(f"path= must be a file path (a str or Path), got {type(path).__name__}; pass the "
-                                ".h5 file that data_fetch.get / convert wrote")
-    return Path(path)
-
-
-def _window_seconds(t_start, t_end) -> None:
-    """The read window's bounds: None or finite seconds, the end after the start (text, lists and True refused here,
-    not blamed on the file)."""
-    from .formats.base import check_reader_window   # here: io.formats imports this module
-
-    check_reader_window(t_start, t_end)
+    """``path`` as a Path; None, a number, a list or bytes are refused naming the argument (Python's "expected str,
+    bytes or os.PathLike object" named none)."""
+    return Path(check_path_type(path, "path", "a file path", "pass the .h5 file that data_fetch.get / convert wrote"))
 
 
 def is_canonical(path) -> bool:
@@ -438,7 +430,8 @@ def read_canonical(path, t_start: float | None = None, t_end: float | None = Non
     """
     from ..core.recording import Recording
 
-    _window_seconds(t_start, t_end)
+    check_reader_window(t_start, t_end)   # the bounds are searched with as given, as before the check
+    t_start, t_end = host_array(t_start), host_array(t_end)   # a tensor as numpy: the same value, no torch warning
     frames = true_or_false(frames, "frames")
     with _open(path) as f:
         try:
@@ -515,7 +508,8 @@ def iter_canonical_events(path, t_start: float | None = None, t_end: float | Non
     10^8-event recording). The window is ``t_start <= t < t_end`` as in :func:`read_canonical`.
     """
     chunk_events = whole_number(chunk_events, "chunk_events", lo=1)   # 2.5 was range()'s TypeError, True one event
-    _window_seconds(t_start, t_end)   # "0" was read as seconds, NaN gave no chunk without a word
+    check_reader_window(t_start, t_end)   # "0" was read as seconds, NaN gave no chunk without a word
+    t_start, t_end = host_array(t_start), host_array(t_end)   # searched with as given (a tensor as numpy)
     with _open(path) as f:
         try:
             info = _info_from(f, path)
@@ -625,7 +619,8 @@ class CanonicalWriter(CloseOrAbort):
         try:
             check_sensor_size(sensor_size)
             check_t_origin(t_origin)
-            real_number(C, "C", lo=0, lo_open=True, hint="the contrast threshold to use with this sequence")
+            real_number(decimal_as_float(C), "C", lo=0, lo_open=True,   # Fraction, Decimal: float(C) as before
+                        hint="the contrast threshold to use with this sequence")
         except EventDataError as err:
             raise self.error(str(err)) from None
         if eval_window is not None:
@@ -709,7 +704,7 @@ class CanonicalWriter(CloseOrAbort):
     def add_frame(self, image, t: float) -> None:
         """Append one uint8 frame taken at ``t`` (s since t_origin): grey [H, W] or colour (R, G, B)
         [H, W, 3]; all frames of a file are of one kind (a colour frame is also stored as grey)."""
-        if not is_real_number(t):   # text, None or a list were Python's "must be real number", True was 1 s
+        if not is_real_number(decimal_as_float(t)):   # text, None, a list: "must be real number"; True was 1 s
             raise self.error(f"frame time must be a finite number of seconds since t_origin, got {t!r} "
                              f"(frame {len(self.frame_t)})")
         image = np.asarray(image)

@@ -16,7 +16,6 @@ Public functions: :func:`parse_event_block` (one block of whole lines), :func:`p
 from __future__ import annotations
 
 import functools
-import math
 import re
 from dataclasses import dataclass
 from fractions import Fraction
@@ -26,6 +25,7 @@ import numpy as np
 
 from ..core.events import (LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, check_t_origin,
                            resolve_time_unit, wrap_hint)
+from ..core.guard import host_array
 
 __all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "blank_leading_comments",
            "parse_frame_list", "line_blocks", "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
@@ -62,9 +62,13 @@ TXT_LAYOUT = TextLayout()   # `t x y p` (IJRR events.txt, rpg_e2vid)
 
 
 def origin_to_ns(t_origin) -> int:
-    """Seconds (float or int) -> exact integer nanoseconds of that float value."""
+    """Seconds -> exact integer nanoseconds of that value (a float's exact binary value, a Fraction's or Decimal's
+    exact value; a numpy scalar, 0-d array or tensor as its Python number)."""
     check_t_origin(t_origin)   # text or a list were Python's "must be real number", True was 1 s
-    return round(Fraction(t_origin) * NS)
+    value = host_array(t_origin)   # a tensor as numpy
+    if isinstance(value, (np.ndarray, np.generic)):   # Fraction() takes no np.float32 nor 0-d array: their .item()
+        value = value.item()
+    return round(Fraction(value) * NS)
 
 
 # ---- vectorised text parsing --------------------------------------------------------------
