@@ -81,15 +81,16 @@ def get_weights(name: str, files=("all",), *, verify: bool = True, progress: boo
     from .registry import get_weight_set
 
     entries = get_weight_set(name)
+    given = files   # for the message: what was passed, not its tuple
     if isinstance(files, str):   # one name, not its letters ("alexnet" was "has no file 'a'")
         files = (files,)
     try:
-        files = tuple(files)
+        files = tuple(files) if not isinstance(files, bytes) else (files,)   # bytes: no tuple of numbers
     except TypeError:   # None, 5: "argument of type 'NoneType' is not iterable"
         files = (None,)
     if not all(isinstance(f, str) for f in files):
         raise DataFetchError(f"files= must be a file name or a list of them ({', '.join(entries)}, or 'all'), got "
-                             f"{files!r}")
+                             f"{given!r:.80}")
     wanted = list(entries) if "all" in files else list(files)
     unknown = [f for f in wanted if f not in entries]
     if unknown:
@@ -130,9 +131,10 @@ def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str 
     """
     from evinr_lite.io.canonical import is_canonical
 
-    from .registry import get_dataset, get_sequence
+    from .registry import get_dataset, get_sequence, sequence_name
 
     if _is_weight_set(dataset):        # model weights (e.g. "lpips"): no conversion
+        sequence_name(sequence)   # a weight file's name, checked as given (5 was blamed on get_weights' files=(5,))
         if url:
             raise DataFetchError(f"--url is not supported for weight files; place the file by hand in "
                                  f"{weights_dir(dataset)}/ instead")

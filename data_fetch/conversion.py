@@ -148,6 +148,10 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
     from . import cache_dir
 
     check_settings(C=C, sensor_size=sensor_size, eval_window=eval_window, time_unit=time_unit)
+    if sequence is not None:   # it names the output <sequence>.h5: "../evil" or "a/b" wrote outside the cache
+        from .registry import sequence_name
+
+        sequence_name(sequence)
     if cfa is not _UNSET:
         from evinr_lite.core.cfa import check_cfa
 
