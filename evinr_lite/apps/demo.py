@@ -18,8 +18,8 @@ import time
 import numpy as np
 
 from ..method.integration import integrate_events
-from ..evaluation.metrics import SCORE_PROTOCOLS, score_frames
-from ..core.checks import ArgumentTypeError, require, true_or_false, whole_number
+from ..evaluation.metrics import SCORE_PROTOCOLS, SSIM_MIN_SIDE, score_frames
+from ..core.checks import check_log, require, true_or_false, whole_number
 from ..core.events import EventDataError, check_sensor_size
 from ..io.output import atomic_output_dir, check_output_path, save_json, save_png
 from ..sim.scenes import make_scene
@@ -69,9 +69,6 @@ def labelled_grid(rows, row_labels, column_labels, *, title: str = "") -> np.nda
     return np.asarray(canvas)
 
 
-SSIM_MIN_SIDE = 11   # pixels: SSIM's gaussian window (sigma 1.5, truncated at 3.5 sigma) is 11 x 11
-
-
 def _check_demo_memory(sensor_size, duration, n_frames, cfg, *, fraction: float = 0.8) -> None:
     """Refuse (EventDataError, before anything is simulated) a demo whose reconstruction (the solver's estimate,
     :func:`~evinr_lite.method.memory.estimate_memory`) and ground-truth frames would not fit in ``fraction`` of
@@ -107,13 +104,14 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
     check_output_path(out_dir, overwrite=overwrite)
     n_frames = whole_number(n_frames, "n_frames", lo=1)   # 2.5 was numpy's error, True one frame, 0 no query time
     require(config, EvINRConfig, "config", none_ok=True)   # {} ran the default recipe
-    if not callable(log):
-        raise ArgumentTypeError(f"log= must be a function log(text) (e.g. print), got {type(log).__name__}")
+    check_log(log)
     H, W = check_sensor_size(sensor_size)
     if min(H, W) < SSIM_MIN_SIDE:   # the scores' SSIM refused it after the training
-        raise EventDataError(f"the demo scores its frames with SSIM, whose window needs at least {SSIM_MIN_SIDE} x "
-                             f"{SSIM_MIN_SIDE} pixels; sensor_size=({H}, {W}) is smaller: choose at least "
-                             f"({SSIM_MIN_SIDE}, {SSIM_MIN_SIDE}) (the default is (120, 160))")
+        # no "sensor_size=" here: the command line would name it --sensor, and the demo's flag is --size
+        side = SSIM_MIN_SIDE
+        raise EventDataError(f"the demo's sensor of {H} x {W} pixels is smaller than the {side} x {side} window of "
+                             f"SSIM, which scores its frames: choose at least {side} x {side} (sensor_size "
+                             f"({side}, {side}), --size {side}x{side}; the default is 120 x 160)")
     cfg = config or EvINRConfig(C=C, seed=seed)
     _check_demo_memory(sensor_size, duration, n_frames, cfg)   # before the scene and its frames are allocated
     sc = make_scene(scene, sensor_size=sensor_size, duration=duration)

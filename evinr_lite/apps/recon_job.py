@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, true_or_false
+from ..core.checks import check_path_type, true_or_false
 from ..core.events import EventDataError
 from ..core.recording import Recording
 from ..io.load import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,  # noqa: F401
@@ -157,9 +157,9 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
     from ..io.output import OutputDir
 
     t0 = time.perf_counter()
-    if not isinstance(path, (str, bytes, os.PathLike)):   # None was Python's "expected str, bytes or os.PathLike"
-        raise ArgumentTypeError(f"path= must be a recording (a file or folder: a str or Path), got "
-                                f"{type(path).__name__}")
+    if isinstance(path, bytes):   # as read_recording takes them (io.formats.registry.recording_path)
+        path = os.fsdecode(path)
+    check_path_type(path, "path", "a recording, a file or folder")   # None: "expected str, bytes or os.PathLike"
     resume = true_or_false(resume, "resume")   # "yes" and 5 were taken as true
     options = RunOptions.of(options, **fields)   # every option checked, once, before anything is touched
     anchor, colour = options.anchor, options.colour
