@@ -4,7 +4,8 @@ canonical HDF5 file's writer and reader (evinr_lite.io.canonical), the readers' 
 ``read_recording``, the output folder of every job (evinr_lite.io.output.OutputDir) and the demo and reconstruct
 jobs called from Python (evinr_lite.apps.demo.run_demo, evinr_lite.apps.recon_job.run_reconstruct).
 
-144 cases, 136 of which failed before their fixes (the other 8 are the guards).
+177 cases, 167 of which failed before their fixes (the other 10 are the guards; 33 cases of section 8, the review's,
+31 of which failed before its fixes).
 
 Fixes (each test failed before its fix): data_fetch's ``list_datasets`` / ``canonical_path`` / ``raw_path`` /
 ``get`` / ``get_all`` of a dataset None, 5 or a list and ``weights_dir`` / ``get_weights`` of such a weight set were
@@ -33,10 +34,31 @@ bytes failed after the training, an existing folder was refused after the traini
 pixels was refused by SSIM after the training. ``run_reconstruct`` took ``resume="yes"`` and 5, and a path of None,
 5 or 1.5 was Python's TypeError.
 
+Review fixes (section 8; each test failed before its fix, on this branch before the review): round 15's window check
+took only int and float, so a window of a 0-d array, a tensor, a Fraction or a Decimal, which ``read_canonical``,
+``iter_canonical_events`` and ``data_fetch.read`` took before, was refused: the check is now
+``core.checks.check_reader_window``, built on ``optional_seconds`` (every windowed reader uses it; a Decimal is taken
+as its float). A t_origin, C or frame time of Fraction or Decimal (``float()`` took them) was refused as "no finite
+number": ``check_t_origin`` takes any real number and Decimal (the text readers' nanoseconds stay exact, through
+Fraction), the writer's C and frame time take Decimal too; ``origin_to_ns`` of np.float32 or a 0-d array (which its
+check took) was Python's TypeError (now their ``.item()``). ``get_weights`` showed the tuple made of what was passed
+((5,), (None,), the bytes' numbers) and ``get("lpips", 5)`` blamed files=: the message shows the value, get checks
+its sequence first. The demo command's small-sensor message named --sensor (the command line's spelling of
+sensor_size=); the demo's flag is --size. ``convert(sequence="../evil")`` and "a/b" (and ``convert --sequence``)
+still wrote outside the cache: the name is checked first. ``run_reconstruct`` let a path of bytes through to
+Python's TypeError: it is read as ``read_recording`` reads it (os.fsdecode). The output folder's refusals are tested
+on a fresh folder (an existing one was refused for being there). One check each: SSIM's 11 pixels
+(``evaluation.metrics.SSIM_MIN_SIDE``), a flag (``true_or_false``, ``run_batch``'s sequential too), a log
+(``check_log``) and a path (``check_path_type``; ``run_batch``'s log=5 and out_dir=None are now TypeErrors as the
+other jobs'); the demo command checked its folder twice; io/text.py imported math unused.
+
 Refused on purpose where they were taken before: a sensor size as text in ``convert`` (("180", "240")), a canonical
 file's text attributes that are no text (dataset=5 was written as a number), frames= of None or 0.5 for the
-canonical reader (None skipped the frames), ``overwrite`` / ``resume`` of None (read as False) and a demo sensor under
-11 x 11 (it failed after the training).
+canonical reader (None skipped the frames), ``overwrite`` / ``resume`` of None (read as False) or of a number other
+than 0 and 1 (1.0 was true), a demo sensor under 11 x 11 (it failed after the training), a sequence given as a Path
+(``canonical_path("ijrr", Path("slider_depth"))``), x / y of bools or Python objects in ``add_events``, and False as a
+time (a t_origin, a window bound, a frame time: it was 0 s), as True is (it was 1 s): a flag given where a time
+belongs.
 
 Left as they are: the other readers' declared-or-given sensor sizes (``sensor_from_header`` / ``check_declared_size``
 compare int() of the given size with the file's: a 12.5 is refused there only when the file's size differs),
@@ -54,6 +76,8 @@ existing refusals next to the new ones).
 """
 import json
 import warnings
+from decimal import Decimal
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -359,16 +383,17 @@ def test_output_dir_refuses_an_out_dir_that_is_no_path(out):
                                         (dict(log=5), r"log= must be a function"),
                                         (dict(command=5), r"command= must be text")])
 def test_output_dir_refuses_settings_before_any_folder(tmp_path, kw, pattern):
-    """overwrite="no" replaced an existing folder (a true value); command=5 was stored in the lock."""
-    (tmp_path / "out").mkdir()
-    (tmp_path / "out" / "keep.txt").write_text("x")
+    """overwrite="no" replaced an existing folder (a true value); a log of 5 and a command of 5 were taken (the
+    command written in the lock). A fresh folder (an existing one was refused for being there, whatever the
+    settings) with overwrite=True where overwrite is not the case: nothing may be made, no folder, no lock."""
+    kw = kw if "overwrite" in kw else {"overwrite": True, **kw}
 
     def use():
         with OutputDir(tmp_path / "out", **kw) as target:
             (target.staging / "new.txt").write_text("y")
             target.commit()
     _no(use, pattern)
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"] and (tmp_path / "out" / "keep.txt").exists()
+    assert list(tmp_path.iterdir()) == []   # no out/, no .out.lock, no staging folder
 
 
 def test_output_dir_as_before(tmp_path):
@@ -467,3 +492,167 @@ def test_run_reconstruct_refuses_a_path_that_is_no_path(tmp_path, path):
 def test_run_reconstruct_refuses_an_out_dir_that_is_no_path(npy, out):
     _no(lambda: run_reconstruct(npy, out, sensor_size=(12, 12), n_iters=1, log=QUIET), r"out_dir= must be a folder",
         TypeError)
+
+
+# ---- 8. the review's fixes -----------------------------------------------------------------------------------------
+
+def _torch_seconds(value):
+    import torch
+
+    return torch.tensor(value, dtype=torch.float64)
+
+
+@pytest.mark.parametrize("make", [np.array, _torch_seconds, lambda v: Fraction(v).limit_denominator(1000),
+                                  lambda v: Decimal(str(v))], ids=["0-d", "tensor", "Fraction", "Decimal"])
+def test_review_windows_of_0d_arrays_tensors_fractions_and_decimals_are_read(files, h5, make):
+    """Round 15's window check took only int and float (numpy's too): a 0-d array (t.max()), a tensor, a Fraction or
+    a Decimal, which read_canonical / iter_canonical_events / data_fetch.read took before, were refused."""
+    lo, hi = make(0.05), make(0.15)
+    want = read_canonical(h5, 0.05, 0.15).events.t
+    assert np.array_equal(read_canonical(h5, lo, hi).events.t, want)
+    assert np.array_equal(data_fetch.read(h5, lo, hi).events.t, want)
+    assert np.array_equal(np.concatenate([c.t for c in iter_canonical_events(h5, lo, hi)]), want)
+    npy = _read(files / "e.npy", sensor_size=(12, 12), t_start=0.05, t_end=0.15).events.t
+    assert np.array_equal(_read(files / "e.npy", sensor_size=(12, 12), t_start=lo, t_end=hi).events.t, npy)
+    _none_of([lambda: read_canonical(h5, False), lambda: read_canonical(h5, np.array([0.05])),
+              lambda: read_canonical(h5, Decimal("NaN"))], r"t_start= must be a finite number of seconds")
+
+
+@pytest.mark.parametrize("value", [Fraction(3, 2), Decimal("1.5")], ids=["Fraction", "Decimal"])
+def test_review_canonical_writer_takes_fractions_and_decimals(tmp_path, value):
+    """float() took them before round 15; its checks refused them as "no finite number"."""
+    with CanonicalWriter(tmp_path / "c.h5", sensor_size=(12, 12), t_origin=value, C=value / 6) as w:
+        w.add_events(EV.t, EV.x, EV.y, P)
+        w.add_frame(np.zeros((12, 12), np.uint8), value / 15)
+    info = canonical_info(tmp_path / "c.h5")
+    assert info["t_origin"] == 1.5 and info["C"] == 0.25
+    assert read_canonical(tmp_path / "c.h5").frames.t[0] == 0.1
+
+
+@pytest.mark.parametrize("name", ["e.txt", "e.csv", "ijrr"])
+@pytest.mark.parametrize("origin", [Fraction(0), Decimal("0"), np.float32(0), np.array(0.0)],
+                         ids=["Fraction", "Decimal", "float32", "0-d"])
+def test_review_text_readers_take_a_t_origin_of_any_number(files, name, origin):
+    """Fraction and Decimal were refused by round 15's check (taken before); np.float32 and a 0-d array passed the
+    check and were Python's "argument should be a string or a Rational instance" in origin_to_ns."""
+    kw = {} if name == "ijrr" else dict(sensor_size=(12, 12))
+    want = _read(files / name, t_origin=0, **kw).events
+    got = _read(files / name, t_origin=origin, **kw).events
+    assert np.array_equal(got.t, want.t) and got.t_origin == want.t_origin
+
+
+def test_review_origin_to_ns_of_numpy_numbers_and_decimals():
+    from evinr_lite.io.text import origin_to_ns
+
+    assert origin_to_ns(np.float32(1.5)) == origin_to_ns(np.array(1.5)) == origin_to_ns(_torch_seconds(1.5)) == \
+        1_500_000_000
+    assert origin_to_ns(Decimal("1468939993.067416")) == 1_468_939_993_067_416_000   # exact, not the float's
+    assert origin_to_ns(1468939993.067416) == round(Fraction(1468939993.067416) * 10**9)
+
+
+@pytest.mark.parametrize("false", [False, np.bool_(False)])
+def test_review_false_is_refused_where_true_is(tmp_path, files, h5, false):
+    """True was 1 s and is refused; False (0 s before round 15) is refused alike: a flag is no time."""
+    _no(lambda: _read(files / "e.txt", sensor_size=(12, 12), t_origin=false), r"t_origin must be a finite number")
+    _no(lambda: CanonicalWriter(tmp_path / "f.h5", sensor_size=(12, 12), t_origin=false), r"t_origin must be")
+    _no(lambda: read_canonical(h5, None, false), r"t_end= must be a finite number of seconds")
+    with CanonicalWriter(tmp_path / "g.h5", sensor_size=(12, 12)) as w:
+        w.add_events([0.0, 0.1], [1, 2], [3, 4], [1, -1])
+        _no(lambda: w.add_frame(np.zeros((12, 12), np.uint8), false), r"frame time must be a finite number")
+    assert not (tmp_path / "f.h5").exists()
+
+
+@pytest.mark.parametrize("files,shown", [(5, "got 5$"), (b"alexnet", r"got b'alexnet'$"), (None, "got None$")])
+def test_review_get_weights_names_what_was_passed(cache, files, shown):
+    """The message showed the tuple made of it: (5,), (None,) or the bytes' numbers (97, 108, ...)."""
+    _no(lambda: data_fetch.get_weights("lpips", files, progress=False), r"files= must be .*" + shown, DataFetchError)
+
+
+def test_review_get_of_a_weight_set_checks_the_file_name(cache):
+    """get("lpips", 5) blamed files=(5,), an argument of get_weights that get's caller never passed."""
+    for bad in (5, None):
+        with pytest.raises(DataFetchError, match=r"sequence must be a name") as err:
+            data_fetch.get("lpips", bad, progress=False)
+        assert "files=" not in str(err.value)
+    assert not cache.exists()
+
+
+def test_review_demo_command_names_its_own_size_flag(tmp_path, capsys):
+    """The message said sensor_size=(8, 10), which the command line rewrote as --sensor 8x10: the demo's flag is
+    --size."""
+    from evinr_lite.apps.cli import main
+
+    assert main(["demo", "--size", "8x10", "--out", str(tmp_path / "d")]) == 2
+    err = capsys.readouterr().err
+    assert "--size 11x11" in err and "8 x 10" in err and "--sensor" not in err, err
+    assert not (tmp_path / "d").exists()
+
+
+@pytest.mark.parametrize("sequence", ["../evil", "a/b", "..", 5])
+def test_review_convert_refuses_a_sequence_that_is_no_name(cache, files, sequence):
+    """convert(sequence="../evil") wrote <cache>/evil.h5, "a/b" <cache>/converted/a/b.h5; the command line too."""
+    from data_fetch.__main__ import main
+
+    _no(lambda: data_fetch.convert(files / "ijrr", progress=False, sequence=sequence), r"sequence must be",
+        DataFetchError)
+    if isinstance(sequence, str):
+        assert main(["convert", str(files / "ijrr"), "--sequence", sequence]) == 2
+    assert not cache.exists() and not list(files.rglob("*.h5"))
+
+
+def test_review_run_reconstruct_reads_a_path_given_as_bytes(npy):
+    """bytes passed the check and were Python's TypeError later; read_recording takes them (os.fsdecode)."""
+    import os
+
+    kw = dict(sensor_size=(12, 12), n_iters=1, fps=10, log=QUIET, progress=False, seed=0)
+    a = run_reconstruct(os.fsencode(npy), npy.parent / "a", **kw)
+    b = run_reconstruct(str(npy), npy.parent / "b", **kw)
+    assert a["n_frames_written"] == b["n_frames_written"] >= 1
+
+
+def test_review_jobs_share_their_checks(tmp_path, monkeypatch, capsys):
+    """One rule each: the demo's smallest side is evaluation.metrics' SSIM_MIN_SIDE; a log of 5 and an out_dir of
+    None are the same TypeError, with the same words, for every job (run_batch's were plain ValueErrors); the demo
+    command checks its output folder once (cli.py checked it before run_demo did again)."""
+    import evinr_lite.apps.demo as demo
+    import evinr_lite.io.output as output
+    from evinr_lite.apps.batch import run_batch
+    from evinr_lite.apps.cli import main
+    from evinr_lite.evaluation.metrics import SSIM_MIN_SIDE, ssim
+
+    assert demo.SSIM_MIN_SIDE is SSIM_MIN_SIDE == 11
+    _no(lambda: ssim(np.zeros((10, 12)), np.zeros((10, 12))), r"at least 11 x 11")
+    npy = tmp_path / "e.npy"
+    np.save(npy, np.stack([EV.t, EV.x, EV.y, EV.p], 1))
+    jobs = [lambda out, log: OutputDir(out, log=log),
+            lambda out, log: run_demo(out, sensor_size=(16, 16), duration=0.2, n_frames=2, config=FAST, log=log),
+            lambda out, log: run_batch([str(npy)], out, sequential=True, log=log),
+            lambda out, log: run_reconstruct(npy, out, sensor_size=(12, 12), n_iters=1, log=log)]
+    for job in jobs:
+        _no(lambda: job(tmp_path / "out", 5), r"^log= must be a function log\(text\) \(e\.g\. print\)", TypeError)
+        _no(lambda: job(None, QUIET), r"^out_dir= must be a folder \(a str or Path\), got NoneType$", TypeError)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e.npy"]
+    calls = []
+    checked = output.check_output_path
+
+    def counted(*a, **k):
+        calls.append(a)
+        return checked(*a, **k)
+    monkeypatch.setattr(output, "check_output_path", counted)
+    monkeypatch.setattr(demo, "check_output_path", counted)
+    assert main(["demo", "--size", "8x10", "--out", str(tmp_path / "d")]) == 2
+    capsys.readouterr()
+    assert len(calls) == 1
+
+
+def test_review_io_text_imports_what_it_uses():
+    """io/text.py imported math and used none of it."""
+    import ast
+    from pathlib import Path
+
+    import evinr_lite.io.text as text
+
+    tree = ast.parse(Path(text.__file__).read_text())
+    imported = {a.asname or a.name for n in tree.body if isinstance(n, ast.Import) for a in n.names}
+    used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+    assert imported <= used, imported - used
