@@ -38,18 +38,19 @@ def cache_dir() -> Path:
 
 def canonical_path(dataset: str, sequence: str) -> Path:
     """Where the converted sequence is (or will be): ``<cache>/<dataset>/<sequence>.h5``."""
-    from .registry import get_dataset
+    from .registry import get_dataset, sequence_name
 
-    return cache_dir() / get_dataset(dataset).name / f"{sequence}.h5"
+    ds = get_dataset(dataset)
+    return cache_dir() / ds.name / f"{sequence_name(sequence)}.h5"
 
 
 def raw_path(dataset: str, sequence: str) -> Path:
     """Where the raw download is (or is to be placed by hand): ``<cache>/raw/<dataset>/<file>``."""
-    from .registry import get_dataset, get_sequence
+    from .registry import get_dataset, get_sequence, sequence_name
 
     ds = get_dataset(dataset)
     if ds.method == "manual":
-        return cache_dir() / "raw" / ds.name / sequence
+        return cache_dir() / "raw" / ds.name / sequence_name(sequence)
     return cache_dir() / "raw" / ds.name / get_sequence(ds.name, sequence).raw_file
 
 
@@ -80,6 +81,16 @@ def get_weights(name: str, files=("all",), *, verify: bool = True, progress: boo
     from .registry import get_weight_set
 
     entries = get_weight_set(name)
+    given = files   # for the message: what was passed, not its tuple
+    if isinstance(files, str):   # one name, not its letters ("alexnet" was "has no file 'a'")
+        files = (files,)
+    try:
+        files = tuple(files) if not isinstance(files, bytes) else (files,)   # bytes: no tuple of numbers
+    except TypeError:   # None, 5: "argument of type 'NoneType' is not iterable"
+        files = (None,)
+    if not all(isinstance(f, str) for f in files):
+        raise DataFetchError(f"files= must be a file name or a list of them ({', '.join(entries)}, or 'all'), got "
+                             f"{given!r:.80}")
     wanted = list(entries) if "all" in files else list(files)
     unknown = [f for f in wanted if f not in entries]
     if unknown:
@@ -95,7 +106,7 @@ def get_weights(name: str, files=("all",), *, verify: bool = True, progress: boo
 def _is_weight_set(name: str) -> bool:
     from .registry import WEIGHTS
 
-    return name.lower() in WEIGHTS
+    return isinstance(name, str) and name.lower() in WEIGHTS
 
 
 def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str | None = None,
@@ -120,9 +131,10 @@ def get(dataset: str, sequence: str, *, url: str | None = None, known_hash: str 
     """
     from evinr_lite.io.canonical import is_canonical
 
-    from .registry import get_dataset, get_sequence
+    from .registry import get_dataset, get_sequence, sequence_name
 
     if _is_weight_set(dataset):        # model weights (e.g. "lpips"): no conversion
+        sequence_name(sequence)   # a weight file's name, checked as given (5 was blamed on get_weights' files=(5,))
         if url:
             raise DataFetchError(f"--url is not supported for weight files; place the file by hand in "
                                  f"{weights_dir(dataset)}/ instead")

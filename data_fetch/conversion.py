@@ -100,20 +100,18 @@ def check_settings(*, C=None, sensor_size=None, eval_window=None, time_unit=None
     """Values that are stored in the converted file, checked before converting (DataFetchError)."""
     import math
 
-    from evinr_lite.core.events import TIME_UNITS, check_time_range
+    from evinr_lite.core.events import TIME_UNITS, EventDataError, check_sensor_size, check_time_range
 
     if C is not None and (isinstance(C, bool) or not isinstance(C, (int, float)) or not math.isfinite(C) or C <= 0):
         raise DataFetchError(f"C must be a positive finite contrast threshold, got {C!r} (--C)")
     if sensor_size is not None:
-        try:
-            H, W = (int(v) for v in sensor_size)
-        except (TypeError, ValueError):
-            raise DataFetchError(f"sensor size must be (H, W), two positive integers; got {sensor_size!r}") from None
-        if not (0 < H <= 1 << 16 and 0 < W <= 1 << 16):
-            raise DataFetchError(f"sensor size must be (H, W) with sides in 1..65536; got {(H, W)} (--sensor-size H W)")
+        try:   # the kit's one check: whole numbers only (int() made 2.5 rows into 2 and True into 1)
+            check_sensor_size(sensor_size)
+        except EventDataError as err:
+            raise DataFetchError(f"{err} (--sensor-size H W)") from None
     if eval_window not in (None, _UNSET):
         check_time_range(eval_window, "eval_window", DataFetchError)
-    if time_unit not in (None, "auto") and time_unit not in TIME_UNITS:
+    if time_unit not in (None, "auto") and not (isinstance(time_unit, str) and time_unit in TIME_UNITS):
         raise DataFetchError(f"time unit must be one of {', '.join(TIME_UNITS)}, got {time_unit!r} (--time-unit)")
 
 
@@ -150,6 +148,10 @@ def convert(raw, out=None, *, dataset: str | None = None, sequence: str | None =
     from . import cache_dir
 
     check_settings(C=C, sensor_size=sensor_size, eval_window=eval_window, time_unit=time_unit)
+    if sequence is not None:   # it names the output <sequence>.h5: "../evil" or "a/b" wrote outside the cache
+        from .registry import sequence_name
+
+        sequence_name(sequence)
     if cfa is not _UNSET:
         from evinr_lite.core.cfa import check_cfa
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-__all__ = ["Dataset", "Sequence", "DATASETS", "get_dataset", "get_sequence", "WeightFile", "WEIGHTS",
+__all__ = ["Dataset", "Sequence", "DATASETS", "get_dataset", "get_sequence", "sequence_name", "WeightFile", "WEIGHTS",
            "get_weight_set"]
 
 IJRR_BASE = "https://rpg.ifi.uzh.ch/datasets/davis/"
@@ -213,10 +213,33 @@ def _aed() -> Dataset:
 DATASETS: dict[str, Dataset] = {d.name: d for d in (_ijrr(), _hqf(), _ced(), _mvsec(), _aed())}
 
 
+def _name(value, what: str) -> str:
+    """A registry name given as text; anything else is a DataFetchError (None or 5 were "has no attribute 'lower'")."""
+    from .errors import DataFetchError
+
+    if not isinstance(value, str):
+        raise DataFetchError(f"{what} must be a name (text), got {value!r}; run `python -m data_fetch list` for the "
+                             "names")
+    return value
+
+
+def sequence_name(name) -> str:
+    """``name`` when it can name a sequence: text that is a file name (no folder part, not "." or ".."); the
+    sequence's files are <cache>/<dataset>/<name>.h5 and <cache>/raw/<dataset>/<name>, so "../x" or "a/b" would
+    lie elsewhere. Anything else is a DataFetchError."""
+    from .errors import DataFetchError
+
+    _name(name, "the sequence")
+    if not name.strip() or name.strip() in (".", "..") or "/" in name or "\\" in name or "\0" in name:
+        raise DataFetchError(f"the sequence must be a sequence's name (no folder, no '/', not '.' or '..'), got "
+                             f"{name!r}; run `python -m data_fetch list` for the names")
+    return name
+
+
 def get_dataset(name: str) -> Dataset:
     from .errors import DataFetchError
 
-    key = name.lower()
+    key = _name(name, "the dataset").lower()
     if key == "ecd":
         key = "ijrr"
     if key not in DATASETS:
@@ -230,6 +253,7 @@ def get_sequence(dataset: str, name: str) -> Sequence:
     from .errors import DataFetchError
 
     ds = get_dataset(dataset)
+    sequence_name(name)
     if name in ds.sequences:
         return ds.sequences[name]
     if ds.url_pattern and re.fullmatch(r"[A-Za-z0-9_]+", name) and (ds.name != "ijrr" or name in ECD_NAMES):
@@ -281,7 +305,7 @@ WEIGHTS: dict[str, dict[str, WeightFile]] = {
 def get_weight_set(name: str) -> dict[str, WeightFile]:
     from .errors import DataFetchError
 
-    key = name.lower()
+    key = _name(name, "the weight set").lower()
     if key not in WEIGHTS:
         raise DataFetchError(f"unknown weight set {name!r}; known: {', '.join(WEIGHTS)}")
     return WEIGHTS[key]

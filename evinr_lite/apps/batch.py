@@ -38,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.checks import check_log, true_or_false
 from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
@@ -589,15 +590,9 @@ def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: 
 
     from ..io.output import given_output_path
 
-    if not isinstance(out_dir, (str, os.PathLike)) or isinstance(os.fspath(out_dir), bytes):   # bytes: TypeError later
-        raise EventDataError(f"out_dir= must be a folder (a str or Path), got {type(out_dir).__name__}")
-    out_dir = given_output_path(out_dir)   # "" is refused, not taken as the current folder
-    if not isinstance(sequential, (bool, np.bool_)) and not (isinstance(sequential, (int, np.integer))
-                                                             and sequential in (0, 1)):
-        raise EventDataError(f"sequential= must be True or False (or 0 / 1), got {sequential!r}")
-    sequential = bool(sequential)
-    if not callable(log):   # it is called after the batch has run
-        raise EventDataError(f"log= must be a function log(text) (e.g. print), got {type(log).__name__}")
+    out_dir = given_output_path(out_dir)   # no path, bytes and "" refused ("" is not taken as the current folder)
+    sequential = true_or_false(sequential, "sequential")   # True / False, numpy's, 0 / 1; "yes" and 2 refused
+    check_log(log)   # it is called after the batch has run
     if client is not None and not callable(getattr(client, "submit", None)):
         raise EventDataError(f"client= must be a distributed.Client (or None), got {type(client).__name__}")
     # every option checked, once; a batch writes no video unless asked

@@ -338,10 +338,8 @@ def _reconstruct(args) -> None:
 
 def _demo(args) -> None:
     from .demo import run_demo
-    from ..io.output import check_output_path
     from ..method.recipes import recipe_config
 
-    check_output_path(args.out, overwrite=args.overwrite)   # say so before training, not after
     config = recipe_config(args.recipe, args.iters, args.tonemap, C=args.C, seed=args.seed)
     run_demo(args.out, scene=args.scene, sensor_size=args.size, duration=args.duration, C=args.C,
              n_frames=args.frames, seed=args.seed, overwrite=args.overwrite, config=config)

@@ -18,8 +18,10 @@ import time
 import numpy as np
 
 from ..method.integration import integrate_events
-from ..evaluation.metrics import SCORE_PROTOCOLS, score_frames
-from ..io.output import atomic_output_dir, save_json, save_png
+from ..evaluation.metrics import SCORE_PROTOCOLS, SSIM_MIN_SIDE, score_frames
+from ..core.checks import check_log, require, true_or_false, whole_number
+from ..core.events import EventDataError, check_sensor_size
+from ..io.output import atomic_output_dir, check_output_path, save_json, save_png
 from ..sim.scenes import make_scene
 from ..sim.simulate import simulate_scene
 from ..method.solver import EvINRConfig, reconstruct
@@ -71,7 +73,6 @@ def _check_demo_memory(sensor_size, duration, n_frames, cfg, *, fraction: float 
     """Refuse (EventDataError, before anything is simulated) a demo whose reconstruction (the solver's estimate,
     :func:`~evinr_lite.method.memory.estimate_memory`) and ground-truth frames would not fit in ``fraction`` of
     the free memory, naming the demo's own settings (its command has no --start/--end or --fps/--at)."""
-    from ..core.events import EventDataError, check_sensor_size
     from ..method.memory import available_bytes, estimate_memory
 
     H, W = check_sensor_size(sensor_size)
@@ -98,6 +99,19 @@ def run_demo(out_dir="evinr_demo", *, scene: str = "camera", sensor_size=(120, 1
         "ssim_clahe", "time_s", "folder"}}, "n_events": int, ...}.
     """
     t0 = time.perf_counter()
+    # before any work (the simulation and the training): the output folder was checked after the training
+    overwrite = true_or_false(overwrite, "overwrite")
+    check_output_path(out_dir, overwrite=overwrite)
+    n_frames = whole_number(n_frames, "n_frames", lo=1)   # 2.5 was numpy's error, True one frame, 0 no query time
+    require(config, EvINRConfig, "config", none_ok=True)   # {} ran the default recipe
+    check_log(log)
+    H, W = check_sensor_size(sensor_size)
+    if min(H, W) < SSIM_MIN_SIDE:   # the scores' SSIM refused it after the training
+        # no "sensor_size=" here: the command line would name it --sensor, and the demo's flag is --size
+        side = SSIM_MIN_SIDE
+        raise EventDataError(f"the demo's sensor of {H} x {W} pixels is smaller than the {side} x {side} window of "
+                             f"SSIM, which scores its frames: choose at least {side} x {side} (sensor_size "
+                             f"({side}, {side}), --size {side}x{side}; the default is 120 x 160)")
     cfg = config or EvINRConfig(C=C, seed=seed)
     _check_demo_memory(sensor_size, duration, n_frames, cfg)   # before the scene and its frames are allocated
     sc = make_scene(scene, sensor_size=sensor_size, duration=duration)

@@ -15,11 +15,13 @@ first event on an absolute clock, else 0), as ``describe_recording`` prints them
 """
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
 import numpy as np
 
+from ..core.checks import check_path_type, true_or_false
 from ..core.events import EventDataError
 from ..core.recording import Recording
 from ..io.load import (FIXED_UNITS, READER_WINDOW_FORMATS, SENSOR_ARG_FORMATS, SIZE_FREE_FORMATS,  # noqa: F401
@@ -155,6 +157,10 @@ def run_reconstruct(path, out_dir, options: RunOptions | None = None, *, overwri
     from ..io.output import OutputDir
 
     t0 = time.perf_counter()
+    if isinstance(path, bytes):   # as read_recording takes them (io.formats.registry.recording_path)
+        path = os.fsdecode(path)
+    check_path_type(path, "path", "a recording, a file or folder")   # None: "expected str, bytes or os.PathLike"
+    resume = true_or_false(resume, "resume")   # "yes" and 5 were taken as true
     options = RunOptions.of(options, **fields)   # every option checked, once, before anything is touched
     anchor, colour = options.anchor, options.colour
     if streamable(options):

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+from decimal import Decimal
 
 import numpy as np
 
@@ -18,7 +20,8 @@ from .guard import InputError, check_unmasked, dense_array, host_array
 
 __all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
-           "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span"]
+           "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
+           "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -147,6 +150,36 @@ def optional_seconds(value, name: str) -> float | None:
     return real_number(value, name, hint="pass seconds on the events' clock (or None for the default)")
 
 
+def decimal_as_float(value):
+    """A finite Decimal as its float, anything else as given: Decimal is no ``numbers.Real`` (so
+    :func:`is_real_number` refuses it), but the canonical file's reader and writer and the text readers' t_origin
+    took it (through ``float()`` / ``math.isfinite``) before their checks; a NaN Decimal stays one, to be refused."""
+    return float(value) if isinstance(value, Decimal) and value.is_finite() else value
+
+
+def check_reader_window(t_start, t_end) -> tuple:
+    """A reader's window ``[t_start, t_end)`` (seconds on the recording's clock), checked before any reading: each
+    bound None or a finite number (:func:`optional_seconds`: a Python or numpy int or float, a 0-d array or tensor, a
+    Fraction; a Decimal too), and t_end after t_start; else an InputError naming the bound. Text, lists and bools
+    (True was 1 s, False 0 s: a flag is no time) are refused.
+
+    Returns the bounds to search with: a Python or numpy int or float as given (the readers compared them so
+    before, float32 included), any other number (0-d array, tensor, Fraction, Decimal) as a float."""
+    bounds = []
+    for name, value in (("t_start", t_start), ("t_end", t_end)):
+        try:
+            seconds = optional_seconds(decimal_as_float(value), name)
+        except EventDataError:
+            raise EventDataError(f"{name}= must be a finite number of seconds (on the recording's clock; None for its "
+                                 f"{'start' if name == 't_start' else 'end'}), got {short_repr(value)}") from None
+        plain = isinstance(value, (int, float, np.integer, np.floating))   # bools were refused above
+        bounds.append(value if plain or value is None else seconds)
+    lo, hi = bounds
+    if lo is not None and hi is not None and hi <= lo:
+        raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
+    return lo, hi
+
+
 def choice(value, allowed, name: str):
     """``value`` when it is one of ``allowed``; else an InputError listing them."""
     try:
@@ -178,6 +211,33 @@ def whole_number(value, name: str, *, lo: int | None = None, hi: int | None = No
     value = int(value)
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         raise EventDataError(f"{name}= must be a whole number{_range(lo, hi)}, got {value}")
+    return value
+
+
+def true_or_false(value, name: str) -> bool:
+    """``value`` as a bool when it is True or False (numpy's too) or the whole number 0 or 1; else an InputError.
+    Text ("no" is a true value), None and other numbers are refused, not read as their truth."""
+    if isinstance(value, (bool, np.bool_)) or (isinstance(value, (int, np.integer)) and value in (0, 1)):
+        return bool(value)
+    raise EventDataError(f"{name}= must be True or False, got {short_repr(value)}")
+
+
+def check_log(log, *, none_ok: bool = False):
+    """``log`` when it is a function ``log(text)`` (or None when ``none_ok``); else an ArgumentTypeError before any
+    work (a log of 5 failed only when the job first logged, after its work)."""
+    if (log is None and none_ok) or callable(log):
+        return log
+    raise ArgumentTypeError(f"log= must be a function log(text) (e.g. print){' or None' if none_ok else ''}, got "
+                            f"{type(log).__name__}")
+
+
+def check_path_type(value, name: str, what: str, hint: str = ""):
+    """``value`` when it is a path: a str or an os.PathLike giving one; else an ArgumentTypeError naming ``name``
+    and ``what`` it must be (None, a number or a list were Python's "expected str, bytes or os.PathLike object",
+    which names no argument; bytes are refused here too: ``Path(b"x")`` is that TypeError)."""
+    if not isinstance(value, (str, os.PathLike)) or isinstance(os.fspath(value), bytes):
+        raise ArgumentTypeError(f"{name}= must be {what} (a str or Path), got {type(value).__name__}"
+                                + (f"; {hint}" if hint else ""))
     return value
 
 

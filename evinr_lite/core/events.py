@@ -15,7 +15,9 @@ Conventions (every module relies on them):
 """
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
+from decimal import Decimal
 
 import numpy as np
 
@@ -162,7 +164,7 @@ def resolve_time_unit(t, time_unit: str | None, source, *, flag: str = "time_uni
     (nanoseconds: ESIM); floating-point timestamps are seconds.
     """
     if time_unit not in (None, "auto"):
-        if time_unit not in TIME_UNITS:
+        if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):   # a list was "unhashable type"
             raise EventDataError(f"unknown {flag}={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
         return time_unit
     kind = np.asarray(t).dtype.kind if not isinstance(t, str) else t
@@ -242,7 +244,7 @@ def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
     Integer timestamps (us, ns) are shifted in integer arithmetic and then divided (correctly
     rounded), so no precision is lost; float timestamps are shifted in float64 (exact for large values).
     """
-    if time_unit not in TIME_UNITS:
+    if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):
         raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
     per_s = round(1 / TIME_UNITS[time_unit])  # 1, 1000, 10**6, 10**9 units per second
     t = np.asarray(t)
@@ -269,8 +271,17 @@ def _is_number(value) -> bool:
 
 
 def check_t_origin(t_origin) -> float:
-    """``t_origin`` (seconds, the absolute time of t = 0) as a finite float, or an EventDataError."""
-    if not _is_number(t_origin) or not math.isfinite(float(t_origin)):
+    """``t_origin`` (seconds, the absolute time of t = 0) as a finite float, or an EventDataError.
+
+    A number: a Python or numpy int or float, a 0-d array or tensor holding one, a Fraction or a Decimal (the
+    text readers turn it into nanoseconds exactly, through Fraction). Text, None, lists and bools are refused:
+    True is no 1 s and False no 0 s (a flag given where a time belongs)."""
+    exact = isinstance(t_origin, (numbers.Rational, Decimal)) and not isinstance(t_origin, (bool, np.bool_))
+    try:
+        finite = (exact or _is_number(t_origin)) and math.isfinite(float(t_origin))
+    except (OverflowError, ValueError):   # 10**400; Decimal("sNaN")
+        finite = False
+    if not finite:
         raise EventDataError(f"t_origin must be a finite number of seconds (the absolute time of t = 0; 0 when the "
                              f"times are already relative), got {t_origin!r}")
     return float(t_origin)
@@ -460,7 +471,7 @@ class Events:
             sort: sort by time (stable) instead of raising on unsorted input.
             t_origin: seconds to add to ``t`` to get the absolute clock.
         """
-        if time_unit not in TIME_UNITS:
+        if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):   # a list was "unhashable type"
             raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
         t, x, y, p = (host_array(a) for a in (t, x, y, p))
         t = dense_array(t, "Events.t", error=EventDataError)   # a ragged nest: named, not numpy's ValueError

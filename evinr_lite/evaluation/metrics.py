@@ -23,7 +23,7 @@ from ..core.checks import check_image_values, host_array, image_stack
 from ..core.events import EventDataError
 from ..core.frames import to_uint8
 
-__all__ = ["mse", "ssim", "equalize", "score_pairs", "score_frames", "protocol_description", "PROTOCOLS",
+__all__ = ["SSIM_MIN_SIDE", "mse", "ssim", "equalize", "score_pairs", "score_frames", "protocol_description", "PROTOCOLS",
            "SCORE_PROTOCOLS", "METRIC_PROTOCOL", "SSIM_PROTOCOL", "EQUALIZATIONS", "CLAHE_CLIP_LIMIT", "CLAHE_TILES"]
 
 EQUALIZATIONS = ("none", "global", "clahe")   # every equalisation equalize() knows
@@ -125,9 +125,13 @@ def _ssim(pred: np.ndarray, gt: np.ndarray) -> float:
                                        use_sample_covariance=False, data_range=1.0))
 
 
+SSIM_MIN_SIDE = 11   # pixels: SSIM's gaussian window (sigma 1.5, truncated at 3.5 sigma) is 11 x 11
+
+
 def _check_ssim_size(shape) -> None:
-    if min(shape) < 11:
-        raise EventDataError(f"SSIM needs images of at least 11 x 11 pixels (its gaussian window), got {shape}")
+    if min(shape) < SSIM_MIN_SIDE:
+        raise EventDataError(f"SSIM needs images of at least {SSIM_MIN_SIDE} x {SSIM_MIN_SIDE} pixels (its gaussian "
+                             f"window), got {shape}")
 
 
 def equalize(img, method: str = "none") -> np.ndarray:

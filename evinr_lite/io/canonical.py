@@ -56,7 +56,10 @@ from pathlib import Path
 import numpy as np
 
 from ..core.cfa import CFA_NAMES, cfa_phase, check_cfa  # the colour filter's one home (names kept here)
-from ..core.events import MAX_SENSOR_SIDE, EventDataError, Events
+from ..core.checks import (check_path_type, check_reader_window, decimal_as_float, host_array, is_real_number,
+                           real_number, true_or_false, whole_number)
+from ..core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_sensor_size, check_t_origin,
+                           check_time_range)
 from ..core.frames import Frames, to_grey_uint8
 from .notes import note
 from .output import CloseOrAbort
@@ -88,11 +91,19 @@ COMPRESSION = dict(compression="gzip", compression_opts=4, shuffle=True)
 DTYPES = {"t": np.float64, "x": np.uint16, "y": np.uint16, "p": np.int8}
 log = logging.getLogger("evinr_lite")
 EVENT_FIELDS = ("t", "x", "y", "p")
+
+
+def _file_path(path) -> Path:
+    """``path`` as a Path; None, a number, a list or bytes are refused naming the argument (Python's "expected str,
+    bytes or os.PathLike object" named none)."""
+    return Path(check_path_type(path, "path", "a file path", "pass the .h5 file that data_fetch.get / convert wrote"))
+
+
 def is_canonical(path) -> bool:
     """True when ``path`` is an HDF5 file in the canonical layout (any version)."""
     import h5py
 
-    path = Path(path)
+    path = _file_path(path)
     if not path.is_file():
         return False
     try:
@@ -110,7 +121,7 @@ def _damaged(path, err) -> EventDataError:
 def _open(path):
     import h5py
 
-    path = Path(path)
+    path = _file_path(path)
     if not path.exists():
         raise EventDataError(f"no such file: {path}; check the path (data_fetch.get(...) returns it)")
     if not path.is_file():
@@ -345,9 +356,6 @@ def _events(f, lo: int, hi: int, sensor_size, origin: float, source) -> Events:
 def _read_open(f, path, t_start, t_end, frames):
     info = _info_from(f, path)
     sensor_size, origin = info["sensor_size"], float(info["t_origin"])
-    for name, value in (("t_start", t_start), ("t_end", t_end)):
-        if value is not None and not math.isfinite(value):
-            raise EventDataError(f"{name}= must be a finite number of seconds, got {value}")
     lo, hi = _window(f, path, t_start, t_end)
     if hi <= lo and (t_start is not None or t_end is not None):
         first, last = info.get("t_first"), info.get("t_last")
@@ -422,6 +430,9 @@ def read_canonical(path, t_start: float | None = None, t_end: float | None = Non
     """
     from ..core.recording import Recording
 
+    check_reader_window(t_start, t_end)   # the bounds are searched with as given, as before the check
+    t_start, t_end = host_array(t_start), host_array(t_end)   # a tensor as numpy: the same value, no torch warning
+    frames = true_or_false(frames, "frames")
     with _open(path) as f:
         try:
             info, lo, hi, events, gt = _read_open(f, path, t_start, t_end, frames)
@@ -450,7 +461,8 @@ class CanonicalSource(RecordingSource):
     """
 
     def __init__(self, path, *, frames: bool = True):
-        path = Path(path)
+        path = _file_path(path)
+        frames = true_or_false(frames, "frames")
         self._f = _open(path)
         try:
             info = _info_from(self._f, path)
@@ -495,8 +507,9 @@ def iter_canonical_events(path, t_start: float | None = None, t_end: float | Non
     Memory stays at one chunk whatever the sequence length (e.g. for event rates or binning of a
     10^8-event recording). The window is ``t_start <= t < t_end`` as in :func:`read_canonical`.
     """
-    if chunk_events < 1:
-        raise EventDataError(f"chunk_events must be a positive number of events, got {chunk_events}")
+    chunk_events = whole_number(chunk_events, "chunk_events", lo=1)   # 2.5 was range()'s TypeError, True one event
+    check_reader_window(t_start, t_end)   # "0" was read as seconds, NaN gave no chunk without a word
+    t_start, t_end = host_array(t_start), host_array(t_end)   # searched with as given (a tensor as numpy)
     with _open(path) as f:
         try:
             info = _info_from(f, path)
@@ -571,6 +584,9 @@ class CanonicalWriter(CloseOrAbort):
         import h5py
 
         self.out = Path(out)
+        self._check_settings(sensor_size, t_origin, C, eval_window, meta,
+                             dict(dataset=dataset, sequence=sequence, source=source, source_url=source_url,
+                                  raw_file=raw_file, converter=converter))   # before any folder or file is made
         self.out.parent.mkdir(parents=True, exist_ok=True)
         self.tmp = self.out.with_name(f".{self.out.name}.partial")
         self.H, self.W = (int(v) for v in sensor_size)
@@ -595,19 +611,51 @@ class CanonicalWriter(CloseOrAbort):
         self.rgb = None              # /frames/rgb once a colour frame arrived
         self.closed = False
 
+    def _check_settings(self, sensor_size, t_origin, C, eval_window, meta, texts: dict) -> None:
+        """Refuse (:attr:`error`) what the file's attributes cannot hold: a sensor size that is no two whole numbers
+        (2.5 rows were written as 2), a C or t_origin that is no finite number (NaN was written), a reversed or
+        non-finite eval_window, meta that JSON cannot hold (found at close, after every event) and attributes that
+        are no text (5 was written as a number, None was h5py's TypeError at close)."""
+        try:
+            check_sensor_size(sensor_size)
+            check_t_origin(t_origin)
+            real_number(decimal_as_float(C), "C", lo=0, lo_open=True,   # Fraction, Decimal: float(C) as before
+                        hint="the contrast threshold to use with this sequence")
+        except EventDataError as err:
+            raise self.error(str(err)) from None
+        if eval_window is not None:
+            check_time_range(eval_window, "eval_window", self.error)
+        try:
+            json.dumps(dict(meta or {}))
+        except (TypeError, ValueError) as err:
+            raise self.error(f"meta= must be a dict of JSON values (numbers, text, lists, dicts; convert numpy "
+                             f"values with .item() or .tolist()), got {type(meta).__name__}: {err}") from None
+        for name, value in texts.items():
+            if not isinstance(value, str):
+                raise self.error(f"{name}= must be text (a str), got {value!r}")
+
     # ---- events -----------------------------------------------------------------------------
     def add_events(self, t, x, y, p, *, where: str = "") -> None:
         """Append events (t float64 s since t_origin, non-decreasing; p in -1/+1).
 
         ``where`` names the position in the raw file for error messages (e.g. "line 1200").
         """
-        t = np.asarray(t, dtype=np.float64)
+        t = np.asarray(t)
         if t.size == 0:
             return
         x, y, p = np.asarray(x), np.asarray(y), np.asarray(p)
         at = f" ({where})" if where else ""
         if not (t.shape == x.shape == y.shape == p.shape) or t.ndim != 1:
             raise self.error(f"t, x, y, p of a block differ in shape{at}: {t.shape}, {x.shape}, {y.shape}, {p.shape}")
+        if t.dtype.kind not in "iuf":
+            raise self.error(f"t must be numbers (seconds since t_origin){at}; got {t.dtype} values such as "
+                             f"{t[:3].tolist()}")
+        t = t.astype(np.float64, copy=False)
+        for name, v in (("x", x), ("y", y)):   # numpy's cast made 1.5 into 1 and NaN into 0
+            if v.dtype.kind not in "iu" and not (v.dtype.kind == "f" and np.all(np.isfinite(v)) and
+                                                 np.all(v == np.round(v))):
+                raise self.error(f"{name} must be whole pixel indices{at}; got {v.dtype} values such as "
+                                 f"{v[:3].tolist()}")
         if not np.all(np.isfinite(t)):
             raise self.error(f"non-finite timestamp{at}; the raw file is damaged")
         steps = np.diff(t, prepend=self.t_last)
@@ -656,6 +704,9 @@ class CanonicalWriter(CloseOrAbort):
     def add_frame(self, image, t: float) -> None:
         """Append one uint8 frame taken at ``t`` (s since t_origin): grey [H, W] or colour (R, G, B)
         [H, W, 3]; all frames of a file are of one kind (a colour frame is also stored as grey)."""
+        if not is_real_number(decimal_as_float(t)):   # text, None, a list: "must be real number"; True was 1 s
+            raise self.error(f"frame time must be a finite number of seconds since t_origin, got {t!r} "
+                             f"(frame {len(self.frame_t)})")
         image = np.asarray(image)
         colour = image.ndim == 3 and image.shape[-1] == 3
         if image.dtype != np.uint8 or not (image.ndim == 2 or colour):

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from ..core.checks import ArgumentTypeError, check_log, check_path_type, true_or_false
 from ..core.events import InputError
 from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, termination_signals  # re-exported
 
@@ -103,18 +104,20 @@ def _inside(a: Path, b: Path) -> bool:
 
 def given_output_path(out_dir) -> Path:
     """``out_dir`` as a Path (``~`` expanded); an empty or blank name is an OutputError, not the current folder
-    (``Path("")`` is ".") nor a folder named by spaces."""
-    if isinstance(out_dir, (str, bytes)) and not out_dir.strip():
+    (``Path("")`` is ".") nor a folder named by spaces; None or a number is refused naming out_dir= (Python's
+    "expected str, bytes or os.PathLike object" named nothing)."""
+    check_path_type(out_dir, "out_dir", "a folder")   # bytes too: Path(b"x") is Python's TypeError
+    if isinstance(out_dir, str) and not out_dir.strip():
         raise OutputError(f"out_dir={out_dir!r} is empty or blank (an empty path would be the current folder); pass "
                           "the folder to write, e.g. out_dir=rec")
-    name = os.fspath(out_dir) if isinstance(out_dir, (str, bytes, os.PathLike)) else ""
-    if (b"\0" if isinstance(name, bytes) else "\0") in name:   # no file name holds one: os calls raise a bare ValueError
+    name = os.fspath(out_dir)   # a str: bytes were refused above
+    if "\0" in name:   # no file name holds one: os calls raise a bare ValueError
         raise OutputError(f"out_dir={name!r} holds a NUL character (\\x00), which no file name can; "
                           "pass the folder's name without it")
     try:
         return Path(out_dir).expanduser()
     except (RuntimeError, KeyError):   # ~someone who is no user here, or no home folder to expand ~ to
-        raise OutputError(f"out_dir={name or out_dir!r} starts with {Path(name).parts[0] if name else '~'}, which "
+        raise OutputError(f"out_dir={name!r} starts with {Path(name).parts[0]}, which "
                           "names no user's home folder on this machine; write the folder's full path (e.g. "
                           "/home/me/results)") from None
 
@@ -232,7 +235,10 @@ class OutputDir:
 
     def __init__(self, out_dir, *, overwrite: bool = False, inputs=(), log=None, command: str = ""):
         self.given = given_output_path(out_dir)
-        self.overwrite = overwrite
+        self.overwrite = true_or_false(overwrite, "overwrite")   # "no" is a true value: it replaced the folder
+        check_log(log, none_ok=True)
+        if not isinstance(command, str):   # it is written into the lock for a second run to read
+            raise ArgumentTypeError(f"command= must be text (the command line, recorded in the lock), got {command!r}")
         self.inputs = tuple(inputs)
         self.log = log or (lambda message: None)
         self.command = command

@@ -16,7 +16,6 @@ Public functions: :func:`parse_event_block` (one block of whole lines), :func:`p
 from __future__ import annotations
 
 import functools
-import math
 import re
 from dataclasses import dataclass
 from fractions import Fraction
@@ -24,8 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.events import (LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, resolve_time_unit,
-                           wrap_hint)
+from ..core.events import (LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, check_t_origin,
+                           resolve_time_unit, wrap_hint)
+from ..core.guard import host_array
 
 __all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "blank_leading_comments",
            "parse_frame_list", "line_blocks", "origin_to_ns", "read_text_bytes", "NS", "NS_PER_UNIT", "CHUNK_BYTES", "EVENT_COLUMNS"]
@@ -62,10 +62,13 @@ TXT_LAYOUT = TextLayout()   # `t x y p` (IJRR events.txt, rpg_e2vid)
 
 
 def origin_to_ns(t_origin) -> int:
-    """Seconds (float or int) -> exact integer nanoseconds of that float value."""
-    if not math.isfinite(t_origin):
-        raise EventDataError(f"t_origin must be a finite number of seconds, got {t_origin!r}")
-    return round(Fraction(t_origin) * NS)
+    """Seconds -> exact integer nanoseconds of that value (a float's exact binary value, a Fraction's or Decimal's
+    exact value; a numpy scalar, 0-d array or tensor as its Python number)."""
+    check_t_origin(t_origin)   # text or a list were Python's "must be real number", True was 1 s
+    value = host_array(t_origin)   # a tensor as numpy
+    if isinstance(value, (np.ndarray, np.generic)):   # Fraction() takes no np.float32 nor 0-d array: their .item()
+        value = value.item()
+    return round(Fraction(value) * NS)
 
 
 # ---- vectorised text parsing --------------------------------------------------------------
@@ -414,7 +417,7 @@ def parse_event_block(buf, origin_ns: int | None, *, source, line_base: int = 0,
         fail(i, f"found {counts[i]} columns, expected 4: {layout.columns}{hint}{names_hint(i)}"
                 f"{_count_hint(_line_text(buf, newlines, i), opens, layout)}")
     empty = np.zeros(0, dtype=np.int64)
-    if time_unit not in TIME_UNITS and time_unit != "auto":
+    if time_unit != "auto" and not (isinstance(time_unit, str) and time_unit in TIME_UNITS):
         raise EventDataError(f"unknown time_unit={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
     if len(starts) == 0:
         return EventBlock(np.zeros(0), empty, empty, empty.astype(np.int8), header, origin_ns, n_lines,

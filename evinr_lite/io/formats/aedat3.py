@@ -283,7 +283,7 @@ def read_aedat3(path, *, sensor_size=None, t_start: float | None = None, t_end: 
         Recording(events, frames or None, meta) with meta["format"] = "aedat3", the source read and its device.
     """
     path = existing(path)
-    check_reader_window(t_start, t_end)
+    t_start, t_end = check_reader_window(t_start, t_end)   # 0-d, Fraction, Decimal: floats
     return read_packets(path, _decoded, sensor_size=sensor_size, t_start=t_start, t_end=t_end, frames_from=frames_from)
 
 

@@ -16,6 +16,7 @@ from typing import Callable
 
 import numpy as np
 
+from ...core.checks import check_reader_window   # re-exported: the readers' window check lives in core.checks
 from ...core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_time_span, fall_back_hint, relative_seconds,
                             resolve_time_unit)
 from ..text import read_text_bytes
@@ -258,18 +259,6 @@ def plain_attr(value):
     if isinstance(value, bytes):
         return value.decode("utf-8", "replace")
     return value
-
-
-def check_reader_window(t_start, t_end) -> None:
-    """Refuse a non-finite or reversed ``[t_start, t_end)`` before any reading."""
-    import math
-
-    for name, value in (("t_start", t_start), ("t_end", t_end)):
-        if value is not None and (not isinstance(value, (int, float, np.integer, np.floating))
-                                  or not math.isfinite(value)):
-            raise EventDataError(f"{name}= must be a finite number of seconds, got {value!r}")
-    if t_start is not None and t_end is not None and t_end <= t_start:
-        raise EventDataError(f"time window [{t_start}, {t_end}) is empty or reversed; t_end must exceed t_start")
 
 
 class Clock:

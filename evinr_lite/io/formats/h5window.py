@@ -111,7 +111,7 @@ def read_window(path, make_layout, t_start=None, t_end=None) -> Recording:
     """The Recording of [t_start, t_end) of the HDF5 file ``path`` (seconds on its returned clock; None:
     open), read through ``make_layout(f, path)``: only the window's rows and frames are read."""
     path = existing(path)
-    check_reader_window(t_start, t_end)
+    t_start, t_end = check_reader_window(t_start, t_end)   # 0-d, Fraction, Decimal: floats
     f = open_h5(path)
     try:
         with f:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...core.events import EventDataError, check_time_span
+from ...core.events import EventDataError, check_sensor_size, check_time_span
 from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
 from ..text import NS, origin_to_ns, parse_event_text, parse_frame_list, read_text_bytes
@@ -136,6 +136,8 @@ def read_ijrr_folder(folder, *, t_origin=None, sensor_size=None, time_unit="auto
     if not events_path.exists():
         raise EventDataError(f"{folder}: no events.txt; an IJRR folder holds events.txt, "
                              "images.txt, images/, calib.txt")
+    if sensor_size is not None:   # whole numbers, before reading: (12.5, 12) was compared as (12, 12) and taken
+        sensor_size = check_sensor_size(sensor_size)
     raw = parse_event_text(events_path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
     check_time_spread(float(raw.t[0]), float(raw.t[-1]), len(raw.t), events_path)   # sorted by the parser
     check_time_span(raw.t, events_path, raw.time_unit)

@@ -154,7 +154,7 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
             read (found by bisection on the time column on disk; the times must be sorted).
         meta: where notes go (``meta["read_notes"]``); they are also warnings (ReadNote).
     """
-    check_reader_window(t_start, t_end)
+    t_start, t_end = check_reader_window(t_start, t_end)   # 0-d, Fraction, Decimal: floats
     opened = _Opened(path, sensor_size, columns, time_unit)
     opened.note_units(time_unit, meta)
     if sort:

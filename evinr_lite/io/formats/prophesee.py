@@ -152,7 +152,7 @@ def read_prophesee(path, *, sensor_size=None, version: str | None = None,
     """
     with decoder_stderr():
         path = existing(path)
-        check_reader_window(t_start, t_end)
+        t_start, t_end = check_reader_window(t_start, t_end)   # 0-d, Fraction, Decimal: floats
         collect = PacketCollector(t_start, t_end)
         with _decoded(path, sensor_size, version) as (size, meta, packets):
             for _, packet in packets:

@@ -272,9 +272,11 @@ def check_options(fmt, options: dict, path) -> None:
     import inspect
 
     params = inspect.signature(fmt.reader).parameters
-    if any(p.kind is p.VAR_KEYWORD for p in params.values()):
-        return
-    taken = [n for n, p in list(params.items())[1:] if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD)]  # [0]: the path
+    if any(p.kind is p.VAR_KEYWORD for p in params.values()):   # read_npy / read_txt / read_csv pass **options on:
+        taken = (["sensor_size"] if fmt.takes_sensor_size else []) + list(fmt.options) + \
+            (["t_start", "t_end"] if fmt.windowed else [])    # their declaration names what the reader takes
+    else:
+        taken = [n for n, p in list(params.items())[1:] if p.kind in (p.KEYWORD_ONLY, p.POSITIONAL_OR_KEYWORD)]  # [0]: the path
     unknown = sorted(set(options) - set(taken))
     if unknown:
         hint = " (camera= is for MVSEC's stereo files)" if "camera" in unknown else ""
