@@ -676,3 +676,39 @@ def test_the_module_docstring_counts_what_the_lists_hold():
     assert (f"{words[len(wrong)]} more wrong solutions across {exercises_wrong} exercises ({with_open} with the one "
             "left open)") in doc
     assert f"{words[len(CORRECT)]} correct alternatives (in {len({r[0] for r in CORRECT})} of those exercises)" in doc
+
+
+# ---- second review of round 12: the import watch (a module's filter equal to one already set, threads, warnings'
+# stacklevel, modules loaded lazily, an interrupt while a watch opens) and np.empty's reruns asked once per input
+def _quiet_check(name, fn):
+    """(verdict, report) of a check run under the caller's warning filters (_report sets filters of its own)."""
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        ok = exercises.check(name, fn)
+    return ok, buf.getvalue()
+
+
+def test_a_module_s_filter_equal_to_one_already_set_replaces_it(tmp_path, monkeypatch):
+    """warnings.simplefilter removes an equal filter before it inserts the new one in front: the module's filter
+    replaces the old one, and a correct solution passes with as many filters as before."""
+    _fresh_module(tmp_path, monkeypatch, "r12b_dup_filter",
+                  "import warnings\nwarnings.simplefilter('ignore', DeprecationWarning)\n")
+
+    def tm_imports_dup(L, gamma):
+        import r12b_dup_filter  # noqa: F401
+        return R("reinhard_tonemap")(L, gamma)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)     # the equal filter, behind another one
+            warnings.simplefilter("ignore")
+            before = list(warnings.filters)
+            ok, report = _quiet_check("reinhard_tonemap", tm_imports_dup)
+            after = list(warnings.filters)
+        assert ok, report
+        assert len(after) == len(before) and sorted(map(repr, after)) == sorted(map(repr, before))
+        assert after[0] == ("ignore", None, DeprecationWarning, None, 0)
+    finally:
+        sys.modules.pop("r12b_dup_filter", None)
+

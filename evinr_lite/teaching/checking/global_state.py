@@ -88,16 +88,19 @@ def _same_entries(a: list, b: list) -> bool:
 def _filters_to_keep(before: list, now: list, imported: list) -> list:
     """The warning filters to set back: ``before``'s, with those of ``now`` that an import added (``imported``), in
     the places they hold now (in front, unless added with append=True) where the caller left ``before``'s own
-    entries in order, else in front."""
+    entries in order, else in front. An entry of ``before`` that is gone from ``now`` and equal to one an import added
+    was replaced by it (warnings.filterwarnings removes an equal filter before it inserts the new one in front)."""
     ours = {id(f) for f in imported}
     added = [f for f in now if id(f) in ours]
     if not added:
         return list(before)
+    present = {id(f) for f in now}
+    before = [f for f in before if id(f) in present or not any(f == a for a in added)]
     old = {id(f) for f in before}
     kept = [f for f in now if id(f) in ours or id(f) in old]
-    if _same_entries([f for f in kept if id(f) in old], list(before)):
+    if _same_entries([f for f in kept if id(f) in old], before):
         return kept
-    return added + list(before)
+    return added + before
 
 
 def restore_settings(before: dict | None, imported: list = ()) -> dict:
