@@ -868,3 +868,20 @@ def test_an_interrupt_while_a_watch_opens_leaves_nothing_behind():
         builtins.__import__, importlib.import_module = originals[:2]
         if originals[2] is not None:
             warnings._add_filter = originals[2]
+
+
+def test_np_empty_s_reruns_are_asked_once_per_input(monkeypatch):
+    """The hint's search asks once whether the memory np.empty is handed explains the answers (four calls of the
+    learner's function), not once more when a second call on the same input differs."""
+    from evinr_lite.teaching.checking import across_calls, run_check
+    asked = []
+    original = across_calls.memory_explains
+
+    def counting(*args, **kwargs):
+        asked.append(1)
+        return original(*args, **kwargs)
+    monkeypatch.setattr(across_calls, "memory_explains", counting)
+    monkeypatch.setattr(run_check, "memory_explains", counting)
+    ok, report = _report("grey_event_frame", gf_empty_ok_but_random)
+    assert not ok and "draws random numbers" in report, report
+    assert len(asked) == 1
