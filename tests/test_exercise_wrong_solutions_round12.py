@@ -57,6 +57,16 @@ index out, which was told of `[[0.0] * W] * H`), one correct alternative (a modu
 importlib.import_module whose own filter stays), and toy exercises for the gradient comparison: an input handed
 back (it was "a new tensor with no autograd history") and dicts built in another key order (their tensors were
 paired by position) pass, where the same with another gradient or a detached entry fails.
+
+Second review (the last section): the import watch wrapped __import__ and importlib.import_module and took every
+filter added while one ran as the module's. A module whose first import adds a filter equal to one already set
+(warnings removes the old entry) failed a correct solution and left one filter more; a learner's filter set while
+another thread imported passed as the module's; two watches in two threads removed each other's list; a warning
+raised with stacklevel by an imported module pointed at global_state.py; a module loaded lazily (LazyLoader) on first
+use had its filter blamed and removed; an interrupt while a watch opened could leave the wrapper in place. The watch
+now wraps warnings._add_filter and counts a filter as a module's where the adding thread's own stack runs importlib's
+bootstrap or a module's top level, per thread, and the equal entry a module's filter replaced is no change. np.empty's
+four reruns were asked twice per input (once more when a second call differed) and are asked once.
 """
 import math
 import sys

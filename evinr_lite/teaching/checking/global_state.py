@@ -5,8 +5,8 @@ A function may switch gradients off (or on), change torch's default dtype, chang
 handling (np.seterr) or the warning filters (warnings.filterwarnings, warnings.simplefilter), or seed numpy's,
 Python's or torch's global random generator. The check reads these before and after each call:
 :func:`global_settings` and :func:`restore_settings` set the settings back (:func:`settings_message` names the
-change; the warning filters a module adds while it is imported for the first time, which :func:`imports_watched`
-gathers, are the module's and stay), and :func:`rng_states`, :func:`other_rng_states` and
+change; the warning filters a module adds while its code is run by an import, which :func:`imports_watched` gathers
+from the adding thread's own stack, are the module's and stay), and :func:`rng_states`, :func:`other_rng_states` and
 :func:`reseeded_generators` tell a function that seeds a generator (two runs from different states end in one
 state) from one that only draws from it. Kept apart from running the call (:mod:`.learner_calls`), which uses the
 settings half, and from the hints built on the generators' states (:mod:`.across_calls`).
@@ -211,8 +211,8 @@ def _filters_to_keep(before: list, now: list, imported: list) -> list:
 
 def restore_settings(before: dict | None, imported: list = ()) -> dict:
     """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was. Warning filters
-    added while a module was imported for the first time are the module's, and stay: ``imported``, the filters
-    that :func:`imports_watched` gathered while the call ran; any other change of the filters is named."""
+    added while a module's code ran under an import are the module's, and stay: ``imported``, the filters that
+    :func:`imports_watched` gathered while the call ran; any other change of the filters is named."""
     if before is None:
         return {}
     now = global_settings()
