@@ -57,6 +57,16 @@ index out, which was told of `[[0.0] * W] * H`), one correct alternative (a modu
 importlib.import_module whose own filter stays), and toy exercises for the gradient comparison: an input handed
 back (it was "a new tensor with no autograd history") and dicts built in another key order (their tensors were
 paired by position) pass, where the same with another gradient or a detached entry fails.
+
+Second review (the last section): the import watch wrapped __import__ and importlib.import_module and took every
+filter added while one ran as the module's. A module whose first import adds a filter equal to one already set
+(warnings removes the old entry) failed a correct solution and left one filter more; a learner's filter set while
+another thread imported passed as the module's; two watches in two threads removed each other's list; a warning
+raised with stacklevel by an imported module pointed at global_state.py; a module loaded lazily (LazyLoader) on first
+use had its filter blamed and removed; an interrupt while a watch opened could leave the wrapper in place. The watch
+now wraps warnings._add_filter and counts a filter as a module's where the adding thread's own stack runs importlib's
+bootstrap or a module's top level, per thread, and the equal entry a module's filter replaced is no change. np.empty's
+four reruns were asked twice per input (once more when a second call differed) and are asked once.
 """
 import math
 import sys
@@ -676,3 +686,212 @@ def test_the_module_docstring_counts_what_the_lists_hold():
     assert (f"{words[len(wrong)]} more wrong solutions across {exercises_wrong} exercises ({with_open} with the one "
             "left open)") in doc
     assert f"{words[len(CORRECT)]} correct alternatives (in {len({r[0] for r in CORRECT})} of those exercises)" in doc
+
+
+# ---- second review of round 12: the import watch (a module's filter equal to one already set, threads, warnings'
+# stacklevel, modules loaded lazily, an interrupt while a watch opens) and np.empty's reruns asked once per input
+def _quiet_check(name, fn):
+    """(verdict, report) of a check run under the caller's warning filters (_report sets filters of its own)."""
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        ok = exercises.check(name, fn)
+    return ok, buf.getvalue()
+
+
+def test_a_module_s_filter_equal_to_one_already_set_replaces_it(tmp_path, monkeypatch):
+    """warnings.simplefilter removes an equal filter before it inserts the new one in front: the module's filter
+    replaces the old one, and a correct solution passes with as many filters as before."""
+    _fresh_module(tmp_path, monkeypatch, "r12b_dup_filter",
+                  "import warnings\nwarnings.simplefilter('ignore', DeprecationWarning)\n")
+
+    def tm_imports_dup(L, gamma):
+        import r12b_dup_filter  # noqa: F401
+        return R("reinhard_tonemap")(L, gamma)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)     # the equal filter, behind another one
+            warnings.simplefilter("ignore")
+            before = list(warnings.filters)
+            ok, report = _quiet_check("reinhard_tonemap", tm_imports_dup)
+            after = list(warnings.filters)
+        assert ok, report
+        assert len(after) == len(before) and sorted(map(repr, after)) == sorted(map(repr, before))
+        assert after[0] == ("ignore", None, DeprecationWarning, None, 0)
+    finally:
+        sys.modules.pop("r12b_dup_filter", None)
+
+
+def test_a_filter_set_while_another_thread_imports_is_the_learner_s(tmp_path, monkeypatch):
+    import threading
+    import types
+    sync = types.ModuleType("r12b_sync")
+    sync.entered, sync.release = threading.Event(), threading.Event()
+    monkeypatch.setitem(sys.modules, "r12b_sync", sync)
+    _fresh_module(tmp_path, monkeypatch, "r12b_slow_import",
+                  "import r12b_sync\nr12b_sync.entered.set()\nr12b_sync.release.wait(10)\n")
+    threads = []
+
+    def tm_filter_beside_a_thread(L, gamma):
+        if not threads:        # first call: another thread imports a module while this call sets a filter
+            threads.append(threading.Thread(target=lambda: __import__("r12b_slow_import")))
+            threads[0].start()
+            sync.entered.wait(10)
+            warnings.filterwarnings("ignore", category=RuntimeWarning)
+            sync.release.set()
+            threads[0].join(10)
+        else:
+            warnings.filterwarnings("ignore", category=RuntimeWarning)
+        return R("reinhard_tonemap")(L, gamma)
+    try:
+        ok, report, before, after = _report_and_filters("reinhard_tonemap", tm_filter_beside_a_thread)
+        assert not ok and "changed the warning filters for the whole notebook" in report, report
+        assert after == before
+    finally:
+        sync.release.set()
+        sys.modules.pop("r12b_slow_import", None)
+
+
+def test_watches_open_in_two_threads_keep_their_own_lists(tmp_path, monkeypatch):
+    """A watch closed in one thread removes its own list, not the other thread's, and the other stays watched."""
+    import threading
+    from evinr_lite.teaching.checking.global_state import imports_watched
+    _fresh_module(tmp_path, monkeypatch, "r12b_thread_filter",
+                  "import warnings\nwarnings.filterwarnings('ignore', message='r12b thread filter')\n")
+    a_open, b_open, a_closed = threading.Event(), threading.Event(), threading.Event()
+    got = {}
+
+    def a():
+        with imports_watched() as imported:
+            a_open.set()
+            b_open.wait(10)
+        got["a"] = list(imported)
+        a_closed.set()
+
+    def b():
+        a_open.wait(10)
+        with imports_watched() as imported:
+            b_open.set()
+            a_closed.wait(10)
+            import r12b_thread_filter  # noqa: F401
+        got["b"] = list(imported)
+    try:
+        with warnings.catch_warnings():
+            threads = [threading.Thread(target=a), threading.Thread(target=b)]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join(20)
+        assert got["a"] == []
+        assert [f[1].pattern for f in got["b"]] == ["r12b thread filter"], got
+    finally:
+        sys.modules.pop("r12b_thread_filter", None)
+
+
+def test_an_import_s_warning_points_at_the_importing_line_while_watched(tmp_path, monkeypatch):
+    from evinr_lite.teaching.checking.global_state import imports_watched
+    _fresh_module(tmp_path, monkeypatch, "r12b_deprecated",
+                  "import warnings\nwarnings.warn('r12b is deprecated', DeprecationWarning, stacklevel=2)\n")
+    try:
+        with imports_watched(), warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            import r12b_deprecated  # noqa: F401
+        assert [w.filename for w in caught] == [__file__]
+    finally:
+        sys.modules.pop("r12b_deprecated", None)
+
+
+def _lazy_module(tmp_path, monkeypatch, name, body):
+    import importlib.util
+    _fresh_module(tmp_path, monkeypatch, name, body)
+    spec = importlib.util.find_spec(name)
+    spec.loader = importlib.util.LazyLoader(spec.loader)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_a_module_loaded_lazily_on_first_use_keeps_its_filter(tmp_path, monkeypatch):
+    """importlib.util.LazyLoader runs a module's code on its first attribute read, outside any import call."""
+    from evinr_lite.teaching.checking.learner_calls import run
+    body = "import warnings\nwarnings.filterwarnings('ignore', message='r12b lazy filter')\ndef f(x):\n    return x\n"
+    try:
+        with warnings.catch_warnings():
+            module = _lazy_module(tmp_path, monkeypatch, "r12b_lazy", body)
+            changed: dict = {}
+            assert run(lambda: module.f(1), (), {}, settings_changed=changed) == 1
+            assert not changed
+            assert "r12b lazy filter" in [getattr(f[1], "pattern", None) for f in warnings.filters]
+        with warnings.catch_warnings():
+            module = _lazy_module(tmp_path, monkeypatch, "r12b_lazy", body)
+
+            def tm_lazy(L, gamma):
+                return module.f(R("reinhard_tonemap")(L, gamma))
+            ok, report = _quiet_check("reinhard_tonemap", tm_lazy)
+            assert ok, report
+            assert "r12b lazy filter" in [getattr(f[1], "pattern", None) for f in warnings.filters]
+    finally:
+        sys.modules.pop("r12b_lazy", None)
+
+
+def test_an_interrupt_while_a_watch_opens_leaves_nothing_behind():
+    """Raised at each line of opening a watch in turn (as Ctrl-C may), the import calls and warnings' own functions
+    are left as they were, and no watch stays open."""
+    import builtins
+    import importlib
+    from evinr_lite.teaching.checking import global_state
+    originals = builtins.__import__, importlib.import_module, getattr(warnings, "_add_filter", None)
+    where = global_state.__file__
+
+    def current():
+        return builtins.__import__, importlib.import_module, getattr(warnings, "_add_filter", None)
+    try:
+        for n in range(1, 200):
+            count = [0]
+
+            def local(frame, event, arg):
+                if event == "line":
+                    count[0] += 1
+                    if count[0] == n:
+                        raise KeyboardInterrupt
+                return local
+
+            def tracer(frame, event, arg):
+                return local if frame.f_code.co_filename == where else None
+            watch = global_state.imports_watched()
+            sys.settrace(tracer)
+            try:
+                watch.__enter__()
+            except KeyboardInterrupt:
+                sys.settrace(None)
+                assert all(x is y for x, y in zip(current(), originals)), n
+                assert not getattr(global_state, "_WATCHES", getattr(global_state, "_IMPORT_WATCHES", None)), n
+                continue
+            finally:
+                sys.settrace(None)
+            watch.__exit__(None, None, None)
+            break
+        assert n > 1
+    finally:
+        builtins.__import__, importlib.import_module = originals[:2]
+        if originals[2] is not None:
+            warnings._add_filter = originals[2]
+
+
+def test_np_empty_s_reruns_are_asked_once_per_input(monkeypatch):
+    """The hint's search asks once whether the memory np.empty is handed explains the answers (four calls of the
+    learner's function), not once more when a second call on the same input differs."""
+    from evinr_lite.teaching.checking import across_calls, run_check
+    asked = []
+    original = across_calls.memory_explains
+
+    def counting(*args, **kwargs):
+        asked.append(1)
+        return original(*args, **kwargs)
+    monkeypatch.setattr(across_calls, "memory_explains", counting)
+    monkeypatch.setattr(run_check, "memory_explains", counting)
+    ok, report = _report("grey_event_frame", gf_empty_ok_but_random)
+    assert not ok and "draws random numbers" in report, report
+    assert len(asked) == 1

@@ -109,11 +109,12 @@ def uninitialised_hint(fn: Callable, ex: ExerciseLike, args, kwargs, got) -> str
 
 
 def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwargs, got,
-                first: bool = False) -> str | None:
+                first: bool = False, memory: bool | None = None) -> str | None:
     """A mutable default argument that changed (or holds data) during the check, or a second call on the same
     input that gives another result: the function keeps state between calls, or draws unseeded random numbers
     (np.empty only where the memory it is handed explains the difference, :func:`memory_explains`).
-    ``first``: the failing input is the first one, where a default cannot hold an earlier call's data yet."""
+    ``first``: the failing input is the first one, where a default cannot hold an earlier call's data yet.
+    ``memory``: :func:`memory_explains`' answer on this input where the caller has it already (None: ask it here)."""
     hint = None if first else mutable_default_hint(fn, before)
     if hint is not None or ex.observe is not None:
         return hint
@@ -122,7 +123,7 @@ def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwa
         again = run(fn, args, kwargs, ex.observe)
         if compare_outputs(again, got, ex.rtol, ex.atol) is None:
             return None
-        if memory_explains(fn, ex, args, kwargs, got):
+        if memory if memory is not None else memory_explains(fn, ex, args, kwargs, got):
             return UNINITIALISED
         return ("called again on the same input, your function returns another result: it keeps state between "
                 "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "

@@ -5,8 +5,8 @@ A function may switch gradients off (or on), change torch's default dtype, chang
 handling (np.seterr) or the warning filters (warnings.filterwarnings, warnings.simplefilter), or seed numpy's,
 Python's or torch's global random generator. The check reads these before and after each call:
 :func:`global_settings` and :func:`restore_settings` set the settings back (:func:`settings_message` names the
-change; the warning filters a module adds while it is imported for the first time, which :func:`imports_watched`
-gathers, are the module's and stay), and :func:`rng_states`, :func:`other_rng_states` and
+change; the warning filters a module adds while its code is run by an import, which :func:`imports_watched` gathers
+from the adding thread's own stack, are the module's and stay), and :func:`rng_states`, :func:`other_rng_states` and
 :func:`reseeded_generators` tell a function that seeds a generator (two runs from different states end in one
 state) from one that only draws from it. Kept apart from running the call (:mod:`.learner_calls`), which uses the
 settings half, and from the hints built on the generators' states (:mod:`.across_calls`).
@@ -14,13 +14,13 @@ settings half, and from the hints built on the generators' states (:mod:`.across
 from __future__ import annotations
 
 import builtins
-import contextlib
 import functools
 import importlib
 import random
 import sys
+import threading
 import warnings
-from typing import Callable, Iterator
+from typing import Callable
 
 import numpy as np
 
@@ -37,13 +37,87 @@ def global_settings() -> dict:
     return out
 
 
-_IMPORT_WATCHES: list[list] = []    # one list per open :func:`imports_watched`, innermost last
+class _Watch:
+    """One open :func:`imports_watched`: the list it yields, and the frame of the code that opened it (a filter is
+    this watch's module's only where an import frame lies between that frame and the code that adds the filter)."""
+    __slots__ = ("added", "frame")
+
+    def __init__(self, frame):
+        self.added: list = []
+        self.frame = frame
+
+
+_WATCHES: dict[int, list[_Watch]] = {}   # thread id -> that thread's open watches, innermost last
+_WATCHES_LOCK = threading.RLock()
+_HOOKED: list = []      # (where, name, original, wrapper) while a watch is open anywhere
+_BOOTSTRAP = ("<frozen importlib._bootstrap>", "<frozen importlib._bootstrap_external>")
+
+
+def _hookable() -> bool:
+    """Whether warnings.filterwarnings and warnings.simplefilter both add through warnings._add_filter (CPython 3.11,
+    3.12), which can then be watched; elsewhere the import calls are (:func:`_watched`)."""
+    if not callable(getattr(warnings, "_add_filter", None)):
+        return False
+    codes = [getattr(getattr(warnings, f, None), "__code__", None) for f in ("filterwarnings", "simplefilter")]
+    return all(code is not None and "_add_filter" in code.co_names for code in codes)
+
+
+def _import_frame(frame) -> bool:
+    """A frame of the import machinery (importlib's bootstrap: an import statement, __import__,
+    importlib.import_module, a LazyLoader's module on first use, importlib.reload), or the top level of a module
+    other than the notebook's (``__main__``) while it runs."""
+    code = frame.f_code
+    if code.co_filename in _BOOTSTRAP:
+        return True
+    if code.co_name != "<module>":
+        return False
+    name = frame.f_globals.get("__name__")
+    module = sys.modules.get(name) if isinstance(name, str) and name != "__main__" else None
+    try:       # object.__getattribute__: a LazyLoader's module not loaded yet would load on a plain attribute read
+        return module is not None and object.__getattribute__(module, "__dict__") is frame.f_globals
+    except Exception:
+        return False
+
+
+def _note_module_filter(entry, frame) -> None:
+    """Give ``entry``, a filter just added by code running in ``frame`` (the caller of warnings._add_filter), to the
+    watches it is a module's for: a watch of this thread when an import frame lies between the watch's own frame
+    and ``frame``; every other thread's watch when this thread's stack holds an import frame at all."""
+    with _WATCHES_LOCK:
+        own = list(_WATCHES.get(threading.get_ident(), ()))
+        others = [w for t, ws in _WATCHES.items() if t != threading.get_ident() for w in ws]
+    keep, importing = [], False
+    while frame is not None:
+        if importing:
+            keep += [w for w in own if w.frame is frame]
+        elif _import_frame(frame):
+            importing = True        # a watch opened in this very frame is the module's own code: not for it
+        frame = frame.f_back
+    if importing:
+        keep += others
+    for watch in keep:
+        watch.added.append(entry)
+
+
+def _watched_add_filter(original: Callable) -> Callable:
+    """``original`` (warnings._add_filter, which filterwarnings and simplefilter call), noting the entry it adds in
+    the open watches it is a module's for (:func:`_note_module_filter`)."""
+    @functools.wraps(original)
+    def adding(*item, append):
+        before = list(warnings.filters)          # kept alive, so that no new entry can share an id with one of them
+        seen = {id(f) for f in before}
+        result = original(*item, append=append)
+        added = [f for f in warnings.filters if id(f) not in seen and f == item]
+        if added:
+            _note_module_filter(added[0], sys._getframe(1))
+        return result
+    return adding
 
 
 def _watched(original: Callable) -> Callable:
-    """``original`` (builtins.__import__ or importlib.import_module), noting the warning filters added while it ran
-    in every open watch: a module imported for the first time runs its own code then, and its filters are its
-    own."""
+    """Where warnings._add_filter cannot be watched (:func:`_hookable`): ``original`` (builtins.__import__ or
+    importlib.import_module), noting the warning filters added while it ran in this thread's open watches: a module
+    imported for the first time runs its own code then, and its filters are its own."""
     @functools.wraps(original)
     def importing(*args, **kwargs):
         before = list(warnings.filters)          # kept alive, so that no new entry can share an id with one of them
@@ -52,33 +126,65 @@ def _watched(original: Callable) -> Callable:
             return original(*args, **kwargs)
         finally:
             added = [f for f in warnings.filters if id(f) not in seen]
-            for watch in _IMPORT_WATCHES:
-                watch.extend(added)
+            for watch in list(_WATCHES.get(threading.get_ident(), ())):
+                watch.added.extend(added)
     return importing
 
 
-@contextlib.contextmanager
-def imports_watched() -> Iterator[list]:
-    """While the block runs, the warning filters added while a module was being imported (an import statement,
-    __import__ or importlib.import_module; numpy's and torch's submodules load lazily, and some add filters) are
-    gathered into the list it yields, for :func:`restore_settings` to keep: they are the module's, not the
-    caller's. A filter set beside the import, by the caller, is not among them. Watches may nest."""
-    added: list = []
-    first = not _IMPORT_WATCHES
-    if first:
-        originals = builtins.__import__, importlib.import_module
-        wrappers = _watched(originals[0]), _watched(originals[1])
-        builtins.__import__, importlib.import_module = wrappers
-    _IMPORT_WATCHES.append(added)
-    try:
-        yield added
-    finally:
-        _IMPORT_WATCHES.pop()
-        if first:
-            if builtins.__import__ is wrappers[0]:
-                builtins.__import__ = originals[0]
-            if importlib.import_module is wrappers[1]:
-                importlib.import_module = originals[1]
+def _hook() -> None:
+    if _hookable():
+        targets = [(warnings, "_add_filter", _watched_add_filter)]
+    else:
+        targets = [(builtins, "__import__", _watched), (importlib, "import_module", _watched)]
+    for where, name, wrap in targets:
+        original = getattr(where, name)
+        wrapper = wrap(original)
+        _HOOKED.append((where, name, original, wrapper))
+        setattr(where, name, wrapper)
+
+
+def _unhook() -> None:
+    while _HOOKED:
+        where, name, original, wrapper = _HOOKED.pop()
+        if getattr(where, name) is wrapper:      # else someone wrapped it again: ours stays, and only passes through
+            setattr(where, name, original)
+
+
+class imports_watched:
+    """While the block runs, the warning filters that a module adds while it is imported (an import statement,
+    __import__, importlib.import_module, a module loaded lazily on first use; numpy's and torch's submodules load
+    lazily, and some add filters) are gathered into the list it yields, for :func:`restore_settings` to keep: they
+    are the module's, not the caller's. A filter counts as a module's when the thread that adds it is running the
+    import machinery or a module's top level at that moment (below the ``with``, for this thread), so the caller's
+    own filter, set beside an import or in another thread while one imports, is not among them. Watches may nest,
+    and may be open in several threads at once."""
+
+    def __init__(self) -> None:
+        self._watch: _Watch | None = None
+
+    def __enter__(self) -> list:
+        try:
+            watch = self._watch = _Watch(sys._getframe(1))
+            with _WATCHES_LOCK:
+                if not _WATCHES:
+                    _hook()
+                _WATCHES.setdefault(threading.get_ident(), []).append(watch)
+            return watch.added
+        except BaseException:       # an interrupt half way in: nothing of this watch is left behind
+            self.__exit__()
+            raise
+
+    def __exit__(self, *exc) -> None:
+        watch, self._watch = self._watch, None
+        with _WATCHES_LOCK:
+            for thread, watches in list(_WATCHES.items()):
+                watches[:] = [w for w in watches if w is not watch]     # this watch's own entry, by identity
+                if not watches:
+                    del _WATCHES[thread]
+            if not _WATCHES:
+                _unhook()
+        if watch is not None:
+            watch.frame = None
 
 
 def _same_entries(a: list, b: list) -> bool:
@@ -88,22 +194,25 @@ def _same_entries(a: list, b: list) -> bool:
 def _filters_to_keep(before: list, now: list, imported: list) -> list:
     """The warning filters to set back: ``before``'s, with those of ``now`` that an import added (``imported``), in
     the places they hold now (in front, unless added with append=True) where the caller left ``before``'s own
-    entries in order, else in front."""
+    entries in order, else in front. An entry of ``before`` that is gone from ``now`` and equal to one an import added
+    was replaced by it (warnings.filterwarnings removes an equal filter before it inserts the new one in front)."""
     ours = {id(f) for f in imported}
     added = [f for f in now if id(f) in ours]
     if not added:
         return list(before)
+    present = {id(f) for f in now}
+    before = [f for f in before if id(f) in present or not any(f == a for a in added)]
     old = {id(f) for f in before}
     kept = [f for f in now if id(f) in ours or id(f) in old]
-    if _same_entries([f for f in kept if id(f) in old], list(before)):
+    if _same_entries([f for f in kept if id(f) in old], before):
         return kept
-    return added + list(before)
+    return added + before
 
 
 def restore_settings(before: dict | None, imported: list = ()) -> dict:
     """The settings changed since ``before`` ({name: (before, now)}), each set back to what it was. Warning filters
-    added while a module was imported for the first time are the module's, and stay: ``imported``, the filters
-    that :func:`imports_watched` gathered while the call ran; any other change of the filters is named."""
+    added while a module's code ran under an import are the module's, and stay: ``imported``, the filters that
+    :func:`imports_watched` gathered while the call ran; any other change of the filters is named."""
     if before is None:
         return {}
     now = global_settings()

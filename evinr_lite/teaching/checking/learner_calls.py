@@ -137,8 +137,8 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     back after every call, whether it returns or
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
     reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
-    the call changed ({name: (before, after)}); warning filters that a module imported for the first time during
-    the call adds are the module's, and stay (:func:`.global_state.imports_watched`). What the learner's function
+    the call changed ({name: (before, after)}); warning filters that a module adds while an import runs its code
+    during the call are the module's, and stay (:func:`.global_state.imports_watched`). What the learner's function
     changed on any call of the check (the hints' calls too) is also kept for the report (see :func:`watching`)."""
     args, kwargs = _deepcopy_with_grads((args, kwargs))
     settings = global_settings()

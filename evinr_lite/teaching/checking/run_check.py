@@ -19,7 +19,7 @@ from typing import Callable
 
 from .across_calls import (UNINITIALISED, fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
                            memory_explains, mutable_defaults, reseed_hint, scalar_factor_hint, shares_output,
-                           stale_argument_hint, state_hint, uninitialised_hint)
+                           stale_argument_hint, state_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
                            rng_states, set_rng_states, settings_message)
 from .hints import (aliased_rows_hint, generic_hint, has_repeated_index, non_square, one_based_hint,
@@ -225,8 +225,10 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     # the function only logs to (`log.append(len(t))`, a common habit) grows just the same and explains nothing
     cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
     hint = cache_hint if proven else None
+    memory = None       # memory_explains' answer on this input, asked once (it runs the function four times)
     if hint is None:
-        hint = uninitialised_hint(fn, ex, args, kwargs, got)
+        memory = memory_explains(fn, ex, args, kwargs, got)
+        hint = UNINITIALISED if memory else None
     if hint is None:
         hint = _own_hint(ex, fn, cases, k, got)
     # mistakes that show only across inputs: state kept from an earlier call, a notebook variable or a
@@ -234,7 +236,7 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     if hint is None:
         hint = swapped_pair_hint(ex, got, expected)
     if hint is None:
-        hint = state_hint(fn, defaults, ex, args, kwargs, got, first=k == 0)
+        hint = state_hint(fn, defaults, ex, args, kwargs, got, first=k == 0, memory=memory)
     if hint is None:
         hint = stale_argument_hint(ex, fn, cases, k, got, expected)
     if hint is None and ex.observe is None:
