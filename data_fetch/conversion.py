@@ -108,7 +108,7 @@ def check_settings(*, C=None, sensor_size=None, eval_window=None, time_unit=None
         try:   # the kit's one check: whole numbers only (int() made 2.5 rows into 2 and True into 1)
             check_sensor_size(sensor_size)
         except EventDataError as err:
-            raise DataFetchError(f"{err} (--sensor-size H W)") from None
+            raise DataFetchError(f"sensor size: {err} (--sensor-size H W)") from None
     if eval_window not in (None, _UNSET):
         check_time_range(eval_window, "eval_window", DataFetchError)
     if time_unit not in (None, "auto") and not (isinstance(time_unit, str) and time_unit in TIME_UNITS):

@@ -22,7 +22,7 @@ from .base import FileFormat
 __all__ = ["FORMATS", "get_format", "detect_format", "read_recording", "read_events", "sniff_format",
            "SUPPORTED_FORMATS", "RECORDING_SUFFIXES", "SIZE_FREE_FORMATS", "READER_WINDOW_FORMATS",
            "SENSOR_ARG_FORMATS", "TIME_UNIT_FORMATS", "FIXED_UNITS", "is_recording_folder", "is_ros2_bag",
-           "recording_path"]
+           "recording_path", "UnknownOptionError"]
 
 HEAD_BYTES = 64
 _AEDAT_FIX = "AEDAT 3.1 and AEDAT4 are read: convert it with iniVation's DV software (Convert to AEDAT4) or export " \
@@ -266,6 +266,11 @@ def read_recording(path, **options) -> Recording:
     return fmt.reader(path, **options)
 
 
+class UnknownOptionError(EventDataError, TypeError):
+    """A keyword a reader does not take: an EventDataError that lists the ones it does, and the TypeError Python
+    raises for an unexpected keyword, so that code catching that still does."""
+
+
 def check_options(fmt, options: dict, path) -> None:
     """Refuse keyword options that ``fmt``'s reader does not take (e.g. ``camera=`` for an IJRR folder), naming the
     ones it does, before anything is read (a reader called with them raised a bare TypeError)."""
@@ -280,7 +285,7 @@ def check_options(fmt, options: dict, path) -> None:
     unknown = sorted(set(options) - set(taken))
     if unknown:
         hint = " (camera= is for MVSEC's stereo files)" if "camera" in unknown else ""
-        raise EventDataError(f"{path}: {fmt.description} takes no option {', '.join(map(repr, unknown))}{hint}; "
+        raise UnknownOptionError(f"{path}: {fmt.description} takes no option {', '.join(map(repr, unknown))}{hint}; "
                              f"its reader takes {', '.join(taken) or 'no options'}")
 
 
