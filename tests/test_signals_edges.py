@@ -110,6 +110,35 @@ def test_an_interrupt_that_a_library_swallowed_never_exits_0(capsys, signum):
     assert f"interrupted by {signal.Signals(signum).name}" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("chained", ["from", "during"])
+def test_a_signal_that_a_library_turned_into_its_own_error_is_an_interruption(capsys, chained):
+    """numpy's import catches any exception raised inside it and raises an ImportError ("IMPORTANT: PLEASE READ
+    THIS ...") from it: a SIGHUP at start-up, while numpy loads, was reported as an internal error (status 1, one
+    CI run of 2026-12-07); the signal behind it is what ended the command."""
+    def body():
+        try:
+            raise Interrupted(signal.SIGHUP)
+        except Interrupted as exc:
+            if chained == "from":
+                raise ImportError("numpy: IMPORTANT: PLEASE READ THIS") from exc
+            raise ImportError("numpy: IMPORTANT: PLEASE READ THIS")   # only __context__
+
+    assert run_guarded("prog", body, []) == 128 + signal.SIGHUP
+    err = capsys.readouterr().err
+    assert "interrupted by SIGHUP" in err and "internal error" not in err
+
+
+def test_an_error_without_a_signal_behind_it_is_still_internal(capsys):
+    def body():
+        try:
+            raise ValueError("a bug's own cause")
+        except ValueError:
+            raise ImportError("not an interruption")
+
+    assert run_guarded("prog", body, []) == 1
+    assert "internal error: ImportError" in capsys.readouterr().err
+
+
 def test_a_second_signal_during_cleanup_is_noted_not_raised():
     cleaned = []
     with pytest.raises(Interrupted):

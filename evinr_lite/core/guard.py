@@ -279,6 +279,29 @@ def _signal_name(signum: int) -> str:
     return signal.Signals(signum).name
 
 
+def _interrupted(prog: str, exc: KeyboardInterrupt, state, interrupted_note) -> int:
+    """Say that ``exc`` (a signal's :class:`Interrupted`, or Python's KeyboardInterrupt) ended the command; its status."""
+    state.armed = False
+    signum = exc.signum if isinstance(exc, Interrupted) else signal.SIGINT
+    note = interrupted_note(exc) if interrupted_note is not None else None
+    where = f"; {note}" if note else ""
+    print(f"\n{prog}: interrupted by {_signal_name(signum)}{where} (partial results are deleted)", file=sys.stderr)
+    return 128 + int(signum)
+
+
+def _interruption_behind(exc: BaseException, depth: int = 16):
+    """The KeyboardInterrupt (or :class:`Interrupted`) that ``exc`` was raised from or while handling, if any: a
+    library that catches a signal's exception and raises its own (numpy's import turns it into an ImportError)."""
+    seen = set()
+    while exc is not None and depth > 0 and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+        depth -= 1
+    return None
+
+
 def run_guarded(prog: str, body, argv, *, expected=(), describe=str, interrupted_note=None, out_of_memory=None,
                 debug=lambda: False, owns_process: bool = False) -> int:
     """Run ``body()`` (which parses ``argv`` and does the work; returns an exit status) under the guard.
@@ -319,19 +342,16 @@ def run_guarded(prog: str, body, argv, *, expected=(), describe=str, interrupted
     except SystemExit as exc:   # argparse: --help (0) or a bad option (2, already printed)
         code = exc.code if isinstance(exc.code, int) else EXIT_ERROR
     except KeyboardInterrupt as exc:
-        state.armed = False
-        signum = exc.signum if isinstance(exc, Interrupted) else signal.SIGINT
-        note = interrupted_note(exc) if interrupted_note is not None else None
-        where = f"; {note}" if note else ""
-        print(f"\n{prog}: interrupted by {_signal_name(signum)}{where} (partial results are deleted)",
-              file=sys.stderr)
-        code = 128 + int(signum)
+        code = _interrupted(prog, exc, state, interrupted_note)
     except (InputError, OSError, *expected) as exc:
         print(f"{prog}: error: {describe(exc)}", file=sys.stderr)
         code = EXIT_ERROR
     except Exception as exc:
         message = out_of_memory(exc) if out_of_memory is not None else None
-        if message:
+        cause = _interruption_behind(exc)
+        if cause is not None:   # a library turned the signal into its own error (numpy's ImportError mid-import)
+            code = _interrupted(prog, cause, state, interrupted_note)
+        elif message:
             print(f"{prog}: error: {message}", file=sys.stderr)
             code = EXIT_ERROR
         elif debug():
