@@ -189,3 +189,19 @@ def test_under_a_fast_shake_the_scale_buys_quality(shaken):
         ssim[s] = {eq: score_frames(frames, truth, eq)["ssim"] for eq in ("none", "clahe")}
     for eq in ("none", "clahe"):
         assert ssim["auto"][eq] > ssim[1.0][eq] + 0.1, ssim        # measured 0.714 against 0.445, 0.592 against 0.306
+
+
+def test_the_jobs_record_the_scale_and_say_when_it_shortened_the_bins():
+    from evinr_lite.apps.stream_job import report_temporal_scale
+
+    for given, used, logged in (("auto", 2.0, True), ("auto", 1.0, False), (1.0, 1.0, None), ("auto", None, None)):
+        settings, lines = {}, []
+        report_temporal_scale(given, used, 1 / 32, settings, lines.append)
+        if logged is None:       # a scale given by hand, or none read: nothing to report
+            assert settings == {} and lines == []
+            continue
+        assert settings == {"temporal_scale_used": used}
+        assert bool(lines) == logged
+    settings, lines = {}, []
+    report_temporal_scale("auto", 2.0, 1 / 32, settings, lines.append)
+    assert "2x shorter (at most 15.6 ms, not 31.2)" in lines[0] and "--temporal-scale 1" in lines[0]

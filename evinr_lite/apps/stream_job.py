@@ -93,8 +93,9 @@ def report_temporal_scale(scale, used, bin_duration: float, settings: dict, log)
         return
     settings["temporal_scale_used"] = float(used)
     if used > 1:
-        log(f"fast changes: the pixels reverse polarity often, so the bins are {1000 * bin_duration / used:.3g} ms "
-            f"(not {1000 * bin_duration:.3g}) and the temporal prior {float(used):.3g}x faster")
+        log(f"fast changes: the pixels reverse polarity often, so the bins are {float(used):.3g}x shorter (at most "
+            f"{1000 * bin_duration / used:.3g} ms, not {1000 * bin_duration:.3g}) and the temporal prior "
+            f"{float(used):.3g}x faster (pass --temporal-scale 1 to keep them)")
 
 
 def report_background(background, used, dt, settings: dict, log) -> None:
