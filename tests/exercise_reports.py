@@ -20,6 +20,20 @@ def report(name, fn):
     return ok, buf.getvalue()
 
 
+def assert_fails_naming(name, wrong, words):
+    """``wrong`` fails exercise ``name`` with a report that holds ``words`` and no traceback."""
+    ok, text = report(name, wrong)
+    assert not ok, text
+    assert words in text, text
+    assert "Traceback" not in text
+
+
+def assert_passes(name, fn):
+    """``fn`` passes exercise ``name``."""
+    ok, text = report(name, fn)
+    assert ok, text
+
+
 def quoted_counts() -> dict:
     """{check name: N} from every notebook's "✓ NAME: matches the reference on N inputs"."""
     quoted = {}
