@@ -2,8 +2,8 @@
 
 An exercise's own hints map a message to a wrong version of its reference; :func:`generic_mistakes` makes a
 few more from any reference, for mistakes every exercise can show (-1/+1 polarities read as 0/1, OFF events
-dropped or polarities made unsigned, an input or the result clipped to [0, 1], a result or a float input
-rounded). The learner's output matching a wrong version's on the failing input is not enough:
+dropped or polarities made unsigned, times made float32, an input or the result clipped to [0, 1], a result or a
+float input rounded). The learner's output matching a wrong version's on the failing input is not enough:
 :func:`same_mistake_elsewhere` asks that it also match on the other inputs where that mistake shows, so that one
 input cannot make two different mistakes look alike. :func:`wrong_axes_hint` makes one more, the reference run on
 transposed images (differences or sums along the wrong image axis), and compares it on the failing input.
@@ -49,6 +49,33 @@ def _with_polarities(kwargs: dict, f: Callable) -> dict | None:
         else:
             out[name] = v
     return out if found else None
+
+
+# inputs that are instants on the recording's clock (not durations such as dt or bin_s): an argument of one of these
+# names, or the ``t`` of events
+TIME_NAMES = ("t", "t_events", "t_query", "times", "boundaries", "t_end", "t_start", "t_a", "t_b", "windows")
+
+
+def _with_times(kwargs: dict, f: Callable) -> dict | None:
+    """``kwargs`` with ``f`` applied to every time input that is a float numpy array or a float (an argument named in
+    :data:`TIME_NAMES`, or the ``t`` of events); None when there is none."""
+    out, found = {}, False
+    for name, v in kwargs.items():
+        if name in TIME_NAMES and ((isinstance(v, np.ndarray) and v.dtype.kind == "f" and v.size)
+                                   or (isinstance(v, float) and not isinstance(v, bool))):
+            out[name], found = f(v), True
+        elif getattr(v, "sensor_size", None) is not None and isinstance(getattr(v, "t", None), np.ndarray) \
+                and v.t.dtype.kind == "f" and v.t.size:
+            ev = copy.copy(v)
+            object.__setattr__(ev, "t", f(v.t))
+            out[name], found = ev, True
+        else:
+            out[name] = v
+    return out if found else None
+
+
+def _float32_time(v):
+    return np.asarray(v, dtype=np.float32) if isinstance(v, np.ndarray) else float(np.float32(v))
 
 
 def _outside_unit(v) -> bool:
@@ -130,6 +157,11 @@ def generic_mistakes(ex: ExerciseLike, cases: list | None = None) -> list[tuple[
          "`(p > 0).astype(np.uint8) - (p < 0).astype(np.uint8)`), where -1 wraps round to 255: keep p signed "
          "(int8, int64) or make it float",
          on_inputs(lambda kw: _with_polarities(kw, lambda p: p.astype(np.uint8)))),
+        ("the times were made float32 (about 7 significant digits: `astype(np.float32)`, torch.tensor(t) or "
+         "torch.Tensor of them, a float32 buffer): a time near 1000 s then moves by up to 30 us, enough to cross an "
+         "edge or change an interval, and on a recording's clock (Unix time, 1.5e9 s) by a minute; keep times "
+         "float64 (np.asarray(t, dtype=np.float64)), or subtract the first time in float64 before anything narrower",
+         on_inputs(lambda kw: _with_times(kw, _float32_time))),
     ]
     try:
         params = list(inspect.signature(ref).parameters)
