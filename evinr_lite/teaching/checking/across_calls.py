@@ -7,7 +7,9 @@ otherwise (:func:`state_hint`) or answers otherwise on freed memory filled with 
 (:func:`stale_argument_hint`, :func:`fixed_size_hint`), one number off by the same factor on every input
 (:func:`scalar_factor_hint`). And, on the second call of the last input:
 :func:`shares_output` (the same array, tensor or dict handed out twice, a buffer or a cached result) and
-:func:`reseed_hint` (a global generator seeded inside the function).
+:func:`reseed_hint` (a global generator seeded inside the function). After that, :func:`same_objects_new_values`
+gives the function input #1's own objects again, refilled in place with a later input's values: a result kept by the
+objects' identity (a cache keyed by id(), `t is last_t`) answers for the old values.
 """
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ import numpy as np
 
 from .global_state import SEED_CALLS, other_rng_states, reseeded_generators, rng_states, set_rng_states
 from .hints import unit_note
-from .learner_calls import poison_freed_memory, run, same_array, uses_uninitialised
+from .learner_calls import copy_inputs, poison_freed_memory, refill_in_place, run, same_array, uses_uninitialised
 from .outputs import compare_outputs, is_tensor, not_finite, to_numpy
 from .protocol import ExerciseLike
 
@@ -119,6 +121,8 @@ def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwa
     if hint is not None or ex.observe is not None:
         return hint
     try:
+        if hasattr(got, "__next__") or compare_outputs(got, got, ex.rtol, ex.atol) is not None:
+            return None     # no numbers to compare (a map object, an array of dtype object): a rerun says nothing
         poison_freed_memory(got)
         again = run(fn, args, kwargs, ex.observe)
         if compare_outputs(again, got, ex.rtol, ex.atol) is None:
@@ -394,3 +398,41 @@ def _fresh_seed_state(key: str, state) -> bool:
     except Exception:
         return False
     return False
+
+
+KEYED_BY_OBJECT = (
+    "every input matched, but called on input #1's own array objects, refilled in place with input #{k}'s values "
+    "(as a notebook does when it reuses a buffer, or changes an array in place and calls again), it does not "
+    "answer as the reference does for those values: your function keeps results keyed by the objects (`id(t)`, "
+    "`t is last_t`) or keeps the objects themselves, and an id is no fingerprint of the values (Python hands a "
+    "freed array's id to the next one, and an array changed in place keeps its id); drop the cache (nothing here "
+    "is slow enough to need one), or key it by the values (`t.tobytes()`) and return copies")
+
+
+def same_objects_new_values(ex: ExerciseLike, fn: Callable, cases: list) -> int | None:
+    """The number (from 1) of a case k > 1 such that ``fn``, called on the first case's objects (a copy) and then on
+    the same objects refilled in place with case k's values (:func:`.learner_calls.refill_in_place`), answers the
+    second call otherwise than the reference on case k; else None (also where the objects cannot be refilled: a
+    tensor, an array the function kept a reference to). The cases are tried from the last one back
+    (a cache keyed by an id and a plain number is fooled only where that number is input #1's). Run after every
+    input matched."""
+    if ex.observe is not None:
+        return None
+    for k in range(len(cases) - 1, 0, -1):
+        holder = copy_inputs(cases[0])
+        try:
+            expected = run(ex.reference, *cases[k])
+            run(fn, holder[0], holder[1], copy_inputs=False)
+            if not refill_in_place(holder, cases[k]):
+                continue
+        except Exception:
+            continue
+        try:
+            got = run(fn, holder[0], holder[1], copy_inputs=False)
+            differs = ex.compare(got, expected) is not None if ex.compare is not None else \
+                compare_outputs(got, expected, ex.rtol, ex.atol) is not None
+        except Exception:          # it answered case k from fresh objects: what it kept fails on these
+            differs = True
+        if differs:
+            return k + 1
+    return None

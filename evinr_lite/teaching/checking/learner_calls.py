@@ -9,7 +9,9 @@ Over a whole check, :func:`watching` gathers what the learner's function changed
 :func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with np.empty
 (:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern rather than
 zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that holds a list
-(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint.
+(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call can leave
+changed in a model besides its parameters (its mode, which parameters require grad), and :func:`refill_in_place`
+writes one case's values into another case's objects without changing their identity (a cache keyed by id()).
 """
 from __future__ import annotations
 
@@ -128,7 +130,8 @@ def watching(fn: Callable) -> Iterator[dict]:
         _WATCHED.pop()
 
 
-def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None):
+def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None,
+        copy_inputs: bool = True):
     """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
     receives the copied ``(args, kwargs)`` as they are after the call.
@@ -139,8 +142,10 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
     the call changed ({name: (before, after)}); warning filters that a module adds while an import runs its code
     during the call are the module's, and stay (:func:`.global_state.imports_watched`). What the learner's function
-    changed on any call of the check (the hints' calls too) is also kept for the report (see :func:`watching`)."""
-    args, kwargs = _deepcopy_with_grads((args, kwargs))
+    changed on any call of the check (the hints' calls too) is also kept for the report (see :func:`watching`).
+    ``copy_inputs=False`` hands the function the objects themselves (to call it twice on the same objects)."""
+    if copy_inputs:
+        args, kwargs = _deepcopy_with_grads((args, kwargs))
     settings = global_settings()
     with imports_watched() as imported:
         try:
@@ -157,6 +162,58 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     return result if observe is None else observe(result, args, kwargs)
 
 
+def copy_inputs(inputs: tuple[tuple, dict]) -> tuple[list, dict]:
+    """A deep copy of a case's (args, kwargs), the args as a list, for :func:`run` with ``copy_inputs=False``."""
+    args, kwargs = _deepcopy_with_grads(inputs)
+    return list(args), kwargs
+
+
+def refill_in_place(holder: tuple[list, dict], new: tuple[tuple, dict]) -> bool:
+    """Write the values of ``new`` (a case's args and kwargs) into the objects of ``holder`` (another case's, made
+    by :func:`copy_inputs`), in place: each numpy array keeps its identity (resized where the sizes differ), as do
+    the arrays inside an object such as ``Events``, and a dict or list input (emptied and refilled with a copy of
+    the new items); plain numbers and tuples are replaced. False (and ``holder`` perhaps partly written) where that
+    cannot be done: another structure or dtype, a tensor, or an array that something else still refers to (a resize would leave it pointing at freed memory, and numpy
+    refuses it)."""
+    (h_args, h_kwargs), (n_args, n_kwargs) = holder, new
+    if len(h_args) != len(n_args) or set(h_kwargs) != set(n_kwargs):
+        return False
+    slots = [(h_args, k, v) for k, v in enumerate(n_args)] + [(h_kwargs, k, v) for k, v in n_kwargs.items()]
+    return all(_refill_slot(box, key, value) for box, key, value in slots)
+
+
+def _refill_slot(box, key, value) -> bool:
+    """``box[key]`` given ``value``'s contents in place (see :func:`refill_in_place`). The array is never bound to a
+    local name before a resize: numpy counts the references, and a local one would make it refuse."""
+    if isinstance(value, np.ndarray):
+        if type(box[key]) is not np.ndarray or box[key].dtype != value.dtype or box[key].ndim != value.ndim:
+            return False
+        if box[key].shape != value.shape:
+            try:
+                box[key].resize(value.shape)
+            except (ValueError, TypeError):
+                return False
+        box[key][...] = value
+        return True
+    fields = getattr(value, "__dict__", None)
+    if isinstance(fields, dict) and not hasattr(value, "parameters") and not is_tensor(value):
+        target = getattr(box[key], "__dict__", None)
+        if type(box[key]) is not type(value) or not isinstance(target, dict) or set(target) != set(fields):
+            return False
+        return all(_refill_slot(target, name, v) for name, v in fields.items())
+    if isinstance(value, dict) and type(box[key]) is dict:     # a table: the same dict object, new rows
+        box[key].clear()
+        box[key].update(copy.deepcopy(value))
+        return True
+    if isinstance(value, list) and type(box[key]) is list:
+        box[key][:] = copy.deepcopy(value)
+        return True
+    if isinstance(value, (int, float, complex, str, bytes, tuple, type(None), np.generic)):
+        box[key] = value
+        return True
+    return False
+
+
 def _arrays_of(v) -> list[tuple[str, Any]]:
     """The arrays (or tensors) an input holds: itself, or the array fields of an object such as ``Events``."""
     if isinstance(v, np.ndarray) or is_tensor(v):
@@ -165,6 +222,37 @@ def _arrays_of(v) -> list[tuple[str, Any]]:
     if isinstance(fields, dict) and not hasattr(v, "parameters"):
         return [(f".{k}", a) for k, a in fields.items() if isinstance(a, np.ndarray) or is_tensor(a)]
     return []
+
+
+def module_flags(inputs: tuple[tuple, dict]) -> dict[str, tuple]:
+    """{input name: (each submodule's training mode, each parameter's requires_grad)} for the torch modules among
+    ``inputs`` (args, kwargs): what a call can leave changed in a model besides its parameters' values."""
+    args, kwargs = inputs
+    named = [(f"argument {k + 1}", a) for k, a in enumerate(args)] + list(kwargs.items())
+    return {name: (tuple(bool(m.training) for m in v.modules()), tuple(bool(q.requires_grad) for q in v.parameters()))
+            for name, v in named if callable(getattr(v, "modules", None)) and callable(getattr(v, "parameters", None))
+            and type(v).__module__.split(".")[0] != "numpy"}
+
+
+def module_flags_message(got: dict, expected: dict) -> str | None:
+    """What the learner's call left otherwise than the reference's in a model (see :func:`module_flags`), or None."""
+    for name in expected:
+        if name not in got:
+            continue
+        (train_g, grad_g), (train_e, grad_e) = got[name], expected[name]
+        if train_g != train_e:
+            mode = "evaluation mode (`model.eval()`)" if not all(train_g) and all(train_e) else \
+                "another mode (`model.train()` / `model.eval()`)"
+            return (f"leaves `{name}` in {mode} after the call, where the reference leaves it as it was: the "
+                    "notebook's later steps (and dropout or batch-norm layers) then run in that mode; put the mode "
+                    "back before returning (`model.train()`), or switch it only inside a `try: ... finally:`")
+        if grad_g != grad_e:
+            off = sum(e and not g for g, e in zip(grad_g, grad_e))
+            return (f"changes which parameters of `{name}` require grad ({off} of {len(grad_e)} no longer do: "
+                    "`p.requires_grad_(False)`, `model.requires_grad_(False)`): every later step then trains "
+                    "nothing through them; leave the parameters as they are (use torch.no_grad() or .detach() for "
+                    "a value you only want to look at)")
+    return None
 
 
 def same_array(a, b) -> bool:
