@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .learner_calls import multiplies_rows
-from .outputs import compare_outputs, is_tensor, to_numpy
+from .outputs import STACK_T_ADVICE, compare_outputs, is_tensor, to_numpy
 from .protocol import ExerciseLike
 
 
@@ -117,9 +117,8 @@ def axes_order_hint(got, expected, rtol: float, atol: float) -> str | None:
                         "first (`H, W = sensor_size`, `np.zeros((H, W))`, `frame[y, x]`), and a `.T` too many (or one "
                         "missing) transposes it, as does `.reshape(H, W)` of an image built [x, y] on a square sensor")
             return (f"the result holds the expected values with the axes in another order (the expected array "
-                    f"transposed by {perm}): `.T` of an array with three or more axes reverses all of them, not "
-                    "only the last two; swap rows and columns with np.swapaxes(a, -1, -2) (a.transpose(0, 2, 1)), "
-                    "move one axis with np.moveaxis, or build the array in the expected order from the start")
+                    f"transposed by {perm}): {STACK_T_ADVICE}, or build the array in the expected order from the "
+                    "start")
         if e.shape[-1] != e.shape[-2] and \
                 compare_outputs(g, np.swapaxes(e, -1, -2).reshape(e.shape), rtol, atol) is None:
             return ("the result holds the transposed result's entries, in their order, poured into the expected "

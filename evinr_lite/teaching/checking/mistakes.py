@@ -38,13 +38,19 @@ def has_polarities(kwargs: dict) -> bool:
 def _with_polarities(kwargs: dict, f: Callable) -> dict | None:
     """``kwargs`` with ``f`` applied to every -1/+1 polarity input (an argument named p or p_events, or the ``p``
     of events); None when there is none."""
+    return _with_field(kwargs, _POLARITY_NAMES, "p", _is_pm1, f)
+
+
+def _with_field(kwargs: dict, names: tuple, field: str, test: Callable, f: Callable) -> dict | None:
+    """``kwargs`` with ``f`` applied to every input that passes ``test``: an argument named in ``names``, or the
+    field ``field`` of events (a copy of them, the field set past their own check); None when there is none."""
     out, found = {}, False
     for name, v in kwargs.items():
-        if name in _POLARITY_NAMES and _is_pm1(v):
+        if name in names and test(v):
             out[name], found = f(v), True
-        elif getattr(v, "sensor_size", None) is not None and _is_pm1(getattr(v, "p", None)):
+        elif getattr(v, "sensor_size", None) is not None and test(getattr(v, field, None)):
             ev = copy.copy(v)
-            object.__setattr__(ev, "p", f(v.p))        # events hold -1/+1 alone: set the field past the check
+            object.__setattr__(ev, field, f(getattr(v, field)))    # events check their fields: set it past that
             out[name], found = ev, True
         else:
             out[name] = v
@@ -56,22 +62,16 @@ def _with_polarities(kwargs: dict, f: Callable) -> dict | None:
 TIME_NAMES = ("t", "t_events", "t_query", "times", "boundaries", "t_end", "t_start", "t_a", "t_b", "windows")
 
 
+def _is_float_time(v) -> bool:
+    """A float numpy array with entries, or a float (not a bool)."""
+    return (isinstance(v, np.ndarray) and v.dtype.kind == "f" and v.size > 0) \
+        or (isinstance(v, float) and not isinstance(v, bool))
+
+
 def _with_times(kwargs: dict, f: Callable) -> dict | None:
     """``kwargs`` with ``f`` applied to every time input that is a float numpy array or a float (an argument named in
     :data:`TIME_NAMES`, or the ``t`` of events); None when there is none."""
-    out, found = {}, False
-    for name, v in kwargs.items():
-        if name in TIME_NAMES and ((isinstance(v, np.ndarray) and v.dtype.kind == "f" and v.size)
-                                   or (isinstance(v, float) and not isinstance(v, bool))):
-            out[name], found = f(v), True
-        elif getattr(v, "sensor_size", None) is not None and isinstance(getattr(v, "t", None), np.ndarray) \
-                and v.t.dtype.kind == "f" and v.t.size:
-            ev = copy.copy(v)
-            object.__setattr__(ev, "t", f(v.t))
-            out[name], found = ev, True
-        else:
-            out[name] = v
-    return out if found else None
+    return _with_field(kwargs, TIME_NAMES, "t", _is_float_time, f)
 
 
 def _float32_time(v):

@@ -18,6 +18,16 @@ from dataclasses import dataclass
 import numpy as np
 
 
+def input_name(k: int) -> str:
+    """How a report names the positional input ``k`` (from 0): "argument 1", "argument 2", ..."""
+    return f"argument {k + 1}"
+
+
+def named_inputs(args, kwargs: dict) -> list:
+    """(name, value) for every input of a call: the positional ones by :func:`input_name`, then the keywords."""
+    return [(input_name(k), a) for k, a in enumerate(args)] + list(kwargs.items())
+
+
 def is_tensor(x) -> bool:
     return type(x).__module__.startswith("torch") and hasattr(x, "detach")
 
@@ -237,6 +247,11 @@ def _tensor_width_message(got, expected, at: str) -> str | None:
             f"multiply by a Python float)")
 
 
+# what `.T` does to a stack, and what to use instead: a shape note here, and hints.axes_order_hint
+STACK_T_ADVICE = ("`.T` of an array with three or more axes reverses all of them, not only the last two; swap rows "
+                  "and columns with np.swapaxes(a, -1, -2) (a.transpose(0, 2, 1)), or move one axis with np.moveaxis")
+
+
 def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
     """A word on a wrong shape that names a common cause: a transposed result, indices for a mask, an array
     holding one number where a number is expected."""
@@ -244,9 +259,7 @@ def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
         return ("; the last two axes are swapped: a transposed result, or (H, W) read as (W, H) (sensor_size and "
                 "images are rows first: `H, W = sensor_size`, `np.zeros((H, W))`, `a[y, x]`)")
     if e.ndim >= 3 and g.ndim == e.ndim and sorted(g.shape) == sorted(e.shape):
-        return ("; the same axes in another order: `.T` of an array with three or more axes reverses all of them, "
-                "not only the last two; swap rows and columns with np.swapaxes(a, -1, -2) (a.transpose(0, 2, 1)), "
-                "or move one axis with np.moveaxis")
+        return "; the same axes in another order: " + STACK_T_ADVICE
     if e.dtype == bool and g.dtype.kind in "iu" and g.size <= e.size:
         return ("; that looks like the indices of the True entries (np.flatnonzero, np.where, np.argwhere): "
                 "return the boolean mask itself, one entry per element")
@@ -330,9 +343,7 @@ def _tensor_pairs(got, expected) -> list | None:
 
 def _grad_inputs(inputs: tuple) -> list:
     """(name, tensor) for the inputs (args, kwargs) that are leaf tensors requiring grad."""
-    args, kwargs = inputs
-    named = [(f"argument {k + 1}", a) for k, a in enumerate(args)] + list(kwargs.items())
-    return [(n, v) for n, v in named if is_tensor(v) and v.requires_grad and v.is_leaf]
+    return [(n, v) for n, v in named_inputs(*inputs) if is_tensor(v) and v.requires_grad and v.is_leaf]
 
 
 def compare_gradients(got, got_inputs: tuple, expected, expected_inputs: tuple) -> Problem | None:
