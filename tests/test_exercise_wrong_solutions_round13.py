@@ -57,9 +57,33 @@ pass: every case's clock is below 2147 s, and a probe tried in this round (the i
 and moved by 2 ** 30 s, a Unix time) failed round 3's correct alternatives (float32 arithmetic in bisect_equal_count
 and events_to_frames_fixed) and round 8's integer microseconds in the background filter, whose designed ties at
 t_j + dt a late clock moves; it was taken out. A cache keyed by id() where no later input has input #1's dtypes
-(anchor_first_offset: a uint8 first frame, then float ones) cannot be refilled and is caught only where Python
-reuses an id, so it has no test here. A read-only broadcast view of the result (anchor_broadcast_view) passes:
-writing to it raises, which tells the learner at once.
+(anchor_first_offset: a uint8 first frame, then float ones; an array keeps its dtype in place) cannot be refilled,
+and, the check's copies now kept alive (below), Python never reuses an id there: it passes, with no test here. Nor
+is a model refilled (frame_train_step: an exercise that observes its step's effects is not probed), nor a tensor
+whose requires_grad, dtype or device differs from input #1's, nor a tuple's identity kept (it is replaced by a
+copy). A read-only broadcast view of the result (anchor_broadcast_view) passes: writing to it raises, which tells
+the learner at once.
+
+Review fixes (each test failed before its fix, on this branch before the review): the refill wrote one slot through
+another where input #1 passes one array twice (``f(x, x)``) or events whose x and y are one array, and failed
+correct solutions (two toy exercises): refill_in_place now declines when two of the holder's arrays or tensors
+share memory, Events' fields included. module_flags called the unbound ``Module.modules()`` of a class among the
+inputs (``torch.nn.Linear`` itself, a toy): a class is skipped. Where the reference freezes parameters and the
+learner's call does not (a toy), the report said "0 of 4 no longer do ... leave the parameters as they are": both
+directions are counted now, each with its own words. A function that drifts after its sixth call
+(ii_drifts_after_six_calls; the last input's expected value is NaN, so the second call saw nothing) was blamed on
+an id() cache: the refilled input is also run on a fresh copy, and where that differs too the report says the
+function keeps state between calls. Tensors were never refilled, so a cache keyed by id() of a tensor passed every
+time: a tensor is now refilled through its ``.data`` (its identity, requires_grad and leaf kept, its gradient
+copied from the case's), and an array may be resized to another number of axes (reinhard_tonemap's (7,) then
+(3, 4)); sld_id_cache, tv_id_cache, tik_id_cache, split_id_cache and tm_id_cache now fail. A tuple input was put
+into the holder as the case's own tuple (the second call got the case's arrays): it is deep-copied. ef_id_cache's
+report changed from run to run (an IndexError on input #2 or #3, or the refill) as freed copies' ids were handed
+out again: ``learner_calls.watching`` keeps every copy the check hands the learner's function until the check ends,
+and the headline is the same on four runs. Copies merged: ``mistakes._with_field`` (polarities and times), one
+``outputs.STACK_T_ADVICE`` sentence, one ``outputs.input_name`` / ``named_inputs``. Six wrong solutions in six
+exercises (three not among the round's twenty: total_variation, tikhonov_autograd, split_index), four toy
+exercises (three correct, one wrong), and nine test functions (fourteen tests) were added; no case was changed.
 """
 import numpy as np
 import pytest
@@ -283,8 +307,8 @@ HOLES = [
     ("sine_layer_derivative", sld_numpy_omega, "got a float64 tensor, expected float32"),
     ("frame_train_step", step_eval_left, "in evaluation mode (`model.eval()`)"),
     ("frame_train_step", step_frozen, "changes which parameters of `model` require grad"),
-    # a cache keyed by id(): in the main run Python may hand a freed copy's id to the next input's copy (then the
-    # report names the notebook variable), else the objects refilled in place catch it; both reports say "keeps"
+    # a cache keyed by id(): the check keeps its copies alive (no id is handed out twice), and the objects
+    # refilled in place catch it
     ("integrate_events_1d", ie_id_cache, "your function keeps"),
     ("grey_event_frame", gf_id_cache, "your function keeps"),
     ("crossfade_weights", cf_same_object, "your function keeps"),
@@ -367,6 +391,8 @@ def test_this_round_counts():
     wrong = HOLES + NAMED + GUARDS + OPEN                    # and ef_bins_kept_once, below
     assert (len(HOLES), len(NAMED), len(GUARDS), len(OPEN), len(CORRECT)) == (14, 10, 1, 3, 14)
     assert len({r[0] for r in wrong}) == 20
+    assert len(REVIEW_HOLES) == len({r[0] for r in REVIEW_HOLES}) == 6           # the review's (see the docstring)
+    assert len({r[0] for r in wrong + REVIEW_HOLES}) == 23
 
 
 def test_the_notebooks_own_cases_are_unchanged():
@@ -425,7 +451,7 @@ def test_a_mode_is_compared_with_the_reference_s_not_with_training():
     assert module_flags_message(after, after) is None
     assert "evaluation mode" in module_flags_message(after, before)
     net.train(); net[0].weight.requires_grad_(False)
-    assert "1 of 2 no longer do" in module_flags_message(module_flags(((), {"model": net})), before)
+    assert "1 of 2 no longer require grad" in module_flags_message(module_flags(((), {"model": net})), before)
 
 
 _ONCE = {}
@@ -447,3 +473,172 @@ def test_an_error_made_by_kept_data_is_told_by_the_cache_alone():
     ok, text = _report("events_to_frames_fixed", ef_bins_kept_once)
     assert not ok and "raised IndexError" in text and "notebook variable `_ONCE`" in text, text
     assert "sensor is not square" not in text, text
+
+
+# ---- review fixes (see the docstring's "Review fixes")
+def _toy(name, reference, make_inputs):
+    exercises.register(name, reference, make_inputs)
+    return name
+
+
+def test_one_array_passed_twice_is_not_refilled():
+    """Input #1 hands one array twice (a signal compared with itself), or events whose x and y are one array: the
+    refill wrote one slot through the other, and a correct a - b was blamed for a cache. Now nothing is refilled."""
+    import dataclasses
+    from evinr_lite.teaching.checking.learner_calls import copy_inputs, refill_in_place
+
+    def make(rng):
+        x = rng.normal(size=5)
+        return [dict(a=x, b=x), dict(a=rng.normal(size=5), b=rng.normal(size=5)),
+                dict(a=rng.normal(size=6), b=rng.normal(size=6))]
+
+    @dataclasses.dataclass
+    class Ev:
+        x: np.ndarray
+        y: np.ndarray
+
+    def make_diag(rng):
+        d = np.arange(4)
+        return [dict(ev=Ev(d, d)), dict(ev=Ev(rng.integers(0, 9, 4), rng.integers(0, 9, 4)))]
+    try:
+        assert_passes(_toy("toy_r13_twice", lambda a, b: np.asarray(a, float) - np.asarray(b, float), make),
+                      lambda a, b: a - b)
+        assert_passes(_toy("toy_r13_diagonal", lambda ev: ev.x * 10 + ev.y, make_diag), lambda ev: ev.x * 10 + ev.y)
+        cases = exercises.get("toy_r13_twice").cases()
+        assert not refill_in_place(copy_inputs(cases[0]), cases[1])
+        d = np.arange(4)
+        assert not refill_in_place(copy_inputs(((), {"ev": Ev(d, d)})), ((), {"ev": Ev(np.ones(4, int), d + 1)}))
+    finally:
+        exercises.unregister("toy_r13_twice"); exercises.unregister("toy_r13_diagonal")
+
+
+def test_a_class_among_the_inputs_is_no_model():
+    """A model class (a factory) among the inputs made module_flags call the unbound Module.modules()."""
+    from evinr_lite.teaching.checking.learner_calls import module_flags
+    assert module_flags(((torch.nn.Linear,), {"cls": torch.nn.Conv2d})) == {}
+    try:
+        name = _toy("toy_r13_class", lambda cls, n: cls(n, 1).weight.shape[1],
+                    lambda rng: [dict(cls=torch.nn.Linear, n=3), dict(cls=torch.nn.Linear, n=4)])
+        assert_passes(name, lambda cls, n: n)
+    finally:
+        exercises.unregister("toy_r13_class")
+
+
+def test_parameters_the_reference_freezes_and_the_learner_leaves_trainable_are_named_so():
+    """The report said "(0 of 4 no longer do) ... leave the parameters as they are", the opposite of the fix."""
+    def make(rng):
+        torch.manual_seed(0)
+        return [dict(model=torch.nn.Sequential(torch.nn.Linear(2, 2), torch.nn.Linear(2, 1)))]
+
+    def ref_freeze(model):
+        model[0].requires_grad_(False)
+        return 1.0
+    try:
+        ok, text = _report(_toy("toy_r13_freeze", ref_freeze, make), lambda model: 1.0)
+    finally:
+        exercises.unregister("toy_r13_freeze")
+    assert not ok and "2 of 4 still require grad after your call, where the reference's call freezes them" in text
+    assert "no longer" not in text and "leave them as they are" not in text, text
+
+
+_CALLS = {"n": 0}
+def ii_drifts_after_six_calls(events):                      # state between calls: off by 0.1 from the 7th call on
+    _CALLS["n"] += 1
+    return R("interval_imbalance")(events) + (_CALLS["n"] > 6) * 0.1
+
+
+def test_a_function_that_drifts_is_told_state_not_an_id_cache():
+    """The last input's expected value is NaN (NaN + 0.1 is NaN), so the second call of the last input saw no drift,
+    and the refill step blamed an id() cache; a fresh copy of the refilled input answers otherwise too."""
+    _CALLS["n"] = 0
+    ok, text = _report("interval_imbalance", ii_drifts_after_six_calls)
+    assert not ok and "answers otherwise when called again on input #" in text, text
+    assert "it keeps state between calls" in text and "keyed by the objects" not in text, text
+
+
+def test_a_tuple_input_is_refilled_with_copies():
+    """A tuple was put in the holder as it was: the second call got the case's own arrays (a notebook's objects)."""
+    from evinr_lite.teaching.checking.learner_calls import copy_inputs, refill_in_place
+    new = ((), {"pair": (np.arange(4.0), np.zeros(4))})
+    holder = copy_inputs(((), {"pair": (np.arange(3.0), np.ones(3))}))
+    assert refill_in_place(holder, new)
+    pair = holder[1]["pair"]
+    assert pair is not new[1]["pair"] and pair[0] is not new[1]["pair"][0] and np.array_equal(pair[0], np.arange(4.0))
+
+
+def test_a_refilled_tensor_keeps_its_identity_requires_grad_and_gradients():
+    from evinr_lite.teaching.checking.learner_calls import copy_inputs, refill_in_place
+    cases = exercises.get("temporal_loss").cases()
+    holder = copy_inputs(cases[0])
+    t = holder[1]["dF_dt"]
+    assert t.requires_grad and refill_in_place(holder, cases[1])
+    assert holder[1]["dF_dt"] is t and t.requires_grad and t.is_leaf and t.grad is None
+    assert torch.equal(t, cases[1][1]["dF_dt"]) and t.shape == cases[1][1]["dF_dt"].shape
+    R("temporal_loss")(**holder[1]).backward()
+    assert t.grad is not None and t.grad.shape == t.shape
+    assert cases[1][1]["dF_dt"].grad is None and holder[1]["delta_L"] is not cases[1][1]["delta_L"]
+    grads = copy_inputs(((), {"F": torch.zeros(2, 3, requires_grad=True)}))
+    assert not refill_in_place(grads, ((), {"F": torch.zeros(2, 3)}))       # another requires_grad: no refill
+
+
+# results kept by id() of a tensor (never refilled before the review), or of an array refilled to another number of
+# axes (reinhard_tonemap: (7,) then (3, 4))
+_T = {}
+def sld_id_cache(h, dh_dt, weight, bias, omega):
+    if id(h) not in _T:
+        _T[id(h)] = R("sine_layer_derivative")(h, dh_dt, weight, bias, omega)
+    return tuple(v.clone() for v in _T[id(h)])
+def tv_id_cache(F):
+    if id(F) not in _T:
+        _T[id(F)] = R("total_variation")(F)
+    return _T[id(F)] * 1.0
+def tik_id_cache(dF_dx, dF_dy):
+    if id(dF_dx) not in _T:
+        _T[id(dF_dx)] = R("tikhonov_autograd")(dF_dx, dF_dy)
+    return _T[id(dF_dx)] * 1.0
+def split_id_cache(index, sensor_size):
+    if id(index) not in _T:
+        _T[id(index)] = R("split_index")(index, sensor_size)
+    return tuple(v.clone() for v in _T[id(index)])
+def tm_id_cache(L, gamma):
+    if id(L) not in _T:
+        _T[id(L)] = R("reinhard_tonemap")(L, gamma)
+    return _T[id(L)].copy()
+
+
+REVIEW_HOLES = [
+    ("sine_layer_derivative", sld_id_cache, "your function keeps"),
+    ("total_variation", tv_id_cache, "your function keeps"),
+    ("tikhonov_autograd", tik_id_cache, "your function keeps"),
+    ("split_index", split_id_cache, "your function keeps"),
+    ("reinhard_tonemap", tm_id_cache, "your function keeps"),
+    ("interval_imbalance", ii_drifts_after_six_calls, "it keeps state between calls"),
+]
+
+
+@pytest.mark.parametrize("name, wrong, words", REVIEW_HOLES, ids=_id(REVIEW_HOLES))
+def test_review_hole_now_fails_and_names_the_mistake(name, wrong, words):
+    _T.clear(); _CALLS["n"] = 0
+    assert_fails_naming(name, wrong, words)
+
+
+def test_an_id_cache_gets_the_same_report_on_every_run():
+    """Freed copies' ids were handed to later ones, so ef_id_cache read "raised IndexError on input #2", "#3" or
+    "answers otherwise when ... refilled" by chance; the check now keeps the copies it hands out until it ends."""
+    headlines = set()
+    for _ in range(4):
+        _EF.clear()
+        ok, text = _report("events_to_frames_fixed", ef_id_cache)
+        assert not ok
+        headlines.add(text.strip().splitlines()[0])
+    assert len(headlines) == 1 and "refilled" in headlines.pop()
+
+
+def test_the_check_s_sentences_and_names_are_written_once():
+    """The `.T` advice, the "argument k" naming and the events' field copy each live in one place."""
+    from pathlib import Path
+    src = Path(exercises.__file__).parent / "checking"
+    text = "".join(p.read_text() for p in sorted(src.glob("*.py")))
+    assert text.count("`.T` of an array with three or more axes reverses all of them") == 1
+    assert text.count('f"argument {k + 1}"') == 1
+    assert text.count("object.__setattr__(ev,") == 1

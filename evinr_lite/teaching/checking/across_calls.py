@@ -110,6 +110,13 @@ def uninitialised_hint(fn: Callable, ex: ExerciseLike, args, kwargs, got) -> str
     return UNINITIALISED if memory_explains(fn, ex, args, kwargs, got) else None
 
 
+STATE_BETWEEN_CALLS = (
+    "called again on the same input, your function returns another result: it keeps state between calls (a "
+    "notebook variable it changes, a mutable default argument), or draws random numbers from the global generator "
+    "(np.random.choice, np.random.randn, torch.randn without a seed of its own); compute everything from the "
+    "arguments, starting afresh in each call, with no randomness (nothing here asks for a random sample)")
+
+
 def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwargs, got,
                 first: bool = False, memory: bool | None = None) -> str | None:
     """A mutable default argument that changed (or holds data) during the check, or a second call on the same
@@ -129,11 +136,7 @@ def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwa
             return None
         if memory if memory is not None else memory_explains(fn, ex, args, kwargs, got):
             return UNINITIALISED
-        return ("called again on the same input, your function returns another result: it keeps state between "
-                "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "
-                "from the global generator (np.random.choice, np.random.randn, torch.randn without a seed of "
-                "its own); compute everything from the arguments, starting afresh in each call, with no "
-                "randomness (nothing here asks for a random sample)")
+        return STATE_BETWEEN_CALLS
     except Exception:
         return None
 
@@ -409,17 +412,26 @@ KEYED_BY_OBJECT = (
     "is slow enough to need one), or key it by the values (`t.tobytes()`) and return copies")
 
 
-def same_objects_new_values(ex: ExerciseLike, fn: Callable, cases: list) -> int | None:
-    """The number (from 1) of a case k > 1 such that ``fn``, called on the first case's objects (a copy) and then on
-    the same objects refilled in place with case k's values (:func:`.learner_calls.refill_in_place`), answers the
-    second call otherwise than the reference on case k; else None (also where the objects cannot be refilled: a
-    tensor, an array the function kept a reference to). The cases are tried from the last one back
-    (a cache keyed by an id and a plain number is fooled only where that number is input #1's). Run after every
-    input matched."""
+def same_objects_new_values(ex: ExerciseLike, fn: Callable, cases: list) -> tuple[int, bool] | None:
+    """(k, state): the number (from 1) of a case k > 1 such that ``fn``, called on the first case's objects (a copy)
+    and then on the same objects refilled in place with case k's values (:func:`.learner_calls.refill_in_place`),
+    answers the second call otherwise than the reference on case k; else None (also where the objects cannot be
+    refilled: an array the function kept a reference to, one array passed twice). ``state``: called once more on a
+    fresh copy of case k, ``fn`` answers otherwise too, so the objects' identity is not what it keeps (a function
+    that drifts after some number of calls, which the second call of the last input may not see: a NaN there hides
+    any drift). The cases are tried from the last one back (a cache keyed by an id and a plain number is fooled only
+    where that number is input #1's). Run after every input matched; the objects refilled are kept alive until it
+    returns, so that none of their ids is handed to a later copy."""
     if ex.observe is not None:
         return None
+
+    def differs(got, expected) -> bool:
+        return ex.compare(got, expected) is not None if ex.compare is not None else \
+            compare_outputs(got, expected, ex.rtol, ex.atol) is not None
+    held = []
     for k in range(len(cases) - 1, 0, -1):
         holder = copy_inputs(cases[0])
+        held.append(holder)
         try:
             expected = run(ex.reference, *cases[k])
             run(fn, holder[0], holder[1], copy_inputs=False)
@@ -428,11 +440,13 @@ def same_objects_new_values(ex: ExerciseLike, fn: Callable, cases: list) -> int 
         except Exception:
             continue
         try:
-            got = run(fn, holder[0], holder[1], copy_inputs=False)
-            differs = ex.compare(got, expected) is not None if ex.compare is not None else \
-                compare_outputs(got, expected, ex.rtol, ex.atol) is not None
+            wrong = differs(run(fn, holder[0], holder[1], copy_inputs=False), expected)
         except Exception:          # it answered case k from fresh objects: what it kept fails on these
-            differs = True
-        if differs:
-            return k + 1
+            wrong = True
+        if wrong:
+            try:
+                state = differs(run(fn, *cases[k]), expected)
+            except Exception:
+                state = True
+            return k + 1, state
     return None

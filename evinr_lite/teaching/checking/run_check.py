@@ -20,8 +20,8 @@ from __future__ import annotations
 
 from typing import Callable
 
-from .across_calls import (KEYED_BY_OBJECT, UNINITIALISED, fixed_size_hint, global_cache_hint, global_containers,
-                           mutable_default_hint, memory_explains, mutable_defaults, reseed_hint,
+from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, fixed_size_hint, global_cache_hint,
+                           global_containers, mutable_default_hint, memory_explains, mutable_defaults, reseed_hint,
                            same_objects_new_values, scalar_factor_hint, shares_output, stale_argument_hint, state_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
                            rng_states, set_rng_states, settings_message)
@@ -128,8 +128,11 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after)
         if failed is not None:
             return failed
-        k = same_objects_new_values(ex, fn, cases)
-        if k is not None:
+        refilled = same_objects_new_values(ex, fn, cases)
+        if refilled is not None:
+            k, state = refilled
+            if state:              # a fresh copy of input #k fails too: the calls, not the objects, made it
+                return False, f"answers otherwise when called again on input #{k}", [STATE_BETWEEN_CALLS]
             return False, f"answers otherwise when input #1's objects are refilled with input #{k}'s values", [
                 KEYED_BY_OBJECT.format(k=k)]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
