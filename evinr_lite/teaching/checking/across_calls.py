@@ -7,7 +7,9 @@ otherwise (:func:`state_hint`) or answers otherwise on freed memory filled with 
 (:func:`stale_argument_hint`, :func:`fixed_size_hint`), one number off by the same factor on every input
 (:func:`scalar_factor_hint`). And, on the second call of the last input:
 :func:`shares_output` (the same array, tensor or dict handed out twice, a buffer or a cached result) and
-:func:`reseed_hint` (a global generator seeded inside the function).
+:func:`reseed_hint` (a global generator seeded inside the function). After that, :func:`same_objects_new_values`
+gives the function input #1's own objects again, refilled in place with a later input's values: a result kept by the
+objects' identity (a cache keyed by id(), `t is last_t`) answers for the old values.
 """
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ import numpy as np
 
 from .global_state import SEED_CALLS, other_rng_states, reseeded_generators, rng_states, set_rng_states
 from .hints import unit_note
-from .learner_calls import poison_freed_memory, run, same_array, uses_uninitialised
+from .learner_calls import copy_inputs, poison_freed_memory, refill_in_place, run, same_array, uses_uninitialised
 from .outputs import compare_outputs, is_tensor, not_finite, to_numpy
 from .protocol import ExerciseLike
 
@@ -108,6 +110,13 @@ def uninitialised_hint(fn: Callable, ex: ExerciseLike, args, kwargs, got) -> str
     return UNINITIALISED if memory_explains(fn, ex, args, kwargs, got) else None
 
 
+STATE_BETWEEN_CALLS = (
+    "called again on the same input, your function returns another result: it keeps state between calls (a "
+    "notebook variable it changes, a mutable default argument), or draws random numbers from the global generator "
+    "(np.random.choice, np.random.randn, torch.randn without a seed of its own); compute everything from the "
+    "arguments, starting afresh in each call, with no randomness (nothing here asks for a random sample)")
+
+
 def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwargs, got,
                 first: bool = False, memory: bool | None = None) -> str | None:
     """A mutable default argument that changed (or holds data) during the check, or a second call on the same
@@ -119,17 +128,15 @@ def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwa
     if hint is not None or ex.observe is not None:
         return hint
     try:
+        if hasattr(got, "__next__") or compare_outputs(got, got, ex.rtol, ex.atol) is not None:
+            return None     # no numbers to compare (a map object, an array of dtype object): a rerun says nothing
         poison_freed_memory(got)
         again = run(fn, args, kwargs, ex.observe)
         if compare_outputs(again, got, ex.rtol, ex.atol) is None:
             return None
         if memory if memory is not None else memory_explains(fn, ex, args, kwargs, got):
             return UNINITIALISED
-        return ("called again on the same input, your function returns another result: it keeps state between "
-                "calls (a notebook variable it changes, a mutable default argument), or draws random numbers "
-                "from the global generator (np.random.choice, np.random.randn, torch.randn without a seed of "
-                "its own); compute everything from the arguments, starting afresh in each call, with no "
-                "randomness (nothing here asks for a random sample)")
+        return STATE_BETWEEN_CALLS
     except Exception:
         return None
 
@@ -394,3 +401,52 @@ def _fresh_seed_state(key: str, state) -> bool:
     except Exception:
         return False
     return False
+
+
+KEYED_BY_OBJECT = (
+    "every input matched, but called on input #1's own array objects, refilled in place with input #{k}'s values "
+    "(as a notebook does when it reuses a buffer, or changes an array in place and calls again), it does not "
+    "answer as the reference does for those values: your function keeps results keyed by the objects (`id(t)`, "
+    "`t is last_t`) or keeps the objects themselves, and an id is no fingerprint of the values (Python hands a "
+    "freed array's id to the next one, and an array changed in place keeps its id); drop the cache (nothing here "
+    "is slow enough to need one), or key it by the values (`t.tobytes()`) and return copies")
+
+
+def same_objects_new_values(ex: ExerciseLike, fn: Callable, cases: list) -> tuple[int, bool] | None:
+    """(k, state): the number (from 1) of a case k > 1 such that ``fn``, called on the first case's objects (a copy)
+    and then on the same objects refilled in place with case k's values (:func:`.learner_calls.refill_in_place`),
+    answers the second call otherwise than the reference on case k; else None (also where the objects cannot be
+    refilled: an array the function kept a reference to, one array passed twice). ``state``: called once more on a
+    fresh copy of case k, ``fn`` answers otherwise too, so the objects' identity is not what it keeps (a function
+    that drifts after some number of calls, which the second call of the last input may not see: a NaN there hides
+    any drift). The cases are tried from the last one back (a cache keyed by an id and a plain number is fooled only
+    where that number is input #1's). Run after every input matched; the objects refilled are kept alive until it
+    returns, so that none of their ids is handed to a later copy."""
+    if ex.observe is not None:
+        return None
+
+    def differs(got, expected) -> bool:
+        return ex.compare(got, expected) is not None if ex.compare is not None else \
+            compare_outputs(got, expected, ex.rtol, ex.atol) is not None
+    held = []
+    for k in range(len(cases) - 1, 0, -1):
+        holder = copy_inputs(cases[0])
+        held.append(holder)
+        try:
+            expected = run(ex.reference, *cases[k])
+            run(fn, holder[0], holder[1], copy_inputs=False)
+            if not refill_in_place(holder, cases[k]):
+                continue
+        except Exception:
+            continue
+        try:
+            wrong = differs(run(fn, holder[0], holder[1], copy_inputs=False), expected)
+        except Exception:          # it answered case k from fresh objects: what it kept fails on these
+            wrong = True
+        if wrong:
+            try:
+                state = differs(run(fn, *cases[k]), expected)
+            except Exception:
+                state = True
+            return k + 1, state
+    return None

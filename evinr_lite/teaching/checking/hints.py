@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .learner_calls import multiplies_rows
-from .outputs import compare_outputs, is_tensor, to_numpy
+from .outputs import STACK_T_ADVICE, compare_outputs, is_tensor, to_numpy
 from .protocol import ExerciseLike
 
 
@@ -94,6 +94,39 @@ def _axes_hint(g: np.ndarray, e: np.ndarray, tol: float) -> str | None:
     if np.allclose(g[::-1], e, atol=tol) and not np.allclose(g, e, atol=tol):
         return ("the two outputs are swapped: return them in the order the docstring gives (for image "
                 "differences, x is the column axis (axis -1, `np.diff(a, axis=-1)`), y the row axis (axis -2))")
+    return None
+
+
+def axes_order_hint(got, expected, rtol: float, atol: float) -> str | None:
+    """The expected values with the axes in another order: a transposed image ([x, y] for [y, x]), a stack's axes
+    reversed by ``.T`` (which reverses all of them, not only the last two), or the transposed image's entries
+    read in order into the expected shape (``.reshape(H, W)`` of a [x, y] array, which never moves an entry)."""
+    import itertools
+    try:
+        g, e = to_numpy(got), to_numpy(expected)
+        if g.dtype == object or e.ndim < 2 or g.shape != e.shape or e.size < 4 or e.ndim > 5 \
+                or compare_outputs(g, np.broadcast_to(e.reshape(-1)[:1], e.shape), rtol, atol) is None:
+            return None                      # (anything matches a constant result)
+        for perm in itertools.permutations(range(e.ndim)):
+            t = np.transpose(e, perm)
+            if perm == tuple(range(e.ndim)) or t.shape != g.shape or compare_outputs(g, t, rtol, atol) is not None:
+                continue
+            if perm == tuple(range(e.ndim - 2)) + (e.ndim - 1, e.ndim - 2):
+                what = "the expected one transposed" if e.ndim == 2 else "the expected images each transposed"
+                return (f"the result is {what}: rows and columns (y and x) swapped; an image is indexed [y, x], rows "
+                        "first (`H, W = sensor_size`, `np.zeros((H, W))`, `frame[y, x]`), and a `.T` too many (or one "
+                        "missing) transposes it, as does `.reshape(H, W)` of an image built [x, y] on a square sensor")
+            return (f"the result holds the expected values with the axes in another order (the expected array "
+                    f"transposed by {perm}): {STACK_T_ADVICE}, or build the array in the expected order from the "
+                    "start")
+        if e.shape[-1] != e.shape[-2] and \
+                compare_outputs(g, np.swapaxes(e, -1, -2).reshape(e.shape), rtol, atol) is None:
+            return ("the result holds the transposed result's entries, in their order, poured into the expected "
+                    "shape: `.reshape(H, W)` (np.reshape, np.resize) of an image built [x, y] keeps the order of the "
+                    "entries and does not transpose, so the rows come out scrambled; transpose with `.T` (np.swapaxes("
+                    "a, -1, -2)), or build the image [y, x] from the start")
+    except Exception:
+        return None
     return None
 
 

@@ -9,7 +9,9 @@ Over a whole check, :func:`watching` gathers what the learner's function changed
 :func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with np.empty
 (:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern rather than
 zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that holds a list
-(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint.
+(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call can leave
+changed in a model besides its parameters (its mode, which parameters require grad), and :func:`refill_in_place`
+writes one case's values into another case's objects without changing their identity (a cache keyed by id()).
 """
 from __future__ import annotations
 
@@ -27,7 +29,7 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from .outputs import is_tensor, to_numpy
+from .outputs import input_name, is_tensor, named_inputs, to_numpy
 from .global_state import global_settings, imports_watched, restore_settings
 
 
@@ -112,23 +114,29 @@ def _deepcopy_with_grads(x):
     return y
 
 
-_WATCHED: list = []   # (the learner's function, what its calls changed of the settings), one per running check
+# (the learner's function, what its calls changed of the settings, the copies of inputs it was handed), one per
+# running check
+_WATCHED: list = []
 
 
 @contextlib.contextmanager
 def watching(fn: Callable) -> Iterator[dict]:
     """While the block runs, what any call of ``fn`` through :func:`run` changes of the global settings (the hints'
     calls too) is gathered into the dict it yields, {name: (before, after)}, the first change of each name kept.
-    Checks may nest (a check run from inside a learner's function): the innermost one's ``fn`` is watched."""
+    The copies of the inputs that :func:`run` hands ``fn`` are kept alive until the block ends, so that no two of
+    them ever have the same id(): Python hands a freed object's id to the next one, and a result kept by id() would
+    then be found or missed by chance, the report changing from run to run. Checks may nest (a check run from inside
+    a learner's function): the innermost one's ``fn`` is watched."""
     seen: dict = {}
-    _WATCHED.append((fn, seen))
+    _WATCHED.append((fn, seen, []))
     try:
         yield seen
     finally:
         _WATCHED.pop()
 
 
-def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None):
+def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None,
+        copy_inputs: bool = True):
     """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
     receives the copied ``(args, kwargs)`` as they are after the call.
@@ -139,8 +147,12 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     reference's, the hints' wrong versions) nor for the notebook; ``settings_changed``, a dict, receives what
     the call changed ({name: (before, after)}); warning filters that a module adds while an import runs its code
     during the call are the module's, and stay (:func:`.global_state.imports_watched`). What the learner's function
-    changed on any call of the check (the hints' calls too) is also kept for the report (see :func:`watching`)."""
-    args, kwargs = _deepcopy_with_grads((args, kwargs))
+    changed on any call of the check (the hints' calls too) is also kept for the report (see :func:`watching`).
+    ``copy_inputs=False`` hands the function the objects themselves (to call it twice on the same objects)."""
+    if copy_inputs:
+        args, kwargs = _deepcopy_with_grads((args, kwargs))
+        if _WATCHED and fn is _WATCHED[-1][0]:
+            _WATCHED[-1][2].append((args, kwargs))        # kept alive: see watching()
     settings = global_settings()
     with imports_watched() as imported:
         try:
@@ -157,6 +169,93 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     return result if observe is None else observe(result, args, kwargs)
 
 
+def copy_inputs(inputs: tuple[tuple, dict]) -> tuple[list, dict]:
+    """A deep copy of a case's (args, kwargs), the args as a list, for :func:`run` with ``copy_inputs=False``."""
+    args, kwargs = _deepcopy_with_grads(inputs)
+    return list(args), kwargs
+
+
+def refill_in_place(holder: tuple[list, dict], new: tuple[tuple, dict]) -> bool:
+    """Write the values of ``new`` (a case's args and kwargs) into the objects of ``holder`` (another case's, made
+    by :func:`copy_inputs`), in place: each numpy array keeps its identity (resized where the sizes differ, to another
+    number of axes too), as do the arrays inside an object such as ``Events``, a tensor (its ``.data`` replaced,
+    its requires_grad kept), and a dict or list input (emptied and refilled with a copy of the new items); plain
+    numbers are replaced, tuples by a copy (never the case's own objects). False (and ``holder`` perhaps partly
+    written) where that cannot be done: another structure, dtype or device, an array that something else still
+    refers to (a resize would leave it pointing at freed memory, and numpy refuses it), or two inputs (or two fields
+    of one) that share memory, such as one array passed twice (``f(x, x)``): writing one would write the other."""
+    (h_args, h_kwargs), (n_args, n_kwargs) = holder, new
+    if len(h_args) != len(n_args) or set(h_kwargs) != set(n_kwargs):
+        return False
+    if _share_memory([a for v in [*h_args, *h_kwargs.values()] for _, a in _arrays_of(v)]):
+        return False
+    slots = [(h_args, k, v) for k, v in enumerate(n_args)] + [(h_kwargs, k, v) for k, v in n_kwargs.items()]
+    return all(_refill_slot(box, key, value) for box, key, value in slots)
+
+
+def _share_memory(arrays: list) -> bool:
+    """Two of ``arrays`` (numpy arrays or tensors) share memory: the same object twice, a view of another, tensors
+    on one storage."""
+    for i, a in enumerate(arrays):
+        for b in arrays[i + 1:]:
+            if a is b:
+                return True
+            if isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and np.shares_memory(a, b):
+                return True
+            if is_tensor(a) and is_tensor(b) and a.numel() and b.numel() \
+                    and a.untyped_storage().data_ptr() == b.untyped_storage().data_ptr():
+                return True
+    return False
+
+
+def _refill_slot(box, key, value) -> bool:
+    """``box[key]`` given ``value``'s contents in place (see :func:`refill_in_place`). The array is never bound to a
+    local name before a resize: numpy counts the references, and a local one would make it refuse."""
+    if isinstance(value, np.ndarray):
+        if type(box[key]) is not np.ndarray or box[key].dtype != value.dtype:
+            return False
+        if box[key].shape != value.shape:
+            try:
+                box[key].resize(value.shape)
+            except (ValueError, TypeError):
+                return False
+        box[key][...] = value
+        return True
+    if is_tensor(value):
+        return _refill_tensor(box[key], value)
+    fields = getattr(value, "__dict__", None)
+    if isinstance(fields, dict) and not hasattr(value, "parameters"):
+        target = getattr(box[key], "__dict__", None)
+        if type(box[key]) is not type(value) or not isinstance(target, dict) or set(target) != set(fields):
+            return False
+        return all(_refill_slot(target, name, v) for name, v in fields.items())
+    if isinstance(value, dict) and type(box[key]) is dict:     # a table: the same dict object, new rows
+        box[key].clear()
+        box[key].update(copy.deepcopy(value))
+        return True
+    if isinstance(value, list) and type(box[key]) is list:
+        box[key][:] = copy.deepcopy(value)
+        return True
+    if isinstance(value, (int, float, complex, str, bytes, tuple, type(None), np.generic)):
+        box[key] = copy.deepcopy(value)       # a tuple of arrays: copies, never the case's own arrays
+        return True
+    return False
+
+
+def _refill_tensor(t, value) -> bool:
+    """The tensor ``t`` given a copy of ``value``'s values and gradient, its identity and requires_grad kept (its
+    ``.data`` replaced, which a leaf that requires grad allows, to any shape); False for another type, dtype,
+    device or requires_grad, or a tensor that is no leaf."""
+    if type(t) is not type(value) or t.dtype != value.dtype or t.device != value.device \
+            or t.requires_grad != value.requires_grad or not t.is_leaf:
+        return False
+    torch = sys.modules["torch"]
+    with torch.no_grad():
+        t.data = value.detach().clone()
+    t.grad = None if value.grad is None else value.grad.detach().clone()
+    return True
+
+
 def _arrays_of(v) -> list[tuple[str, Any]]:
     """The arrays (or tensors) an input holds: itself, or the array fields of an object such as ``Events``."""
     if isinstance(v, np.ndarray) or is_tensor(v):
@@ -165,6 +264,51 @@ def _arrays_of(v) -> list[tuple[str, Any]]:
     if isinstance(fields, dict) and not hasattr(v, "parameters"):
         return [(f".{k}", a) for k, a in fields.items() if isinstance(a, np.ndarray) or is_tensor(a)]
     return []
+
+
+def module_flags(inputs: tuple[tuple, dict]) -> dict[str, tuple]:
+    """{input name: (each submodule's training mode, each parameter's requires_grad)} for the torch modules among
+    ``inputs`` (args, kwargs): what a call can leave changed in a model besides its parameters' values."""
+    return {name: (tuple(bool(m.training) for m in v.modules()), tuple(bool(q.requires_grad) for q in v.parameters()))
+            for name, v in named_inputs(*inputs) if not isinstance(v, type)      # a class (nn.Linear) is no model
+            and callable(getattr(v, "modules", None)) and callable(getattr(v, "parameters", None))
+            and type(v).__module__.split(".")[0] != "numpy"}
+
+
+def module_flags_message(got: dict, expected: dict) -> str | None:
+    """What the learner's call left otherwise than the reference's in a model (see :func:`module_flags`), or None."""
+    for name in expected:
+        if name not in got:
+            continue
+        (train_g, grad_g), (train_e, grad_e) = got[name], expected[name]
+        if train_g != train_e:
+            mode = "evaluation mode (`model.eval()`)" if not all(train_g) and all(train_e) else \
+                "another mode (`model.train()` / `model.eval()`)"
+            return (f"leaves `{name}` in {mode} after the call, where the reference leaves it as it was: the "
+                    "notebook's later steps (and dropout or batch-norm layers) then run in that mode; put the mode "
+                    "back before returning (`model.train()`), or switch it only inside a `try: ... finally:`")
+        if grad_g != grad_e:
+            return _requires_grad_message(name, grad_g, grad_e)
+    return None
+
+
+def _requires_grad_message(name: str, got: tuple, expected: tuple) -> str:
+    """Which parameters of the model ``name`` require grad after the learner's call (``got``) and not after the
+    reference's (``expected``), or the reverse: each direction has its own fix."""
+    off = sum(e and not g for g, e in zip(got, expected))      # the learner's call froze them, the reference's not
+    on = sum(g and not e for g, e in zip(got, expected))       # the reference's call froze them, the learner's not
+    n = len(expected)
+    parts = []
+    if off:
+        parts.append(f"{off} of {n} no longer require grad after your call (`p.requires_grad_(False)`, "
+                     "`model.requires_grad_(False)`), where the reference's call leaves them trainable: every later "
+                     "step then trains nothing through them; leave them as they are (use torch.no_grad() or "
+                     ".detach() for a value you only want to look at)")
+    if on:
+        parts.append(f"{on} of {n} still require grad after your call, where the reference's call freezes them: "
+                     "later steps then go on training what the exercise holds fixed; freeze them as the exercise "
+                     "asks (`p.requires_grad_(False)` for each, or `layer.requires_grad_(False)`)")
+    return f"changes which parameters of `{name}` require grad otherwise than the reference: " + "; and ".join(parts)
 
 
 def same_array(a, b) -> bool:
@@ -196,7 +340,7 @@ def changed_inputs(before: tuple[tuple, dict], after: tuple[tuple, dict]) -> lis
     """Names of the array inputs (or array fields of an input), and of the dict and list inputs (a key added,
     removed or changed, an item appended, the list sorted), that the call changed in place."""
     (args0, kwargs0), (args1, kwargs1) = before, after
-    pairs = [(f"argument {k + 1}", a, b) for k, (a, b) in enumerate(zip(args0, args1))]
+    pairs = [(input_name(k), a, b) for k, (a, b) in enumerate(zip(args0, args1))]
     pairs += [(name, kwargs0[name], kwargs1[name]) for name in kwargs0 if name in kwargs1]
     changed = []
     for name, v0, v1 in pairs:
@@ -224,8 +368,7 @@ def in_place_message(changed: list[str], containers: tuple = ()) -> str:
 
 def container_names(args: tuple, kwargs: dict) -> tuple:
     """The names `changed_inputs` gives the dict and list inputs."""
-    return tuple([f"argument {k + 1}" for k, a in enumerate(args) if isinstance(a, (dict, list))]
-                 + [name for name, v in kwargs.items() if isinstance(v, (dict, list))])
+    return tuple(name for name, v in named_inputs(args, kwargs) if isinstance(v, (dict, list)))
 
 
 POISON_LIMIT = 1 << 20     # the largest block poison_freed_memory fills (1 MiB): eight of each size are made

@@ -2,8 +2,8 @@
 
 An exercise's own hints map a message to a wrong version of its reference; :func:`generic_mistakes` makes a
 few more from any reference, for mistakes every exercise can show (-1/+1 polarities read as 0/1, OFF events
-dropped or polarities made unsigned, an input or the result clipped to [0, 1], a result or a float input
-rounded). The learner's output matching a wrong version's on the failing input is not enough:
+dropped or polarities made unsigned, times made float32, an input or the result clipped to [0, 1], a result or a
+float input rounded). The learner's output matching a wrong version's on the failing input is not enough:
 :func:`same_mistake_elsewhere` asks that it also match on the other inputs where that mistake shows, so that one
 input cannot make two different mistakes look alike. :func:`wrong_axes_hint` makes one more, the reference run on
 transposed images (differences or sums along the wrong image axis), and compares it on the failing input.
@@ -38,17 +38,44 @@ def has_polarities(kwargs: dict) -> bool:
 def _with_polarities(kwargs: dict, f: Callable) -> dict | None:
     """``kwargs`` with ``f`` applied to every -1/+1 polarity input (an argument named p or p_events, or the ``p``
     of events); None when there is none."""
+    return _with_field(kwargs, _POLARITY_NAMES, "p", _is_pm1, f)
+
+
+def _with_field(kwargs: dict, names: tuple, field: str, test: Callable, f: Callable) -> dict | None:
+    """``kwargs`` with ``f`` applied to every input that passes ``test``: an argument named in ``names``, or the
+    field ``field`` of events (a copy of them, the field set past their own check); None when there is none."""
     out, found = {}, False
     for name, v in kwargs.items():
-        if name in _POLARITY_NAMES and _is_pm1(v):
+        if name in names and test(v):
             out[name], found = f(v), True
-        elif getattr(v, "sensor_size", None) is not None and _is_pm1(getattr(v, "p", None)):
+        elif getattr(v, "sensor_size", None) is not None and test(getattr(v, field, None)):
             ev = copy.copy(v)
-            object.__setattr__(ev, "p", f(v.p))        # events hold -1/+1 alone: set the field past the check
+            object.__setattr__(ev, field, f(getattr(v, field)))    # events check their fields: set it past that
             out[name], found = ev, True
         else:
             out[name] = v
     return out if found else None
+
+
+# inputs that are instants on the recording's clock (not durations such as dt or bin_s): an argument of one of these
+# names, or the ``t`` of events
+TIME_NAMES = ("t", "t_events", "t_query", "times", "boundaries", "t_end", "t_start", "t_a", "t_b", "windows")
+
+
+def _is_float_time(v) -> bool:
+    """A float numpy array with entries, or a float (not a bool)."""
+    return (isinstance(v, np.ndarray) and v.dtype.kind == "f" and v.size > 0) \
+        or (isinstance(v, float) and not isinstance(v, bool))
+
+
+def _with_times(kwargs: dict, f: Callable) -> dict | None:
+    """``kwargs`` with ``f`` applied to every time input that is a float numpy array or a float (an argument named in
+    :data:`TIME_NAMES`, or the ``t`` of events); None when there is none."""
+    return _with_field(kwargs, TIME_NAMES, "t", _is_float_time, f)
+
+
+def _float32_time(v):
+    return np.asarray(v, dtype=np.float32) if isinstance(v, np.ndarray) else float(np.float32(v))
 
 
 def _outside_unit(v) -> bool:
@@ -130,6 +157,11 @@ def generic_mistakes(ex: ExerciseLike, cases: list | None = None) -> list[tuple[
          "`(p > 0).astype(np.uint8) - (p < 0).astype(np.uint8)`), where -1 wraps round to 255: keep p signed "
          "(int8, int64) or make it float",
          on_inputs(lambda kw: _with_polarities(kw, lambda p: p.astype(np.uint8)))),
+        ("the times were made float32 (about 7 significant digits: `astype(np.float32)`, torch.tensor(t) or "
+         "torch.Tensor of them, a float32 buffer): a time near 1000 s then moves by up to 30 us, enough to cross an "
+         "edge or change an interval, and on a recording's clock (Unix time, 1.5e9 s) by a minute; keep times "
+         "float64 (np.asarray(t, dtype=np.float64)), or subtract the first time in float64 before anything narrower",
+         on_inputs(lambda kw: _with_times(kw, _float32_time))),
     ]
     try:
         params = list(inspect.signature(ref).parameters)

@@ -1,8 +1,9 @@
 """Comparing a learner's output with the reference's, and describing values in a report.
 
 :func:`compare_outputs` walks the two outputs together (tuples, lists, dicts, arrays, tensors, plain values) and
-returns the first :class:`Problem`: a missing ``return``, a wrong type, shape or dtype (with a word on the likely
-cause), or wrong values (how many, where, by how much). It is the one built-in yardstick every other module of the
+returns the first :class:`Problem`: a missing ``return``, a wrong type (an array subclass such as np.matrix, a lazy
+iterator, an array of Python objects), shape or dtype (a tensor's float width too: torch does not convert between
+float32 and float64 in a layer), with a word on the likely cause, or wrong values (how many, where, by how much). It is the one built-in yardstick every other module of the
 check uses: the main run, the hints' wrong versions, the second call (an exercise may bring its own ``compare``,
 which the main run and the second call use in its place). Where the values match and the reference's result is a
 differentiable tensor, :func:`compare_gradients` compares what back-propagation from it reaches: a result rebuilt
@@ -15,6 +16,16 @@ import sys
 from dataclasses import dataclass
 
 import numpy as np
+
+
+def input_name(k: int) -> str:
+    """How a report names the positional input ``k`` (from 0): "argument 1", "argument 2", ..."""
+    return f"argument {k + 1}"
+
+
+def named_inputs(args, kwargs: dict) -> list:
+    """(name, value) for every input of a call: the positional ones by :func:`input_name`, then the keywords."""
+    return [(input_name(k), a) for k, a in enumerate(args)] + list(kwargs.items())
 
 
 def is_tensor(x) -> bool:
@@ -130,6 +141,8 @@ def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") ->
     if isinstance(expected, np.ndarray) and is_tensor(got):
         return Problem(f"returned a torch.Tensor{at}, expected a numpy array: compute with numpy, or convert "
                         "with `.detach().cpu().numpy()`")
+    if type(expected) is np.ndarray and isinstance(got, np.ndarray) and type(got) is not np.ndarray:
+        return Problem(_subclass_message(got, at))
     if isinstance(expected, np.ndarray) and isinstance(got, (list, tuple)):
         return Problem(f"returned a {type(got).__name__}{at}, expected a numpy array: return "
                         "`np.asarray(...)` of it (later cells use array methods such as .shape)")
@@ -140,12 +153,16 @@ def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") ->
             return Problem(f"returned a {type(got).__name__}{at}, expected numbers")
         e = to_numpy(expected)
         if g.dtype == object or g.dtype.kind not in "biufc":
-            return Problem(f"returned {type(got).__name__} of dtype {g.dtype}{at}, expected numbers")
+            return Problem(f"returned {type(got).__name__} of dtype {g.dtype}{at}, expected numbers"
+                           + _object_note(got, g))
         if g.shape != e.shape:
             return Problem(f"wrong shape{at}: got {g.shape}, expected {e.shape}" + _shape_note(g, e))
         if _kind(g) != _kind(e):
             return Problem(f"wrong dtype{at}: got {_kind(g)} ({g.dtype}), expected {_kind(e)} ({e.dtype})"
                             + _dtype_note(g, e))
+        width = _tensor_width_message(got, expected, at)
+        if width:
+            return Problem(width)
         close = np.isclose(g, e, rtol=rtol, atol=atol, equal_nan=True)
         if np.all(close):
             return None
@@ -181,12 +198,68 @@ def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") ->
     return None
 
 
+def _subclass_message(got: np.ndarray, at: str) -> str:
+    """A numpy array subclass (np.matrix, a masked array, ...) where the reference returns a plain array."""
+    if isinstance(got, np.matrix):
+        return (f"returned a numpy.matrix{at}, expected a plain numpy array: np.matrix (np.matrix(A), np.asmatrix, "
+                "`.I`, `.H`) is deprecated and behaves otherwise: `*` is a matrix product, a row `W[0]` or "
+                "`W.ravel()` stays 2-D; compute with arrays (`@`, np.linalg.solve, np.linalg.inv), or return "
+                "np.asarray(...) of it")
+    if isinstance(got, np.ma.MaskedArray):
+        return (f"returned a masked array (np.ma){at}, expected a plain numpy array: later cells' sums and means "
+                "skip its masked entries and its .data may hold anything there; compute the values themselves "
+                "(np.where for a choice per entry), or return np.ma.filled(result, value) with the value the "
+                "exercise asks for")
+    return (f"returned a {type(got).__module__}.{type(got).__name__}{at} (a subclass of numpy's array), expected a "
+            "plain numpy array: return np.asarray(...) of it")
+
+
+def _object_note(got, g: np.ndarray) -> str:
+    """A word on a result that holds no numbers: a lazy iterator (map, filter, zip, a generator), or an array of
+    Python objects."""
+    if hasattr(got, "__next__"):
+        return (f": a {type(got).__name__} object is a lazy iterator, read once and then empty, not the values "
+                "themselves; make an array of it: np.array(list(...)), or use numpy on the whole array "
+                "(np.exp(L), not map(math.exp, L))")
+    if isinstance(got, np.ndarray) and got.dtype == object:
+        return (": an array of dtype object holds Python objects, one per entry (`.astype(object)`, np.array of "
+                "a list that mixes arrays of different lengths, numbers and None, or of a list of tensors); "
+                "build it with a numeric dtype (np.zeros(..., dtype=...), np.stack, np.concatenate)")
+    return ""
+
+
+def _tensor_width_message(got, expected, at: str) -> str | None:
+    """A float32 tensor of values (one or more axes) where the reference's is float64, or the reverse: unlike numpy,
+    torch does not convert for a matrix product or a layer (`expected scalar type Float but found Double`), so the
+    width is part of the answer. bfloat16 and float16 keep their own words (after the values)."""
+    if not (is_tensor(got) and is_tensor(expected)) or expected.dim() == 0:
+        return None          # a loss (one number) may be float64: it feeds no layer, and backward() casts back
+    widths = {"torch.float32": "float32", "torch.float64": "float64"}
+    g, e = widths.get(str(got.dtype)), widths.get(str(expected.dtype))
+    if g is None or e is None or g == e:
+        return None
+    how = ("a float64 tensor comes from numpy floats (torch.as_tensor / torch.from_numpy of a float64 array or of "
+           "np.float64(omega)), torch.tensor of a float64 array, or .double()") if g == "float64" else \
+        "a float32 tensor comes from torch.tensor(...) of Python floats, .float(), or torch.Tensor(...)"
+    return (f"wrong dtype{at}: got a {g} tensor, expected {e} like the inputs: torch does not convert between them "
+            f"in a matrix product or a layer (`expected scalar type Float but found Double`), so the next step "
+            f"fails or a loss mixes widths; {how}: keep the inputs' dtype (torch.as_tensor(x, dtype=h.dtype), or "
+            f"multiply by a Python float)")
+
+
+# what `.T` does to a stack, and what to use instead: a shape note here, and hints.axes_order_hint
+STACK_T_ADVICE = ("`.T` of an array with three or more axes reverses all of them, not only the last two; swap rows "
+                  "and columns with np.swapaxes(a, -1, -2) (a.transpose(0, 2, 1)), or move one axis with np.moveaxis")
+
+
 def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
     """A word on a wrong shape that names a common cause: a transposed result, indices for a mask, an array
     holding one number where a number is expected."""
     if e.ndim >= 2 and g.ndim == e.ndim and g.shape[:-2] == e.shape[:-2] and g.shape[-2:] == e.shape[-2:][::-1]:
         return ("; the last two axes are swapped: a transposed result, or (H, W) read as (W, H) (sensor_size and "
                 "images are rows first: `H, W = sensor_size`, `np.zeros((H, W))`, `a[y, x]`)")
+    if e.ndim >= 3 and g.ndim == e.ndim and sorted(g.shape) == sorted(e.shape):
+        return "; the same axes in another order: " + STACK_T_ADVICE
     if e.dtype == bool and g.dtype.kind in "iu" and g.size <= e.size:
         return ("; that looks like the indices of the True entries (np.flatnonzero, np.where, np.argwhere): "
                 "return the boolean mask itself, one entry per element")
@@ -270,9 +343,7 @@ def _tensor_pairs(got, expected) -> list | None:
 
 def _grad_inputs(inputs: tuple) -> list:
     """(name, tensor) for the inputs (args, kwargs) that are leaf tensors requiring grad."""
-    args, kwargs = inputs
-    named = [(f"argument {k + 1}", a) for k, a in enumerate(args)] + list(kwargs.items())
-    return [(n, v) for n, v in named if is_tensor(v) and v.requires_grad and v.is_leaf]
+    return [(n, v) for n, v in named_inputs(*inputs) if is_tensor(v) and v.requires_grad and v.is_leaf]
 
 
 def compare_gradients(got, got_inputs: tuple, expected, expected_inputs: tuple) -> Problem | None:

@@ -7,9 +7,12 @@ result too), and at the first difference looks for a hint (:func:`_hint_for`), i
 notebook variable (when it made the difference), np.empty (a rerun on zeroed memory answers otherwise), the
 exercise's own wrong versions, a swapped pair, state kept between calls, an argument taken from input #1, the
 generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
-patterns read off the values (:mod:`.hints`: indices from 1, rows aliased by one list, then the rest), and last a
-notebook variable that only grew. After every input matched, the last one is run a second time from other states of
-the global generators (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`). The order is the report's:
+patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
+the rest), and last a notebook variable that only grew. A model among the inputs left in another mode, or with other
+parameters requiring grad, than the reference leaves it is named after each call. After every input matched, the last
+one is run a second time from other states of the global generators (:func:`_second_call`, :mod:`.across_calls`,
+:mod:`.global_state`), and input #1's own objects are refilled in place with a later input's values and given again
+(:func:`.across_calls.same_objects_new_values`: a cache keyed by id()). The order is the report's:
 change it and other hints win. Returns (passed, headline, detail lines); printing is
 :func:`evinr_lite.teaching.exercises.check`'s.
 """
@@ -17,15 +20,15 @@ from __future__ import annotations
 
 from typing import Callable
 
-from .across_calls import (UNINITIALISED, fixed_size_hint, global_cache_hint, global_containers, mutable_default_hint,
-                           memory_explains, mutable_defaults, reseed_hint, scalar_factor_hint, shares_output,
-                           stale_argument_hint, state_hint)
+from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, fixed_size_hint, global_cache_hint,
+                           global_containers, mutable_default_hint, memory_explains, mutable_defaults, reseed_hint,
+                           same_objects_new_values, scalar_factor_hint, shares_output, stale_argument_hint, state_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
                            rng_states, set_rng_states, settings_message)
-from .hints import (aliased_rows_hint, generic_hint, has_repeated_index, non_square, one_based_hint,
-                    size_from_events_hint, swapped_pair_hint)
-from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, poison_freed_memory,
-                            run, watching, where_raised)
+from .hints import (aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
+                    one_based_hint, size_from_events_hint, swapped_pair_hint)
+from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, module_flags,
+                            module_flags_message, poison_freed_memory, run, watching, where_raised)
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
@@ -93,6 +96,10 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             return False, f"changed the notebook's global settings on {where}", [settings_message(changed_settings)]
         if not ref_after:
             expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after)
+        model_changed = module_flags_message(module_flags(after[0]), module_flags(ref_after[0])) \
+            if after and ref_after else None
+        if model_changed:
+            return False, f"changed the model's settings on {where}", [model_changed]
         problem = _first_difference(ex, got, expected)
         # inputs changed in place (a function with side effects says what to compare through `observe`)
         changed = changed_inputs((args, kwargs), after[0]) if ex.observe is None and after else []
@@ -121,6 +128,13 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after)
         if failed is not None:
             return failed
+        refilled = same_objects_new_values(ex, fn, cases)
+        if refilled is not None:
+            k, state = refilled
+            if state:              # a fresh copy of input #k fails too: the calls, not the objects, made it
+                return False, f"answers otherwise when called again on input #{k}", [STATE_BETWEEN_CALLS]
+            return False, f"answers otherwise when input #1's objects are refilled with input #{k}'s values", [
+                KEYED_BY_OBJECT.format(k=k)]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
 
 
@@ -169,6 +183,10 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     state = mutable_default_hint(fn, defaults) if k > 0 else None
     if state is None and k > 0:
         cache, proven = global_cache_hint(fn, containers, ex, (args, kwargs), raised=True)
+        if proven and cache:
+            # the kept data made the error (with the variable emptied the call answers): a guess read off the
+            # error's words (a sensor that is not square, say) explains nothing more; the cache's hint comes first
+            details = [d for d in details if not d.startswith("hint:")]
         if proven or not any(d.startswith("hint:") for d in details):
             state = cache        # a list only logged to, which changes nothing, is a fallback
     if state:
@@ -251,6 +269,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     if hint is None:
         hint = fixed_size_hint(ex, cases, k, got, expected)
     if problem.values:
+        if hint is None:
+            hint = axes_order_hint(got, expected, ex.rtol, ex.atol)
         if hint is None:
             hint = one_based_hint(got, expected, ex.rtol, ex.atol)
         if hint is None:
