@@ -205,3 +205,20 @@ def test_the_jobs_record_the_scale_and_say_when_it_shortened_the_bins():
     settings, lines = {}, []
     report_temporal_scale("auto", 2.0, 1 / 32, settings, lines.append)
     assert "2x shorter (at most 15.6 ms, not 31.2)" in lines[0] and "--temporal-scale 1" in lines[0]
+
+
+def test_the_constant_benchmark_sets_the_rule_for_a_block_and_puts_it_back():
+    from benchmarks import temporal_scale as bench
+    from evinr_lite.method import tempo
+
+    with pytest.raises(RuntimeError):
+        with bench.flips_ref(1.0, max_scale=np.inf):
+            assert scale_from_rate(10.0) == 10.0           # the rule reads the constants at each call
+            raise RuntimeError("a failure inside the block")
+    assert (tempo.FLIPS_REF, tempo.MAX_SCALE) == (FLIPS_REF, MAX_SCALE)
+    assert scale_from_rate(10.0) == min(10.0 / FLIPS_REF, MAX_SCALE)
+    row = {"ssim_clahe": 0.5, "ssim_none": 0.6, "mse_none": 0.01}
+    out = {"a": {"set": "zoo", "rate": 3.0, "kit": {"2.0": {**row, "ssim_clahe": 0.52}, "2.5": row, "3.0": row}}}
+    lines = bench.summary(out, [2.0, 2.5, 3.0], 2.5)
+    assert len(lines) == 2 and "+0.0200" in lines[0] and "1 up, 0 down" in lines[0] and "+0.0000" in lines[1]
+    assert "| zoo | a | 3.00 | 0.520 / 0.600 / 0.0100 | 0.500" in bench.markdown(out, [2.0, 2.5, 3.0], lines)
