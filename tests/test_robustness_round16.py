@@ -21,8 +21,8 @@ than 700, the command's "internal error"; reconstruct and batch alike), 1e-6 or 
 (``first_omega_per_s=1e-9``) gives finite frames (a spread of e^2000 is matched to its mean exactly).
 ``tempo.flip_rate`` of a span "1" or None was numpy's ufunc error and True was 1 s; text counts were numpy's
 conversion error, negative or NaN counts gave a negative or NaN rate; ``scale_from_rate`` of text or None was
-numpy's error and a list or True were taken. ``plan_from_counts`` of a config None, a dict or a text was an AttributeError,
-counts of two shapes, text, None or 1-D were numpy's broadcast or conversion errors or a plan for no sensor, flips or
+numpy's error and a list or True were taken. ``plan_from_counts`` of a config None, a dict or a text was an
+AttributeError, counts of two shapes, text, None or 1-D were numpy's broadcast or conversion errors or a plan for no sensor, flips or
 intervals of another shape numpy's broadcast error, span_s "1" Python's TypeError, and NaN or -1 were taken (the
 scale left "auto"). ``polarity_counts`` / ``interval_sums`` / ``slice_counts`` of None, a path or an array were
 AttributeErrors; ``interval_sums``' ``last`` of 5, text or one array were Python's errors, of another shape numpy's
@@ -31,8 +31,8 @@ taken; ``slice_counts`` with no edges was numpy's "negative dimensions", one edg
 edges counted without a word; ``span_slices`` of k 0 or -1 gave one or no boundary, 2.5 and "8" were numpy's
 errors, NaN spans gave NaN boundaries and a reversed span slices one microsecond; ``interval_stride`` /
 ``PolarityCounts`` of None, 5, text, (0, 5), (-5, 5) or (2.5, 3) were Python's or numpy's errors or a stride and
-counts for no pixel; ``PolarityCounts(decay="0.5")`` was taken and None was Python's TypeError; ``balance_from_counts`` of negative
-counts and a min_events of -1 or NaN gave a fit without a word, text counts were numpy's error. Whole floats (a
+counts for no pixel; ``PolarityCounts(decay="0.5")`` was taken and None was Python's TypeError;
+``balance_from_counts`` of negative counts and a min_events of -1 or NaN gave a fit without a word, text counts were numpy's error. Whole floats (a
 count of 8.0 slices, 4.0 pixels, a sensor 12.0 wide) were Python's "cannot be interpreted as an integer".
 ``sample_thresholds`` of n_pixels -1, 2.5, "3" or None were numpy's errors, a NaN, negative or text C and a NaN,
 negative or text sigma were taken (thresholds of NaN or -0.2), rng=5 an AttributeError. ``zoo.fresh`` of a seed "0"
