@@ -22,32 +22,32 @@ than 700, the command's "internal error"; reconstruct and batch alike), 1e-6 or 
 ``tempo.flip_rate`` of a span "1" or None was numpy's ufunc error and True was 1 s; text counts were numpy's
 conversion error, negative or NaN counts gave a negative or NaN rate; ``scale_from_rate`` of text or None was
 numpy's error and a list or True were taken. ``plan_from_counts`` of a config None, a dict or a text was an
-AttributeError, counts of two shapes, text, None or 1-D were numpy's broadcast or conversion errors or a plan for no sensor, flips or
-intervals of another shape numpy's broadcast error, span_s "1" Python's TypeError, and NaN or -1 were taken (the
-scale left "auto"). ``polarity_counts`` / ``interval_sums`` / ``slice_counts`` of None, a path or an array were
-AttributeErrors; ``interval_sums``' ``last`` of 5, text or one array were Python's errors, of another shape numpy's
-IndexError, a polarity of NaN or 3 was cast to int8 and a time given where no polarity is (or NaN where one is) was
-taken; ``slice_counts`` with no edges was numpy's "negative dimensions", one edge gave no slice, NaN or reversed
-edges counted without a word; ``span_slices`` of k 0 or -1 gave one or no boundary, 2.5 and "8" were numpy's
-errors, NaN spans gave NaN boundaries and a reversed span slices one microsecond; ``interval_stride`` /
+AttributeError, counts of two shapes, text, None or 1-D were numpy's broadcast or conversion errors or a plan for no
+sensor, flips or intervals of another shape numpy's broadcast error, span_s "1" Python's TypeError, and NaN or -1
+were taken (the scale left "auto"). ``polarity_counts`` / ``interval_sums`` / ``slice_counts`` of None, a path or an
+array were AttributeErrors; ``interval_sums``' ``last`` of 5, text or one array were Python's errors, of another
+shape numpy's IndexError, a polarity of NaN or 3 was cast to int8 and a time given where no polarity is (or NaN
+where one is) was taken; ``slice_counts`` with no edges was numpy's "negative dimensions", one edge gave no slice,
+NaN or reversed edges counted without a word; ``span_slices`` of k 0 or -1 gave one or no boundary, 2.5 and "8" were
+numpy's errors, NaN spans gave NaN boundaries and a reversed span slices one microsecond; ``interval_stride`` /
 ``PolarityCounts`` of None, 5, text, (0, 5), (-5, 5) or (2.5, 3) were Python's or numpy's errors or a stride and
 counts for no pixel; ``PolarityCounts(decay="0.5")`` was taken and None was Python's TypeError;
-``balance_from_counts`` of negative counts and a min_events of -1 or NaN gave a fit without a word, text counts were numpy's error. Whole floats (a
-count of 8.0 slices, 4.0 pixels, a sensor 12.0 wide) were Python's "cannot be interpreted as an integer".
-``sample_thresholds`` of n_pixels -1, 2.5, "3" or None were numpy's errors, a NaN, negative or text C and a NaN,
-negative or text sigma were taken (thresholds of NaN or -0.2), rng=5 an AttributeError. ``zoo.fresh`` of a seed "0"
-or NaN was numpy's SeedSequence error and -1 its ValueError, n -1 gave no scene and 2.5 or "3" scenes without a word;
-``quick`` / ``simulate`` / ``imbalance`` / ``effective_C`` of a name or None were AttributeErrors;
-``default_scenes("no")`` counted the long scenes. ``write_colour_davis_recording`` of a path None, 5, bytes or a
-list was Python's TypeError, and ``overwrite="no"`` (or 2, "False") replaced the user's file. ``score_sequence`` /
-``evaluate`` with ``lpips_model`` True, 5, 1.5, {} or [1] failed inside the first LPIPS distance (AttributeError):
-a model must be a torch module. ``plot_reconstruction_1d`` with curves None, a list or text was an AttributeError,
-curves or a truth of another length, t None and text values were matplotlib's errors, NaN times were drawn; every
-figure taking ``ax=`` (``plot_count_map``, ``plot_polarity``, ``plot_event_rate``, ``plot_boundaries``,
-``plot_signal_and_events``, ``plot_reconstruction_1d``, ``plot_window_errors``) failed inside matplotlib on a
-Figure, a number or an array of axes: the one check is ``viz.signals.axes_or_new``, naming fig.axes[0] / axes[0].
-A 1 x 1 sensor reconstructed at one time was refused as "constant frames although the input varies; check C": one
-value cannot vary (``check_result_frames`` asks for more than one).
+``balance_from_counts`` of negative counts and a min_events of -1 or NaN gave a fit without a word, text counts were
+numpy's error. Whole floats (a count of 8.0 slices, 4.0 pixels, a sensor 12.0 wide) were Python's "cannot be
+interpreted as an integer". ``sample_thresholds`` of n_pixels -1, 2.5, "3" or None were numpy's errors, a NaN,
+negative or text C and a NaN, negative or text sigma were taken (thresholds of NaN or -0.2), rng=5 an
+AttributeError. ``zoo.fresh`` of a seed "0" or NaN was numpy's SeedSequence error and -1 its ValueError, n -1 gave
+no scene and 2.5 or "3" scenes without a word; ``quick`` / ``simulate`` / ``imbalance`` / ``effective_C`` of a name
+or None were AttributeErrors; ``default_scenes("no")`` counted the long scenes. ``write_colour_davis_recording`` of
+a path None, 5, bytes or a list was Python's TypeError, and ``overwrite="no"`` (or 2, "False") replaced the user's
+file. ``score_sequence`` / ``evaluate`` with ``lpips_model`` True, 5, 1.5, {} or [1] failed inside the first LPIPS
+distance (AttributeError): a model must be a torch module. ``plot_reconstruction_1d`` with curves None, a list or
+text was an AttributeError, curves or a truth of another length, t None and text values were matplotlib's errors,
+NaN times were drawn; every figure taking ``ax=`` (``plot_count_map``, ``plot_polarity``, ``plot_event_rate``,
+``plot_boundaries``, ``plot_signal_and_events``, ``plot_reconstruction_1d``, ``plot_window_errors``) failed inside
+matplotlib on a Figure, a number or an array of axes: the one check is ``viz.signals.axes_or_new``, naming
+fig.axes[0] / axes[0]. A 1 x 1 sensor reconstructed at one time was refused as "constant frames although the input
+varies; check C": one value cannot vary (``check_result_frames`` asks for more than one).
 
 Refused on purpose where they were taken before: a hand-set temporal scale in (0, 1/64) (0.01 gave frames; below
 the floor the network hardly changes over a window), a rate of -1 in ``scale_from_rate`` (it was 1), an
