@@ -33,7 +33,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..core.checks import checked_span, real_number, require
+from ..core.checks import ArgumentTypeError, checked_span, real_number
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
 from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, fit_background, sample_spans, tile_counts
@@ -92,9 +92,11 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sl
     "auto", which trains as 1), and the hot pixels to drop (bool [H, W], all False
     unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
     changed (a copy)."""
-    from .config import EvINRConfig   # here: the config module imports this one
-
-    require(cfg, EvINRConfig, "plan_from_counts: cfg")
+    # the config's fields, by name: method.config imports this module (None, a dict or a recipe's name was an
+    # AttributeError on cfg.hot_pixels)
+    if not all(hasattr(cfg, a) for a in ("hot_pixels", "balance", "C", "lam", "temporal_scale")):
+        raise ArgumentTypeError(f"plan_from_counts: cfg= must be EvINRConfig, got {type(cfg).__name__}; e.g. "
+                                "EvINRConfig() or EvINRConfig.paper()")
     n_on = check_counts(n_on, "plan_from_counts: n_on").astype(np.float64)
     n_off = check_counts(n_off, "plan_from_counts: n_off").astype(np.float64)
     if n_on.shape != n_off.shape or n_on.ndim != 2:

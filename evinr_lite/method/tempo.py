@@ -61,7 +61,7 @@ def flip_rate(flips, n_events, span_s: float) -> float:
     if flips.shape != n_events.shape or flips.ndim != 2:
         raise EventDataError(f"flip_rate: flips and n_events must be [H, W] arrays of one shape, got "
                              f"{flips.shape} and {n_events.shape}")
-    span_s = real_number(span_s, "flip_rate: span_s", lo=0, lo_open=True, hint="the span's length in seconds")
+    span_s = real_number(span_s, "flip_rate: span_s", lo=0, lo_open=True, hint="the span's length, a positive number of seconds")
     if flips.size == 0:
         return float("nan")
     s = interval_stride(flips.shape)
