@@ -278,7 +278,8 @@ def test_running_counts_refuse_a_decay_outside_0_1(decay):
 @pytest.mark.parametrize("n_on, n_off, kw, pattern", [
     (-FIVE, FIVE, {}, r"n_on must be finite event counts"),
     (np.full((12, 12), np.nan), FIVE, {}, r"n_on must be" + OLD_COUNTS),
-    (FIVE, "abc", {}, r"n_off must be event counts"), (np.ones(5), np.ones(5), {}, r"must be \[H, W\] counts"),
+    (FIVE, "abc", {}, r"n_off must be event counts"),
+    (np.ones(5), np.ones(5), {}, r"must be \[H, W\] counts of the same shape"),
     (FIVE, FIVE, {"min_events": -1}, r"min_events= must be a finite number >= 0"),
     (FIVE, FIVE, {"min_events": np.nan}, r"min_events= must be a finite number >= 0")])
 def test_balance_from_counts_refuses_counts_that_are_no_counts(n_on, n_off, kw, pattern):

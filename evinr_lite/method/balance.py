@@ -491,7 +491,7 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
     n_on = check_counts(n_on, "n_on").astype(np.float64)
     n_off = check_counts(n_off, "n_off").astype(np.float64)
     if n_on.shape != n_off.shape or n_on.ndim != 2:
-        raise EventDataError(f"n_on {n_on.shape} and n_off {n_off.shape} must be [H, W] counts of one shape")
+        raise EventDataError(f"n_on {n_on.shape} and n_off {n_off.shape} must be [H, W] counts of the same shape")
     min_events = real_number(min_events, "min_events", lo=0, hint="the fewest events a pixel needs to count (e.g. 4)")
     if intervals is not None and (len(intervals) != 4 or any(np.shape(a) != n_on.shape for a in intervals)):
         raise EventDataError(f"intervals must be four arrays of the counts' shape {n_on.shape} (log_on, k_on, "
