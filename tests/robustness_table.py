@@ -29,7 +29,7 @@ LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustn
          "test_api_round6.py", "test_ragged_inputs.py", "test_fuzz_readers.py", "test_robustness_round7.py",
          "test_robustness_round8.py", "test_robustness_round9.py", "test_robustness_round10.py",
          "test_robustness_round11.py", "test_robustness_round12.py", "test_robustness_round13.py",
-         "test_robustness_round14.py", "test_robustness_round15.py"]
+         "test_robustness_round14.py", "test_robustness_round15.py", "test_robustness_round16.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
@@ -65,6 +65,10 @@ CLASSES = [
     ("data_fetch's names and settings, the canonical file's writer and reader, the readers' keyword options, every "
      "job's output folder and the demo and reconstruct jobs from Python: names, paths, flags, counts, windows, "
      "round 15", "test_robustness_round15.py", r"test_"),
+    ("the temporal scale set by hand (a floor) and the tone map's overflow, the tempo helpers, the solver's plan from "
+     "counts and the balance's sums, the simulator's thresholds, the zoo, the colour recording's writer, the scorer's "
+     "LPIPS model, the figures' axes and one-pixel curves, degenerate recordings: counts, shapes, spans, flags, "
+     "round 16", "test_robustness_round16.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"

@@ -163,8 +163,8 @@ LAM_HELP = ("the spatial regularizer's weight lambda: auto (the kit's: chosen fr
             "default: the recipe's own (auto for kit, 0.05 for paper and v0_1)")
 SCALE_HELP = ("how much shorter the event bins are, and faster the temporal prior, than the recipe's: auto (the "
               "kit's: 1 unless the pixels reverse polarity more than 2.5 times a second, as under a fast shake; at "
-              "most 4) or a number > 0 (1: the recipe's 1/32 s bins as they are); default: the recipe's own (auto "
-              "for kit, 1 for paper and v0_1)")
+              "most 4) or a number from 1/64 up (1: the recipe's 1/32 s bins as they are); default: the recipe's own "
+              "(auto for kit, 1 for paper and v0_1)")
 ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose output layer is solved in closed "
               "form; 300 for paper and v0_1, with coarse-to-fine at a third and two thirds)")
 
@@ -383,6 +383,7 @@ FLAG_FOR = [
     (re.compile(r"use a longer bin_duration, a shorter tau or fewer hidden_features, or "), ""),
     (re.compile(r" or use a longer bin_duration"), ""),
     (re.compile(r"\btemporal_scale=1\b"), "--temporal-scale 1"),
+    (re.compile(r"\btemporal_scale=(?=[\d.])"), "--temporal-scale "),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)=(?=[\w'\"(.+-])"),
      lambda m: FLAGS[m.group(1)] + " "),
     (re.compile(r"\b(t_start|t_end|n_iters|out_dir|fps|at|C|time_unit)="), lambda m: FLAGS[m.group(1)]),

@@ -20,6 +20,7 @@ import numpy as np
 
 from ..core.events import TIME_UNITS, EventDataError
 from ..method.anchor import ANCHOR_MODES
+from ..method.tempo import MIN_SCALE, scale_floor_message
 from ..core.recording import Recording
 from ..io.formats.mvsec import CAMERAS
 from ..io.text import MAX_CLOCK_S
@@ -145,6 +146,8 @@ def temporal_scale_option(value) -> float | str:
             or not math.isfinite(value) or value <= 0:
         raise EventDataError(f"temporal_scale= must be 'auto' (read from the events) or a number > 0 (1: the recipe's "
                              f"bins and temporal prior as they are; 2: bins half as long), got {value!r}")
+    if value < MIN_SCALE:
+        raise EventDataError(scale_floor_message("temporal_scale", value))
     return float(value)
 
 

@@ -333,7 +333,8 @@ def check_result_frames(frames, *, what: str, input_varies: bool, fix: str) -> n
         bad = int(np.size(finite) - np.count_nonzero(finite))
         raise ResultError(f"{what} gave {bad:,} NaN or infinite value(s) of {frames.size:,}: that is not a result; "
                           f"{fix}")
-    if input_varies and frames.size and float(frames.max()) == float(frames.min()):
+    # one value (a 1 x 1 sensor at one time) cannot vary: it was refused as if the settings had failed
+    if input_varies and frames.size > 1 and float(frames.max()) == float(frames.min()):
         raise ResultError(f"{what} gave constant frames (every pixel {float(frames.min()):.6g}) although the input "
                           f"varies: that is not a result; {fix}")
     return frames

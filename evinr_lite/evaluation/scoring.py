@@ -76,6 +76,12 @@ def resolve_lpips(lpips_model=None):
         raise EventDataError(f"lpips_model must be None or 'auto' (the cached weights), False (skip LPIPS) or an LPIPS "
                              f"model, got the text {lpips_model!r}")
     if lpips_model is not None and lpips_model != "auto":
+        import torch
+
+        if not isinstance(lpips_model, torch.nn.Module):   # True, 5 or a dict failed inside the first distance
+            raise EventDataError(f"lpips_model must be None or 'auto' (the cached weights), False (skip LPIPS) or an "
+                                 f"LPIPS model (a torch module, as evaluation.lpips.load_lpips() gives), got "
+                                 f"{type(lpips_model).__name__} {lpips_model!r:.40}")
         return lpips_model, ""
     from ..core.runtime import default_device
     from .lpips import LPIPSUnavailable, load_lpips, lpips_paths

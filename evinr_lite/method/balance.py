@@ -103,10 +103,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.checks import is_real_number, require
-from ..core.events import EventDataError, Events
+from ..core.checks import checked_span, is_real_number, real_number, require, whole_number
+from ..core.events import EventDataError, Events, check_sensor_size
 from .binning import as_thresholds
-from .denoise import hot_threshold
+from .denoise import check_counts, hot_threshold
 
 __all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "interval_stride",
            "balance_from_counts", "estimate_balance", "pooled_imbalance", "slope_imbalance", "interval_imbalance", "minmod",
@@ -182,6 +182,7 @@ class BalanceFit:
 
 def polarity_counts(events: Events) -> tuple[np.ndarray, np.ndarray]:
     """(n_on, n_off): int64 [H, W] ON and OFF event counts per pixel."""
+    require(events, Events, "polarity_counts: events")
     H, W = events.sensor_size
     flat = events.y.astype(np.int64) * W + events.x
     on = events.p > 0
@@ -196,8 +197,9 @@ def slice_counts(events: Events, edges) -> tuple[np.ndarray, np.ndarray]:
     it opens); events before the first or after the last boundary count in the first or last slice.
     The events are time-ordered, so each slice is one run of them, counted on its own (the memory
     beyond the result is one [H, W] count)."""
+    require(events, Events, "slice_counts: events")
     H, W = events.sensor_size
-    edges = np.asarray(edges, np.float64)
+    edges = _slice_edges(edges, "slice_counts: edges")
     K = len(edges) - 1
     t = np.asarray(events.t, np.float64)
     cut = np.concatenate([[0], np.searchsorted(t, edges[1:-1], side="left"), [len(t)]])
@@ -208,16 +210,45 @@ def slice_counts(events: Events, edges) -> tuple[np.ndarray, np.ndarray]:
     return out
 
 
+def _slice_edges(edges, name: str) -> np.ndarray:
+    """Slice boundaries as float64 [K + 1]: at least two finite, increasing times (s)."""
+    arr = None if isinstance(edges, (str, bytes)) or edges is None else np.asarray(edges)
+    if arr is None or arr.dtype.kind not in "iuf" or arr.ndim != 1 or len(arr) < 2:
+        raise EventDataError(f"{name} must be at least two increasing times in seconds (a slice's boundaries, as "
+                             f"span_slices(t_start, t_end) gives), got {edges!r:.80}")
+    arr = arr.astype(np.float64)
+    if not (np.isfinite(arr).all() and np.all(np.diff(arr) > 0)):
+        raise EventDataError(f"{name} must be finite, increasing times (s), got {arr!r:.80}")
+    return arr
+
+
 def interval_stride(sensor_size) -> int:
     """The stride s of the pixel grid whose intervals are timed: every pixel (s = 1) up to
     MAX_INTERVAL_PIXELS pixels, else every s-th row and column, the least s that keeps the grid within
     it (1280 x 720: s = 4, 57,600 pixels). The estimate pools their pairs; more pixels add time, not
     evidence, and a grid below 2^16 pixels sorts in one 16-bit radix pass."""
-    H, W = sensor_size
+    H, W = check_sensor_size(sensor_size)
     s = 1
     while -(-H // s) * -(-W // s) > MAX_INTERVAL_PIXELS:
         s += 1
     return s
+
+
+def _check_last(last, shape) -> tuple:
+    """interval_sums' ``last``: (last_t, last_p), float64 [H, W] times (NaN: none) and polarities -1, 0 or +1."""
+    want = (f"last must be (last_t, last_p), two [H, W] = {shape} arrays (each pixel's last time, NaN where none, and "
+            "its polarity +1, -1 or 0), as interval_sums returned them for the span before; or None")
+    if isinstance(last, (str, bytes)) or not hasattr(last, "__len__") or len(last) != 2:
+        raise EventDataError(f"{want}; got {last!r:.80}")
+    t, p = np.asarray(last[0]), np.asarray(last[1])
+    if t.shape != tuple(shape) or p.shape != tuple(shape) or t.dtype.kind not in "iuf" or p.dtype.kind not in "iuf":
+        raise EventDataError(f"{want}; got arrays of shapes {t.shape} and {p.shape} (dtypes {t.dtype}, {p.dtype})")
+    if not np.isin(p, (-1, 0, 1)).all():
+        odd = p[~np.isin(p, (-1, 0, 1))][0]
+        raise EventDataError(f"{want}; last_p holds other values than -1, 0 and +1 (e.g. {odd!r})")
+    if (np.isnan(t) != (p == 0)).any() if t.dtype.kind == "f" else (p == 0).any():
+        raise EventDataError(f"{want}; last_t is NaN exactly where last_p is 0 (no event before)")
+    return np.array(t, np.float64), np.array(p, np.int8)
 
 
 def interval_sums(events: Events, last=None, with_flips: bool = False) -> tuple:
@@ -240,11 +271,11 @@ def interval_sums(events: Events, last=None, with_flips: bool = False) -> tuple:
         floored at MIN_INTERVAL (1 us, the timestamp resolution of event cameras). With ``with_flips``,
         (..., last_t, last_p, flips).
     """
+    require(events, Events, "interval_sums: events")
     H, W = events.sensor_size
     s = interval_stride((H, W))
     Hs, Ws = -(-H // s), -(-W // s)
-    last_t = np.full((H, W), np.nan) if last is None else np.array(last[0], np.float64)
-    last_p = np.zeros((H, W), np.int8) if last is None else np.array(last[1], np.int8)
+    last_t, last_p = (np.full((H, W), np.nan), np.zeros((H, W), np.int8)) if last is None else _check_last(last, (H, W))
     x, y, t, p = events.x, events.y, np.asarray(events.t, np.float64), events.p
     if s > 1:
         on_grid = (x % s == 0) & (y % s == 0)
@@ -313,9 +344,9 @@ class PolarityCounts:
     counts_only: bool = False                               # n_on / n_off alone (a hot-pixel pass)
 
     def __post_init__(self):
-        if not (0 < float(self.decay) <= 1):
-            raise EventDataError(f"decay must be in (0, 1], got {self.decay!r}")
-        H, W = self.sensor_size
+        self.decay = real_number(self.decay, "decay", lo=0, hi=1, lo_open=True,
+                                 hint="the weight of the counts so far at each update (1: all windows alike)")
+        H, W = self.sensor_size = check_sensor_size(self.sensor_size)
         self.n_on = np.zeros((H, W)) if self.n_on is None else np.asarray(self.n_on, np.float64)
         self.n_off = np.zeros((H, W)) if self.n_off is None else np.asarray(self.n_off, np.float64)
         if self.intervals is None:
@@ -457,10 +488,11 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
     if not (is_real_number(max_imbalance) and 0 <= max_imbalance < 1):
         raise EventDataError(f"max_imbalance must be a number in [0, 1) (|b| = |C+ - C-| / (C+ + C-) < 1), "
                              f"got {max_imbalance!r}")
-    n_on = np.asarray(n_on, np.float64)
-    n_off = np.asarray(n_off, np.float64)
-    if n_on.shape != n_off.shape:
-        raise EventDataError(f"n_on {n_on.shape} and n_off {n_off.shape} must have the same shape")
+    n_on = check_counts(n_on, "n_on").astype(np.float64)
+    n_off = check_counts(n_off, "n_off").astype(np.float64)
+    if n_on.shape != n_off.shape or n_on.ndim != 2:
+        raise EventDataError(f"n_on {n_on.shape} and n_off {n_off.shape} must be [H, W] counts of the same shape")
+    min_events = real_number(min_events, "min_events", lo=0, hint="the fewest events a pixel needs to count (e.g. 4)")
     if intervals is not None and (len(intervals) != 4 or any(np.shape(a) != n_on.shape for a in intervals)):
         raise EventDataError(f"intervals must be four arrays of the counts' shape {n_on.shape} (log_on, k_on, "
                              "log_off, k_off, as interval_sums returns)")
@@ -523,5 +555,6 @@ def estimate_balance(events: Events, C, **kw) -> BalanceFit:
 def span_slices(t_start: float, t_end: float, k: int = SLICES) -> np.ndarray:
     """Boundaries (float64 [k + 1], s) of k equal time slices of [t_start, t_end] (a span of zero length
     gets one of 1 us, so that the boundaries increase)."""
-    t_start, t_end = float(t_start), float(t_end)
+    t_start, t_end = checked_span(t_start, t_end, "span_slices")
+    k = whole_number(k, "span_slices: k", lo=1)
     return np.linspace(t_start, max(t_end, t_start + MIN_INTERVAL), k + 1)

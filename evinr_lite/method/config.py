@@ -23,6 +23,7 @@ from .binning import as_thresholds
 from .denoise import DEFAULT_DT
 from .offset import OFFSET_SOLVES, STATIC_REST
 from .prepare import BACKGROUND_MODES
+from .tempo import MIN_SCALE, scale_floor_message
 from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEMAPS
 
 __all__ = ["EvINRConfig", "CAMERAS"]
@@ -234,7 +235,7 @@ class EvINRConfig:
             (c_pos, c_neg): ON events weigh +c_pos, OFF events -c_neg (real sensors differ; fit both
             from APS frames with :func:`evinr_lite.method.contrast.fit_contrast`).
         bin_duration: final event-frame length in seconds (paper: 1/32 s), before ``temporal_scale``.
-        temporal_scale: "auto" (the kit's) or a number s > 0: the bins are bin_duration / s and the
+        temporal_scale: "auto" (the kit's) or a number s >= 1/64: the bins are bin_duration / s and the
             first layer's frequency (first_omega_per_s, or first_omega_0) s times higher. "auto" reads s
             from the events (:mod:`~evinr_lite.method.tempo`: 1 unless the pixels reverse polarity more
             than 2.5 times a second, as under a fast shake; at most 4); 1 keeps bin_duration and the
@@ -485,6 +486,8 @@ class EvINRConfig:
         else:
             if not number("temporal_scale", self.temporal_scale) > 0:
                 raise EventDataError(f"temporal_scale must be positive (or 'auto'), got {self.temporal_scale!r}")
+            if float(self.temporal_scale) < MIN_SCALE:
+                raise EventDataError(scale_floor_message("temporal_scale", self.temporal_scale))
             self.temporal_scale = float(self.temporal_scale)
         if isinstance(self.lam, str):
             if self.lam != "auto":

@@ -62,7 +62,8 @@ import numpy as np
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 
-__all__ = ["hot_pixel_mask", "hot_threshold", "remove_hot_pixels", "correlation_filter", "denoise", "denoise_mask",
+__all__ = ["hot_pixel_mask", "hot_threshold", "check_counts",
+           "remove_hot_pixels", "correlation_filter", "denoise", "denoise_mask",
            "DenoiseReport", "DEFAULT_WINDOW", "DEFAULT_SAME_POLARITY",
            "DEFAULT_DT", "DEFAULT_HOT_FACTOR", "DEFAULT_HOT_RULE", "HOT_RULES", "WINDOWS", "CHUNK"]
 
@@ -116,7 +117,7 @@ def hot_threshold(counts: np.ndarray, factor: float = DEFAULT_HOT_FACTOR, rule: 
     Returns +inf when no pixel fired.
     """
     factor = _check_factor(factor, rule)
-    counts = _check_counts(counts)
+    counts = check_counts(counts)
     active = counts[counts > 0].astype(np.float64)
     if active.size == 0:
         return float("inf")
@@ -127,15 +128,16 @@ def hot_threshold(counts: np.ndarray, factor: float = DEFAULT_HOT_FACTOR, rule: 
     return m + factor * s
 
 
-def _check_counts(counts) -> np.ndarray:
+def check_counts(counts, name: str = "counts") -> np.ndarray:
     """Per-pixel event counts as an array: numbers, finite, >= 0 (a list was Python's TypeError; NaN and negative
-    counts were left out of the statistics without a word)."""
-    arr = None if isinstance(counts, (str, bytes)) else dense_array(counts, "counts", error=EventDataError)
+    counts were left out of the statistics without a word). ``name``: the argument, in the message."""
+    arr = None if isinstance(counts, (str, bytes)) or counts is None else \
+        dense_array(counts, name, error=EventDataError)
     if arr is None or arr.dtype.kind not in "biuf":
-        raise EventDataError(f"counts must be event counts per pixel (numbers >= 0), got {counts!r:.60}")
+        raise EventDataError(f"{name} must be event counts per pixel (numbers >= 0), got {counts!r:.60}")
     bad = ~(np.isfinite(arr) & (arr >= 0)) if arr.dtype.kind == "f" else arr < 0
     if bad.any():
-        raise EventDataError(f"counts must be finite event counts >= 0, but {int(bad.sum())} of them are NaN, inf or "
+        raise EventDataError(f"{name} must be finite event counts >= 0, but {int(bad.sum())} of them are NaN, inf or "
                              "negative")
     return arr
 

@@ -33,11 +33,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..core.checks import checked_span, real_number
+from ..core.checks import ArgumentTypeError, checked_span, real_number
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
 from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, fit_background, sample_spans, tile_counts
-from .denoise import DEFAULT_DT, denoise_mask, hot_pixel_mask, hot_threshold
+from .denoise import DEFAULT_DT, check_counts, denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 from .tempo import temporal_scale
 
@@ -92,8 +92,27 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sl
     "auto", which trains as 1), and the hot pixels to drop (bool [H, W], all False
     unless ``cfg.hot_pixels == "drop"``), from the span's per-pixel counts. The caller's config is not
     changed (a copy)."""
-    n_on = np.asarray(n_on, np.float64)
-    n_off = np.asarray(n_off, np.float64)
+    # the config's fields, by name: method.config imports this module (None, a dict or a recipe's name was an
+    # AttributeError on cfg.hot_pixels)
+    if not all(hasattr(cfg, a) for a in ("hot_pixels", "balance", "C", "lam", "temporal_scale")):
+        raise ArgumentTypeError(f"plan_from_counts: cfg= must be EvINRConfig, got {type(cfg).__name__}; e.g. "
+                                "EvINRConfig() or EvINRConfig.paper()")
+    n_on = check_counts(n_on, "plan_from_counts: n_on").astype(np.float64)
+    n_off = check_counts(n_off, "plan_from_counts: n_off").astype(np.float64)
+    if n_on.shape != n_off.shape or n_on.ndim != 2:
+        raise EventDataError(f"plan_from_counts: n_on {n_on.shape} and n_off {n_off.shape} must be [H, W] counts of "
+                             "one shape (the span's ON and OFF events per pixel)")
+    if intervals is not None and (isinstance(intervals, (str, bytes)) or len(intervals) != 4):
+        raise EventDataError("plan_from_counts: intervals must be four [H, W] arrays (log_on, k_on, log_off, k_off, "
+                             "as interval_sums returns), or None")
+    named = [("flips", flips)] + [(f"intervals[{i}]", a) for i, a in enumerate(() if intervals is None else intervals)]
+    for name, a in named:
+        if a is not None and np.shape(a) != n_on.shape:
+            raise EventDataError(f"plan_from_counts: {name} has shape {np.shape(a)}, not the counts' {n_on.shape}")
+    if flips is not None:
+        flips = check_counts(flips, "plan_from_counts: flips")
+    if span_s is not None:
+        span_s = real_number(span_s, "plan_from_counts: span_s", lo=0, hint="the span's length in seconds")
     n = n_on + n_off
     hot = np.zeros(n.shape, bool)
     if cfg.hot_pixels == "drop":

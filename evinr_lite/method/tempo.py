@@ -22,14 +22,28 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.checks import host_array, is_real_number, real_number
 from ..core.events import EventDataError
 from .balance import interval_stride
+from .denoise import check_counts
 
-__all__ = ["FLIPS_REF", "MAX_SCALE", "MIN_EVENTS", "flip_rate", "scale_from_rate", "temporal_scale"]
+__all__ = ["FLIPS_REF", "MAX_SCALE", "MIN_EVENTS", "MIN_SCALE", "scale_floor_message",
+           "flip_rate", "scale_from_rate", "temporal_scale"]
 
 FLIPS_REF = 2.5    # reversals per pixel and second up to which the base bins and prior stand
 MAX_SCALE = 4.0    # at most 4x shorter bins (1/128 s from 1/32) and a 4x faster prior: bins cost memory and time
 MIN_EVENTS = 4     # a pixel's events for its reversals to count (one or two events cannot reverse often)
+# the least scale set by hand: 64x longer bins and a 64x slower prior (5/64 rad per second). Below, the first layer
+# hardly changes over a window, the network's time derivative cannot follow the events and its log intensity
+# diverges (a scale of 1e-9 gave frames of 0 and 1 at a "gain" of 10^26, or an overflow in the tone map)
+MIN_SCALE = 1.0 / 64
+
+
+def scale_floor_message(name: str, value) -> str:
+    """The refusal of a hand-set temporal scale below MIN_SCALE (``name``: the field or the flag)."""
+    return (f"{name}={value!r} is below {MIN_SCALE:g} (1/64: bins 64x longer and a temporal prior 64x slower than the "
+            f"recipe's); the network could not follow the events in time and its log intensity diverges: use 1 (the "
+            f"recipe's bins and prior), a number from {MIN_SCALE:g} up, or 'auto'")
 
 
 def flip_rate(flips, n_events, span_s: float) -> float:
@@ -42,13 +56,14 @@ def flip_rate(flips, n_events, span_s: float) -> float:
         n_events: float [H, W] events per pixel over the same span (ON + OFF).
         span_s: the span's length in seconds (> 0).
     """
-    flips = np.asarray(flips, np.float64)
-    n_events = np.asarray(n_events, np.float64)
+    flips = check_counts(flips, "flip_rate: flips").astype(np.float64)
+    n_events = check_counts(n_events, "flip_rate: n_events").astype(np.float64)
     if flips.shape != n_events.shape or flips.ndim != 2:
         raise EventDataError(f"flip_rate: flips and n_events must be [H, W] arrays of one shape, got "
                              f"{flips.shape} and {n_events.shape}")
-    if not (np.isfinite(span_s) and span_s > 0):
-        raise EventDataError(f"flip_rate: span_s must be a positive number of seconds, got {span_s!r}")
+    span_s = real_number(span_s, "flip_rate: span_s", lo=0, lo_open=True, hint="the span's length, a positive number of seconds")
+    if flips.size == 0:
+        return float("nan")
     s = interval_stride(flips.shape)
     f, n = flips[::s, ::s], n_events[::s, ::s]
     active = n >= MIN_EVENTS
@@ -57,6 +72,10 @@ def flip_rate(flips, n_events, span_s: float) -> float:
 
 def scale_from_rate(rate: float) -> float:
     """s = clip(rate / FLIPS_REF, 1, MAX_SCALE); 1 for NaN (no pixel fired often enough to tell)."""
+    if not is_real_number(rate) or float(host_array(rate)) < 0:
+        raise EventDataError(f"scale_from_rate: rate must be polarity reversals per pixel and second (a number >= 0, "
+                             f"or NaN where no pixel fired often enough), got {rate!r}")
+    rate = float(host_array(rate))
     return 1.0 if not np.isfinite(rate) else float(np.clip(rate / FLIPS_REF, 1.0, MAX_SCALE))
 
 

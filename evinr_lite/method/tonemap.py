@@ -159,7 +159,11 @@ def display_shift(reference, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6,
 
     def shown_mean(c):   # mean of min(exp(v + c), 1)
         k = np.searchsorted(v, -c)                                 # v_i < -c are not clipped
-        return (below[k] * math.exp(top + c) + (n - k)) / n
+        if top + c < 700:
+            return (below[k] * math.exp(top + c) + (n - k)) / n
+        # values spread over more than e^700 (a network that diverged in time): exp(top + c) overflowed
+        # while below[k] underflowed; their product is summed directly (each exp(v_i + c) < 1 for i < k)
+        return (float(np.exp(v[:k] + c).sum()) + (n - k)) / n
 
     lo, hi = math.log(display_mean) - top, -v[0]                   # shown_mean(lo) <= display_mean <= shown_mean(hi) = 1
     for _ in range(60):

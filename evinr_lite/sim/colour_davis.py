@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.checks import real_number
+from ..core.checks import check_path_type, real_number, true_or_false
 from ..core.events import EventDataError
 from ..core.frames import Frames, to_grey_uint8
 from ..core.recording import Recording
@@ -65,7 +65,8 @@ def write_colour_davis_recording(out, image="coffee", *, overwrite: bool = False
     """:func:`colour_davis_recording` written as a canonical ``.h5`` (with its ``cfa`` attribute and
     /frames/rgb), atomically (written beside and renamed). ``kwargs`` as colour_davis_recording.
     Returns the path."""
-    out = Path(out)
+    out = Path(check_path_type(out, "out", "the .h5 file to write"))
+    overwrite = true_or_false(overwrite, "overwrite")   # "no" replaced an existing file
     if out.exists() and not overwrite:
         raise EventDataError(f"{out} already exists; choose another path or pass overwrite=True")
     rec = colour_davis_recording(image, **kwargs)

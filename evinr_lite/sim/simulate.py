@@ -164,6 +164,14 @@ def sample_thresholds(n_pixels: int, C_pos: float, C_neg: float, threshold_sigma
     Returns:
         (C_pos_pix, C_neg_pix): float64 [n_pixels] each, log units.
     """
+    n_pixels = whole_number(n_pixels, "sample_thresholds: n_pixels", lo=0)
+    C_pos, C_neg = (real_number(c, f"sample_thresholds: {name}", lo=0, lo_open=True,
+                                hint="a contrast threshold in log units (e.g. 0.2)")
+                    for c, name in ((C_pos, "C_pos"), (C_neg, "C_neg")))
+    threshold_sigma = real_number(threshold_sigma, "sample_thresholds: threshold_sigma", lo=0,
+                                  hint="the thresholds' relative spread (0: every pixel the nominal C; e.g. 0.03)")
+    if threshold_sigma > 0 and rng is not None:
+        require(rng, np.random.Generator, "sample_thresholds: rng")
     C_pos_pix = np.full(n_pixels, C_pos, dtype=np.float64)
     C_neg_pix = np.full(n_pixels, C_neg, dtype=np.float64)
     if threshold_sigma > 0:

@@ -28,6 +28,7 @@ from functools import partial
 
 import numpy as np
 
+from ..core.checks import require, true_or_false, whole_number
 from . import scenes as sc
 from .simulate import add_background_noise, add_hot_pixels, add_light_noise, simulate_scene
 
@@ -257,9 +258,11 @@ def fresh(seed: int, n: int = 16) -> list:
     sensor: C 0.15-0.3 with C+ / C- 0.75-1.33 (given as their mean), 0-5 % mismatch, a refractory
     period, and on half the scenes background activity and hot pixels (ON-only on half of those). Each
     scene's ``doc`` says what was drawn (``python benchmarks/quality_zoo.py --fresh SEED``)."""
+    seed = whole_number(seed, "fresh: seed", lo=0)   # NaN and "0" were numpy's SeedSequence error
+    n = whole_number(n, "fresh: n", lo=0)            # -1 gave no scene, 2.5 two and "3" three without a word
     rng = np.random.default_rng(seed)
     out = []
-    for k in range(int(n)):
+    for k in range(n):
         img = str(rng.choice(sc.IMAGE_NAMES))
         size = FRESH_SIZES[int(rng.integers(len(FRESH_SIZES)))]
         duration = float(rng.choice([2.0, 2.5, 3.0]))
@@ -335,6 +338,7 @@ def _static(img, obj, s, d):
 
 def quick(z: ZooScene) -> ZooScene:
     """A smaller, shorter version (--quick): 3/5 of the size, 3/4 of the length."""
+    require(z, ZooScene, "quick: z")   # a name was an AttributeError; get(name) gives its scene
     H, W = z.size
     return ZooScene(**{**asdict(z), "build": z.build, "size": (int(H * 0.6) // 2 * 2, int(W * 0.6) // 2 * 2),
                        "duration": round(z.duration * 0.75, 3)})
@@ -349,6 +353,7 @@ def simulate(z: ZooScene, labels: bool = False):
     ``labels=True`` appends (labels int8 [N]: SIGNAL 0, BACKGROUND 1 (background activity, also the
     dark noise), HOT 2; the hot pixels' flat indices int64 [K]): the same seeds, draws and events.
     """
+    require(z, ZooScene, "simulate: z")   # a name was an AttributeError; get(name) gives its scene
     scene = z.build(z.size, z.duration)
     kw = {} if z.C_pos is None else {"C_pos": z.C_pos, "C_neg": z.C_neg}
     if z.threshold_drift:
@@ -386,11 +391,13 @@ def _relabelled(kind: np.ndarray, added: np.ndarray, label: int) -> np.ndarray:
 
 def imbalance(z: ZooScene) -> float:
     """The scene's simulated ON/OFF imbalance (C+ - C-) / (C+ + C-) (0 when C+ = C-)."""
+    require(z, ZooScene, "imbalance: z")   # a name was an AttributeError; get(name) gives its scene
     return 0.0 if z.C_pos is None else (z.C_pos - z.C_neg) / (z.C_pos + z.C_neg)
 
 
 def effective_C(z: ZooScene) -> float:
     """The one threshold every method is given: the mean of C+ and C- (the solvers take one C)."""
+    require(z, ZooScene, "effective_C: z")   # a name was an AttributeError; get(name) gives its scene
     return z.C if z.C_pos is None else 0.5 * (z.C_pos + z.C_neg)
 
 
@@ -398,6 +405,7 @@ def effective_C(z: ZooScene) -> float:
 
 def default_scenes(long: bool = False) -> list:
     """The scenes a zoo run scores: every scene, or (``long=False``) all but the long recordings."""
+    long = true_or_false(long, "default_scenes: long")   # "no" was true
     return [z for z in ZOO if long or not z.long]
 
 

@@ -27,7 +27,7 @@ from ..core.checks import (ArgumentTypeError, host_array, is_real_number, option
                            whole_number)
 from ..core.events import EventDataError, Events
 from ..method.binning import EventFrames, event_rate
-from .signals import OFF_COLOR, ON_COLOR
+from .signals import OFF_COLOR, ON_COLOR, axes_or_new
 
 __all__ = ["ON_COLOR", "OFF_COLOR", "ON_RGB", "OFF_RGB", "subsample_index", "subsample", "count_map",
            "polarity_image", "plot_xyt", "plot_count_map", "plot_polarity", "plot_event_rate",
@@ -39,9 +39,7 @@ EVENT_FRAME_CMAP = "RdBu_r"   # red > 0 (more ON), blue < 0 (more OFF)
 
 
 def _axes(ax, figsize=(6, 4)):
-    if ax is None:
-        _, ax = plt.subplots(figsize=figsize)
-    return ax
+    return axes_or_new(ax, figsize)
 
 
 # ---- numbers ------------------------------------------------------------------------------

@@ -9,19 +9,42 @@ import numpy as np
 import matplotlib.pyplot as plt
 from matplotlib.transforms import blended_transform_factory
 
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from ..core.checks import ArgumentTypeError, seconds_array, short_repr
+from ..core.events import EventDataError
 from ..sim.simulate import pixel_events
 
-__all__ = ["ON_COLOR", "OFF_COLOR", "plot_event_ticks", "plot_signal_and_events", "plot_reconstruction_1d",
+__all__ = ["ON_COLOR", "OFF_COLOR", "axes_or_new",
+           "plot_event_ticks", "plot_signal_and_events", "plot_reconstruction_1d",
            "plot_window_errors"]
 
 ON_COLOR = "tab:red"
 OFF_COLOR = "tab:blue"
 
 
-def _axes(ax, figsize=(8, 3.5)):
+def axes_or_new(ax, figsize=(8, 3.5)):
+    """``ax`` when it is a matplotlib Axes, a new figure's (of ``figsize`` inches) when None; else an
+    ArgumentTypeError (a Figure, a number or an array of axes failed inside the first drawing call)."""
     if ax is None:
         _, ax = plt.subplots(figsize=figsize)
+    elif not isinstance(ax, Axes):
+        fix = (" (a Figure: pass one of its axes, e.g. fig.axes[0], or fig.add_subplot())" if isinstance(ax, Figure)
+               else " (an array of axes from plt.subplots: pass one of them, e.g. axes[0])"
+               if isinstance(ax, np.ndarray) else "")
+        raise ArgumentTypeError(f"ax= must be a matplotlib Axes or None (a new figure), got {type(ax).__name__}{fix}")
     return ax
+
+
+def _curve(values, name: str, n: int) -> np.ndarray:
+    """A curve to draw against n times: numbers whose first axis has length n."""
+    arr = None if isinstance(values, (str, bytes)) or values is None else np.asarray(values)
+    if arr is None or arr.dtype.kind not in "biuf" or arr.ndim == 0:
+        raise EventDataError(f"{name} must be numbers, one per time ([T] = [{n}]), got {short_repr(values)}")
+    if len(arr) != n:
+        raise EventDataError(f"{name} holds {len(arr)} values but t holds {n} times; pass one value per time")
+    return arr
 
 
 def plot_event_ticks(ax, t_events, p_events, height: float = 0.08, legend: bool = True):
@@ -58,7 +81,7 @@ def plot_signal_and_events(t, L, events, C: float | None = None, *, ax=None, pix
     if L.shape != t.shape:           # matplotlib's "x and y must have same first dimension"
         raise ValueError(f"L has shape {L.shape} for {t.size} sample times; pass one log intensity per time in t")
     te, pe = pixel_events(events, pixel)   # refuses None, [] and t / p of different lengths, naming the fix
-    ax = _axes(ax)
+    ax = axes_or_new(ax)
     L0 = L[0] if L0 is None else float(L0)
     ax.plot(t, L, color="black", lw=1.5, label=label)
     if C is not None and show_levels:
@@ -85,8 +108,13 @@ def plot_reconstruction_1d(t, curves: dict, truth=None, *, events=None, ax=None,
         truth: float [T] true log intensity (thick black), optional.
         events: optional events drawn as ticks at the bottom.
     """
-    ax = _axes(ax)
-    t = np.asarray(t)
+    t = seconds_array(t, "t")
+    if not isinstance(curves, dict):   # a list or None was an AttributeError
+        raise ArgumentTypeError(f"curves= must be a dict {{label: values [T]}}, got {type(curves).__name__}; e.g. "
+                                "{'EvINR': L_hat}")
+    curves = {label: _curve(values, f"curves[{label!r}]", len(t)) for label, values in curves.items()}
+    truth = None if truth is None else _curve(truth, "truth", len(t))
+    ax = axes_or_new(ax)
     if truth is not None:
         ax.plot(t, truth, color="black", lw=2.5, alpha=0.35, label="true L(t)")
     for label, values in curves.items():
@@ -114,7 +142,7 @@ def plot_window_errors(result: dict, *, ax=None, C: float | None = None):
         raise ValueError("result holds no window lengths; pass eq4_error_vs_window at least one window")
     if bad:
         raise ValueError(f"result holds {w.size} window length(s) but errors of shape {bad}; pass one error per window")
-    ax = _axes(ax, (5, 3.5))
+    ax = axes_or_new(ax, (5, 3.5))
     ax.loglog(w, result["taylor"], "o-", label="Eq. 3 with the exact ΔL (Taylor error)")
     if "events" in result:
         ax.loglog(w, result["events"], "s-", label="Eq. 4 with events")
