@@ -27,7 +27,7 @@ from ..core.events import EventDataError
 from .balance import interval_stride
 from .denoise import check_count_pair
 
-__all__ = ["FLIPS_REF", "MAX_SCALE", "MIN_EVENTS", "MIN_SCALE", "scale_floor_message",
+__all__ = ["FLIPS_REF", "MAX_SCALE", "MIN_EVENTS", "MIN_SCALE", "SCALE_RANGE", "scale_floor_message",
            "flip_rate", "scale_from_rate", "temporal_scale"]
 
 FLIPS_REF = 2.5    # reversals per pixel and second up to which the base bins and prior stand
@@ -37,6 +37,7 @@ MIN_EVENTS = 4     # a pixel's events for its reversals to count (one or two eve
 # hardly changes over a window, the network's time derivative cannot follow the events and its log intensity
 # diverges (a scale of 1e-9 gave frames of 0 and 1 at a "gain" of 10^26, or an overflow in the tone map)
 MIN_SCALE = 1.0 / 64
+SCALE_RANGE = "a number from 1/64 (tempo.MIN_SCALE) up"   # a hand-set scale, in messages (as the CLI's help)
 
 
 def scale_floor_message(name: str, value) -> str:
