@@ -9,8 +9,10 @@ figures' ``ax`` and one pixel's curves (``plot_reconstruction_1d``), and recordi
 degenerate for the method (one polarity, one pixel, one timestamp, a ten-hour gap, time going back 0.1 ms, sensors of
 1 x N, N x 1 and 1 x 1).
 
-197 cases, 159 of which failed before their fixes (the other 38: 25 guards and 13 refusals that stood before, kept
-beside the new ones with their old message allowed).
+234 cases. Sections 1 to 8: 195, 157 of which failed before their fixes (the other 38: 25 guards and 13 refusals that
+stood before, kept beside the new ones with their old message allowed); section 9, the review's: 39, 31 of which
+failed before its fixes (2 of them, a per-pixel C of the wrong length or holding NaN, only by their message: this
+branch refused any array there as no number), and 8 guards.
 
 Fixes (each test failed before its fix): a temporal scale set by hand had no floor: 1e-9 (bins of 3 * 10^7 s and a
 prior of 5 * 10^-9 rad/s) diverged and overflowed the linear tone map's shift (``display_shift``: math.exp of more
@@ -42,17 +44,45 @@ or None were AttributeErrors; ``default_scenes("no")`` counted the long scenes. 
 a path None, 5, bytes or a list was Python's TypeError, and ``overwrite="no"`` (or 2, "False") replaced the user's
 file. ``score_sequence`` / ``evaluate`` with ``lpips_model`` True, 5, 1.5, {} or [1] failed inside the first LPIPS
 distance (AttributeError): a model must be a torch module. ``plot_reconstruction_1d`` with curves None, a list or
-text was an AttributeError, curves or a truth of another length, t None and text values were matplotlib's errors,
-NaN times were drawn; every figure taking ``ax=`` (``plot_count_map``, ``plot_polarity``, ``plot_event_rate``,
+text was an AttributeError, curves or a truth of another length, t None and text values were matplotlib's errors; every
+figure taking ``ax=`` (``plot_count_map``, ``plot_polarity``, ``plot_event_rate``,
 ``plot_boundaries``, ``plot_signal_and_events``, ``plot_reconstruction_1d``, ``plot_window_errors``) failed inside
 matplotlib on a Figure, a number or an array of axes: the one check is ``viz.signals.axes_or_new``, naming
 fig.axes[0] / axes[0]. A 1 x 1 sensor reconstructed at one time was refused as "constant frames although the input
 varies; check C": one value cannot vary (``check_result_frames`` asks for more than one).
 
+Review fixes (section 9; each test failed before its fix, on this branch before the review): the round's checks
+refused what worked before it, and copied checks that existed. ``plot_reconstruction_1d`` sent its times through
+``seconds_array``, the event timestamps' check, which refused float32 times at 20 s (torch.linspace's default),
+float16 times and NaN (matplotlib's gap in the line): a figure's times are float64 1-D numbers of the curves'
+length, NaN allowed, as ``plot_signal_and_events`` takes them (section 7's case of NaN times is gone).
+``balance_from_counts`` asked every call for [H, W] counts and refused 1-D counts that fitted before (section 4's
+case of them is gone): only ``sliced=`` (the edges' estimate, which needs a sensor's neighbours) asks for them.
+``sample_thresholds`` took only a np.random.Generator and one number per threshold: any generator with
+``standard_normal`` (np.random.RandomState) and per-pixel arrays of C (n_pixels of them, or one) are taken again, a
+Decimal C too, and the thresholds are checked by the simulators' own ``_check_thresholds`` (one rule: a C below
+MIN_C, 10^-3, which it took and ``simulate_events_1d`` refuses, is refused; section 5's four threshold cases match
+that message now). ``zoo.fresh`` took whole numbers only: a np.random.SeedSequence and a list of whole numbers, which
+numpy's default_rng takes, draw again (named by their numbers; [3] and SeedSequence(3) draw fresh(3)'s scenes).
+``span_slices`` and ``balance_from_counts(min_events=)`` refused a Decimal: it is taken as its float
+(``core.checks.decimal_as_float``). ``plot_histories``, ``plot_tradeoff`` and ``plot_xyt`` kept their own ``if ax
+is None`` and failed inside matplotlib on a Figure or an array of axes: they go through ``axes_or_new``, whose
+``projection="3d"`` makes ``plot_xyt``'s new axes and names a 2-D one; a Figure without axes was told "e.g.
+fig.axes[0]" (an IndexError) and a SubFigure got no hint: both are told fig.add_subplot(). Copies: ``PolarityCounts``
+checked its slices by a second rule that took an infinite edge (refused at the first update, as slice_counts'
+edges): it calls ``_slice_edges``; smoothing's copy of ``check_counts`` is gone, and the four checks of "two counts
+of one [H, W] shape" (smoothing, tempo, prepare, balance) are one, ``denoise.check_count_pair``. A temporal scale of
+0 was told "must be positive" (``EvINRConfig``) or "a number > 0" (``RunOptions``, --temporal-scale), and then 0.001
+was refused by the floor: the first message says the range, "a number from 1/64 (tempo.MIN_SCALE) up, or 'auto'"
+(--temporal-scale: "from 1/64 up"), as the command's help does.
+
 Refused on purpose where they were taken before: a hand-set temporal scale in (0, 1/64) (0.01 gave frames; below
 the floor the network hardly changes over a window), a rate of -1 in ``scale_from_rate`` (it was 1), an
-``interval_sums`` ``last`` whose times and polarities disagree, ``plan_from_counts(span_s=-1)``, and the zoo's
-``default_scenes(None)`` / ``(2)``.
+``interval_sums`` ``last`` whose times and polarities disagree, ``plan_from_counts(span_s=-1)``, the zoo's
+``default_scenes(None)`` / ``(2)``; from the review: ``sample_thresholds``' C below MIN_C (10^-3, as the
+simulators), ``zoo.fresh``'s seed None, a np.random.Generator or BitGenerator (numpy takes them, but the scenes are
+named by their seed, to be drawn again) and an empty list, and ``plot_reconstruction_1d``'s times of datetime64 or
+any other non-number (its axis is seconds).
 
 Left as they are: ``flip_rate`` of counts of zero size (no pixel: NaN, as before), ``span_slices`` / ``zoo.fresh``
 of 10^12 slices or scenes (a MemoryError or hours: a count, not a type), ``estimate_balance``'s unknown keywords
@@ -68,27 +98,32 @@ Guards: odd inputs next to these that already behave and must keep their outcome
 counts, no span, a 0 x 0 sensor and interval sums; np.int64 sizes, float32 decays, one-instant spans, chained
 interval sums, int64 edges; np.int64 counts and float32 C in sample_thresholds; np.int64 seeds; np.bool_ / 0 / 1
 flags; overwrite=np.bool_(True); LPIPS skipped or any torch module; given and new axes, lists and 2-D curves; the
-degenerate recordings of section 8).
+degenerate recordings of section 8; section 9's: a 2-D or text t, 1-D counts with slices, the seeds that name no
+scene, and the other figures on given and new axes).
 """
 import math
+import re
+from decimal import Decimal
 
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+import torch
 
 from evinr_lite import EvINRConfig, EventDataError, Events, reconstruct
 from evinr_lite.apps import cli
-from evinr_lite.apps.options import RunOptions
+from evinr_lite.apps.options import RunOptions, temporal_scale_option
 from evinr_lite.evaluation import evaluate, score_sequence
 from evinr_lite.method import balance, tempo
 from evinr_lite.method.prepare import plan_from_counts
+from evinr_lite.method.smoothing import auto_lam
 from evinr_lite.method.tonemap import display_shift
 from evinr_lite.sim import make_scene, simulate_scene, write_example_recording, zoo
 from evinr_lite.sim.colour_davis import write_colour_davis_recording
 from evinr_lite.sim.simulate import sample_thresholds
-from evinr_lite.viz import (plot_boundaries, plot_count_map, plot_event_rate, plot_polarity, plot_reconstruction_1d,
-                            plot_signal_and_events, plot_window_errors)
+from evinr_lite.viz import (plot_boundaries, plot_count_map, plot_event_rate, plot_histories, plot_polarity,
+                            plot_reconstruction_1d, plot_signal_and_events, plot_tradeoff, plot_window_errors, plot_xyt)
 
 from refusals import all_refused as _none_of, refused as _no   # noqa: E402  (shared by rounds 11-16)
 
@@ -279,7 +314,6 @@ def test_running_counts_refuse_a_decay_outside_0_1(decay):
     (-FIVE, FIVE, {}, r"n_on must be finite event counts"),
     (np.full((12, 12), np.nan), FIVE, {}, r"n_on must be" + OLD_COUNTS),
     (FIVE, "abc", {}, r"n_off must be event counts"),
-    (np.ones(5), np.ones(5), {}, r"must be \[H, W\] counts of the same shape"),
     (FIVE, FIVE, {"min_events": -1}, r"min_events= must be a finite number >= 0"),
     (FIVE, FIVE, {"min_events": np.nan}, r"min_events= must be a finite number >= 0")])
 def test_balance_from_counts_refuses_counts_that_are_no_counts(n_on, n_off, kw, pattern):
@@ -314,8 +348,8 @@ def test_a_whole_float_count_is_taken(call, size):
 @pytest.mark.parametrize("args, kw, pattern", [
     ((-1, 0.2, 0.2), {}, r"n_pixels= must be a whole number >= 0"), ((2.5, 0.2, 0.2), {}, r"n_pixels= must be a whole"),
     (("3", 0.2, 0.2), {}, r"n_pixels= must be a whole"), ((None, 0.2, 0.2), {}, r"n_pixels= must be a whole"),
-    ((3, np.nan, 0.2), {}, r"C_pos= must be a finite number > 0"), ((3, -0.2, 0.2), {}, r"C_pos= must be"),
-    ((3, "0.2", 0.2), {}, r"C_pos= must be"), ((3, 0.2, 0.0), {}, r"C_neg= must be a finite number > 0"),
+    ((3, np.nan, 0.2), {}, r"threshold C_pos must be a positive number"), ((3, -0.2, 0.2), {}, r"C_pos must be"),
+    ((3, "0.2", 0.2), {}, r"C_pos must be"), ((3, 0.2, 0.0), {}, r"threshold C_neg must be a positive number"),
     ((3, 0.2, 0.2, np.nan), {}, r"threshold_sigma= must be a finite number >= 0"),
     ((3, 0.2, 0.2, -1), {}, r"threshold_sigma= must be"), ((3, 0.2, 0.2, "0.1"), {}, r"threshold_sigma= must be"),
     ((3, 0.2, 0.2, 0.1), {"rng": 5}, r"rng= must be Generator")])
@@ -423,8 +457,7 @@ def test_plot_reconstruction_1d_refuses_curves_that_are_no_dict(curves):
     (T10, {"a": np.ones(10)}, np.ones(3), r"truth holds 3 values"),
     (None, {"a": np.ones(10)}, None, r"t= must be seconds"),
     (T10, {"a": "abcdefghij"}, None, r"curves\['a'\] must be numbers"),
-    (T10, {"a": None}, None, r"curves\['a'\] must be numbers"),
-    ([np.nan] * 10, {"a": np.ones(10)}, None, r"t= .*(NaN|finite)")])
+    (T10, {"a": None}, None, r"curves\['a'\] must be numbers")])
 def test_plot_reconstruction_1d_refuses_curves_that_do_not_fit_the_times(t, curves, truth, pattern):
     _no(lambda: plot_reconstruction_1d(t, curves, truth), pattern)
 
@@ -509,3 +542,161 @@ def test_guard_degenerate_recordings_that_are_refused_clearly(case, pattern):
         return reconstruct(events, times, FAST)
 
     _no(run, pattern)
+
+
+# ---- 9. the review's fixes: what the round's checks refused that worked before, and its copies ----------------------
+
+def _message(fn):
+    with pytest.raises(ValueError) as info:
+        fn()
+    return str(info.value)
+
+
+@pytest.mark.parametrize("t, curve", [
+    (torch.linspace(0, 20, 500), torch.sin(torch.linspace(0, 20, 500))),     # float32 at 20 s: a plot, no timestamps
+    (np.r_[0.0, 0.5, np.nan, 1.0], [1, 2, 3, 4]),                            # NaN: matplotlib's gap in the line
+    (np.linspace(0, 1, 10).astype(np.float16), np.ones(10))],
+    ids=["float32 at 20 s", "NaN gap", "float16"])
+def test_plot_reconstruction_1d_draws_the_times_it_drew_before(t, curve):
+    # seconds_array (event timestamps' float32 precision check, no NaN) refused them
+    assert plot_reconstruction_1d(t, {"fit": curve}, curve).get_lines()
+
+
+def test_guard_plot_reconstruction_1d_still_refuses_times_that_are_no_1d_numbers():
+    _none_of([lambda: plot_reconstruction_1d(np.zeros((10, 1)), {"a": np.ones(10)}),
+              lambda: plot_reconstruction_1d(["a"] * 10, {"a": np.ones(10)})], r"t= must be (a 1-D array of )?seconds")
+
+
+N600 = np.random.default_rng(0).integers(5, 50, 600).astype(float)
+
+
+@pytest.mark.parametrize("shape", [(600,), (2, 10, 30)])
+def test_balance_from_counts_takes_counts_of_any_one_shape_without_slices(shape):
+    # 1-D counts fitted before the round ([H, W] was asked of every call); only the slices' edges need a sensor
+    n_on, n_off = N600.reshape(shape), 1.1 * N600.reshape(shape)
+    fit = balance.balance_from_counts(n_on, n_off, 0.2)
+    assert fit.applied and fit.raw_imbalance == pytest.approx(balance.balance_from_counts(
+        n_on.reshape(20, 30), n_off.reshape(20, 30), 0.2, rule="counts").raw_imbalance)
+
+
+def test_guard_balance_from_counts_with_slices_still_asks_for_one_sensor():
+    sliced = (np.ones((2, 600)), np.ones((2, 600)))
+    _no(lambda: balance.balance_from_counts(N600, N600, 0.2, sliced=sliced), r"\[H, W\]")
+
+
+def test_sample_thresholds_takes_a_random_state_and_per_pixel_thresholds():
+    # a RandomState (np.random's legacy generator) drew before: only Generator was taken
+    pos, neg = sample_thresholds(4, 0.2, 0.2, 0.05, np.random.RandomState(0))
+    draw = np.random.RandomState(0).standard_normal(8)
+    assert np.allclose(pos, 0.2 * (1 + 0.05 * draw[:4])) and np.allclose(neg, 0.2 * (1 + 0.05 * draw[4:]))
+    pos, neg = sample_thresholds(3, np.array([0.2, 0.3, 0.4]), np.float32(0.2))   # one C per pixel, as before
+    assert np.allclose(pos, [0.2, 0.3, 0.4]) and np.allclose(neg, 0.2)
+    assert np.allclose(sample_thresholds(3, Decimal("0.25"), 0.2)[0], 0.25)        # float() took it
+
+
+@pytest.mark.parametrize("c, pattern", [(1e-4, "far below any sensor"), (np.array([0.2, 1e-4, 0.2]), "far below any"),
+                                        (np.array([0.2, 0.2]), r"one per pixel: a 1-D array of 3"),
+                                        (np.array([0.2, np.nan, 0.2]), r"C_pos must be a positive number")])
+def test_sample_thresholds_checks_its_thresholds_by_the_simulators_rule(c, pattern):
+    # the simulators' one rule, MIN_C included (1e-4 was taken here and refused by simulate_events_1d)
+    _no(lambda: sample_thresholds(3, c, 0.2), pattern)
+
+
+@pytest.mark.parametrize("seed, same_as", [(np.random.SeedSequence(3), 3), ([3], 3), (np.array([3]), 3)])
+def test_fresh_takes_the_seeds_numpy_takes(seed, same_as):
+    # a SeedSequence or a list of ints seeded numpy's generator before; the same seed draws the same scenes
+    assert [z.name for z in zoo.fresh(seed, 2)] == [z.name for z in zoo.fresh(same_as, 2)]
+
+
+def test_fresh_names_a_list_seed_by_its_numbers():
+    scenes = zoo.fresh([1, 2], 1)
+    assert scenes[0].name.startswith("fresh1-2_00_")
+    assert zoo.fresh(np.random.SeedSequence(5, spawn_key=(1,)), 1)[0].name.startswith("fresh5s1_00_")
+
+
+@pytest.mark.parametrize("seed", [None, np.random.default_rng(0), [], [-1], ["0"]],
+                         ids=["None", "Generator", "empty list", "[-1]", "['0']"])
+def test_guard_fresh_refuses_seeds_that_name_no_scene(seed):
+    _no(lambda: zoo.fresh(seed, 1), r"seed= (must be a whole number|is an empty list)")
+
+
+def test_span_slices_and_min_events_take_a_decimal():
+    # float() took a Decimal before the round's number checks
+    assert np.allclose(balance.span_slices(Decimal("0"), Decimal("1"), 4), [0, 0.25, 0.5, 0.75, 1])
+    assert balance.balance_from_counts(FIVE, FIVE, 0.2, min_events=Decimal("4")).C == (0.2, 0.2)
+
+
+def _more_figure_calls(ax):
+    row = {"ssim_clahe": 0.5, "train_time_s": 1.0, "name": "x"}
+    return [lambda: plot_histories({"a": [1.0, 0.5]}, ax=ax), lambda: plot_tradeoff([row], ax=ax),
+            lambda: plot_xyt(EV, ax=ax)]
+
+
+@pytest.mark.parametrize("which", range(3), ids=["plot_histories", "plot_tradeoff", "plot_xyt"])
+@pytest.mark.parametrize("ax", ["figure", "axes array"])
+def test_the_other_figures_refuse_an_ax_that_is_no_axes(which, ax):
+    ax = plt.figure() if ax == "figure" else plt.subplots(1, 2)[1]
+    _no(_more_figure_calls(ax)[which], r"ax= must be a (3-D )?matplotlib Axes", TypeError)
+
+
+def test_plot_xyt_refuses_2d_axes_by_name():
+    _no(lambda: plot_xyt(EV, ax=plt.subplots()[1]), r"projection='3d'.*fig\.add_subplot\(projection='3d'\)", TypeError)
+
+
+def test_guard_the_other_figures_draw_on_given_axes_or_a_new_one():
+    axes = [plt.subplots()[1], plt.subplots()[1], plt.figure().add_subplot(projection="3d")]
+    for call in _more_figure_calls(None) + [_more_figure_calls(ax)[i] for i, ax in enumerate(axes)]:
+        assert call() is not None
+
+
+@pytest.mark.parametrize("fig", ["figure", "subfigure"])
+def test_an_empty_figure_is_told_to_add_axes_not_to_index_them(fig):
+    # "e.g. fig.axes[0]" was an IndexError on a figure without axes; a SubFigure got no hint at all
+    fig = plt.figure() if fig == "figure" else plt.figure().subfigures(1, 2)[0]
+    text = _message(lambda: plot_count_map(EV, ax=fig))
+    assert "add_subplot()" in text and "axes[0]" not in text
+
+
+def test_polarity_counts_refuse_an_infinite_slice_edge_when_made():
+    # taken at construction and refused at the first update as slice_counts' edges
+    _no(lambda: balance.PolarityCounts((12, 12), slices=[0.0, np.inf]), r"^slices must be finite")
+
+
+def test_the_count_pairs_are_checked_by_one_rule():
+    # four copies of "two counts of one [H, W] shape" (and smoothing's copy of check_counts) said it four ways
+    shapes = [_message(lambda: fn(FIVE, np.ones((5, 5)))) for fn in
+              (tempo_pair, plan_pair, balance_pair, smoothing_pair)]
+    assert all(re.search(r"must be (\[H, W\] )?counts of one shape .*got shapes \(12, 12\) and \(5, 5\)", m)
+               for m in shapes), shapes
+    nans = [_message(lambda: fn(np.full((12, 12), np.nan), FIVE)) for fn in (plan_pair, balance_pair, smoothing_pair)]
+    assert len({m.split("n_on ", 1)[1] for m in nans}) == 1, nans
+
+
+def tempo_pair(a, b):
+    return tempo.flip_rate(a, b, 1.0)
+
+
+def plan_pair(a, b):
+    return plan_from_counts(a, b, CFG)
+
+
+def balance_pair(a, b):
+    return balance.balance_from_counts(a, b, 0.2, sliced=(np.ones((2, *np.shape(a))),) * 2)
+
+
+def smoothing_pair(a, b):
+    return auto_lam(a, b)
+
+
+@pytest.mark.parametrize("call", [lambda: EvINRConfig(temporal_scale=0), lambda: EvINRConfig(temporal_scale=-1.0),
+                                  lambda: RunOptions(temporal_scale=0.0), lambda: temporal_scale_option(-2)],
+                         ids=["config 0", "config -1", "RunOptions 0", "option -2"])
+def test_a_scale_of_zero_is_told_the_range_not_positive(call):
+    # "must be positive" / "a number > 0", and then 0.001 was refused by the floor
+    _no(call, r"a number from 1/64 \(tempo\.MIN_SCALE\) up")
+
+
+def test_the_command_tells_the_range_of_a_zero_scale(capsys):
+    with pytest.raises(SystemExit):
+        cli.build_parser().parse_args(["reconstruct", "x.h5", "--out", "o", "--temporal-scale", "0"])
+    assert "a number from 1/64 up" in capsys.readouterr().err

@@ -62,7 +62,7 @@ def test_bad_counts_are_refused(call, pattern):
         call()
 
 
-@pytest.mark.parametrize("value, pattern", [("fast", "'auto'"), ("2", "'auto'"), (0, "positive"), (-1.0, "positive"),
+@pytest.mark.parametrize("value, pattern", [("fast", "'auto'"), ("2", "'auto'"), (0, "from 1/64"), (-1.0, "from 1/64"),
                                             (float("nan"), "finite"), (None, "finite"), (True, "finite")])
 def test_the_config_refuses_a_scale_it_cannot_use(value, pattern):
     with pytest.raises(EventDataError, match=pattern):

@@ -72,9 +72,10 @@ def _contrast(text: str):
                                          f"0.22,0.18) or auto, got {text!r}") from None
 
 
-def _auto_or(text: str, positive: bool):
-    """"auto", or a finite number >= 0 (> 0 when ``positive``): --lam and --temporal-scale."""
-    bound = "> 0" if positive else ">= 0"
+def _auto_or(text: str, positive: bool, bound: str | None = None):
+    """"auto", or a finite number >= 0 (> 0 when ``positive``): --lam and --temporal-scale (``bound``: the range in
+    the message, when the caller checks more)."""
+    bound = bound or ("> 0" if positive else ">= 0")
     if text.strip().lower() == "auto":
         return "auto"
     try:
@@ -170,8 +171,8 @@ ITERS_HELP = ("Adam iterations (default: the recipe's own: none for kit, whose o
 
 
 def _scale(text: str):
-    """--temporal-scale: "auto" or a number > 0."""
-    return _auto_or(text, positive=True)
+    """--temporal-scale: "auto" or a number > 0 (RunOptions refuses one below tempo.MIN_SCALE, naming the floor)."""
+    return _auto_or(text, positive=True, bound="from 1/64 up")
 
 
 def build_parser() -> argparse.ArgumentParser:

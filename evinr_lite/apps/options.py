@@ -20,7 +20,7 @@ import numpy as np
 
 from ..core.events import TIME_UNITS, EventDataError
 from ..method.anchor import ANCHOR_MODES
-from ..method.tempo import MIN_SCALE, scale_floor_message
+from ..method.tempo import MIN_SCALE, SCALE_RANGE, scale_floor_message
 from ..core.recording import Recording
 from ..io.formats.mvsec import CAMERAS
 from ..io.text import MAX_CLOCK_S
@@ -139,13 +139,14 @@ def lam_option(value) -> float | str:
 
 
 def temporal_scale_option(value) -> float | str:
-    """``temporal_scale=`` checked: "auto" or a finite number > 0 (as a float); EventDataError naming the fix."""
+    """``temporal_scale=`` checked: "auto" or a finite number >= tempo.MIN_SCALE (as a float); EventDataError naming
+    the fix."""
     if isinstance(value, str) and value.strip().lower() == "auto":
         return "auto"
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
             or not math.isfinite(value) or value <= 0:
-        raise EventDataError(f"temporal_scale= must be 'auto' (read from the events) or a number > 0 (1: the recipe's "
-                             f"bins and temporal prior as they are; 2: bins half as long), got {value!r}")
+        raise EventDataError(f"temporal_scale= must be 'auto' (read from the events) or {SCALE_RANGE} (1: the "
+                             f"recipe's bins and temporal prior as they are; 2: bins half as long), got {value!r}")
     if value < MIN_SCALE:
         raise EventDataError(scale_floor_message("temporal_scale", value))
     return float(value)

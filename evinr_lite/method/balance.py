@@ -103,10 +103,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.checks import checked_span, is_real_number, real_number, require, whole_number
+from ..core.checks import checked_span, decimal_as_float, is_real_number, real_number, require, whole_number
 from ..core.events import EventDataError, Events, check_sensor_size
 from .binning import as_thresholds
-from .denoise import check_counts, hot_threshold
+from .denoise import check_count_pair, hot_threshold
 
 __all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "interval_stride",
            "balance_from_counts", "estimate_balance", "pooled_imbalance", "slope_imbalance", "interval_imbalance", "minmod",
@@ -353,9 +353,7 @@ class PolarityCounts:
             self.intervals = tuple(np.zeros((H, W)) for _ in range(4))
         self.flips = np.zeros((H, W)) if self.flips is None else np.asarray(self.flips, np.float64)
         if self.slices is not None:
-            self.slices = np.asarray(self.slices, np.float64)
-            if self.slices.ndim != 1 or len(self.slices) < 2 or not np.all(np.diff(self.slices) > 0):
-                raise EventDataError(f"slices must be at least two increasing times (s), got {self.slices!r}")
+            self.slices = _slice_edges(self.slices, "slices")
             if self.sliced is None:
                 K = len(self.slices) - 1
                 self.sliced = (np.zeros((K, H, W), np.float32), np.zeros((K, H, W), np.float32))
@@ -488,11 +486,10 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
     if not (is_real_number(max_imbalance) and 0 <= max_imbalance < 1):
         raise EventDataError(f"max_imbalance must be a number in [0, 1) (|b| = |C+ - C-| / (C+ + C-) < 1), "
                              f"got {max_imbalance!r}")
-    n_on = check_counts(n_on, "n_on").astype(np.float64)
-    n_off = check_counts(n_off, "n_off").astype(np.float64)
-    if n_on.shape != n_off.shape or n_on.ndim != 2:
-        raise EventDataError(f"n_on {n_on.shape} and n_off {n_off.shape} must be [H, W] counts of the same shape")
-    min_events = real_number(min_events, "min_events", lo=0, hint="the fewest events a pixel needs to count (e.g. 4)")
+    # [H, W] only where the edges' estimate needs a sensor's neighbours (sliced); other shapes pool their pixels
+    n_on, n_off = check_count_pair(n_on, n_off, grid=sliced is not None)
+    min_events = real_number(decimal_as_float(min_events), "min_events", lo=0,
+                             hint="the fewest events a pixel needs to count (e.g. 4)")
     if intervals is not None and (len(intervals) != 4 or any(np.shape(a) != n_on.shape for a in intervals)):
         raise EventDataError(f"intervals must be four arrays of the counts' shape {n_on.shape} (log_on, k_on, "
                              "log_off, k_off, as interval_sums returns)")
@@ -555,6 +552,6 @@ def estimate_balance(events: Events, C, **kw) -> BalanceFit:
 def span_slices(t_start: float, t_end: float, k: int = SLICES) -> np.ndarray:
     """Boundaries (float64 [k + 1], s) of k equal time slices of [t_start, t_end] (a span of zero length
     gets one of 1 us, so that the boundaries increase)."""
-    t_start, t_end = checked_span(t_start, t_end, "span_slices")
+    t_start, t_end = checked_span(decimal_as_float(t_start), decimal_as_float(t_end), "span_slices")
     k = whole_number(k, "span_slices: k", lo=1)
     return np.linspace(t_start, max(t_end, t_start + MIN_INTERVAL), k + 1)

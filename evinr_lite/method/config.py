@@ -23,7 +23,7 @@ from .binning import as_thresholds
 from .denoise import DEFAULT_DT
 from .offset import OFFSET_SOLVES, STATIC_REST
 from .prepare import BACKGROUND_MODES
-from .tempo import MIN_SCALE, scale_floor_message
+from .tempo import MIN_SCALE, SCALE_RANGE, scale_floor_message
 from .tonemap import DEFAULT_DISPLAY_MEAN, DEFAULT_TONEMAP, DISPLAY_MEANS, TONEMAPS
 
 __all__ = ["EvINRConfig", "CAMERAS"]
@@ -481,11 +481,11 @@ class EvINRConfig:
             setattr(self, name, int(getattr(self, name)))
         if isinstance(self.temporal_scale, str):
             if self.temporal_scale != "auto":
-                raise EventDataError(f"temporal_scale must be 'auto' (read from the events) or a positive number "
-                                     f"(1: bin_duration and the temporal prior as given), got {self.temporal_scale!r}")
+                raise EventDataError(f"temporal_scale must be 'auto' (read from the events) or {SCALE_RANGE} (1: "
+                                     f"bin_duration and the temporal prior as given), got {self.temporal_scale!r}")
         else:
             if not number("temporal_scale", self.temporal_scale) > 0:
-                raise EventDataError(f"temporal_scale must be positive (or 'auto'), got {self.temporal_scale!r}")
+                raise EventDataError(f"temporal_scale must be {SCALE_RANGE}, or 'auto', got {self.temporal_scale!r}")
             if float(self.temporal_scale) < MIN_SCALE:
                 raise EventDataError(scale_floor_message("temporal_scale", self.temporal_scale))
             self.temporal_scale = float(self.temporal_scale)

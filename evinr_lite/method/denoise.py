@@ -62,7 +62,7 @@ import numpy as np
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 
-__all__ = ["hot_pixel_mask", "hot_threshold", "check_counts",
+__all__ = ["hot_pixel_mask", "hot_threshold", "check_counts", "check_count_pair",
            "remove_hot_pixels", "correlation_filter", "denoise", "denoise_mask",
            "DenoiseReport", "DEFAULT_WINDOW", "DEFAULT_SAME_POLARITY",
            "DEFAULT_DT", "DEFAULT_HOT_FACTOR", "DEFAULT_HOT_RULE", "HOT_RULES", "WINDOWS", "CHUNK"]
@@ -140,6 +140,20 @@ def check_counts(counts, name: str = "counts") -> np.ndarray:
         raise EventDataError(f"{name} must be finite event counts >= 0, but {int(bad.sum())} of them are NaN, inf or "
                              "negative")
     return arr
+
+
+def check_count_pair(n_on, n_off, name: str = "", *, grid: bool = True, names=("n_on", "n_off")) -> tuple:
+    """Two per-pixel counts of one shape (:func:`check_counts` each), as float64: ``grid`` asks for one [H, W]
+    sensor (2-D), else any one shape. ``name``: the caller, before the arguments' names in the messages (e.g.
+    "flip_rate: "); ``names``: the two arguments. Counts of two shapes were numpy's broadcast error, or one
+    broadcast silently over the other."""
+    a, b = names
+    n_on = check_counts(n_on, f"{name}{a}").astype(np.float64)
+    n_off = check_counts(n_off, f"{name}{b}").astype(np.float64)
+    if n_on.shape != n_off.shape or (grid and n_on.ndim != 2):
+        raise EventDataError(f"{name}{a} and {b} must be {'[H, W] ' if grid else ''}counts of one shape (the same "
+                             f"shape, one count per pixel), got shapes {n_on.shape} and {n_off.shape}")
+    return n_on, n_off
 
 
 def _check_switch(value, name: str) -> bool:

@@ -37,7 +37,7 @@ from ..core.checks import ArgumentTypeError, checked_span, real_number
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
 from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, fit_background, sample_spans, tile_counts
-from .denoise import DEFAULT_DT, check_counts, denoise_mask, hot_pixel_mask, hot_threshold
+from .denoise import DEFAULT_DT, check_count_pair, check_counts, denoise_mask, hot_pixel_mask, hot_threshold
 from .smoothing import auto_lam, window_fraction
 from .tempo import temporal_scale
 
@@ -97,11 +97,7 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sl
     if not all(hasattr(cfg, a) for a in ("hot_pixels", "balance", "C", "lam", "temporal_scale")):
         raise ArgumentTypeError(f"plan_from_counts: cfg= must be EvINRConfig, got {type(cfg).__name__}; e.g. "
                                 "EvINRConfig() or EvINRConfig.paper()")
-    n_on = check_counts(n_on, "plan_from_counts: n_on").astype(np.float64)
-    n_off = check_counts(n_off, "plan_from_counts: n_off").astype(np.float64)
-    if n_on.shape != n_off.shape or n_on.ndim != 2:
-        raise EventDataError(f"plan_from_counts: n_on {n_on.shape} and n_off {n_off.shape} must be [H, W] counts of "
-                             "one shape (the span's ON and OFF events per pixel)")
+    n_on, n_off = check_count_pair(n_on, n_off, "plan_from_counts: ")   # the span's ON and OFF events per pixel
     if intervals is not None and (isinstance(intervals, (str, bytes)) or len(intervals) != 4):
         raise EventDataError("plan_from_counts: intervals must be four [H, W] arrays (log_on, k_on, log_off, k_off, "
                              "as interval_sums returns), or None")

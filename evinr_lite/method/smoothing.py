@@ -26,6 +26,7 @@ import numpy as np
 from ..core.checks import real_number
 from ..core.events import EventDataError
 from ..core.guard import dense_array
+from .denoise import check_count_pair
 
 __all__ = ["activity", "auto_lam", "covered_fraction", "window_fraction", "LAM_SCALE", "LAM_MIN", "LAM_MAX"]
 
@@ -36,24 +37,8 @@ LAM_MAX = 0.01      # the most: the fixed default before issue 21 (sparser windo
 
 def activity(n_on, n_off) -> float:
     """Mean over pixels of ``2 min(n_on, n_off)`` ([H, W] counts): events that came and went."""
-    n_on, n_off = _counts(n_on, "n_on"), _counts(n_off, "n_off")
-    if n_on.shape != n_off.shape:   # was numpy's broadcast error (or a silent broadcast of one over the other)
-        raise EventDataError(f"n_on and n_off must be counts of one shape [H, W] (one per pixel), got shapes "
-                             f"{n_on.shape} and {n_off.shape}")
+    n_on, n_off = check_count_pair(n_on, n_off, grid=False)   # NaN or negative counts gave LAM_MAX silently
     return float(2 * np.minimum(n_on, n_off).mean()) if n_on.size else 0.0
-
-
-def _counts(value, name: str) -> np.ndarray:
-    """Per-pixel event counts as float64: numbers, finite, >= 0 (NaN or negative counts gave LAM_MAX silently)."""
-    arr = None if isinstance(value, (str, bytes)) else dense_array(value, name, error=EventDataError)
-    if arr is None or arr.dtype.kind not in "biuf":
-        raise EventDataError(f"{name} must be finite counts >= 0 (events per pixel), got {value!r:.60}")
-    arr = arr.astype(np.float64)
-    bad = ~(np.isfinite(arr) & (arr >= 0))
-    if bad.any():
-        raise EventDataError(f"{name} must be finite counts >= 0 (events per pixel), but it holds {int(bad.sum())} "
-                             "NaN, inf or negative value(s)")
-    return arr
 
 
 def covered_fraction(windows) -> float:

@@ -25,9 +25,9 @@ import numpy as np
 from ..core.checks import host_array, is_real_number, real_number
 from ..core.events import EventDataError
 from .balance import interval_stride
-from .denoise import check_counts
+from .denoise import check_count_pair
 
-__all__ = ["FLIPS_REF", "MAX_SCALE", "MIN_EVENTS", "MIN_SCALE", "scale_floor_message",
+__all__ = ["FLIPS_REF", "MAX_SCALE", "MIN_EVENTS", "MIN_SCALE", "SCALE_RANGE", "scale_floor_message",
            "flip_rate", "scale_from_rate", "temporal_scale"]
 
 FLIPS_REF = 2.5    # reversals per pixel and second up to which the base bins and prior stand
@@ -37,6 +37,7 @@ MIN_EVENTS = 4     # a pixel's events for its reversals to count (one or two eve
 # hardly changes over a window, the network's time derivative cannot follow the events and its log intensity
 # diverges (a scale of 1e-9 gave frames of 0 and 1 at a "gain" of 10^26, or an overflow in the tone map)
 MIN_SCALE = 1.0 / 64
+SCALE_RANGE = "a number from 1/64 (tempo.MIN_SCALE) up"   # a hand-set scale, in messages (as the CLI's help)
 
 
 def scale_floor_message(name: str, value) -> str:
@@ -56,11 +57,7 @@ def flip_rate(flips, n_events, span_s: float) -> float:
         n_events: float [H, W] events per pixel over the same span (ON + OFF).
         span_s: the span's length in seconds (> 0).
     """
-    flips = check_counts(flips, "flip_rate: flips").astype(np.float64)
-    n_events = check_counts(n_events, "flip_rate: n_events").astype(np.float64)
-    if flips.shape != n_events.shape or flips.ndim != 2:
-        raise EventDataError(f"flip_rate: flips and n_events must be [H, W] arrays of one shape, got "
-                             f"{flips.shape} and {n_events.shape}")
+    flips, n_events = check_count_pair(flips, n_events, "flip_rate: ", names=("flips", "n_events"))
     span_s = real_number(span_s, "flip_rate: span_s", lo=0, lo_open=True, hint="the span's length, a positive number of seconds")
     if flips.size == 0:
         return float("nan")

@@ -42,12 +42,13 @@ intervals (a Python loop over time) and is vectorised over pixels and events.
 """
 from __future__ import annotations
 
+import math
 from typing import Callable, Iterable, Iterator
 
 import numpy as np
 
-from ..core.checks import (ArgumentTypeError, check_seconds_precision, host_array, is_real_number, optional_seconds,
-                           real_number, require, whole_number)
+from ..core.checks import (ArgumentTypeError, check_seconds_precision, decimal_as_float, host_array, is_real_number,
+                           optional_seconds, real_number, require, short_repr, whole_number)
 from ..core.guard import dense_array
 from ..core.events import MAX_SPAN_S, EventDataError, Events
 
@@ -107,20 +108,36 @@ def _check_times(t) -> np.ndarray:
     return t
 
 
-def _check_thresholds(C, C_pos, C_neg) -> tuple[float, float]:
-    C_pos = C if C_pos is None else C_pos
-    C_neg = C if C_neg is None else C_neg
-    C_pos, C_neg = host_array(C_pos), host_array(C_neg)   # a 0-d array or tensor is a number
-    for name, value in (("C_pos", C_pos), ("C_neg", C_neg)):
-        if not (is_real_number(value) and np.isfinite(value) and value > 0):
-            pair = " (for two thresholds pass C_pos= and C_neg=)" if isinstance(value, (tuple, list)) else ""
-            raise EventDataError(f"contrast threshold {name} (or C) must be a positive number in log units, got "
-                                 f"{value!r}{pair}")
-        if value < MIN_C:
-            raise EventDataError(f"contrast threshold {name} (or C) = {value!r} log units is far below any sensor's "
-                                 f"(about 0.05 to 1.5): each pixel would fire |change of log intensity| / C events, "
-                                 f"millions of them; use C >= {MIN_C:g} (e.g. C=0.2)")
-    return float(C_pos), float(C_neg)
+def _check_thresholds(C, C_pos, C_neg, *, n_pixels: int | None = None, where: str = "") -> tuple:
+    """(C_pos, C_neg), each C where not given: the kit's one rule for a contrast threshold, a finite number > 0 (log
+    units) and at least MIN_C. With ``n_pixels`` (:func:`sample_thresholds`) each may also be one per pixel, a 1-D
+    array of ``n_pixels`` such numbers (or of one), returned as float64; else floats. ``where``: the caller, before
+    the message."""
+    alias = "" if n_pixels is not None else " (or C)"
+    out = []
+    for name, value in (("C_pos", C if C_pos is None else C_pos), ("C_neg", C if C_neg is None else C_neg)):
+        value = host_array(value)   # a 0-d array or tensor is a number
+        what = f"{where}contrast threshold {name}{alias}"
+        per_pixel = n_pixels is not None and not isinstance(value, (str, bytes)) and np.ndim(value) == 1
+        if per_pixel:
+            arr = np.asarray(value)
+            ok = (arr.dtype.kind in "iuf" and len(arr) in (1, n_pixels)
+                  and bool(np.all(np.isfinite(arr) & (arr > 0))))
+            low = float(arr.min()) if ok and arr.size else None
+        else:
+            ok = is_real_number(value) and math.isfinite(float(value)) and value > 0
+            low = float(value) if ok else None
+        if not ok:
+            pair = " (for two thresholds pass C_pos= and C_neg=)" if isinstance(value, (tuple, list)) and \
+                n_pixels is None else ""
+            each = f" (or one per pixel: a 1-D array of {n_pixels} of them)" if n_pixels is not None else ""
+            raise EventDataError(f"{what} must be a positive number in log units{each}, got {short_repr(value)}{pair}")
+        if low is not None and low < MIN_C:
+            raise EventDataError(f"{what} = {low!r} log units is far below any sensor's (about 0.05 to 1.5): each "
+                                 f"pixel would fire |change of log intensity| / C events, millions of them; use C >= "
+                                 f"{MIN_C:g} (e.g. C=0.2)")
+        out.append(np.asarray(value, np.float64) if per_pixel else float(value))
+    return tuple(out)
 
 
 def _noise_span(events, t_start, t_end, *, allow_empty: bool = False) -> tuple[float, float]:
@@ -165,13 +182,14 @@ def sample_thresholds(n_pixels: int, C_pos: float, C_neg: float, threshold_sigma
         (C_pos_pix, C_neg_pix): float64 [n_pixels] each, log units.
     """
     n_pixels = whole_number(n_pixels, "sample_thresholds: n_pixels", lo=0)
-    C_pos, C_neg = (real_number(c, f"sample_thresholds: {name}", lo=0, lo_open=True,
-                                hint="a contrast threshold in log units (e.g. 0.2)")
-                    for c, name in ((C_pos, "C_pos"), (C_neg, "C_neg")))
-    threshold_sigma = real_number(threshold_sigma, "sample_thresholds: threshold_sigma", lo=0,
+    C_pos, C_neg = _check_thresholds(None, decimal_as_float(C_pos), decimal_as_float(C_neg), n_pixels=n_pixels,
+                                     where="sample_thresholds: ")
+    threshold_sigma = real_number(decimal_as_float(threshold_sigma), "sample_thresholds: threshold_sigma", lo=0,
                                   hint="the thresholds' relative spread (0: every pixel the nominal C; e.g. 0.03)")
-    if threshold_sigma > 0 and rng is not None:
-        require(rng, np.random.Generator, "sample_thresholds: rng")
+    if threshold_sigma > 0 and rng is not None and not callable(getattr(rng, "standard_normal", None)):
+        raise ArgumentTypeError(f"sample_thresholds: rng= must be Generator-like (a random generator with "
+                                f"standard_normal: np.random.default_rng(seed), or np.random.RandomState(seed)), got "
+                                f"{type(rng).__name__}")
     C_pos_pix = np.full(n_pixels, C_pos, dtype=np.float64)
     C_neg_pix = np.full(n_pixels, C_neg, dtype=np.float64)
     if threshold_sigma > 0:

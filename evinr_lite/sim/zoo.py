@@ -29,6 +29,7 @@ from functools import partial
 import numpy as np
 
 from ..core.checks import require, true_or_false, whole_number
+from ..core.events import EventDataError
 from . import scenes as sc
 from .simulate import add_background_noise, add_hot_pixels, add_light_noise, simulate_scene
 
@@ -250,6 +251,29 @@ FRESH_KINDS = ("pan", "shake", "warp", "speed", "light", "static")   # the zoo's
 FRESH_SIZES = ((90, 120), (120, 160), (150, 200), (180, 240))
 
 
+def _fresh_seed(seed) -> tuple:
+    """(seed, label): :func:`fresh`'s seed as ``np.random.default_rng`` takes it, and its label in the scenes' names.
+    Taken: a whole number >= 0 (the label is the number, as always), a list, tuple or 1-D array of them (joined by
+    "-"; a list of one is the number's own generator) or a ``np.random.SeedSequence`` (its entropy, then "s" and its
+    spawn key when it has one). Refused (numpy takes them): None, a Generator or BitGenerator (scenes nobody could
+    draw again from their names) and an empty list (a name with no seed)."""
+    if isinstance(seed, np.random.SeedSequence):
+        entropy = seed.entropy if np.ndim(seed.entropy) else [seed.entropy]
+        key = f"s{'-'.join(str(int(k)) for k in seed.spawn_key)}" if seed.spawn_key else ""
+        return seed, "-".join(str(int(e)) for e in entropy) + key
+    if isinstance(seed, (list, tuple, np.ndarray)) and np.ndim(seed) == 1:
+        if len(seed) == 0:
+            raise EventDataError("fresh: seed= is an empty list; give a whole number >= 0 (e.g. 23) or a list of them")
+        whole = [whole_number(v, "fresh: seed", lo=0) for v in seed]
+        return whole, "-".join(map(str, whole))
+    if seed is None or isinstance(seed, (np.random.Generator, np.random.BitGenerator)):
+        raise EventDataError(f"fresh: seed= must be a whole number >= 0, a list of them or a np.random.SeedSequence, "
+                             f"got {type(seed).__name__}: the scenes are named by their seed, so that they can be "
+                             "drawn again (e.g. fresh(23))")
+    seed = whole_number(seed, "fresh: seed", lo=0)
+    return seed, str(seed)
+
+
 def fresh(seed: int, n: int = 16) -> list:
     """``n`` scenes drawn at random (a generator seeded ``seed``) the ways the zoo's are built, for a check
     no default was chosen on: one of the zoo's scene classes (a pan with rotation and zoom, a hand-held
@@ -257,8 +281,9 @@ def fresh(seed: int, n: int = 16) -> list:
     background), any of the images, a sensor size, a duration and motion in the zoo's ranges, and a
     sensor: C 0.15-0.3 with C+ / C- 0.75-1.33 (given as their mean), 0-5 % mismatch, a refractory
     period, and on half the scenes background activity and hot pixels (ON-only on half of those). Each
-    scene's ``doc`` says what was drawn (``python benchmarks/quality_zoo.py --fresh SEED``)."""
-    seed = whole_number(seed, "fresh: seed", lo=0)   # NaN and "0" were numpy's SeedSequence error
+    scene's ``doc`` says what was drawn (``python benchmarks/quality_zoo.py --fresh SEED``). ``seed``: a whole
+    number >= 0, a list of them or a ``np.random.SeedSequence`` (see :func:`_fresh_seed`)."""
+    seed, label = _fresh_seed(seed)                  # NaN and "0" were numpy's SeedSequence error
     n = whole_number(n, "fresh: n", lo=0)            # -1 gave no scene, 2.5 two and "3" three without a word
     rng = np.random.default_rng(seed)
     out = []
@@ -303,7 +328,7 @@ def fresh(seed: int, n: int = 16) -> list:
         sensor = (f"C+ {c_pos:.3f}, C- {c_neg:.3f} given as {C}, {100 * sigma:.1f} % mismatch"
                   + (f", {noise_hz} Hz background, {hot} {'ON-only ' if on_only else ''}hot pixels" if noisy
                      else ", no noise"))
-        out.append(ZooScene(f"fresh{seed}_{k:02d}_{kind}_{img}", f"{what}; {sensor}", build, size=size,
+        out.append(ZooScene(f"fresh{label}_{k:02d}_{kind}_{img}", f"{what}; {sensor}", build, size=size,
                             duration=duration, C=C, C_pos=c_pos, C_neg=c_neg, threshold_sigma=sigma,
                             refractory=refractory, noise_hz=noise_hz, hot_pixels=hot, hot_on_only=on_only,
                             seed=int(rng.integers(1000, 9999)), tags=("fresh", kind)))
@@ -414,6 +439,4 @@ def get(name: str) -> ZooScene:
     for z in ZOO + HELDOUT + STRESS + LARGE:
         if z.name == name:
             return z
-    from ..core.events import EventDataError
-
     raise EventDataError(f"no zoo scene {name!r}; the zoo holds {[z.name for z in ZOO + HELDOUT + STRESS + LARGE]}")

@@ -164,8 +164,7 @@ def plot_xyt(events: Events, ax=None, max_points: int = 5000, seed: int = 0, siz
     if len(events) == 0:   # empty 3-D axes titled "0 of 0 events"
         raise EventDataError("plot_xyt: no events to draw; pick a time window or a recording that holds some")
     sub = subsample(events, max_points, seed)
-    if ax is None:
-        ax = plt.figure(figsize=(7, 5)).add_subplot(projection="3d")
+    ax = axes_or_new(ax, (7, 5), projection="3d")   # a 2-D Axes, a Figure or an array failed inside matplotlib
     for sign, color, name in ((1, ON_COLOR, "ON"), (-1, OFF_COLOR, "OFF")):
         sel = sub.p == sign
         ax.scatter(sub.t[sel], sub.x[sel], sub.y[sel], s=size, c=color, depthshade=False,

@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 import matplotlib.pyplot as plt
 
+from .signals import axes_or_new
+
 __all__ = ["show_frames", "show_images", "plot_histories"]
 
 
@@ -129,8 +131,7 @@ def plot_histories(histories: dict, key: str = "loss", *, ax=None, xlabel: str =
     if missing:
         raise ValueError(f"no {key!r} in the history of {missing}; pass key= one of its curves "
                          f"(e.g. {sorted(histories[missing[0]])[:5]})")
-    if ax is None:
-        _, ax = plt.subplots(figsize=(5, 3))
+    ax = axes_or_new(ax, (5, 3))
     for label, h in histories.items():
         values = np.asarray(h[key] if isinstance(h, dict) else h, dtype=np.float64)
         ax.semilogy(np.maximum(values, 1e-16), label=label)

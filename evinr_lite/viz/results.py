@@ -5,6 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..evaluation.ablation import COLUMN_LABELS, pareto_front
+from .signals import axes_or_new
 
 __all__ = ["plot_results", "plot_ablation", "plot_tradeoff", "plot_robustness"]
 
@@ -118,8 +119,7 @@ def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = 
     c = np.array([r[cost] for r in rows], dtype=np.float64)
     q = np.array([r[quality] for r in rows], dtype=np.float64)
     front = pareto_front(c, q) if front is None else np.asarray(front, bool)
-    if ax is None:
-        _, ax = plt.subplots(figsize=(8, 4.5))
+    ax = axes_or_new(ax, (8, 4.5))
     ax.scatter(c[~front], q[~front], color="0.6", s=18, label="dominated")
     ax.scatter(c[front], q[front], color="tab:red", s=30, label="Pareto front")
     order = np.flatnonzero(front)[np.argsort(c[front])]

@@ -10,9 +10,9 @@ import matplotlib.pyplot as plt
 from matplotlib.transforms import blended_transform_factory
 
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
+from matplotlib.figure import FigureBase
 
-from ..core.checks import ArgumentTypeError, seconds_array, short_repr
+from ..core.checks import ArgumentTypeError, host_array, short_repr
 from ..core.events import EventDataError
 from ..sim.simulate import pixel_events
 
@@ -24,27 +24,51 @@ ON_COLOR = "tab:red"
 OFF_COLOR = "tab:blue"
 
 
-def axes_or_new(ax, figsize=(8, 3.5)):
+def axes_or_new(ax, figsize=(8, 3.5), *, projection: str | None = None):
     """``ax`` when it is a matplotlib Axes, a new figure's (of ``figsize`` inches) when None; else an
-    ArgumentTypeError (a Figure, a number or an array of axes failed inside the first drawing call)."""
+    ArgumentTypeError (a Figure, a number or an array of axes failed inside the first drawing call).
+    ``projection="3d"``: the axes must be 3-D (a new one is made so; a 2-D one failed inside the drawing)."""
+    kw = {} if projection is None else {"projection": projection}
     if ax is None:
-        _, ax = plt.subplots(figsize=figsize)
-    elif not isinstance(ax, Axes):
-        fix = (" (a Figure: pass one of its axes, e.g. fig.axes[0], or fig.add_subplot())" if isinstance(ax, Figure)
-               else " (an array of axes from plt.subplots: pass one of them, e.g. axes[0])"
-               if isinstance(ax, np.ndarray) else "")
-        raise ArgumentTypeError(f"ax= must be a matplotlib Axes or None (a new figure), got {type(ax).__name__}{fix}")
+        return plt.figure(figsize=figsize).add_subplot(**kw)
+    new = f"fig.add_subplot({', '.join(f'{k}={v!r}' for k, v in kw.items())})"
+    if not isinstance(ax, Axes):
+        if isinstance(ax, FigureBase):   # a Figure or a SubFigure
+            fits = [i for i, a in enumerate(ax.axes) if projection is None or a.name == projection]
+            fix = (f" (a {type(ax).__name__}: pass one of its axes, e.g. fig.axes[{fits[0]}], or {new})" if fits
+                   else f" (a {type(ax).__name__} without {'' if projection is None else '3-D '}axes: pass {new})")
+        else:
+            fix = (" (an array of axes from plt.subplots: pass one of them, e.g. axes[0])"
+                   if isinstance(ax, np.ndarray) else "")
+        kind = "a 3-D matplotlib Axes" if projection == "3d" else "a matplotlib Axes"
+        raise ArgumentTypeError(f"ax= must be {kind} or None (a new figure), got {type(ax).__name__}{fix}")
+    if projection is not None and ax.name != projection:
+        raise ArgumentTypeError(f"ax= must be an Axes of projection={projection!r}, got one of projection="
+                                f"{ax.name!r}; make it with {new}")
     return ax
 
 
 def _curve(values, name: str, n: int) -> np.ndarray:
     """A curve to draw against n times: numbers whose first axis has length n."""
-    arr = None if isinstance(values, (str, bytes)) or values is None else np.asarray(values)
+    arr = None if isinstance(values, (str, bytes)) or values is None else np.asarray(host_array(values))
     if arr is None or arr.dtype.kind not in "biuf" or arr.ndim == 0:
         raise EventDataError(f"{name} must be numbers, one per time ([T] = [{n}]), got {short_repr(values)}")
     if len(arr) != n:
         raise EventDataError(f"{name} holds {len(arr)} values but t holds {n} times; pass one value per time")
     return arr
+
+
+def _times(t) -> np.ndarray:
+    """A figure's times as float64 [T]: numbers on one axis, NaN allowed (matplotlib leaves a gap there), any float
+    type (float32 or float16 times are drawn as they are: no event timestamps, whose precision matters)."""
+    try:
+        arr = None if isinstance(t, (str, bytes)) or t is None else np.asarray(host_array(t))
+    except (TypeError, ValueError):   # a ragged list
+        arr = None
+    if arr is None or arr.dtype.kind not in "iuf" or arr.ndim != 1:
+        raise EventDataError(f"t= must be seconds, a 1-D array of numbers [T], got "
+                             f"{short_repr(t) if arr is None or arr.ndim == 1 else f'shape {arr.shape}'}")
+    return arr.astype(np.float64)
 
 
 def plot_event_ticks(ax, t_events, p_events, height: float = 0.08, legend: bool = True):
@@ -108,7 +132,7 @@ def plot_reconstruction_1d(t, curves: dict, truth=None, *, events=None, ax=None,
         truth: float [T] true log intensity (thick black), optional.
         events: optional events drawn as ticks at the bottom.
     """
-    t = seconds_array(t, "t")
+    t = _times(t)
     if not isinstance(curves, dict):   # a list or None was an AttributeError
         raise ArgumentTypeError(f"curves= must be a dict {{label: values [T]}}, got {type(curves).__name__}; e.g. "
                                 "{'EvINR': L_hat}")
