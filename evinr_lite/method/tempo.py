@@ -69,10 +69,11 @@ def flip_rate(flips, n_events, span_s: float) -> float:
 
 def scale_from_rate(rate: float) -> float:
     """s = clip(rate / FLIPS_REF, 1, MAX_SCALE); 1 for NaN (no pixel fired often enough to tell)."""
-    if not is_real_number(rate) or float(host_array(rate)) < 0:
+    value = float(host_array(rate)) if is_real_number(rate) else None
+    if value is None or value < 0:
         raise EventDataError(f"scale_from_rate: rate must be polarity reversals per pixel and second (a number >= 0, "
                              f"or NaN where no pixel fired often enough), got {rate!r}")
-    rate = float(host_array(rate))
+    rate = value
     return 1.0 if not np.isfinite(rate) else float(np.clip(rate / FLIPS_REF, 1.0, MAX_SCALE))
 
 
