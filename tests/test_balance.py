@@ -279,6 +279,42 @@ def test_busy_spans_take_the_counts_alone_unless_the_intervals_contradict_them()
     assert np.isnan(fit.slope_imbalance) and fit.chosen == "minmod"
 
 
+def test_the_counts_alone_are_bounded_by_the_three_other_estimates(monkeypatch):
+    """Where the edges' estimate is there, the slope taken alone is bounded by the range of the pooled
+    counts, the edges and the intervals: it stands where they bracket it, it is moved to the nearest
+    where all three lie on one side of it. Without slice counts it stands alone, as before."""
+    from evinr_lite.method import balance
+
+    C, b = 0.2, -0.15
+    n = 200.0 * np.linspace(0.5, 1.5, 20)[:, None] * np.ones((1, 20))
+    n_on, n_off = _counts_with(b, n, -0.7, C)            # the light pulls the pooled counts to -0.1325
+    ivl = _interval_arrays(n.shape, 2 * np.arctanh(-0.01), 0.0)
+    sliced = (np.ones((4,) + n.shape), np.ones((4,) + n.shape))
+    assert balance_from_counts(n_on, n_off, C, intervals=ivl).imbalance == pytest.approx(b, abs=1e-9)
+    for grad, expect in ((-0.2, b), (-0.12, None), (-0.01, None)):
+        monkeypatch.setattr(balance, "gradient_imbalance", lambda *a, g=grad: g)
+        fit = balance_from_counts(n_on, n_off, C, intervals=ivl, sliced=sliced)
+        assert fit.chosen == "counts" and fit.slope_imbalance == pytest.approx(b, abs=1e-9)
+        nearest = min(fit.raw_imbalance, fit.gradient_imbalance, fit.interval_imbalance)   # all above b
+        assert fit.imbalance == pytest.approx(expect if expect is not None else nearest, abs=1e-9)
+        assert (fit.imbalance != pytest.approx(b, abs=1e-6)) == (expect is None)
+
+
+def test_a_busy_shake_whose_slope_errs_gets_the_others_range():
+    """fresh24_07_shake_brick (174 events per pixel, C+ 0.151 and C- 0.171: b = -0.064): the counts'
+    slope reads about -0.01 (the shake stops mid-swing, so the pixels' net change goes with their
+    counts), while the pooled counts, the edges and the intervals read about -0.065; the slope is
+    bounded by them."""
+    from evinr_lite.sim.zoo import effective_C, fresh, imbalance, simulate
+
+    z = fresh(24)[7]
+    _, events, _, _ = simulate(z)
+    events, _ = prepare_events(events, EvINRConfig(C=effective_C(z), balance="none", progress=False))
+    fit = estimate_balance(events, effective_C(z))
+    assert fit.chosen == "counts" and abs(fit.slope_imbalance - imbalance(z)) > 0.04
+    assert abs(fit.imbalance - imbalance(z)) < 0.01
+
+
 def test_a_long_change_of_light_is_not_read_as_an_imbalance():
     """20 s to and fro, equal thresholds, while the light falls by e^-2: more OFF than ON events, so the
     pooled counts read an imbalance; the counts fitted with an intercept do not."""

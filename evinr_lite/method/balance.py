@@ -51,8 +51,14 @@ apart: dark_falling +0.61 and -0.43). Alone, they are fitted with an intercept
 (:func:`slope_imbalance`: ``n- - n+ = b n - dL / C`` at every pixel, so a change of light common to
 all pixels goes to the intercept): on a long recording a change of light is bounded while the events
 keep coming, and the pooled counts would read the light falling 7x over the 20 s pan as b = +0.10,
-the slope as +0.008 (``python benchmarks/balance.py --light``). ``BalanceFit.chosen`` says which was
-taken.
+the slope as +0.008 (``python benchmarks/balance.py --light``). The slope has an error of its own, the
+part of the scene's per-pixel change that goes with the event count: on a busy shake that stops
+mid-swing (fresh24_07_shake_brick, 174 events per pixel) it read -0.009 for -0.064, while the pooled
+counts, the edges and the intervals read -0.066, -0.065 and -0.075. Those three err for other reasons
+(a change of light pushes the first two one way and the intervals the other), so where all three lie
+on one side of the slope, the slope is **bounded by their range** (taken as the nearest of them);
+where they bracket it, it stands. Without slice counts (no edges' estimate) the slope stands alone.
+``BalanceFit.chosen`` says which was taken.
 
 The edges' estimate took the pooled counts' place in the minmod on 2026-12-04: rms error of the applied
 b 0.104 -> 0.092 on the off-heavy short scenes, 0.069 -> 0.063 on 44 fresh random sensors
@@ -526,8 +532,14 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
         elif s <= COUNTS_ALONE and np.isfinite(slope) and abs(slope - ivl) <= max_imbalance:
             # enough events that the counts' error (the mean log change over C mean n) is below the
             # intervals' own bias, and the intervals do not contradict them: the counts fitted with an
-            # intercept, so that a change of light common to all pixels is not read as an imbalance
+            # intercept, so that a change of light common to all pixels is not read as an imbalance.
+            # With the edges' estimate there are three others whose errors have other causes (a change
+            # of light pushes the pooled counts and the edges one way, the intervals the other): where
+            # all three lie on one side of the slope, it is the slope that errs, and it is bounded by
+            # their range (the module docstring has the figures)
             b, chosen = slope, "counts"
+            if np.isfinite(grad):
+                b = float(np.clip(slope, min(raw, grad, ivl), max(raw, grad, ivl)))
         else:
             # the edges' estimate where there are slice counts (a change of light common to all pixels
             # does not enter it, as it enters the pooled counts), else the pooled counts
