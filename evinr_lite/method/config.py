@@ -330,8 +330,9 @@ class EvINRConfig:
             different assumptions, the edges' (b that keeps each edge's change over time from
             following its two pixels' count difference) and the intervals between events of one
             polarity, and the counts alone (fitted with an intercept, so a change of light shared by all pixels
-            does not count) where the span holds enough events that their error scale
-            NET_CHANGE / (C events per pixel) is at most COUNTS_ALONE (long or busy recordings);
+            does not count, and kept within the range of the other three estimates) where the span holds
+            enough events that their error scale NET_CHANGE / (C events per pixel) is at most COUNTS_ALONE
+            (long or busy recordings);
             "counts": the counts' estimate alone, shrunk towards C as far as the span carries little
             evidence (the rule before the intervals). A given pair is used as it is.
         hot_pixels: "keep" or "drop": the events of pixels firing far above the sensor's robust rate
