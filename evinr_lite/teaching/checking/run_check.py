@@ -12,7 +12,11 @@ the rest), and last a notebook variable that only grew. A model among the inputs
 parameters requiring grad, than the reference leaves it is named after each call. After every input matched, the last
 one is run a second time from other states of the global generators (:func:`_second_call`, :mod:`.across_calls`,
 :mod:`.global_state`), and input #1's own objects are refilled in place with a later input's values and given again
-(:func:`.across_calls.same_objects_new_values`: a cache keyed by id()). The order is the report's:
+(:func:`.across_calls.same_objects_new_values`: a cache keyed by id()), and last the function is called as the
+notebooks call it, its arguments in order and its optional ones left out (:func:`.signature.called_as_notebook`, only
+where its signature differs from the reference's). Slips read off the learner's source (:mod:`.learner_source`: the
+None of ``b = b.sort()``, `^` for a power, a default other than the stub's where an input leaves it out) come first
+among the hints, and in a raised error's report before the guesses from the error's words. The order is the report's:
 change it and other hints win. Returns (passed, headline, detail lines); printing is
 :func:`evinr_lite.teaching.exercises.check`'s.
 """
@@ -29,9 +33,11 @@ from .hints import (aliased_rows_hint, axes_order_hint, generic_hint, has_repeat
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, module_flags,
                             module_flags_message, poison_freed_memory, run, watching, where_raised)
+from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
+from .signature import called_as_notebook, signature_default_hint
 
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
 
@@ -87,7 +93,9 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             got = run(fn, args, kwargs, ex.observe, inputs_after=after, settings_changed=changed_settings)
             if k == n - 1:
                 rng_after = rng_states()
-        except NotImplementedError:
+        except NotImplementedError as err:
+            if not stub_raised(err):      # torch's own (an operation it has no kernel for), not the stub's
+                return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except Exception as err:
@@ -135,6 +143,9 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
                 return False, f"answers otherwise when called again on input #{k}", [STATE_BETWEEN_CALLS]
             return False, f"answers otherwise when input #1's objects are refilled with input #{k}'s values", [
                 KEYED_BY_OBJECT.format(k=k)]
+        as_called = called_as_notebook(ex, fn, cases)
+        if as_called is not None:
+            return False, as_called[0], as_called[1]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
 
 
@@ -146,7 +157,10 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     kept between calls)."""
     args, kwargs = cases[k]
     details = [f"{type(err).__name__}: {err}"] + where_raised(err)
-    if isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
+    written = xor_power_hint(fn, err) or none_from_in_place_hint(fn) or signature_default_hint(ex, fn, kwargs)
+    if written:                 # read off the learner's source: what the error's words would only guess at
+        details.append(f"hint: {written}")
+    elif isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
         details.append("hint: a cache (functools.lru_cache, functools.cache, or a dict keyed by the "
                        "arguments) needs hashable arguments, and an array, a list or a dict is not one; "
                        "drop the cache (nothing here is slow enough to need one), or key it by "
@@ -170,7 +184,8 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
         details.append("hint: `-` on two bool arrays or tensors is refused: make them integers first "
                        "(`.astype(int)`, `.long()` for tensors) for a difference of counts or a sign; for masks "
                        "use `&`, `|`, `~` (a and not b: `a & ~b`)")
-    details += _python_on_arrays_hints(err, " ".join(details[1:]))
+    if not written:
+        details += _python_on_arrays_hints(err, " ".join(details[1:]))
     if isinstance(err, RuntimeError) and "does not require grad" in str(err):
         details.append("hint: the loss has no autograd graph to back-propagate: it was computed under "
                        "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
@@ -205,7 +220,7 @@ def _python_on_arrays_hints(err: Exception, line: str) -> list[str]:
         return ["hint: `and`, `or`, `not`, `if` and a chained comparison such as `a < t <= b` (which Python reads "
                 "as `a < t and t <= b`) each need one True or False, and an array holds many: combine element-wise "
                 "comparisons with `&`, `|` and `~`, each comparison in its own brackets: `(a < t) & (t <= b)`"]
-    if isinstance(err, TypeError) and "ufunc 'bitwise_" in msg:
+    if isinstance(err, TypeError) and "ufunc 'bitwise_" in msg and "bitwise_xor" not in msg:
         return ["hint: `&` and `|` bind more tightly than comparisons: `t > a & t <= b` reads `t > (a & t) <= b`, "
                 "and `&` of floats is refused; put each comparison in brackets: `(t > a) & (t <= b)`"]
     if isinstance(err, TypeError) and "converted to Python scalars" in msg and "math." in line:
@@ -243,6 +258,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     # the function only logs to (`log.append(len(t))`, a common habit) grows just the same and explains nothing
     cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
     hint = cache_hint if proven else None
+    if hint is None:            # slips read off the source (a value of None, `^` for `**`, another default)
+        hint = none_from_in_place_hint(fn) or xor_power_hint(fn) or signature_default_hint(ex, fn, kwargs)
     memory = None       # memory_explains' answer on this input, asked once (it runs the function four times)
     if hint is None:
         memory = memory_explains(fn, ex, args, kwargs, got)
