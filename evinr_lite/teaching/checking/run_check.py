@@ -13,10 +13,14 @@ parameters requiring grad, than the reference leaves it is named after each call
 one is run a second time from other states of the global generators (:func:`_second_call`, :mod:`.across_calls`,
 :mod:`.global_state`), and input #1's own objects are refilled in place with a later input's values and given again
 (:func:`.across_calls.same_objects_new_values`: a cache keyed by id()), and last the function is called as the
-notebooks call it, its arguments in order and its optional ones left out (:func:`.signature.called_as_notebook`, only
-where its signature differs from the reference's). Slips read off the learner's source (:mod:`.learner_source`: the
-None of ``b = b.sort()``, `^` for a power, a default other than the stub's where an input leaves it out) come first
-among the hints, and in a raised error's report before the guesses from the error's words. The order is the report's:
+notebooks call it (:func:`.signature.called_as_notebook`, each exercise's recorded call, only where its signature
+differs from the stub's); a function that cannot take the inputs by name (a parameter renamed, or positional-only) is
+called so throughout (:func:`.signature.notebook_caller`). Slips read off the learner's source and proven by a call
+come first among the hints, and in a raised error's report before the guesses from the error's words: `^` for a
+power (the function with `**` in its place matches, or numpy's or torch's error refuses `^` on floats) and a default
+other than the stub's where an input leaves it out (with the stub's default passed, the input matches); the None of
+``b = b.sort()`` (:mod:`.learner_source`), named only where a None shows (the error's words, a traced call), comes
+after the exercise's own and the generic wrong versions. The order is the report's:
 change it and other hints win. Returns (passed, headline, detail lines); printing is
 :func:`evinr_lite.teaching.exercises.check`'s.
 """
@@ -37,7 +41,7 @@ from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
-from .signature import called_as_notebook, signature_default_hint
+from .signature import called_as_notebook, learner_function, notebook_caller, signature_default_hint
 
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
 
@@ -53,6 +57,7 @@ def run_check(ex: ExerciseLike, fn: Callable) -> Report:
     main run never reaches (a hint's search runs the others), or that raises right after, leaves the notebook as
     it was. Such a change is named in the report (`also: ...`) when the main run did not name it already."""
     settings = global_settings()
+    fn = notebook_caller(ex, fn)       # a parameter renamed or positional-only: called as the notebook calls it
     with imports_watched() as imported:
         try:
             with watching(fn) as seen:
@@ -143,7 +148,7 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
                 return False, f"answers otherwise when called again on input #{k}", [STATE_BETWEEN_CALLS]
             return False, f"answers otherwise when input #1's objects are refilled with input #{k}'s values", [
                 KEYED_BY_OBJECT.format(k=k)]
-        as_called = called_as_notebook(ex, fn, cases)
+        as_called = called_as_notebook(ex, learner_function(fn), cases)
         if as_called is not None:
             return False, as_called[0], as_called[1]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
@@ -157,7 +162,8 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     kept between calls)."""
     args, kwargs = cases[k]
     details = [f"{type(err).__name__}: {err}"] + where_raised(err)
-    written = xor_power_hint(fn, err) or none_from_in_place_hint(fn) or signature_default_hint(ex, fn, kwargs)
+    written = xor_power_hint(fn, err, ex, (args, kwargs)) or signature_default_hint(ex, fn, args, kwargs) \
+        or none_from_in_place_hint(fn, err, (args, kwargs), ex.observe)
     if written:                 # read off the learner's source: what the error's words would only guess at
         details.append(f"hint: {written}")
     elif isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
@@ -172,8 +178,12 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
                        "itself (np.unique(..., axis=0, return_counts=True), np.add.at)")
     elif isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
         names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
-        details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
-                       "stub's parameter names and order")
+        if "positional-only arguments passed as keyword" in str(err):
+            details.append(f"hint: the check passes the arguments by name ({names}), and your `/` makes the ones "
+                           "before it positional-only: remove the `/` (the stub has none)")
+        else:
+            details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
+                           "stub's parameter names and order")
     if ("boolean subtract" in str(err) or "with two bool tensors" in str(err)) and has_polarities(kwargs):
         # numpy's and torch's words; with polarities at hand the likely aim is a sign, which `^` is not
         details.append("hint: `-` on two bool arrays or tensors (a sign as `(p > 0) - (p < 0)`) is refused, and "
@@ -258,8 +268,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     # the function only logs to (`log.append(len(t))`, a common habit) grows just the same and explains nothing
     cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
     hint = cache_hint if proven else None
-    if hint is None:            # slips read off the source (a value of None, `^` for `**`, another default)
-        hint = none_from_in_place_hint(fn) or xor_power_hint(fn) or signature_default_hint(ex, fn, kwargs)
+    if hint is None:            # slips read off the source, each proven: `^` for `**`, another default
+        hint = xor_power_hint(fn, None, ex, (args, kwargs), expected) or signature_default_hint(ex, fn, args, kwargs)
     memory = None       # memory_explains' answer on this input, asked once (it runs the function four times)
     if hint is None:
         memory = memory_explains(fn, ex, args, kwargs, got)
@@ -276,6 +286,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
         hint = stale_argument_hint(ex, fn, cases, k, got, expected)
     if hint is None and ex.observe is None:
         hint = _generic_mistake_hint(ex, fn, cases, k, got, expected)
+    if hint is None:            # the None of `b = b.sort()`, where a traced call sees the None
+        hint = none_from_in_place_hint(fn, None, (args, kwargs), ex.observe)
     # a global generator seeded inside: random numbers, the same at every call (after the generic mistakes: a
     # seed that draws nothing explains no value, and is only noted)
     seed_note = None
