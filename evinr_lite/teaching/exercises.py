@@ -76,6 +76,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .checking.run_check import NOT_DONE, run_check
+from .notebook_calls import NOTEBOOK_CALLS, NotebookCall
 
 __all__ = [
     "Exercise", "ExerciseWarning", "register", "unregister", "exercise", "get", "names", "reference",
@@ -101,6 +102,7 @@ class Exercise:
     atol: float = 1e-8
     compare: Callable[[Any, Any], str | None] | None = None
     observe: Callable[[Any, tuple, dict], Any] | None = None
+    call: NotebookCall | None = None     # how the notebooks call it (notebook_calls.py); None for an exercise of none
 
     def cases(self) -> list[tuple[tuple, dict]]:
         """The seeded inputs as (args, kwargs) pairs."""
@@ -140,7 +142,8 @@ def register(name: str, reference: Callable, make_inputs: Callable, *, hints: di
     """
     if not callable(reference) or not callable(make_inputs):
         raise TypeError("register needs a callable reference and a callable make_inputs(rng)")
-    ex = Exercise(name, reference, make_inputs, dict(hints or {}), rtol, atol, compare, observe)
+    ex = Exercise(name, reference, make_inputs, dict(hints or {}), rtol, atol, compare, observe,
+                  NOTEBOOK_CALLS.get(name))
     _REGISTRY[name] = ex
     return ex
 

@@ -14,11 +14,18 @@ check itself, one job per module, lowest first:
   inputs;
 - ``across_calls``: mistakes seen only across inputs or on a second call (kept state, a stale argument, the same
   factor on every input, a shared result, a reseeded generator);
+- ``learner_source``: slips read off the learner's source once it failed, each named on evidence (`^` for a power,
+  where `**` in its place matches; the None of ``b = b.sort()``, where the None shows), and whether a
+  NotImplementedError is the stub's own raise;
+- ``signature``: the function called as the notebooks call it (each exercise's call, teaching/notebook_calls.py), and
+  a default other than the stub's named where the stub's default makes the input match;
 - ``run_check``: the main loop tying them together, in the order the report relies on.
 
 An exercise is named in annotations by the protocol ``ExerciseLike``, never by the registry's ``Exercise``: this
 package never imports the registry (which imports it), so that the check stays below the registry, with no circle.
 """
-from . import across_calls, global_state, hints, learner_calls, mistakes, outputs, protocol, run_check
+from . import (across_calls, global_state, hints, learner_calls, learner_source, mistakes, outputs, protocol, run_check,
+               signature)
 
-__all__ = ["protocol", "outputs", "global_state", "learner_calls", "hints", "mistakes", "across_calls", "run_check"]
+__all__ = ["protocol", "outputs", "global_state", "learner_calls", "hints", "mistakes", "across_calls",
+           "learner_source", "signature", "run_check"]

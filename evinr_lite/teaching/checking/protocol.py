@@ -17,6 +17,7 @@ class ExerciseLike(Protocol):
     atol: float
     compare: Callable[[Any, Any], str | None] | None          # compare(got, expected) -> message, replacing it
     observe: Callable[[Any, tuple, dict], Any] | None         # observe(result, args, kwargs): what is compared
+    call: Any                 # how the notebooks call it (teaching.notebook_calls.NotebookCall), or None
 
     def cases(self) -> list[tuple[tuple, dict]]:
         """The seeded inputs as (args, kwargs) pairs."""

@@ -12,7 +12,15 @@ the rest), and last a notebook variable that only grew. A model among the inputs
 parameters requiring grad, than the reference leaves it is named after each call. After every input matched, the last
 one is run a second time from other states of the global generators (:func:`_second_call`, :mod:`.across_calls`,
 :mod:`.global_state`), and input #1's own objects are refilled in place with a later input's values and given again
-(:func:`.across_calls.same_objects_new_values`: a cache keyed by id()). The order is the report's:
+(:func:`.across_calls.same_objects_new_values`: a cache keyed by id()), and last the function is called as the
+notebooks call it (:func:`.signature.called_as_notebook`, each exercise's recorded call, only where its signature
+differs from the stub's); a function that cannot take the inputs by name (a parameter renamed, or positional-only) is
+called so throughout (:func:`.signature.notebook_caller`). Slips read off the learner's source and proven by a call
+come first among the hints, and in a raised error's report before the guesses from the error's words: `^` for a
+power (the function with `**` in its place matches, or numpy's or torch's error refuses `^` on floats) and a default
+other than the stub's where an input leaves it out (with the stub's default passed, the input matches); the None of
+``b = b.sort()`` (:mod:`.learner_source`), named only where a None shows (the error's words, a traced call), comes
+after the exercise's own and the generic wrong versions. The order is the report's:
 change it and other hints win. Returns (passed, headline, detail lines); printing is
 :func:`evinr_lite.teaching.exercises.check`'s.
 """
@@ -29,9 +37,11 @@ from .hints import (aliased_rows_hint, axes_order_hint, generic_hint, has_repeat
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
 from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, module_flags,
                             module_flags_message, poison_freed_memory, run, watching, where_raised)
+from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
+from .signature import called_as_notebook, learner_function, notebook_caller, signature_default_hint
 
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
 
@@ -47,6 +57,7 @@ def run_check(ex: ExerciseLike, fn: Callable) -> Report:
     main run never reaches (a hint's search runs the others), or that raises right after, leaves the notebook as
     it was. Such a change is named in the report (`also: ...`) when the main run did not name it already."""
     settings = global_settings()
+    fn = notebook_caller(ex, fn)       # a parameter renamed or positional-only: called as the notebook calls it
     with imports_watched() as imported:
         try:
             with watching(fn) as seen:
@@ -87,7 +98,9 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             got = run(fn, args, kwargs, ex.observe, inputs_after=after, settings_changed=changed_settings)
             if k == n - 1:
                 rng_after = rng_states()
-        except NotImplementedError:
+        except NotImplementedError as err:
+            if not stub_raised(err):      # torch's own (an operation it has no kernel for), not the stub's
+                return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except Exception as err:
@@ -135,6 +148,9 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
                 return False, f"answers otherwise when called again on input #{k}", [STATE_BETWEEN_CALLS]
             return False, f"answers otherwise when input #1's objects are refilled with input #{k}'s values", [
                 KEYED_BY_OBJECT.format(k=k)]
+        as_called = called_as_notebook(ex, learner_function(fn), cases)
+        if as_called is not None:
+            return False, as_called[0], as_called[1]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
 
 
@@ -146,7 +162,11 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     kept between calls)."""
     args, kwargs = cases[k]
     details = [f"{type(err).__name__}: {err}"] + where_raised(err)
-    if isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
+    written = xor_power_hint(fn, err, ex, (args, kwargs)) or signature_default_hint(ex, fn, args, kwargs) \
+        or none_from_in_place_hint(fn, err, (args, kwargs), ex.observe)
+    if written:                 # read off the learner's source: what the error's words would only guess at
+        details.append(f"hint: {written}")
+    elif isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
         details.append("hint: a cache (functools.lru_cache, functools.cache, or a dict keyed by the "
                        "arguments) needs hashable arguments, and an array, a list or a dict is not one; "
                        "drop the cache (nothing here is slow enough to need one), or key it by "
@@ -158,8 +178,12 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
                        "itself (np.unique(..., axis=0, return_counts=True), np.add.at)")
     elif isinstance(err, TypeError) and len(details) == 1:    # the call itself failed, not a line inside
         names = ", ".join(list(kwargs)) or f"{len(args)} positional arguments"
-        details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
-                       "stub's parameter names and order")
+        if "positional-only arguments passed as keyword" in str(err):
+            details.append(f"hint: the check passes the arguments by name ({names}), and your `/` makes the ones "
+                           "before it positional-only: remove the `/` (the stub has none)")
+        else:
+            details.append(f"hint: the check calls your function as the stub declares it ({names}): keep the "
+                           "stub's parameter names and order")
     if ("boolean subtract" in str(err) or "with two bool tensors" in str(err)) and has_polarities(kwargs):
         # numpy's and torch's words; with polarities at hand the likely aim is a sign, which `^` is not
         details.append("hint: `-` on two bool arrays or tensors (a sign as `(p > 0) - (p < 0)`) is refused, and "
@@ -170,7 +194,8 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
         details.append("hint: `-` on two bool arrays or tensors is refused: make them integers first "
                        "(`.astype(int)`, `.long()` for tensors) for a difference of counts or a sign; for masks "
                        "use `&`, `|`, `~` (a and not b: `a & ~b`)")
-    details += _python_on_arrays_hints(err, " ".join(details[1:]))
+    if not written:
+        details += _python_on_arrays_hints(err, " ".join(details[1:]))
     if isinstance(err, RuntimeError) and "does not require grad" in str(err):
         details.append("hint: the loss has no autograd graph to back-propagate: it was computed under "
                        "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
@@ -205,7 +230,7 @@ def _python_on_arrays_hints(err: Exception, line: str) -> list[str]:
         return ["hint: `and`, `or`, `not`, `if` and a chained comparison such as `a < t <= b` (which Python reads "
                 "as `a < t and t <= b`) each need one True or False, and an array holds many: combine element-wise "
                 "comparisons with `&`, `|` and `~`, each comparison in its own brackets: `(a < t) & (t <= b)`"]
-    if isinstance(err, TypeError) and "ufunc 'bitwise_" in msg:
+    if isinstance(err, TypeError) and "ufunc 'bitwise_" in msg and "bitwise_xor" not in msg:
         return ["hint: `&` and `|` bind more tightly than comparisons: `t > a & t <= b` reads `t > (a & t) <= b`, "
                 "and `&` of floats is refused; put each comparison in brackets: `(t > a) & (t <= b)`"]
     if isinstance(err, TypeError) and "converted to Python scalars" in msg and "math." in line:
@@ -243,6 +268,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     # the function only logs to (`log.append(len(t))`, a common habit) grows just the same and explains nothing
     cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
     hint = cache_hint if proven else None
+    if hint is None:            # slips read off the source, each proven: `^` for `**`, another default
+        hint = xor_power_hint(fn, None, ex, (args, kwargs), expected) or signature_default_hint(ex, fn, args, kwargs)
     memory = None       # memory_explains' answer on this input, asked once (it runs the function four times)
     if hint is None:
         memory = memory_explains(fn, ex, args, kwargs, got)
@@ -259,6 +286,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
         hint = stale_argument_hint(ex, fn, cases, k, got, expected)
     if hint is None and ex.observe is None:
         hint = _generic_mistake_hint(ex, fn, cases, k, got, expected)
+    if hint is None:            # the None of `b = b.sort()`, where a traced call sees the None
+        hint = none_from_in_place_hint(fn, None, (args, kwargs), ex.observe)
     # a global generator seeded inside: random numbers, the same at every call (after the generic mistakes: a
     # seed that draws nothing explains no value, and is only noted)
     seed_note = None
