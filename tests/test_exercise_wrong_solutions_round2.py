@@ -233,9 +233,7 @@ WRONG = [
     ("esim_interval", lambda L_a, L_b, t_a, t_b, ref, C: (
         lambda times, p, r: (times, p, float(L_b)))(*exercises.reference("esim_interval")(L_a, L_b, t_a, t_b, ref, C)),
      "not to L_b"),
-    # a parameter dropped: neither the inputs' names nor notebook 01's positional call fit (renamed ones, which the
-    # notebook's positional call fits, pass since round 14's review)
-    ("integrate_events_1d", lambda t, p, C: pde1d.integrate_events_1d(t, p, C, np.zeros(1)), "parameter names"),
+    ("integrate_events_1d", lambda t, p, C, tq: pde1d.integrate_events_1d(t, p, C, tq), "parameter names"),
 ]
 
 

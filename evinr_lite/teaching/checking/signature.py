@@ -114,12 +114,15 @@ def _how(call, ref: inspect.Signature) -> str:
 
 
 def notebook_caller(ex: ExerciseLike, fn: Callable) -> Callable:
-    """``fn``, or, where some input cannot be passed to it by name (a parameter renamed, or positional-only) but
-    every input can be passed as the notebook's call passes it, a function that takes the inputs by name and calls
-    ``fn`` that way (:func:`learner_function` gives ``fn`` back)."""
+    """``fn``, or, where some input cannot be passed to it by name (a positional-only parameter of the stub's name)
+    but every input can be passed as the notebook's call passes it, a function that takes the inputs by name and
+    calls ``fn`` that way (:func:`learner_function` gives ``fn`` back). A parameter renamed is not: the stub's
+    names are the exercise's contract (round 2), and the report says so."""
     call, ref, own = getattr(ex, "call", None), _signature(ex.reference), _signature(fn)
     if call is None or ref is None or own is None or _same_signature(ref, own):
         return fn
+    if list(own.parameters) != list(ref.parameters):
+        return fn       # a parameter renamed, added or dropped: the stub's names are the exercise's contract
     try:
         cases = ex.cases()
     except Exception:
