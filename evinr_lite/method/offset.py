@@ -55,6 +55,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
+from ..core.checks import real_number, short_repr, whole_number
+from ..core.events import EventDataError
+from ..core.guard import dense_array
 from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues
 
@@ -76,9 +79,48 @@ STATIC_COARSE_PX = 8.0   # camera="static": the rest solve sets the offset's str
 LEFT_OUT = 1e6           # +-M for a left-out frame's value (times the values' scale): far outside any gradient
 
 
+def _numbers(value, name: str, what: str) -> np.ndarray:
+    """``value`` as an array of finite numbers (any shape, its dtype kept; ``what``: what it must be, in the
+    message); None, text, booleans, NaN or inf were numpy's or Python's errors, or came out as NaN without a word."""
+    arr = None if value is None or isinstance(value, (str, bytes)) else \
+        dense_array(value, f"{name}=", error=EventDataError, want=what)
+    if arr is None or arr.dtype.kind not in "iuf":
+        raise EventDataError(f"{name}= must be {what} (numbers), got {short_repr(value)}")
+    if arr.dtype.kind == "f" and arr.size and not (np.isfinite(arr.min()) and np.isfinite(arr.max())):
+        n_bad = int((~np.isfinite(arr)).sum())
+        raise EventDataError(f"{name}= holds {n_bad:,} NaN or infinite value(s); the result would be NaN: repair "
+                             f"or drop them")
+    return arr
+
+
+def _log_stack(frames, name: str = "frames") -> np.ndarray:
+    """``frames`` as the [K, H, W] log intensities of the offset solves (at least one frame of one pixel, finite);
+    its dtype kept. None or text were "got shape ()", NaN gave a NaN offset."""
+    F = _numbers(frames, name, "log intensities [K, H, W]")
+    if F.ndim != 3 or min(F.shape) < 1:
+        raise EventDataError(f"{name}= must be [K, H, W] log intensities (at least one frame of at least one "
+                             f"pixel), got shape {F.shape}" + ("; one image [H, W] is frames[None]"
+                                                               if F.ndim == 2 else ""))
+    return F
+
+
 def poisson_integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
     """The image g [H, W] whose forward differences best match (gx [H, W-1], gy [H-1, W]) in least
-    squares: (Dx^T Dx + Dy^T Dy) g = Dx^T gx + Dy^T gy, solved with the DCT; mean(g) = 0."""
+    squares: (Dx^T Dx + Dy^T Dy) g = Dx^T gx + Dy^T gy, solved with the DCT; mean(g) = 0.
+
+    gx and gy are checked: finite numbers, 2-D, of the shapes of one H x W image's differences (None or text were
+    AttributeErrors, shapes that disagree numpy's broadcast errors, NaN a NaN image)."""
+    gx = _numbers(gx, "gx", "the x differences [H, W-1]")
+    gy = _numbers(gy, "gy", "the y differences [H-1, W]")
+    if gx.ndim != 2 or gy.ndim != 2 or gy.shape != (gx.shape[0] - 1, gx.shape[1] + 1):
+        raise EventDataError(f"gx and gy must be the differences of one H x W image, gx [H, W-1] and gy [H-1, W], "
+                             f"got shapes {gx.shape} and {gy.shape}; e.g. gx = np.diff(img, axis=1), "
+                             "gy = np.diff(img, axis=0)")
+    return _integrate(gx, gy)
+
+
+def _integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
+    """:func:`poisson_integrate` without its checks (the solves' own differences)."""
     H, W = gx.shape[0], gy.shape[1]
     div = np.zeros((H, W))
     div[:, :-1] -= gx
@@ -97,7 +139,11 @@ def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
     DCT-II basis (the mirrored image's Fourier basis) each coefficient is multiplied by the Gaussian's
     transfer function exp(-sigma^2 (wx^2 + wy^2) / 2), w = pi k / N the frequency along each axis. From
     2 px on it is scipy.ndimage.gaussian_filter(mode="reflect") to 1e-9 (below, sampling its kernel aliases)."""
-    img = np.asarray(image, np.float64)
+    img = _numbers(image, "image", "an image [H, W]")
+    if img.ndim != 2 or img.size == 0:
+        raise EventDataError(f"image= must be one image [H, W] of at least one pixel, got shape {img.shape}")
+    img = img.astype(np.float64, copy=False)
+    sigma_px = real_number(sigma_px, "sigma_px", lo=0, hint="the Gaussian's standard deviation in pixels")
     H, W = img.shape
     wy, wx = np.pi * np.arange(H) / H, np.pi * np.arange(W) / W
     gain = np.exp(-0.5 * sigma_px ** 2 * (wy[:, None] ** 2 + wx[None, :] ** 2))
@@ -108,9 +154,7 @@ def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
 def median_gradient_offset(frames) -> np.ndarray:
     """The offset g [H, W] (float64, mean 0) to add to every frame of ``frames`` [K, H, W] (log
     intensities over the sequence) so that the temporal median of each pixel's gradient is zero."""
-    frames = np.asarray(frames)
-    if frames.ndim != 3 or frames.shape[0] < 1:
-        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {frames.shape}")
+    frames = _log_stack(frames)
     # a block of rows at a time, with time as the contiguous axis: the same float64 differences and
     # medians as on the whole stack, a few times faster, and work arrays of one block (about 2 M
     # cells) instead of three float64 copies of the stack (which matters at HD, where K is 64 or more)
@@ -132,7 +176,7 @@ def median_gradient_offset(frames) -> np.ndarray:
     # numpy's median releases the GIL: the blocks run on the kit's threads (the same numbers on any count)
     with ThreadPoolExecutor(max(1, min(len(starts), cpu_threads()))) as pool:
         list(pool.map(block_medians, starts))
-    return poisson_integrate(gx, gy)
+    return _integrate(gx, gy)
 
 
 class SumAbsProx:
@@ -307,9 +351,9 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
     ``rest``: None (every frame counts), or log units: each edge's term counts only the frames where one
     of its pixels lies more than ``rest`` from its temporal median (a static camera; the module's
     docstring); the frames' median image [H, W] is one more float32 image in memory."""
-    F = np.asarray(frames)
-    if F.ndim != 3 or F.shape[0] < 1:
-        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {F.shape}")
+    F = _log_stack(frames)
+    max_iters = whole_number(max_iters, "max_iters", lo=0)
+    tol = real_number(tol, "tol", lo=0, hint="a share of the mean |gradient| (e.g. 1e-3)")
     K, H, W = F.shape
     if H < 2 or W < 2:                              # no edges in one direction: the median answer
         return median_gradient_offset(F)
@@ -325,13 +369,13 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
             both(lambda: _leave_out_rest(bx, moved, 2, scale), lambda: _leave_out_rest(by, moved, 1, scale))
         rho = K * L1_RHO / scale if scale > 0 else 1.0
         px, py = both(lambda: SumAbsProx(bx, rho), lambda: SumAbsProx(by, rho))
-        g = poisson_integrate(px.median.reshape(H, W - 1), py.median.reshape(H - 1, W))   # the per-edge medians
+        g = _integrate(px.median.reshape(H, W - 1), py.median.reshape(H - 1, W))   # the per-edge medians
         if not scale > 0:                           # flat frames: nothing to make sparser
             return g
         x, y = _EdgeSplit(px, np.diff(g, axis=1)), _EdgeSplit(py, np.diff(g, axis=0))
         for _ in range(max_iters):
             tx, ty = both(lambda: x.step(np.diff(g, axis=1)), lambda: y.step(np.diff(g, axis=0)))
-            g_new = poisson_integrate(tx.reshape(H, W - 1), ty.reshape(H - 1, W))
+            g_new = _integrate(tx.reshape(H, W - 1), ty.reshape(H - 1, W))
             moved = float(np.abs(g_new - g).max())
             g = g_new
             if moved <= tol * scale:
