@@ -63,25 +63,64 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.checks import real_number, short_repr, whole_number
 from ..core.events import EventDataError
+from ..core.guard import dense_array
 from ..core.frames import Frames
 
 __all__ = ["FRAME_EPS", "ANCHOR_MODES", "AnchorFit", "frames_in_window", "select_anchors", "fit_anchor",
-           "frame_log", "linear_frames", "held_out"]
+           "frame_log", "linear_frames", "linear_frames_unchecked", "held_out"]
 
 FRAME_EPS = 1.0 / 255.0     # added to frame intensities in [0, 1] before the log (black pixels stay finite)
 ANCHOR_MODES = ("none", "first", "all")
 
 
+def _check_eps(eps) -> float:
+    """The offset added before the log: a finite number in [0, 1) (FRAME_EPS, 1/255, by default); None or text were
+    numpy's errors, NaN gave NaN frames and a negative one the log of negative intensities."""
+    eps = real_number(eps, "eps", lo=0.0, hint="the intensity added before the log (FRAME_EPS, 1/255)")
+    if eps >= 1:
+        raise EventDataError(f"eps= must be a finite number in [0, 1) (the intensity added before the log, "
+                             f"FRAME_EPS = 1/255), got {eps!r}")
+    return eps
+
+
+def _values(value, name: str, what: str) -> np.ndarray:
+    """``value`` as an array of numbers (booleans, text and None refused by ``name``; its dtype kept)."""
+    arr = None if value is None or isinstance(value, (str, bytes)) else \
+        dense_array(value, f"{name}=", error=EventDataError, want=what)
+    if arr is None or arr.dtype.kind not in "iuf":
+        raise EventDataError(f"{name}= must be {what} (numbers), got {short_repr(value)}")
+    return arr
+
+
 def frame_log(images, eps: float = FRAME_EPS) -> np.ndarray:
-    """log(I + eps) of frames given as uint8 (0..255) or float in [0, 1]: float64, same shape."""
-    a = np.asarray(images)
+    """log(I + eps) of frames given as uint8 (0..255) or float in [0, 1]: float64, same shape. NaN images and an
+    eps outside [0, 1) are refused (they gave NaN logs)."""
+    eps_value = _check_eps(eps)
+    a = _values(images, "images", "frames, uint8 or floats in [0, 1]")
+    if a.dtype.kind == "f" and np.isnan(a).any():
+        raise EventDataError(f"images= holds {int(np.isnan(a).sum()):,} NaN value(s); a frame's intensity must be "
+                             "a number: repair or drop those frames")
     a = a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else np.clip(a.astype(np.float64), 0.0, 1.0)
-    return np.log(a + eps)
+    return np.log(a + (eps if isinstance(eps, (int, float, np.integer, np.floating)) else eps_value))
 
 
 def linear_frames(L, eps: float = FRAME_EPS) -> np.ndarray:
-    """Anchored log intensity -> the frames' linear intensity, clip(exp(L) - eps, 0, 1): float32."""
+    """Anchored log intensity -> the frames' linear intensity, clip(exp(L) - eps, 0, 1): float32.
+
+    ``L``: numbers (a NaN was a NaN frame, None a NaN "frame" of no shape); +-inf are the logs of saturation and 0.
+    ``eps``: a finite number in [0, 1)."""
+    eps_value = _check_eps(eps)
+    values = _values(L, "L", "log intensities")
+    if values.dtype.kind == "f" and np.isnan(values).any():
+        raise EventDataError(f"L= holds {int(np.isnan(values).sum()):,} NaN value(s); a log intensity must be a "
+                             "number (NaN frames would come out)")
+    return linear_frames_unchecked(L, eps if isinstance(eps, (int, float, np.integer, np.floating)) else eps_value)
+
+
+def linear_frames_unchecked(L, eps: float = FRAME_EPS) -> np.ndarray:
+    """:func:`linear_frames` without its checks (the solver's own values, checked with its result)."""
     return np.clip(np.exp(np.minimum(np.asarray(L, np.float64), 1.0)) - eps, 0.0, 1.0).astype(np.float32)
 
 
@@ -113,7 +152,9 @@ def select_anchors(n_frames: int, mode: str, every: int = 2) -> np.ndarray:
     if mode == "first":
         return np.zeros(1, np.int64)
     if mode == "all":
-        return np.arange(0, n_frames, int(every), dtype=np.int64)
+        n_frames = whole_number(n_frames, "n_frames", lo=1)
+        every = whole_number(every, "every", lo=1)   # 0 was a ZeroDivisionError, -1 no anchor, 2.5 and "2" taken
+        return np.arange(0, n_frames, every, dtype=np.int64)
     raise EventDataError(f"anchor must be one of {ANCHOR_MODES}, got {mode!r}")
 
 
@@ -127,7 +168,13 @@ def held_out(frame_t, anchor_times, tol: float = 1e-9) -> np.ndarray:
 
 
 def smoothing_matrix(times: np.ndarray, smoothing: float) -> np.ndarray:
-    """The K x K matrix I + s D^T diag(1 / dt) D of the soft-anchor problem (symmetric positive definite)."""
+    """The K x K matrix I + s D^T diag(1 / dt) D of the soft-anchor problem (symmetric positive definite).
+    ``times``: finite seconds [K], in order; ``smoothing``: seconds >= 0 (NaN or -1 were no smoothing, times out of
+    order a matrix of 10^8)."""
+    smoothing = real_number(smoothing, "smoothing", lo=0.0, hint="seconds (anchor_smoothing_s, e.g. 0.03)")
+    times = _values(times, "times", "anchor times in seconds [K]")
+    if times.ndim != 1 or (times.dtype.kind == "f" and not np.isfinite(times).all()) or (np.diff(times) < 0).any():
+        raise EventDataError(f"times= must be finite seconds [K] in time order, got {short_repr(times)}")
     K = len(times)
     A = np.eye(K)
     if K > 1 and smoothing > 0:
