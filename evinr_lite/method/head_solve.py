@@ -41,6 +41,8 @@ import scipy.fft
 import scipy.linalg
 import torch
 
+from ..core.checks import real_number, short_repr, whole_number
+from ..core.events import EventDataError
 from ..core.runtime import cpu_threads
 
 __all__ = ["solve_head", "laplacian_eigenvalues", "penalty_spectrum"]
@@ -57,7 +59,17 @@ def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int | str = 1)
     |D f|^2); order 2, mu^2 / mu_ref (the Laplacian's energy, |D^T D f|^2, scaled to equal order 1 at
     ``ORDER_REFERENCE`` of Nyquist): less smoothing of the coarser structure, more of the finer;
     "banded", mu up to mu_ref and mu^3 / mu_ref^2 beyond (the gradient's energy for structure coarser than
-    the reference wavelength, a third-order roll-off for finer structure; continuous at mu_ref)."""
+    the reference wavelength, a third-order roll-off for finer structure; continuous at mu_ref).
+
+    Checked: ``mu`` an array of numbers (None came back as None), ``cx``, ``cy`` finite weights >= 0 (text or NaN
+    were taken or numpy's errors), ``order`` 1, 2 or "banded" (True was taken as 1)."""
+    if mu is None or isinstance(mu, (str, bytes)) or np.asarray(mu).dtype.kind not in "iuf":
+        raise EventDataError(f"mu= must be the Laplacian's eigenvalues [H, W] (numbers; laplacian_eigenvalues(...)), "
+                             f"got {short_repr(mu)}")
+    for name, c in (("cx", cx), ("cy", cy)):
+        real_number(c, name, lo=0.0, hint="the penalty's weight along that axis")
+    if isinstance(order, (bool, np.bool_)):
+        raise ValueError(f"order must be 1 (the gradient), 2 (the Laplacian) or 'banded', got {order!r}")
     if order == 1:
         return mu
     if order not in (2, "banded"):
@@ -72,8 +84,18 @@ def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int | str = 1)
 
 def laplacian_eigenvalues(sensor_size, cx: float = 1.0, cy: float = 1.0) -> np.ndarray:
     """Eigenvalues [H, W] of cx Dx^T Dx + cy Dy^T Dy (forward differences, Neumann borders) in the
-    orthonormal DCT-II basis (``scipy.fft.dctn(..., norm="ortho")``); [0, 0] is 0 (constants)."""
-    H, W = sensor_size
+    orthonormal DCT-II basis (``scipy.fft.dctn(..., norm="ortho")``); [0, 0] is 0 (constants).
+
+    ``sensor_size``: (H, W), whole numbers >= 1 (0 or -1 gave eigenvalues of no pixel, 2.5 of a made-up sensor);
+    ``cx``, ``cy``: finite weights >= 0 (NaN gave NaN eigenvalues, -1 negative ones)."""
+    try:
+        H, W = sensor_size
+    except (TypeError, ValueError):
+        raise EventDataError(f"sensor_size= must be (H, W), two whole numbers >= 1, got {short_repr(sensor_size)}") \
+            from None
+    H, W = whole_number(H, "sensor_size: H", lo=1), whole_number(W, "sensor_size: W", lo=1)
+    for name, c in (("cx", cx), ("cy", cy)):
+        real_number(c, name, lo=0.0, hint="the weight of that axis' differences")
     ex = 2 - 2 * np.cos(np.pi * np.arange(W) / W)
     ey = 2 - 2 * np.cos(np.pi * np.arange(H) / H)
     return cy * ey[:, None] + cx * ex[None, :]

@@ -22,23 +22,62 @@ from __future__ import annotations
 
 import torch
 
+from ..core.events import EventDataError
+
 __all__ = ["temporal_loss_derivative", "temporal_loss_difference", "tikhonov", "total_variation", "spatial_differences"]
+
+
+def _frames_tensor(value, name: str, what: str = "[..., B, H, W]") -> torch.Tensor:
+    """``value`` when it is a torch tensor of at least three axes (frames over bins); None, text or a numpy array
+    were Python's or torch's errors ("'NoneType' object is not subscriptable", "too many indices")."""
+    if not isinstance(value, torch.Tensor):
+        raise EventDataError(f"{name} must be a torch tensor {what}, got {type(value).__name__}"
+                             + ("; torch.from_numpy(a) makes one" if type(value).__module__ == "numpy" else ""))
+    if value.ndim < 3:
+        raise EventDataError(f"{name} must be frames {what} (at least 3 axes), got shape {tuple(value.shape)}")
+    return value
+
+
+def _same_frames(a: torch.Tensor, b: torch.Tensor, names: str, extra_bin: int = 0) -> None:
+    """Two stacks of frames over bins that go together (``a`` has ``extra_bin`` more bins): their H x W, bins and
+    leading axes must agree (torch's "size of tensor a (5) must match" named neither)."""
+    lead = True
+    try:
+        torch.broadcast_shapes(a.shape[:-3], b.shape[:-3])
+    except RuntimeError:
+        lead = False
+    if not lead or a.shape[-2:] != b.shape[-2:] or a.shape[-3] != b.shape[-3] + extra_bin:
+        raise EventDataError(f"{names} do not go together: shapes {tuple(a.shape)} and {tuple(b.shape)}"
+                             + (f" (the first must have one more bin: B + 1 boundaries for B bins, of one H x W)"
+                                if extra_bin else " (one frame per bin each, of one H x W)"))
 
 
 def temporal_loss_derivative(dF_dt: torch.Tensor, event_frames: torch.Tensor, durations: torch.Tensor) -> torch.Tensor:
     """Eq. 5-6. dF_dt, event_frames: [..., B, H, W]; durations: [..., B] seconds. Returns a scalar."""
+    _same_frames(_frames_tensor(dF_dt, "dF_dt"), _frames_tensor(event_frames, "event_frames"),
+                 "dF_dt and event_frames")
+    if not isinstance(durations, torch.Tensor) or durations.ndim < 1 or durations.shape[-1] != dF_dt.shape[-3]:
+        raise EventDataError(f"durations must be a torch tensor [..., B] of the {dF_dt.shape[-3]} bins' lengths in "
+                             f"seconds, got {type(durations).__name__} "
+                             f"{tuple(durations.shape) if hasattr(durations, 'shape') else ''}".rstrip())
     predicted = dF_dt * durations[..., None, None]
     return torch.mean((event_frames - predicted) ** 2)
 
 
 def temporal_loss_difference(F_boundaries: torch.Tensor, event_frames: torch.Tensor) -> torch.Tensor:
     """F at the B + 1 bin boundaries [..., B + 1, H, W] against event frames [..., B, H, W]. Scalar."""
+    _same_frames(_frames_tensor(F_boundaries, "F_boundaries", "[..., B + 1, H, W]"),
+                 _frames_tensor(event_frames, "event_frames"), "F_boundaries and event_frames", extra_bin=1)
     predicted = F_boundaries[..., 1:, :, :] - F_boundaries[..., :-1, :, :]
     return torch.mean((event_frames - predicted) ** 2)
 
 
 def spatial_differences(F: torch.Tensor):
     """Forward differences along x (columns) and y (rows): ([..., H, W-1], [..., H-1, W])."""
+    if not isinstance(F, torch.Tensor) or F.ndim < 2:
+        raise EventDataError(f"F must be a torch tensor of frames [..., H, W], got {type(F).__name__}"
+                             + (f" of shape {tuple(F.shape)}" if hasattr(F, "shape") else "")
+                             + ("; torch.from_numpy(a) makes one" if type(F).__module__ == "numpy" else ""))
     return F[..., :, 1:] - F[..., :, :-1], F[..., 1:, :] - F[..., :-1, :]
 
 
