@@ -116,7 +116,7 @@ def linear_frames(L, eps: float = FRAME_EPS) -> np.ndarray:
     if values.dtype.kind == "f" and np.isnan(values).any():
         raise EventDataError(f"L= holds {int(np.isnan(values).sum()):,} NaN value(s); a log intensity must be a "
                              "number (NaN frames would come out)")
-    return linear_frames_unchecked(L, eps if isinstance(eps, (int, float, np.integer, np.floating)) else eps_value)
+    return linear_frames_unchecked(values, eps if isinstance(eps, (int, float, np.integer, np.floating)) else eps_value)
 
 
 def linear_frames_unchecked(L, eps: float = FRAME_EPS) -> np.ndarray:
