@@ -59,11 +59,12 @@ from ..core.checks import real_number, short_repr, whole_number
 from ..core.events import EventDataError
 from ..core.guard import dense_array
 from ..core.runtime import cpu_threads
-from .head_solve import laplacian_eigenvalues
+from .head_solve import laplacian_eigenvalues_unchecked
 
 __all__ = ["median_gradient_offset", "l1_gradient_offset", "SumAbsProx", "offset_image", "poisson_integrate",
            "offset_trend", "trend_intervals", "trend_knots", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES",
-           "STATIC_REST", "STATIC_COARSE_PX", "gaussian_lowpass"]
+           "STATIC_REST", "STATIC_COARSE_PX", "gaussian_lowpass",
+           "gaussian_lowpass_unchecked", "MAX_SIGMA_PX"]
 
 MIN_TREND_FRAMES = 8     # a knot's median looks at least at this many grid frames (the nearest, if its window holds fewer)
 OFFSET_SOLVES = ("none", "median_gradient", "l1_gradient")
@@ -127,7 +128,7 @@ def _integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
     div[:, 1:] += gx
     div[:-1, :] -= gy
     div[1:, :] += gy
-    mu = laplacian_eigenvalues((H, W))
+    mu = laplacian_eigenvalues_unchecked((H, W))
     mu[0, 0] = 1.0
     g = scipy.fft.dctn(div, type=2, norm="ortho", workers=cpu_threads()) / mu
     g[0, 0] = 0.0
@@ -142,8 +143,19 @@ def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
     img = _numbers(image, "image", "an image [H, W]")
     if img.ndim != 2 or img.size == 0:
         raise EventDataError(f"image= must be one image [H, W] of at least one pixel, got shape {img.shape}")
-    img = img.astype(np.float64, copy=False)
     sigma_px = real_number(sigma_px, "sigma_px", lo=0, hint="the Gaussian's standard deviation in pixels")
+    return gaussian_lowpass_unchecked(img, sigma_px)
+
+
+MAX_SIGMA_PX = 1e100   # a Gaussian this wide keeps only the mean (every other gain underflows to 0); sigma^2 fits
+
+
+def gaussian_lowpass_unchecked(image, sigma_px: float) -> np.ndarray:
+    """:func:`gaussian_lowpass` without its checks (the solves' own images, which may hold a diverged network's
+    NaN: the caller's result check names that). A sigma above MAX_SIGMA_PX blurs as MAX_SIGMA_PX does (to the
+    image's mean): its square overflowed (Python's OverflowError at 1e200)."""
+    img = np.asarray(image, np.float64)
+    sigma_px = min(sigma_px, MAX_SIGMA_PX)
     H, W = img.shape
     wy, wx = np.pi * np.arange(H) / H, np.pi * np.arange(W) / W
     gain = np.exp(-0.5 * sigma_px ** 2 * (wy[:, None] ** 2 + wx[None, :] ** 2))
@@ -154,7 +166,14 @@ def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
 def median_gradient_offset(frames) -> np.ndarray:
     """The offset g [H, W] (float64, mean 0) to add to every frame of ``frames`` [K, H, W] (log
     intensities over the sequence) so that the temporal median of each pixel's gradient is zero."""
-    frames = _log_stack(frames)
+    return _median_gradient(_log_stack(frames))
+
+
+def _median_gradient(frames) -> np.ndarray:
+    """:func:`median_gradient_offset` without its checks (:func:`offset_image`: the solver's own frames)."""
+    frames = np.asarray(frames)
+    if frames.ndim != 3 or frames.shape[0] < 1:
+        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {frames.shape}")
     # a block of rows at a time, with time as the contiguous axis: the same float64 differences and
     # medians as on the whole stack, a few times faster, and work arrays of one block (about 2 M
     # cells) instead of three float64 copies of the stack (which matters at HD, where K is 64 or more)
@@ -354,9 +373,18 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
     F = _log_stack(frames)
     max_iters = whole_number(max_iters, "max_iters", lo=0)
     tol = real_number(tol, "tol", lo=0, hint="a share of the mean |gradient| (e.g. 1e-3)")
+    return _l1_gradient(F, max_iters, tol, rest)
+
+
+def _l1_gradient(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TOL, rest: float | None = None) -> np.ndarray:
+    """:func:`l1_gradient_offset` without its checks (:func:`offset_image`: the solver's own frames, which may
+    hold a diverged network's NaN; the solver's result check names that, with the settings to change)."""
+    F = np.asarray(frames)
+    if F.ndim != 3 or F.shape[0] < 1:
+        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {F.shape}")
     K, H, W = F.shape
     if H < 2 or W < 2:                              # no edges in one direction: the median answer
-        return median_gradient_offset(F)
+        return _median_gradient(F)
     # x and y edges are independent until the Poisson step: two threads (numpy releases the GIL), the
     # same numbers on any count
     with ThreadPoolExecutor(2 if cpu_threads() >= 2 else 1) as pool:
@@ -394,14 +422,14 @@ def offset_image(frames, method: str, rest: float | None = None) -> np.ndarray:
     if rest is not None and method != "l1_gradient":
         raise ValueError(f"rest= (a static camera) needs the 'l1_gradient' offset solve, got {method!r}")
     if method == "median_gradient":
-        return median_gradient_offset(frames)
+        return _median_gradient(frames)
     if method != "l1_gradient":
         raise ValueError(f"offset method must be 'median_gradient' or 'l1_gradient', got {method!r}")
-    plain = l1_gradient_offset(frames)
+    plain = _l1_gradient(frames)
     if rest is None:
         return plain
-    moved = l1_gradient_offset(frames, rest=rest)    # a static camera: its fine structure, the plain solve's coarse
-    return moved + gaussian_lowpass(plain - moved, STATIC_COARSE_PX)
+    moved = _l1_gradient(frames, rest=rest)    # a static camera: its fine structure, the plain solve's coarse
+    return moved + gaussian_lowpass_unchecked(plain - moved, STATIC_COARSE_PX)
 
 
 @dataclass
