@@ -58,10 +58,11 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from ..core.checks import real_number, require, short_repr, whole_number
+from ..core.checks import require, short_repr, whole_number
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from ..core.guard import dense_array
+from .anchor import check_frame_eps
 from .binning import events_to_frames
 
 __all__ = ["frame_log_changes", "estimate_contrast_threshold", "frame_event_counts", "frame_trajectories",
@@ -71,12 +72,14 @@ __all__ = ["frame_log_changes", "estimate_contrast_threshold", "frame_event_coun
 def _check_pairing(frames, events, eps, exposed) -> float:
     """The frames, events, ``eps`` and ``exposed`` of a comparison of frames with events, checked (those of
     :func:`fit_contrast`, :func:`frame_log_changes`, :func:`frame_event_counts` and :func:`frame_trajectories`):
-    a Frames and an Events of one sensor, eps in (0, 1], exposed (low, high) with 0 <= low < high <= 1. Returns
+    a Frames and an Events of one sensor, eps a finite number >= 0 (:func:`~evinr_lite.method.anchor.check_frame_eps`,
+    the anchor's one rule; 0 worked for the helpers and is taken by fit_contrast too: the exposed mask leaves black
+    pixels out), exposed (low, high) with 0 <= low < high <= 1. Returns
     eps as a float. (Frames of another size than the events' sensor were compared pixel by pixel without a word,
     an eps of None or text and an exposed of None, one number or text were Python's or numpy's errors.)"""
     require(frames, Frames, "frames")
     require(events, Events, "events")
-    eps = real_number(eps, "eps", lo=0.0, hi=1.0, lo_open=True)
+    eps = check_frame_eps(eps)
     try:
         lo, hi = (float(v) for v in exposed)
     except (TypeError, ValueError):
@@ -171,27 +174,28 @@ def estimate_contrast_threshold(log_changes, net_counts):
         log_changes: float [M], ΔL of M pixels (already masked).
         net_counts: int [M], ON minus OFF events of the same pixels over the same intervals.
     Returns:
-        float C = sum(ΔL n) / sum(n^2) (NaN when every net count is 0: no event says what C is).
+        float C = sum(ΔL n) / sum(n^2); NaN when every net count is 0 or no pixel is given (no event says what C
+        is: an ON-only recording's OFF pixels, ``estimate_contrast_threshold(dL[off], n[off])``, are none).
     Raises:
-        EventDataError: values that are no numbers (None was NaN, text numpy's error), NaN or inf, none at all
-            (C of nothing was NaN), or two shapes (numpy's broadcast error, or one broadcast over the other).
+        EventDataError: values that are no numbers (None was NaN, text numpy's error), NaN or inf, or two shapes
+            (numpy's broadcast error). One count for every pixel (a scalar broadcast) is refused too: it summed
+            ΔL n over the M pixels but n^2 once (estimate_contrast_threshold(dL, 1) was sum(dL), not C).
     """
     d, n = (_pixel_values(v, name) for v, name in ((log_changes, "log_changes"), (net_counts, "net_counts")))
     if d.shape != n.shape:
         raise EventDataError(f"log_changes and net_counts must be one value per pixel each, of one shape, got shapes "
                              f"{d.shape} and {n.shape}; mask both with the same mask")
-    return float(np.sum(d * n) / np.sum(n * n))
+    with np.errstate(invalid="ignore", divide="ignore"):     # 0 / 0: no count says what C is (NaN, documented)
+        return float(np.sum(d * n) / np.sum(n * n))
 
 
 def _pixel_values(value, name: str) -> np.ndarray:
-    """``value`` (one number per pixel) as float64: numbers, finite, at least one."""
+    """``value`` (one number per pixel) as float64: numbers, finite (none at all is taken: C is NaN)."""
     arr = None if value is None or isinstance(value, (str, bytes)) else \
         dense_array(value, f"{name}=", error=EventDataError, want="one number per pixel (a 1-D array)")
     if arr is None or arr.dtype.kind not in "iuf":
         raise EventDataError(f"{name}= must be one number per pixel (a 1-D array of numbers), got {short_repr(value)}")
     arr = arr.astype(np.float64)
-    if arr.size == 0:
-        raise EventDataError(f"{name}= is empty: no pixel to fit C on (check the mask)")
     if not np.isfinite(arr).all():
         raise EventDataError(f"{name}= holds {int((~np.isfinite(arr)).sum()):,} NaN or infinite value(s); mask "
                              "them out")
