@@ -29,7 +29,8 @@ LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustn
          "test_api_round6.py", "test_ragged_inputs.py", "test_fuzz_readers.py", "test_robustness_round7.py",
          "test_robustness_round8.py", "test_robustness_round9.py", "test_robustness_round10.py",
          "test_robustness_round11.py", "test_robustness_round12.py", "test_robustness_round13.py",
-         "test_robustness_round14.py", "test_robustness_round15.py", "test_robustness_round16.py"]
+         "test_robustness_round14.py", "test_robustness_round15.py", "test_robustness_round16.py",
+         "test_robustness_round17.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
@@ -69,6 +70,10 @@ CLASSES = [
      "counts and the balance's sums, the simulator's thresholds, the zoo, the colour recording's writer, the scorer's "
      "LPIPS model, the figures' axes and one-pixel curves, degenerate recordings: counts, shapes, spans, flags, "
      "round 16", "test_robustness_round16.py", r"test_"),
+    ("the offset solves and their parts (Poisson integration, the low-pass), the anchor's helpers, the frames-against-"
+     "events helpers of the fit of C and its threshold, the head solve's spectrum and the notebooks' losses: NaN "
+     "frames, shapes that do not go together, eps, exposed, sensors, weights, counts of iterations and anchors, "
+     "round 17", "test_robustness_round17.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"

@@ -63,25 +63,66 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.checks import real_number, short_repr, whole_number
 from ..core.events import EventDataError
+from ..core.guard import dense_array
 from ..core.frames import Frames
 
 __all__ = ["FRAME_EPS", "ANCHOR_MODES", "AnchorFit", "frames_in_window", "select_anchors", "fit_anchor",
-           "frame_log", "linear_frames", "held_out"]
+           "frame_log", "linear_frames", "linear_frames_unchecked", "check_frame_eps", "held_out"]
 
 FRAME_EPS = 1.0 / 255.0     # added to frame intensities in [0, 1] before the log (black pixels stay finite)
 ANCHOR_MODES = ("none", "first", "all")
 
 
+def check_frame_eps(eps) -> float:
+    """The intensity added to frames in [0, 1] before the log (FRAME_EPS, 1/255, by default), checked: a finite
+    number >= 0, as a float. The one check of :func:`frame_log`, :func:`linear_frames` and the fit of C's frame
+    helpers (:mod:`evinr_lite.method.contrast`). None or text were numpy's errors, NaN gave NaN frames and a
+    negative one the log of negative intensities; 0 (black pixels' log is -inf, which the fit of C masks and
+    :func:`linear_frames` maps to 0) and 1 or more (a flatter log) are numbers that worked and still do."""
+    return real_number(eps, "eps", lo=0.0, hint="the intensity added to frames in [0, 1] before the log "
+                                                 "(FRAME_EPS = 1/255)")
+
+
+def _values(value, name: str, what: str, *, flags: bool = False) -> np.ndarray:
+    """``value`` as an array of numbers (text and None refused by ``name``, booleans too unless ``flags``, read as
+    0 and 1 as numpy reads them; its dtype kept)."""
+    arr = None if value is None or isinstance(value, (str, bytes)) else \
+        dense_array(value, f"{name}=", error=EventDataError, want=what)
+    if arr is None or arr.dtype.kind not in ("biuf" if flags else "iuf"):
+        raise EventDataError(f"{name}= must be {what} (numbers), got {short_repr(value)}")
+    return arr
+
+
 def frame_log(images, eps: float = FRAME_EPS) -> np.ndarray:
-    """log(I + eps) of frames given as uint8 (0..255) or float in [0, 1]: float64, same shape."""
-    a = np.asarray(images)
+    """log(I + eps) of frames given as uint8 (0..255) or float in [0, 1]: float64, same shape (booleans are 0 and 1,
+    a black and white image). NaN images and an eps that is no finite number >= 0 are refused (they gave NaN logs):
+    :func:`check_frame_eps`."""
+    eps_value = check_frame_eps(eps)
+    a = _values(images, "images", "frames, uint8 or floats in [0, 1]", flags=True)
+    if a.dtype.kind == "f" and np.isnan(a).any():
+        raise EventDataError(f"images= holds {int(np.isnan(a).sum()):,} NaN value(s); a frame's intensity must be "
+                             "a number: repair or drop those frames")
     a = a.astype(np.float64) / 255.0 if a.dtype == np.uint8 else np.clip(a.astype(np.float64), 0.0, 1.0)
-    return np.log(a + eps)
+    return np.log(a + (eps if isinstance(eps, (int, float, np.integer, np.floating)) else eps_value))
 
 
 def linear_frames(L, eps: float = FRAME_EPS) -> np.ndarray:
-    """Anchored log intensity -> the frames' linear intensity, clip(exp(L) - eps, 0, 1): float32."""
+    """Anchored log intensity -> the frames' linear intensity, clip(exp(L) - eps, 0, 1): float32.
+
+    ``L``: numbers (a NaN was a NaN frame, None a NaN "frame" of no shape); +-inf are the logs of saturation and 0;
+    booleans are 0 and 1, as numpy reads them (they were taken before). ``eps``: :func:`check_frame_eps`."""
+    eps_value = check_frame_eps(eps)
+    values = _values(L, "L", "log intensities", flags=True)
+    if values.dtype.kind == "f" and np.isnan(values).any():
+        raise EventDataError(f"L= holds {int(np.isnan(values).sum()):,} NaN value(s); a log intensity must be a "
+                             "number (NaN frames would come out)")
+    return linear_frames_unchecked(values, eps if isinstance(eps, (int, float, np.integer, np.floating)) else eps_value)
+
+
+def linear_frames_unchecked(L, eps: float = FRAME_EPS) -> np.ndarray:
+    """:func:`linear_frames` without its checks (the solver's own values, checked with its result)."""
     return np.clip(np.exp(np.minimum(np.asarray(L, np.float64), 1.0)) - eps, 0.0, 1.0).astype(np.float32)
 
 
@@ -109,11 +150,16 @@ def frames_in_window(frames, sensor_size, t_start: float, t_end: float, mode: st
 
 def select_anchors(n_frames: int, mode: str, every: int = 2) -> np.ndarray:
     """Indices (into the window's frames, in time order) of the anchor frames: [0] for "first",
-    [0, every, 2 every, ...] for "all" (every = 1: all of them, nothing left to score)."""
+    [0, every, 2 every, ...] for "all" (every = 1: all of them, nothing left to score). ``n_frames``: a whole
+    number >= 0 in both modes (-3 or None gave [0] for "first" and no anchor or Python's error for "all"); of no
+    frame there is no anchor ([] in both modes: "first" gave [0], the index of a frame that is not there)."""
+    if mode in ("first", "all"):
+        n_frames = whole_number(n_frames, "n_frames", lo=0)
     if mode == "first":
-        return np.zeros(1, np.int64)
+        return np.zeros(min(n_frames, 1), np.int64)
     if mode == "all":
-        return np.arange(0, n_frames, int(every), dtype=np.int64)
+        every = whole_number(every, "every", lo=1)   # 0 was a ZeroDivisionError, -1 no anchor, 2.5 and "2" taken
+        return np.arange(0, n_frames, every, dtype=np.int64)
     raise EventDataError(f"anchor must be one of {ANCHOR_MODES}, got {mode!r}")
 
 
@@ -127,7 +173,19 @@ def held_out(frame_t, anchor_times, tol: float = 1e-9) -> np.ndarray:
 
 
 def smoothing_matrix(times: np.ndarray, smoothing: float) -> np.ndarray:
-    """The K x K matrix I + s D^T diag(1 / dt) D of the soft-anchor problem (symmetric positive definite)."""
+    """The K x K matrix I + s D^T diag(1 / dt) D of the soft-anchor problem (symmetric positive definite).
+    ``times``: finite seconds [K], increasing (anchors are distinct frames: :func:`frames_in_window` refuses APS
+    frames of one timestamp); ``smoothing``: seconds >= 0 (NaN or -1 were no smoothing, times out of order a matrix
+    of 10^8, two equal times one of 10^7 from the 1e-9 s floor of a gap)."""
+    smoothing = real_number(smoothing, "smoothing", lo=0.0,
+                            hint="seconds (EvINRConfig.anchor_smoothing, e.g. 0.03)")
+    times = _values(times, "times", "anchor times in seconds [K]")
+    if times.ndim != 1 or (times.dtype.kind == "f" and not np.isfinite(times).all()):
+        raise EventDataError(f"times= must be finite seconds [K], increasing, got {short_repr(times)}")
+    if (np.diff(times) <= 0).any():
+        i = int(np.flatnonzero(np.diff(times) <= 0)[0])
+        raise EventDataError(f"times= must be increasing (distinct anchor times, in order), got {times[i]!r} then "
+                             f"{times[i + 1]!r} at {i}, {i + 1}; drop repeated frames")
     K = len(times)
     A = np.eye(K)
     if K > 1 and smoothing > 0:

@@ -33,7 +33,7 @@ from ..core.checks import (ArgumentTypeError, check_reach, check_seconds_precisi
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 from ..core.frames import Frames
-from .anchor import frame_log, linear_frames
+from .anchor import frame_log, linear_frames_unchecked
 from .binning import as_thresholds
 from .integration import integrate_events
 from .offset import OFFSET_SOLVES, offset_image
@@ -374,7 +374,7 @@ class BaselineReconstruction:
 
     def frames_at(self, times) -> np.ndarray:
         if self.method in FRAME_BASELINES:     # in the APS frames' own intensity space
-            return linear_frames(self.at(times))
+            return linear_frames_unchecked(self.at(times))
         return to_display(self.at(times), self.params["tonemap"], self.params["gamma"]).astype(np.float32)
 
 
@@ -471,7 +471,7 @@ def _complementary_reconstruction(events, query_times, C, frames, gain, t_start,
     t0 = time.perf_counter()
     L = fn(q)
     seconds = time.perf_counter() - t0
-    return BaselineReconstruction(q, L, linear_frames(L), "complementary",
+    return BaselineReconstruction(q, L, linear_frames_unchecked(L), "complementary",
                                   {"C": C, "gamma": gamma, "display_mean": display_mean, "offset_solve": "none",
                                    "gain": float(gain), "output": "linear"}, 0.0,
                                   {"train_time_s": 0.0, "time_s": seconds}, fn)

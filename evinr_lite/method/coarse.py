@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from .binning import events_to_frames_chunked
-from .offset import gaussian_lowpass, offset_image
+from .offset import gaussian_lowpass, gaussian_lowpass_unchecked, offset_image
 
 __all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "coarse_times", "integrated_frames", "MAX_SPAN_S"]
 
@@ -78,5 +78,6 @@ def coarse_correction(chunks, C, times, frames, coarse_px: float, method: str, r
         return np.zeros((H, W), np.float32)
     static = I.mean(axis=0, dtype=np.float64) + offset_image(I, method, rest)
     del I
-    d = gaussian_lowpass(static - F.mean(axis=0, dtype=np.float64), coarse_px)
+    # unchecked: a diverged network's NaN reaches the solver's result check, which names the settings to change
+    d = gaussian_lowpass_unchecked(static - F.mean(axis=0, dtype=np.float64), coarse_px)
     return (d - d.mean()).astype(np.float32)

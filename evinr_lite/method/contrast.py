@@ -58,13 +58,39 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from ..core.checks import real_number, require, whole_number
+from ..core.checks import require, short_repr, whole_number
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
+from ..core.guard import dense_array
+from .anchor import check_frame_eps
 from .binning import events_to_frames
 
 __all__ = ["frame_log_changes", "estimate_contrast_threshold", "frame_event_counts", "frame_trajectories",
            "fit_contrast", "fit_contrast_arrays", "ContrastFit", "FIT_METHODS"]
+
+
+def _check_pairing(frames, events, eps, exposed) -> float:
+    """The frames, events, ``eps`` and ``exposed`` of a comparison of frames with events, checked (those of
+    :func:`fit_contrast`, :func:`frame_log_changes`, :func:`frame_event_counts` and :func:`frame_trajectories`):
+    a Frames and an Events of one sensor, eps a finite number >= 0 (:func:`~evinr_lite.method.anchor.check_frame_eps`,
+    the anchor's one rule; 0 worked for the helpers and is taken by fit_contrast too: the exposed mask leaves black
+    pixels out), exposed (low, high) with 0 <= low < high <= 1. Returns
+    eps as a float. (Frames of another size than the events' sensor were compared pixel by pixel without a word,
+    an eps of None or text and an exposed of None, one number or text were Python's or numpy's errors.)"""
+    require(frames, Frames, "frames")
+    require(events, Events, "events")
+    eps = check_frame_eps(eps)
+    try:
+        lo, hi = (float(v) for v in exposed)
+    except (TypeError, ValueError):
+        lo = hi = math.nan
+    if not 0.0 <= lo < hi <= 1.0:
+        raise EventDataError(f"exposed= must be (low, high) with 0 <= low < high <= 1 (intensities in [0, 1]), "
+                             f"got {exposed!r}")
+    if tuple(frames.size) != tuple(events.sensor_size):
+        raise EventDataError(f"frames are {frames.size} but the events' sensor is {events.sensor_size} (H, W); "
+                             "they cannot be compared")
+    return eps
 
 
 def _usable_pairs(frames: Frames, events: Events) -> np.ndarray:
@@ -117,6 +143,7 @@ def frame_log_changes(frames: Frames, events: Events, *, eps: float = 1 / 255, e
         OFF events in (t_k, t_{k+1}]; bool [K, H, W] the well-exposed pixels. K = usable pairs.
         :func:`frame_event_counts` gives the ON and OFF counts apart.
     """
+    _check_pairing(frames, events, eps, exposed)
     frames = _in_order(frames)
     usable = _usable_pairs(frames, events)
     dL, mask = _log_changes(frames, usable, eps, exposed)
@@ -131,6 +158,7 @@ def frame_event_counts(frames: Frames, events: Events, *, eps: float = 1 / 255, 
         events (both >= 0) in (t_k, t_{k+1}]; bool [K, H, W] the well-exposed pixels.
         ``n_on - n_off`` is :func:`frame_log_changes`'s net count.
     """
+    _check_pairing(frames, events, eps, exposed)
     frames = _in_order(frames)
     usable = _usable_pairs(frames, events)
     dL, mask = _log_changes(frames, usable, eps, exposed)
@@ -146,11 +174,32 @@ def estimate_contrast_threshold(log_changes, net_counts):
         log_changes: float [M], ΔL of M pixels (already masked).
         net_counts: int [M], ON minus OFF events of the same pixels over the same intervals.
     Returns:
-        float C = sum(ΔL n) / sum(n^2).
+        float C = sum(ΔL n) / sum(n^2); NaN when every net count is 0 or no pixel is given (no event says what C
+        is: an ON-only recording's OFF pixels, ``estimate_contrast_threshold(dL[off], n[off])``, are none).
+    Raises:
+        EventDataError: values that are no numbers (None was NaN, text numpy's error), NaN or inf, or two shapes
+            (numpy's broadcast error). One count for every pixel (a scalar broadcast) is refused too: it summed
+            ΔL n over the M pixels but n^2 once (estimate_contrast_threshold(dL, 1) was sum(dL), not C).
     """
-    d = np.asarray(log_changes, dtype=np.float64)
-    n = np.asarray(net_counts, dtype=np.float64)
-    return float(np.sum(d * n) / np.sum(n * n))
+    d, n = (_pixel_values(v, name) for v, name in ((log_changes, "log_changes"), (net_counts, "net_counts")))
+    if d.shape != n.shape:
+        raise EventDataError(f"log_changes and net_counts must be one value per pixel each, of one shape, got shapes "
+                             f"{d.shape} and {n.shape}; mask both with the same mask")
+    with np.errstate(invalid="ignore", divide="ignore"):     # 0 / 0: no count says what C is (NaN, documented)
+        return float(np.sum(d * n) / np.sum(n * n))
+
+
+def _pixel_values(value, name: str) -> np.ndarray:
+    """``value`` (one number per pixel) as float64: numbers, finite (none at all is taken: C is NaN)."""
+    arr = None if value is None or isinstance(value, (str, bytes)) else \
+        dense_array(value, f"{name}=", error=EventDataError, want="one number per pixel (a 1-D array)")
+    if arr is None or arr.dtype.kind not in "iuf":
+        raise EventDataError(f"{name}= must be one number per pixel (a 1-D array of numbers), got {short_repr(value)}")
+    arr = arr.astype(np.float64)
+    if not np.isfinite(arr).all():
+        raise EventDataError(f"{name}= holds {int((~np.isfinite(arr)).sum()):,} NaN or infinite value(s); mask "
+                             "them out")
+    return arr
 
 
 # ---- C+ and C- -------------------------------------------------------------------------------
@@ -348,6 +397,8 @@ def frame_trajectories(frames: Frames, events: Events, *, eps: float = 1 / 255, 
         float64 [K, H, W] ON and OFF events (>= 0) in (t_0, t_k] (zero at k = 0); bool [K, H, W] the
         well-exposed samples.
     """
+    _check_pairing(frames, events, eps, exposed)
+    max_frames = whole_number(max_frames, "max_frames", lo=2)
     frames = _in_order(frames)
     t = frames.t
     if len(events) == 0:
@@ -404,17 +455,7 @@ def fit_contrast(frames: Frames, events: Events, *, method: str = "iv", span: st
     block = whole_number(block, "block", lo=1)
     n_bootstrap = whole_number(n_bootstrap, "n_bootstrap", lo=0)
     seed = whole_number(seed, "seed", lo=0)
-    eps = real_number(eps, "eps", lo=0.0, hi=1.0, lo_open=True)
-    try:
-        lo, hi = (float(v) for v in exposed)
-    except (TypeError, ValueError):
-        lo = hi = math.nan
-    if not 0.0 <= lo < hi <= 1.0:
-        raise EventDataError(f"exposed= must be (low, high) with 0 <= low < high <= 1 (intensities in [0, 1]), "
-                             f"got {exposed!r}")
-    if tuple(frames.size) != tuple(events.sensor_size):
-        raise EventDataError(f"frames are {frames.size} but the events' sensor is {events.sensor_size} (H, W); "
-                             "they cannot be compared")
+    eps = _check_pairing(frames, events, eps, exposed)
     if span == "pairs":
         y, n_on, n_off, mask = frame_event_counts(frames, events, eps=eps, exposed=exposed)
         n_on, n_off = n_on.astype(np.float64), n_off.astype(np.float64)

@@ -41,9 +41,11 @@ import scipy.fft
 import scipy.linalg
 import torch
 
+from ..core.checks import real_number, short_repr, whole_number
+from ..core.events import EventDataError
 from ..core.runtime import cpu_threads
 
-__all__ = ["solve_head", "laplacian_eigenvalues", "penalty_spectrum"]
+__all__ = ["solve_head", "laplacian_eigenvalues", "laplacian_eigenvalues_unchecked", "penalty_spectrum"]
 
 
 # the spatial frequency (a fraction of Nyquist along both axes: a wavelength of 8 px) at which the second-order
@@ -57,11 +59,25 @@ def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int | str = 1)
     |D f|^2); order 2, mu^2 / mu_ref (the Laplacian's energy, |D^T D f|^2, scaled to equal order 1 at
     ``ORDER_REFERENCE`` of Nyquist): less smoothing of the coarser structure, more of the finer;
     "banded", mu up to mu_ref and mu^3 / mu_ref^2 beyond (the gradient's energy for structure coarser than
-    the reference wavelength, a third-order roll-off for finer structure; continuous at mu_ref)."""
+    the reference wavelength, a third-order roll-off for finer structure; continuous at mu_ref).
+
+    Checked: ``mu`` an array of numbers, none NaN or negative (None came back as None, NaN gave NaN penalties and
+    a negative mu at order 2 a positive one, as if it were smoothing), ``cx``, ``cy`` finite weights >= 0 (text or
+    NaN were taken or numpy's errors), ``order`` 1, 2 or "banded" (True was taken as 1)."""
+    values = None if mu is None or isinstance(mu, (str, bytes)) else np.asarray(mu)
+    if values is None or values.dtype.kind not in "iuf":
+        raise EventDataError(f"mu= must be the Laplacian's eigenvalues [H, W] (numbers; laplacian_eigenvalues(...)), "
+                             f"got {short_repr(mu)}")
+    if values.dtype.kind == "f" and np.isnan(values).any() or (values < 0).any():
+        raise EventDataError(f"mu= must be the Laplacian's eigenvalues, numbers >= 0 (laplacian_eigenvalues(...)), "
+                             f"got {int(np.isnan(values).sum()):,} NaN and {int((values < 0).sum()):,} negative "
+                             "value(s)")
+    for name, c in (("cx", cx), ("cy", cy)):
+        real_number(c, name, lo=0.0, hint="the penalty's weight along that axis")
+    if isinstance(order, (bool, np.bool_)) or (order != 1 and order not in (2, "banded")):
+        raise EventDataError(f"order must be 1 (the gradient), 2 (the Laplacian) or 'banded', got {order!r}")
     if order == 1:
         return mu
-    if order not in (2, "banded"):
-        raise ValueError(f"order must be 1 (the gradient), 2 (the Laplacian) or 'banded', got {order!r}")
     ref = (cx + cy) * (2 - 2 * np.cos(np.pi * ORDER_REFERENCE))
     if ref <= 0:
         return mu
@@ -72,7 +88,32 @@ def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int | str = 1)
 
 def laplacian_eigenvalues(sensor_size, cx: float = 1.0, cy: float = 1.0) -> np.ndarray:
     """Eigenvalues [H, W] of cx Dx^T Dx + cy Dy^T Dy (forward differences, Neumann borders) in the
-    orthonormal DCT-II basis (``scipy.fft.dctn(..., norm="ortho")``); [0, 0] is 0 (constants)."""
+    orthonormal DCT-II basis (``scipy.fft.dctn(..., norm="ortho")``); [0, 0] is 0 (constants).
+
+    ``sensor_size``: (H, W), whole numbers >= 1 (0 or -1 gave eigenvalues of no pixel, 2.5 of a made-up sensor,
+    text such as "45" was read letter by letter); ``cx``, ``cy``: finite weights >= 0 (NaN gave NaN eigenvalues, -1
+    negative ones), a number or an array of one (np.array([0.3]) is 0.3, as it was)."""
+    try:
+        if isinstance(sensor_size, (str, bytes)):
+            raise TypeError
+        H, W = sensor_size
+    except (TypeError, ValueError):
+        raise EventDataError(f"sensor_size= must be (H, W), two whole numbers >= 1, got {short_repr(sensor_size)}") \
+            from None
+    H, W = whole_number(H, "sensor_size: H", lo=1), whole_number(W, "sensor_size: W", lo=1)
+    cx, cy = _one_value(cx), _one_value(cy)
+    for name, c in (("cx", cx), ("cy", cy)):
+        real_number(c, name, lo=0.0, hint="the weight of that axis' differences")
+    return laplacian_eigenvalues_unchecked((H, W), cx, cy)
+
+
+def _one_value(c):
+    """A weight given as a numpy array of one element, as its 0-d array (the eigenvalues broadcast it as before)."""
+    return c.reshape(()) if isinstance(c, np.ndarray) and c.size == 1 else c
+
+
+def laplacian_eigenvalues_unchecked(sensor_size, cx: float = 1.0, cy: float = 1.0) -> np.ndarray:
+    """:func:`laplacian_eigenvalues` without its checks (the solves' own sizes, each ADMM iteration's DCT solve)."""
     H, W = sensor_size
     ex = 2 - 2 * np.cos(np.pi * np.arange(W) / W)
     ey = 2 - 2 * np.cos(np.pi * np.arange(H) / H)

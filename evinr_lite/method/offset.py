@@ -55,12 +55,16 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
+from ..core.checks import real_number, short_repr, whole_number
+from ..core.events import EventDataError
+from ..core.guard import dense_array
 from ..core.runtime import cpu_threads
-from .head_solve import laplacian_eigenvalues
+from .head_solve import laplacian_eigenvalues_unchecked
 
 __all__ = ["median_gradient_offset", "l1_gradient_offset", "SumAbsProx", "offset_image", "poisson_integrate",
            "offset_trend", "trend_intervals", "trend_knots", "OffsetTrend", "offset_grid", "MIN_TREND_FRAMES", "OFFSET_SOLVES",
-           "STATIC_REST", "STATIC_COARSE_PX", "gaussian_lowpass"]
+           "STATIC_REST", "STATIC_COARSE_PX", "gaussian_lowpass",
+           "gaussian_lowpass_unchecked", "MAX_SIGMA_PX"]
 
 MIN_TREND_FRAMES = 8     # a knot's median looks at least at this many grid frames (the nearest, if its window holds fewer)
 OFFSET_SOLVES = ("none", "median_gradient", "l1_gradient")
@@ -76,16 +80,55 @@ STATIC_COARSE_PX = 8.0   # camera="static": the rest solve sets the offset's str
 LEFT_OUT = 1e6           # +-M for a left-out frame's value (times the values' scale): far outside any gradient
 
 
+def _numbers(value, name: str, what: str) -> np.ndarray:
+    """``value`` as an array of finite numbers (any shape, its dtype kept; ``what``: what it must be, in the
+    message); None, text, booleans, NaN or inf were numpy's or Python's errors, or came out as NaN without a word."""
+    arr = None if value is None or isinstance(value, (str, bytes)) else \
+        dense_array(value, f"{name}=", error=EventDataError, want=what)
+    if arr is None or arr.dtype.kind not in "iuf":
+        raise EventDataError(f"{name}= must be {what} (numbers), got {short_repr(value)}")
+    if arr.dtype.kind == "f" and arr.size and not (np.isfinite(arr.min()) and np.isfinite(arr.max())):
+        n_bad = int((~np.isfinite(arr)).sum())
+        raise EventDataError(f"{name}= holds {n_bad:,} NaN or infinite value(s); the result would be NaN: repair "
+                             f"or drop them")
+    return arr
+
+
+def _log_stack(frames, name: str = "frames") -> np.ndarray:
+    """``frames`` as the [K, H, W] log intensities of the offset solves (at least one frame of one pixel, finite);
+    its dtype kept. None or text were "got shape ()", NaN gave a NaN offset."""
+    F = _numbers(frames, name, "log intensities [K, H, W]")
+    if F.ndim != 3 or min(F.shape) < 1:
+        raise EventDataError(f"{name}= must be [K, H, W] log intensities (at least one frame of at least one "
+                             f"pixel), got shape {F.shape}" + ("; one image [H, W] is frames[None]"
+                                                               if F.ndim == 2 else ""))
+    return F
+
+
 def poisson_integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
     """The image g [H, W] whose forward differences best match (gx [H, W-1], gy [H-1, W]) in least
-    squares: (Dx^T Dx + Dy^T Dy) g = Dx^T gx + Dy^T gy, solved with the DCT; mean(g) = 0."""
+    squares: (Dx^T Dx + Dy^T Dy) g = Dx^T gx + Dy^T gy, solved with the DCT; mean(g) = 0.
+
+    gx and gy are checked: finite numbers, 2-D, of the shapes of one H x W image's differences (None or text were
+    AttributeErrors, shapes that disagree numpy's broadcast errors, NaN a NaN image)."""
+    gx = _numbers(gx, "gx", "the x differences [H, W-1]")
+    gy = _numbers(gy, "gy", "the y differences [H-1, W]")
+    if gx.ndim != 2 or gy.ndim != 2 or gy.shape != (gx.shape[0] - 1, gx.shape[1] + 1):
+        raise EventDataError(f"gx and gy must be the differences of one H x W image, gx [H, W-1] and gy [H-1, W], "
+                             f"got shapes {gx.shape} and {gy.shape}; e.g. gx = np.diff(img, axis=1), "
+                             "gy = np.diff(img, axis=0)")
+    return _integrate(gx, gy)
+
+
+def _integrate(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
+    """:func:`poisson_integrate` without its checks (the solves' own differences)."""
     H, W = gx.shape[0], gy.shape[1]
     div = np.zeros((H, W))
     div[:, :-1] -= gx
     div[:, 1:] += gx
     div[:-1, :] -= gy
     div[1:, :] += gy
-    mu = laplacian_eigenvalues((H, W))
+    mu = laplacian_eigenvalues_unchecked((H, W))
     mu[0, 0] = 1.0
     g = scipy.fft.dctn(div, type=2, norm="ortho", workers=cpu_threads()) / mu
     g[0, 0] = 0.0
@@ -97,7 +140,22 @@ def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
     DCT-II basis (the mirrored image's Fourier basis) each coefficient is multiplied by the Gaussian's
     transfer function exp(-sigma^2 (wx^2 + wy^2) / 2), w = pi k / N the frequency along each axis. From
     2 px on it is scipy.ndimage.gaussian_filter(mode="reflect") to 1e-9 (below, sampling its kernel aliases)."""
+    img = _numbers(image, "image", "an image [H, W]")
+    if img.ndim != 2 or img.size == 0:
+        raise EventDataError(f"image= must be one image [H, W] of at least one pixel, got shape {img.shape}")
+    sigma_px = real_number(sigma_px, "sigma_px", lo=0, hint="the Gaussian's standard deviation in pixels")
+    return gaussian_lowpass_unchecked(img, sigma_px)
+
+
+MAX_SIGMA_PX = 1e100   # a Gaussian this wide keeps only the mean (every other gain underflows to 0); sigma^2 fits
+
+
+def gaussian_lowpass_unchecked(image, sigma_px: float) -> np.ndarray:
+    """:func:`gaussian_lowpass` without its checks (the solves' own images, which may hold a diverged network's
+    NaN: the caller's result check names that). A sigma above MAX_SIGMA_PX blurs as MAX_SIGMA_PX does (to the
+    image's mean): its square overflowed (Python's OverflowError at 1e200)."""
     img = np.asarray(image, np.float64)
+    sigma_px = min(sigma_px, MAX_SIGMA_PX)
     H, W = img.shape
     wy, wx = np.pi * np.arange(H) / H, np.pi * np.arange(W) / W
     gain = np.exp(-0.5 * sigma_px ** 2 * (wy[:, None] ** 2 + wx[None, :] ** 2))
@@ -108,6 +166,11 @@ def gaussian_lowpass(image, sigma_px: float) -> np.ndarray:
 def median_gradient_offset(frames) -> np.ndarray:
     """The offset g [H, W] (float64, mean 0) to add to every frame of ``frames`` [K, H, W] (log
     intensities over the sequence) so that the temporal median of each pixel's gradient is zero."""
+    return _median_gradient(_log_stack(frames))
+
+
+def _median_gradient(frames) -> np.ndarray:
+    """:func:`median_gradient_offset` without its checks (:func:`offset_image`: the solver's own frames)."""
     frames = np.asarray(frames)
     if frames.ndim != 3 or frames.shape[0] < 1:
         raise ValueError(f"frames must be [K, H, W] log intensities, got shape {frames.shape}")
@@ -132,7 +195,7 @@ def median_gradient_offset(frames) -> np.ndarray:
     # numpy's median releases the GIL: the blocks run on the kit's threads (the same numbers on any count)
     with ThreadPoolExecutor(max(1, min(len(starts), cpu_threads()))) as pool:
         list(pool.map(block_medians, starts))
-    return poisson_integrate(gx, gy)
+    return _integrate(gx, gy)
 
 
 class SumAbsProx:
@@ -307,12 +370,21 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
     ``rest``: None (every frame counts), or log units: each edge's term counts only the frames where one
     of its pixels lies more than ``rest`` from its temporal median (a static camera; the module's
     docstring); the frames' median image [H, W] is one more float32 image in memory."""
+    F = _log_stack(frames)
+    max_iters = whole_number(max_iters, "max_iters", lo=0)
+    tol = real_number(tol, "tol", lo=0, hint="a share of the mean |gradient| (e.g. 1e-3)")
+    return _l1_gradient(F, max_iters, tol, rest)
+
+
+def _l1_gradient(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TOL, rest: float | None = None) -> np.ndarray:
+    """:func:`l1_gradient_offset` without its checks (:func:`offset_image`: the solver's own frames, which may
+    hold a diverged network's NaN; the solver's result check names that, with the settings to change)."""
     F = np.asarray(frames)
     if F.ndim != 3 or F.shape[0] < 1:
         raise ValueError(f"frames must be [K, H, W] log intensities, got shape {F.shape}")
     K, H, W = F.shape
     if H < 2 or W < 2:                              # no edges in one direction: the median answer
-        return median_gradient_offset(F)
+        return _median_gradient(F)
     # x and y edges are independent until the Poisson step: two threads (numpy releases the GIL), the
     # same numbers on any count
     with ThreadPoolExecutor(2 if cpu_threads() >= 2 else 1) as pool:
@@ -325,13 +397,13 @@ def l1_gradient_offset(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TO
             both(lambda: _leave_out_rest(bx, moved, 2, scale), lambda: _leave_out_rest(by, moved, 1, scale))
         rho = K * L1_RHO / scale if scale > 0 else 1.0
         px, py = both(lambda: SumAbsProx(bx, rho), lambda: SumAbsProx(by, rho))
-        g = poisson_integrate(px.median.reshape(H, W - 1), py.median.reshape(H - 1, W))   # the per-edge medians
+        g = _integrate(px.median.reshape(H, W - 1), py.median.reshape(H - 1, W))   # the per-edge medians
         if not scale > 0:                           # flat frames: nothing to make sparser
             return g
         x, y = _EdgeSplit(px, np.diff(g, axis=1)), _EdgeSplit(py, np.diff(g, axis=0))
         for _ in range(max_iters):
             tx, ty = both(lambda: x.step(np.diff(g, axis=1)), lambda: y.step(np.diff(g, axis=0)))
-            g_new = poisson_integrate(tx.reshape(H, W - 1), ty.reshape(H - 1, W))
+            g_new = _integrate(tx.reshape(H, W - 1), ty.reshape(H - 1, W))
             moved = float(np.abs(g_new - g).max())
             g = g_new
             if moved <= tol * scale:
@@ -350,14 +422,14 @@ def offset_image(frames, method: str, rest: float | None = None) -> np.ndarray:
     if rest is not None and method != "l1_gradient":
         raise ValueError(f"rest= (a static camera) needs the 'l1_gradient' offset solve, got {method!r}")
     if method == "median_gradient":
-        return median_gradient_offset(frames)
+        return _median_gradient(frames)
     if method != "l1_gradient":
         raise ValueError(f"offset method must be 'median_gradient' or 'l1_gradient', got {method!r}")
-    plain = l1_gradient_offset(frames)
+    plain = _l1_gradient(frames)
     if rest is None:
         return plain
-    moved = l1_gradient_offset(frames, rest=rest)    # a static camera: its fine structure, the plain solve's coarse
-    return moved + gaussian_lowpass(plain - moved, STATIC_COARSE_PX)
+    moved = _l1_gradient(frames, rest=rest)    # a static camera: its fine structure, the plain solve's coarse
+    return moved + gaussian_lowpass_unchecked(plain - moved, STATIC_COARSE_PX)
 
 
 @dataclass

@@ -47,7 +47,7 @@ from ..core.checks import (check_reach, check_result_frames, host_array, optiona
                            require, seconds_array, whole_number)
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
-from .anchor import fit_anchor, frames_in_window, linear_frames
+from .anchor import fit_anchor, frames_in_window, linear_frames_unchecked
 from .prepare import prepare_events
 from .config import EvINRConfig
 from .memory import check_memory
@@ -137,7 +137,7 @@ class Reconstruction:
         """Frames in [0, 1] at any times: float32 [Q, H, W]; tone-mapped, or the APS frames' linear
         intensity when anchored (:func:`evinr_lite.method.anchor.linear_frames`)."""
         if self.anchor is not None:
-            return linear_frames(self._at(times, 256, "frames_at"))
+            return linear_frames_unchecked(self._at(times, 256, "frames_at"))
         return to_display(self._at(times, 256, "frames_at"), self.config.tonemap, self.config.gamma).astype(np.float32)
 
 
@@ -185,7 +185,7 @@ def reconstruct(events: Events, query_times, config: EvINRConfig | None = None, 
                          every=cfg.anchor_every, smoothing=cfg.anchor_smoothing)
         history["anchor"] = fit.summary()
         L = blend_networks(model, windows, q, offsets) + fit.offset_at(q)       # = Reconstruction.at(q)
-        return _checked_result(Reconstruction(q, L, linear_frames(L), model, windows, offsets, cfg, history, fit))
+        return _checked_result(Reconstruction(q, L, linear_frames_unchecked(L), model, windows, offsets, cfg, history, fit))
     grid = offset_grid(t_start, t_end, len(windows), cfg.offset_solve)
     trend = None
     if cfg.offset_solve != "none":                                              # 4. offset solve
