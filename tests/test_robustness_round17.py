@@ -8,7 +8,7 @@ frames-against-events helpers of the fit of C (evinr_lite.method.contrast: ``fra
 (evinr_lite.method.losses: ``temporal_loss_difference``, ``temporal_loss_derivative``, ``tikhonov``,
 ``total_variation``, ``spatial_differences``).
 
-270 cases. Sections 1 to 7: 211, 188 of which failed before their fixes (six cases the review found to refuse
+283 cases. Sections 1 to 7: 211, 188 of which failed before their fixes (six cases the review found to refuse
 what worked before are gone: bool L, an eps of 1 for ``linear_frames`` and ``frame_log``, ``select_anchors(0,
 "all")``, empty values in the threshold, a numpy array for ``spatial_differences``). The other 23: 17 guards (valid odd inputs that worked before and
 must keep their outcome: float32, int, list and tensor frames, one frame, 1 x 1 and 1 x N images, max_iters 0, sigma
@@ -84,8 +84,18 @@ script: arrays' bytes and dtypes, fits' reprs; after the review, the reviewer's 
 round: of those that worked there, all give the same bytes except the ones changed on purpose above: -inf frames,
 an infinite image (a NaN image), repeated anchor times, one count for all pixels, a 2-D dF_dt and
 ``select_anchors(0, "first")``).
+
+The session's final review (section 9: 13 cases, 10 of which failed before their fixes; the other 3, an eps of
+np.float32, guards): the head solve still called the checked ``laplacian_eigenvalues`` and ``penalty_spectrum`` with
+the cx, cy its lam gives, so ``lam=1e308`` was told "cx= must be a finite number >= 0, got inf" (an argument the
+user never passed) instead of the solver's ResultError: it calls ``laplacian_eigenvalues_unchecked`` and
+``penalty_spectrum_unchecked``. ``frame_log_changes``, ``frame_event_counts`` and ``frame_trajectories`` checked eps
+and then used the raw value (a Fraction was numpy's "no callable log method", a 0-d tensor "Concatenation operation
+is not implemented"): they use the float the check returns, as ``fit_contrast`` did. ``penalty_spectrum`` checked
+np.asarray(mu) and computed with mu (a list was Python's "can't multiply sequence", or came back as the list).
 """
 import re
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -553,3 +563,41 @@ def test_the_admm_iterations_call_no_checked_eigenvalues(monkeypatch):
     g = offset.l1_gradient_offset(STACK)
     monkeypatch.undo()
     assert np.array_equal(g, offset.l1_gradient_offset(STACK))
+
+
+# ---- 9. the session's final review ----------------------------------------------------------------------------
+# Each case failed before its fix (the round's code after its first review).
+
+@pytest.mark.parametrize("order", [1, 2, "banded"])
+def test_a_lam_so_large_that_the_head_solve_overflows_is_the_solvers_result_error(order):
+    # the head solve called the checked laplacian_eigenvalues / penalty_spectrum with the cx, cy its lam gave:
+    # "cx= must be a finite number >= 0, got inf" named an argument the user never passed
+    from evinr_lite import EvINRConfig, reconstruct
+    from evinr_lite.core.checks import ResultError
+    from evinr_lite.sim.scenes import make_scene
+    from evinr_lite.sim.simulate import simulate_scene
+
+    events = simulate_scene(make_scene("camera", sensor_size=(12, 16), duration=0.3), 0.0, 0.3, C=0.2, seed=0)
+    with pytest.raises(ResultError, match=r"NaN or infinite.*the settings do not fit these events"):
+        reconstruct(events, [0.1, 0.2], EvINRConfig(C=0.2, lam=1e308, spatial_order=order, progress=False))
+
+
+@pytest.mark.parametrize("fn", ["frame_log_changes", "frame_event_counts", "frame_trajectories"])
+@pytest.mark.parametrize("eps", [Fraction(1, 255), torch.tensor(1 / 255), np.float32(1 / 255)])   # float32: guard
+def test_the_frame_helpers_use_the_eps_their_check_read(fn, eps):
+    # the check read eps as a float and the helper used the raw value: a Fraction was numpy's "no callable log
+    # method", a 0-d tensor "Concatenation operation is not implemented"
+    got = getattr(contrast, fn)(FRAMES, EVENTS, eps=eps)
+    want = getattr(contrast, fn)(FRAMES, EVENTS, eps=float(eps))
+    for a, b in zip(got if isinstance(got, tuple) else (got,), want if isinstance(want, tuple) else (want,)):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+
+
+def test_penalty_spectrum_computes_with_the_array_it_checked():
+    # a list of eigenvalues passed the check and then met Python's list arithmetic: "can't multiply sequence by
+    # non-int of type 'list'" (order 2), or came back as the list itself (order 1)
+    mu = [[0.0, 1.0], [2.0, 3.0]]
+    for order in (1, 2, "banded"):
+        got = head_solve.penalty_spectrum(mu, 1.0, 1.0, order)
+        assert isinstance(got, np.ndarray)
+        assert np.array_equal(got, head_solve.penalty_spectrum(np.asarray(mu), 1.0, 1.0, order))

@@ -143,7 +143,7 @@ def frame_log_changes(frames: Frames, events: Events, *, eps: float = 1 / 255, e
         OFF events in (t_k, t_{k+1}]; bool [K, H, W] the well-exposed pixels. K = usable pairs.
         :func:`frame_event_counts` gives the ON and OFF counts apart.
     """
-    _check_pairing(frames, events, eps, exposed)
+    eps = _check_pairing(frames, events, eps, exposed)
     frames = _in_order(frames)
     usable = _usable_pairs(frames, events)
     dL, mask = _log_changes(frames, usable, eps, exposed)
@@ -158,7 +158,7 @@ def frame_event_counts(frames: Frames, events: Events, *, eps: float = 1 / 255, 
         events (both >= 0) in (t_k, t_{k+1}]; bool [K, H, W] the well-exposed pixels.
         ``n_on - n_off`` is :func:`frame_log_changes`'s net count.
     """
-    _check_pairing(frames, events, eps, exposed)
+    eps = _check_pairing(frames, events, eps, exposed)
     frames = _in_order(frames)
     usable = _usable_pairs(frames, events)
     dL, mask = _log_changes(frames, usable, eps, exposed)
@@ -397,7 +397,7 @@ def frame_trajectories(frames: Frames, events: Events, *, eps: float = 1 / 255, 
         float64 [K, H, W] ON and OFF events (>= 0) in (t_0, t_k] (zero at k = 0); bool [K, H, W] the
         well-exposed samples.
     """
-    _check_pairing(frames, events, eps, exposed)
+    eps = _check_pairing(frames, events, eps, exposed)
     max_frames = whole_number(max_frames, "max_frames", lo=2)
     frames = _in_order(frames)
     t = frames.t

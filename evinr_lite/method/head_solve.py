@@ -45,7 +45,8 @@ from ..core.checks import real_number, short_repr, whole_number
 from ..core.events import EventDataError
 from ..core.runtime import cpu_threads
 
-__all__ = ["solve_head", "laplacian_eigenvalues", "laplacian_eigenvalues_unchecked", "penalty_spectrum"]
+__all__ = ["solve_head", "laplacian_eigenvalues", "laplacian_eigenvalues_unchecked", "penalty_spectrum",
+           "penalty_spectrum_unchecked"]
 
 
 # the spatial frequency (a fraction of Nyquist along both axes: a wavelength of 8 px) at which the second-order
@@ -76,6 +77,12 @@ def penalty_spectrum(mu: np.ndarray, cx: float, cy: float, order: int | str = 1)
         real_number(c, name, lo=0.0, hint="the penalty's weight along that axis")
     if isinstance(order, (bool, np.bool_)) or (order != 1 and order not in (2, "banded")):
         raise EventDataError(f"order must be 1 (the gradient), 2 (the Laplacian) or 'banded', got {order!r}")
+    return penalty_spectrum_unchecked(values, cx, cy, order)
+
+
+def penalty_spectrum_unchecked(mu: np.ndarray, cx: float, cy: float, order: int | str = 1) -> np.ndarray:
+    """:func:`penalty_spectrum` without its checks, for the head solve (whose lam, not a user's mu, gives cx and
+    cy: a lam so large that they overflow is the solver's result check's to name)."""
     if order == 1:
         return mu
     ref = (cx + cy) * (2 - 2 * np.cos(np.pi * ORDER_REFERENCE))
@@ -240,7 +247,7 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
     target = model.head_weight.data if in_place else torch.empty((N, d, P), dtype=torch.float32)
     weights = target.numpy()
     cx, cy = _weights(B, T, (H, W), lam if regularizer == "tikhonov" else 0.0)
-    mu = penalty_spectrum(laplacian_eigenvalues((H, W), cx, cy), cx, cy, order).ravel()   # [P]
+    mu = penalty_spectrum_unchecked(laplacian_eigenvalues_unchecked((H, W), cx, cy), cx, cy, order).ravel()   # [P]
     total = 0.0
     for n in range(N):
         S = A64[n].T @ A64[n]
