@@ -78,6 +78,7 @@ shares memory with an input (no reference returns a view of an input, and no wro
 without also changing the input in place, which is named already), nor for a tensor on another device (no
 accelerator on the machines that run the checks).
 """
+import inspect
 import math
 
 import numpy as np
@@ -507,3 +508,40 @@ def test_review_the_recorded_notebook_calls_are_the_notebooks():
         assert (call.notebook, call.cell, call.keywords, call.text) == (nb, cell, keywords, text), name
         assert positional in (None, call.positional), name
         assert exercises.get(name).call is call
+
+
+# ---- final review: each failed before the final review's fixes
+class _Unloaded:
+    @property
+    def data(self):
+        raise RuntimeError("not loaded")
+unloaded = _Unloaded()
+def tm_property_raises(L, gamma):                              # a global whose property raises, read by the hint
+    x = unloaded.data.sort()
+    return R("reinhard_tonemap")(L, gamma)
+
+
+def test_final_a_property_that_raises_does_not_crash_the_check():
+    ok, text = _report("reinhard_tonemap", tm_property_raises)
+    assert not ok and "the check itself failed" not in text and "RuntimeError: not loaded" in text, text
+
+
+def test_final_a_hint_that_raises_does_not_crash_the_check(monkeypatch):
+    from evinr_lite.teaching.checking import run_check as rc
+
+    def boom(*a, **k):
+        raise ValueError("hint broke")
+    for name in ("xor_power_hint", "signature_default_hint", "none_from_in_place_hint"):
+        monkeypatch.setattr(rc, name, boom)
+    for exercise, fn in (("reinhard_tonemap", tm_xor), ("bisect_equal_count", bis_sort_none),
+                         ("estimate_contrast_threshold", ect_xor)):
+        ok, text = _report(exercise, fn)
+        assert not ok and "the check itself failed" not in text, text
+
+
+def test_final_learner_source_and_signature_are_a_layer_and_share_learner_function():
+    from exercise_reports import ROOT
+    from evinr_lite.teaching.checking import learner_calls, learner_source, signature
+    assert '"learner_source | signature",' in (ROOT / "pyproject.toml").read_text()
+    assert "_learner_function" not in inspect.getsource(learner_source)
+    assert signature.learner_function is learner_calls.learner_function

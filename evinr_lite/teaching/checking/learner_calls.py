@@ -33,6 +33,13 @@ from .outputs import input_name, is_tensor, named_inputs, to_numpy
 from .global_state import global_settings, imports_watched, restore_settings
 
 
+def learner_function(fn: Callable) -> Callable:
+    """The learner's own function behind the check's notebook-call wrapper (signature.notebook_caller sets its
+    ``wraps_learner_function``), ``fn`` itself otherwise: what the readers of code, globals and defaults read, while
+    the check calls the wrapper."""
+    return getattr(fn, "wraps_learner_function", fn)
+
+
 def library_file(filename: str) -> bool:
     """A file of an installed library or of Python itself (numpy, torch, the standard library), not the learner's
     notebook or module (nor this kit, whose frames say which of its functions the learner's call broke)."""

@@ -23,7 +23,7 @@ import textwrap
 import types
 from typing import Callable
 
-from .learner_calls import library_file, run
+from .learner_calls import learner_function, library_file, run
 from .outputs import compare_outputs
 
 # methods that change their object in place and return None (ndarray.sort/.fill/.resize, list.sort/.append/...,
@@ -35,8 +35,8 @@ XOR_ERROR_WORDS = ("ufunc 'bitwise_xor'", '"bitwise_xor_cpu"', '"bitwise_xor_cud
 
 
 def _own(fn: Callable) -> Callable:
-    """The learner's function behind the check's notebook-call wrapper (signature.notebook_caller)."""
-    return getattr(fn, "_learner_function", fn)
+    """The learner's function behind the check's notebook-call wrapper (:func:`.learner_calls.learner_function`)."""
+    return learner_function(fn)
 
 
 def _tree(fn: Callable) -> ast.AST | None:
@@ -53,7 +53,10 @@ def _resolve(node: ast.AST, namespace: dict):
         return namespace.get(node.id)
     if isinstance(node, ast.Attribute):
         base = _resolve(node.value, namespace)
-        return getattr(base, node.attr, None) if base is not None else None
+        try:            # a property or a module's __getattr__ may raise anything: a hint never crashes the check
+            return getattr(base, node.attr, None) if base is not None else None
+        except Exception:
+            return None
     return None
 
 

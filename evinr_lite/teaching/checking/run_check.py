@@ -162,8 +162,9 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     kept between calls)."""
     args, kwargs = cases[k]
     details = [f"{type(err).__name__}: {err}"] + where_raised(err)
-    written = xor_power_hint(fn, err, ex, (args, kwargs)) or signature_default_hint(ex, fn, args, kwargs) \
-        or none_from_in_place_hint(fn, err, (args, kwargs), ex.observe)
+    written = _safely(xor_power_hint, fn, err, ex, (args, kwargs)) \
+        or _safely(signature_default_hint, ex, fn, args, kwargs) \
+        or _safely(none_from_in_place_hint, fn, err, (args, kwargs), ex.observe)
     if written:                 # read off the learner's source: what the error's words would only guess at
         details.append(f"hint: {written}")
     elif isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
@@ -219,6 +220,15 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     return False, f"raised {type(err).__name__} on {where}", details
 
 
+def _safely(hint: Callable, *args) -> str | None:
+    """``hint(*args)``, or None where it raises: a hint read off the learner's source (its globals' properties, a
+    module's ``__getattr__``) must never crash the check."""
+    try:
+        return hint(*args)
+    except Exception:
+        return None
+
+
 def _python_on_arrays_hints(err: Exception, line: str) -> list[str]:
     """Hints for Python's one-value tools used on whole arrays or tensors, from the error numpy or torch raised:
     `and` / `or` / `if` / a chained comparison (one truth value), `&` read before a comparison, the math module (one
@@ -269,7 +279,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
     hint = cache_hint if proven else None
     if hint is None:            # slips read off the source, each proven: `^` for `**`, another default
-        hint = xor_power_hint(fn, None, ex, (args, kwargs), expected) or signature_default_hint(ex, fn, args, kwargs)
+        hint = _safely(xor_power_hint, fn, None, ex, (args, kwargs), expected) \
+            or _safely(signature_default_hint, ex, fn, args, kwargs)
     memory = None       # memory_explains' answer on this input, asked once (it runs the function four times)
     if hint is None:
         memory = memory_explains(fn, ex, args, kwargs, got)
@@ -287,7 +298,7 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     if hint is None and ex.observe is None:
         hint = _generic_mistake_hint(ex, fn, cases, k, got, expected)
     if hint is None:            # the None of `b = b.sort()`, where a traced call sees the None
-        hint = none_from_in_place_hint(fn, None, (args, kwargs), ex.observe)
+        hint = _safely(none_from_in_place_hint, fn, None, (args, kwargs), ex.observe)
     # a global generator seeded inside: random numbers, the same at every call (after the generic mistakes: a
     # seed that draws nothing explains no value, and is only noted)
     seed_note = None

@@ -18,16 +18,11 @@ from __future__ import annotations
 import inspect
 from typing import Callable
 
-from .learner_calls import run
+from .learner_calls import learner_function, run
 from .outputs import compare_outputs
 from .protocol import ExerciseLike
 
 _ORDERED = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
-
-
-def learner_function(fn: Callable) -> Callable:
-    """The learner's own function behind :func:`notebook_caller`'s wrapper (``fn`` itself otherwise)."""
-    return getattr(fn, "_learner_function", fn)
 
 
 def _signature(fn: Callable) -> inspect.Signature | None:
@@ -143,7 +138,7 @@ def notebook_caller(ex: ExerciseLike, fn: Callable) -> Callable:
     def called_as_in_the_notebook(*args, **kwargs):
         pos, named = notebook_args(ex, args, kwargs)
         return fn(*pos, **named)
-    called_as_in_the_notebook._learner_function = fn
+    called_as_in_the_notebook.wraps_learner_function = fn
     return called_as_in_the_notebook
 
 
