@@ -15,7 +15,7 @@ check itself, one job per module, lowest first:
 - ``across_calls``: mistakes seen only across inputs or on a second call (kept state, a stale argument, the same
   factor on every input, a shared result, a reseeded generator);
 - ``learner_source``: slips read off the learner's source once it failed, each named on evidence (`^` for a power,
-  where `**` in its place matches; the None of ``b = b.sort()``, where the None shows), and whether a
+  where `**` in its place matches; the None of ``b = b.sort()``, where the call on a line of its own matches), and whether a
   NotImplementedError is the stub's own raise;
 - ``signature``: the function called as the notebooks call it (each exercise's call, teaching/notebook_calls.py), and
   a default other than the stub's named where the stub's default makes the input match;

@@ -22,7 +22,8 @@ import numpy as np
 
 from .global_state import SEED_CALLS, other_rng_states, reseeded_generators, rng_states, set_rng_states
 from .hints import unit_note
-from .learner_calls import copy_inputs, poison_freed_memory, refill_in_place, run, same_array, uses_uninitialised
+from .learner_calls import (copy_inputs, learner_function, poison_freed_memory, refill_in_place, run, same_array,
+                            uses_uninitialised)
 from .outputs import compare_outputs, is_tensor, not_finite, to_numpy
 from .protocol import ExerciseLike
 
@@ -36,7 +37,7 @@ def mutable_defaults(fn: Callable) -> dict[str, Any]:
     """Copies of ``fn``'s default argument values that can change in place (lists, dicts, sets, arrays)."""
     out: dict[str, Any] = {}
     try:
-        params = inspect.signature(fn).parameters.values()
+        params = inspect.signature(learner_function(fn)).parameters.values()
     except (TypeError, ValueError):
         return out
     for p in params:
@@ -60,7 +61,7 @@ def _same_value(a, b) -> bool:
 def mutable_default_hint(fn: Callable, before: dict[str, Any]) -> str | None:
     """A mutable default argument that changed (or holds data) during the check."""
     try:
-        now = {p.name: p.default for p in inspect.signature(fn).parameters.values()}
+        now = {p.name: p.default for p in inspect.signature(learner_function(fn)).parameters.values()}
     except (TypeError, ValueError):
         now = {}
     for name, old in before.items():
@@ -144,6 +145,7 @@ def state_hint(fn: Callable, before: dict[str, Any], ex: ExerciseLike, args, kwa
 def global_containers(fn: Callable) -> dict[str, tuple[int, int]]:
     """The dicts, lists and sets among the notebook variables (``fn``'s globals) that ``fn``'s code names:
     {name: (id, length)}."""
+    fn = learner_function(fn)          # the notebook-call wrapper's code names nothing of the learner's
     code, names = getattr(fn, "__code__", None), set()
     namespace = getattr(fn, "__globals__", None)
     if code is None or not isinstance(namespace, dict):
@@ -182,7 +184,7 @@ def _kept_data_matters(ex: ExerciseLike, fn: Callable, name: str, case: tuple, g
     """``fn`` on ``case`` with the notebook variable ``name`` emptied for the call (a shallow copy, cleared: a
     defaultdict keeps its factory) gives another answer than ``got`` (a result where it raised, or another
     result); the variable is put back whatever happens. Cannot tell (it raises again, or otherwise): False."""
-    namespace = fn.__globals__
+    namespace = learner_function(fn).__globals__
     kept = namespace.get(name)
     try:
         empty = copy.copy(kept)

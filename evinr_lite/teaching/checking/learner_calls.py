@@ -33,6 +33,13 @@ from .outputs import input_name, is_tensor, named_inputs, to_numpy
 from .global_state import global_settings, imports_watched, restore_settings
 
 
+def learner_function(fn: Callable) -> Callable:
+    """The learner's own function behind the check's notebook-call wrapper (signature.notebook_caller sets its
+    ``wraps_learner_function``), ``fn`` itself otherwise: what the readers of code, globals and defaults read, while
+    the check calls the wrapper."""
+    return getattr(fn, "wraps_learner_function", fn)
+
+
 def library_file(filename: str) -> bool:
     """A file of an installed library or of Python itself (numpy, torch, the standard library), not the learner's
     notebook or module (nor this kit, whose frames say which of its functions the learner's call broke)."""
@@ -73,6 +80,7 @@ def cache_raised(fn: Callable, err: BaseException) -> bool:
     """An "unhashable type" TypeError that a cache raised: ``fn`` is an lru_cache (it has ``cache_info``), the
     error came from no line of the learner's code (the cache's wrapper, in C, builds the key before the call), or
     the learner's line that raised calls a notebook function that is an lru_cache (a cached helper)."""
+    fn = learner_function(fn)
     if hasattr(fn, "cache_info"):
         return True
     frames = [f for f in traceback.extract_tb(err.__traceback__) if not _check_file(f.filename)]
@@ -420,6 +428,7 @@ def uses_uninitialised(fn) -> bool:
     torch.empty_like: ``empty`` read off np, numpy or torch (or another name for either module, in the notebook or
     imported in the function), or a name imported from them (``from numpy import empty``). Another object's
     ``empty`` (a queue's ``q.empty()``, a DataFrame's ``.empty``) is not one."""
+    fn = learner_function(fn)
     namespace = getattr(fn, "__globals__", None)
     namespace = namespace if isinstance(namespace, dict) else {}
     modules = {"np", "numpy", "torch"} | {k for k, v in namespace.items() if _array_module(v)}
@@ -456,7 +465,7 @@ def multiplies_rows(fn) -> bool:
     ``[[0.0] * W] * H``, or ``[row] * H`` where ``row = [0.0] * W``, H references to one row list. Read off the
     bytecode by following what each value on the stack is (a list of numbers, a list holding a list, anything
     else) through list displays, ``*`` and the names they are stored in; runs nothing."""
-    codes = [getattr(fn, "__code__", None)]
+    codes = [getattr(learner_function(fn), "__code__", None)]
     while codes:
         code = codes.pop()
         if code is None:

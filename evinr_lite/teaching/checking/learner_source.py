@@ -4,11 +4,15 @@ Two slips of Python itself, which leave no pattern in the numbers that the other
 :func:`none_from_in_place_hint`, a method that works in place and returns None used for its value (``b = b.sort()``,
 ``return out.sort()``, ``x = np.random.shuffle(x)``: the name holds None from there on), and :func:`xor_power_hint`,
 ``^`` written for a power (``n ^ 2`` is n XOR 2 in Python; on floats numpy and torch refuse it with words about
-"bitwise_xor"). Each is asked only once the function has failed (a wrong value, an error), and named only on evidence:
-the None hint where the error's words name a None, or a trace of the failing call sees the name hold None (or the
-function return it); the `^` hint where numpy's or torch's error refuses `^` on floats, or where the function, its
-`^` rewritten to `**` (recompiled with its globals and closure), then matches the reference, so that a correct `^`
-on bits (``dominated ^ 1``, a polarity flipped) is never blamed for another mistake. :func:`stub_raised` tells the
+"bitwise_xor"). Each is asked only once the function has failed (a wrong value, an error), and named only on a
+proof: the function rewritten and compiled again with its globals and closure (:func:`recompiled`; the learner's
+own function, behind the check's notebook-call wrapper and behind its decorators) and called as the check calls
+it. The None hint where the function, the method called on a line of its own and the name kept holding the object,
+matches the reference (or, where the function raised or returned None or another shape, no longer fails but in its
+numbers); the `^` hint where numpy's or torch's error refuses `^` on floats, or where the function, its `^`
+rewritten to `**`, matches while with `^ b` removed it does not (a constant 0, 1, True or False after `^` is a bit
+flipped, never a power), so that a correct `^` on bits (``dominated ^ 1``) or a torch ``.sort()`` (values and
+indices) is never blamed for another mistake; where it cannot be compiled again, no hint. :func:`stub_raised` tells the
 stub's own ``raise NotImplementedError`` (the learner's frame, a raise instruction) from torch's. The source comes from :func:`inspect.getsource`, which reads a
 notebook cell as well as a file; where there is none (a builtin, a lambda typed at a prompt) the hints say nothing.
 """
@@ -17,14 +21,12 @@ from __future__ import annotations
 import ast
 import dis
 import inspect
-import re
-import sys
 import textwrap
 import types
 from typing import Callable
 
-from .learner_calls import library_file, run
-from .outputs import compare_outputs
+from .learner_calls import learner_function, library_file, run
+from .outputs import compare_outputs, not_finite
 
 # methods that change their object in place and return None (ndarray.sort/.fill/.resize, list.sort/.append/...,
 # dict.update, random.shuffle); `add` and `pop` are left out: a tensor's `add` and every `pop` return a value
@@ -35,8 +37,14 @@ XOR_ERROR_WORDS = ("ufunc 'bitwise_xor'", '"bitwise_xor_cpu"', '"bitwise_xor_cud
 
 
 def _own(fn: Callable) -> Callable:
-    """The learner's function behind the check's notebook-call wrapper (signature.notebook_caller)."""
-    return getattr(fn, "_learner_function", fn)
+    """The learner's own function: behind the check's notebook-call wrapper (:func:`.learner_calls.learner_function`)
+    and behind its decorators (``@torch.no_grad()``, a functools.wraps wrapper: :func:`inspect.unwrap`), so that
+    its source, globals, closure and defaults are read off one function."""
+    own = learner_function(fn)
+    try:
+        return inspect.unwrap(own)
+    except (ValueError, TypeError):
+        return own
 
 
 def _tree(fn: Callable) -> ast.AST | None:
@@ -53,7 +61,10 @@ def _resolve(node: ast.AST, namespace: dict):
         return namespace.get(node.id)
     if isinstance(node, ast.Attribute):
         base = _resolve(node.value, namespace)
-        return getattr(base, node.attr, None) if base is not None else None
+        try:            # a property or a module's __getattr__ may raise anything: a hint never crashes the check
+            return getattr(base, node.attr, None) if base is not None else None
+        except Exception:
+            return None
     return None
 
 
@@ -88,52 +99,106 @@ def _in_place_uses(fn: Callable) -> list:
     return out
 
 
-def _none_seen(fn: Callable, case: tuple, observe=None) -> tuple[set, bool]:
-    """(the local names seen holding None, whether it returned None) in ``fn``'s own frame, on a traced call."""
-    code, names, returned = getattr(_own(fn), "__code__", None), set(), [False]
-    if code is None:
-        return names, False
+_OBJECT = "_in_place_object_"
 
-    def local(frame, event, arg):
-        for name, value in frame.f_locals.items():
-            if value is None:
-                names.add(name)
-        if event == "return" and arg is None:
-            returned[0] = True
-        return local
 
-    def tracer(frame, event, arg):
-        return local if frame.f_code is code else None
-    before = sys.gettrace()
-    sys.settrace(tracer)
+class _ObjectForNone(ast.NodeTransformer):
+    """``b = <obj>.sort(...)`` rewritten as ``_o = <obj>; _o.sort(...); b = _o`` (``return <obj>.sort()`` as
+    ``...; return _o``): the method called on a line of its own and the name kept holding the object; for a
+    module's ``shuffle`` (``x = np.random.shuffle(x)``), the call on its own and the name given its argument.
+    Counts what it rewrote."""
+
+    def __init__(self, namespace: dict):
+        self.namespace, self.count = namespace, 0
+
+    def _rewrite(self, node, call, keep):
+        if _returns_none(call, self.namespace) is None:
+            return node
+        receiver = call.func.value
+        if isinstance(_resolve(receiver, self.namespace), types.ModuleType):       # random.shuffle(x)
+            if not call.args or isinstance(call.args[0], ast.Starred):
+                return node
+            out = [ast.Expr(call), keep(call.args[0])]
+        else:
+            call.func.value = ast.Name(_OBJECT, ast.Load())
+            out = [ast.Assign([ast.Name(_OBJECT, ast.Store())], receiver), ast.Expr(call),
+                   keep(ast.Name(_OBJECT, ast.Load()))]
+        self.count += 1
+        return [ast.copy_location(n, node) for n in out]
+
+    def visit_Assign(self, node):
+        if len(node.targets) == 1 and isinstance(node.targets[0], ast.Name):
+            name = node.targets[0].id
+            return self._rewrite(node, node.value, lambda v: ast.Assign([ast.Name(name, ast.Store())], v))
+        return node
+
+    def visit_Return(self, node):
+        if node.value is None:
+            return node
+        return self._rewrite(node, node.value, lambda v: ast.Return(v))
+
+
+def _outcome(got, expected, ex) -> str:
+    """"match"; "values" where only the numbers differ (the reference's type and shape, finite where the
+    reference is); else "other" (None returned, another type or shape, NaN or inf; by an exercise's own
+    comparison, any difference)."""
+    if ex.compare is not None and ex.observe is None:
+        return "match" if ex.compare(got, expected) is None else "other"
+    problem = compare_outputs(got, expected, ex.rtol, ex.atol)
+    if problem is None:
+        return "match"
+    return "values" if problem.values and not (not_finite(got) and not not_finite(expected)) else "other"
+
+
+def _run_outcome(fn: Callable, ex, case: tuple, expected, call_as) -> str:
+    """:func:`_outcome` of ``fn`` called as the check calls the learner's (``call_as``) on ``case`` of exercise
+    ``ex``, against the reference's ``expected`` (run here where None); "raised" where either raises."""
     try:
-        run(fn, case[0], case[1], observe)
+        if expected is None:
+            expected = run(ex.reference, case[0], case[1], ex.observe)
+        got = run(call_as(fn) if call_as is not None else fn, case[0], case[1], ex.observe)
+        return _outcome(got, expected, ex)
     except Exception:
-        pass
-    finally:
-        sys.settrace(before)
-    return names, returned[0]
+        return "raised"
 
 
-def none_from_in_place_hint(fn: Callable, err: BaseException | None = None, case: tuple | None = None,
-                            observe=None) -> str | None:
+def _matches_reference(fn: Callable, ex, case: tuple, expected, call_as) -> bool:
+    return _run_outcome(fn, ex, case, expected, call_as) == "match"
+
+
+_RAISED = object()      # none_from_in_place_hint's ``got`` where the learner's call raised
+
+
+def none_from_in_place_hint(fn: Callable, ex=None, case: tuple | None = None, expected=None,
+                            call_as: Callable | None = None, got=_RAISED) -> str | None:
     """A hint where ``fn`` uses the value of a method that works in place and returns None, assigned to one name
-    (``b = b.sort()``) or returned (``return out.sort()``), and a None shows: the error ``err`` names one, or a
-    traced call on ``case`` ((args, kwargs)) sees the name hold None (or the function return None); else None.
-    A torch tensor's ``.sort()`` returns (values, indices), and is never blamed."""
+    (``b = b.sort()``) or returned (``return out.sort()``), and that None made the failure on ``case`` of exercise
+    ``ex``: the function rewritten to call the method on a line of its own and keep the object
+    (:class:`_ObjectForNone`, compiled again with its globals and closure), called as the check calls ``fn``
+    (``call_as``), matches the reference (``expected``; run here where None), or, where ``fn`` raised (``got``
+    left out) or returned ``got`` of another type or shape than the reference's (None, NaN), no longer fails so:
+    only its numbers differ (a second mistake, such as sorting what the reference keeps in order). Else None, and
+    None where it cannot be compiled again. A torch tensor's ``.sort()`` returns (values, indices): rewritten, it
+    raises or stops matching."""
+    if ex is None or case is None:
+        return None
     uses = _in_place_uses(fn)
     if not uses:
         return None
-    if err is not None and re.search(r"\bNone(Type)?\b", str(err)):
-        node, method, target = uses[0]
-    elif case is not None:
-        names, returned = _none_seen(fn, case, observe)
-        found = [u for u in uses if (u[2] in names if u[2] is not None else returned)]
-        if not found:
-            return None
-        node, method, target = found[0]
-    else:
+    rewrite = _ObjectForNone(getattr(_own(fn), "__globals__", {}))
+    kept = recompiled(fn, rewrite)
+    if kept is None or not rewrite.count:
         return None
+    try:
+        if expected is None:
+            expected = run(ex.reference, case[0], case[1], ex.observe)
+        before = "raised" if got is _RAISED else _outcome(got, expected, ex)
+    except Exception:
+        return None
+    after = _run_outcome(kept, ex, case, expected, call_as)
+    if not (after == "match" or (after == "values" and before in ("raised", "other"))):
+        return None
+    node, method, target = uses[0]
     what = f"`{target}` is None from there on" if target is not None else "the function returns None"
     line = ast.get_source_segment(textwrap.dedent(inspect.getsource(_own(fn))), node) or ""
     alternative = {"sort": " (for a sorted copy: `np.sort(a)`, `sorted(a)`)",
@@ -150,22 +215,35 @@ XOR_HINT = ("`^` is exclusive or (of the bits) in Python, not a power: `n ^ 2` i
             "refuse `^` on floats; write a power with `**` (`x ** 2`, `(I / (I + 1)) ** gamma`)")
 
 
-class _PowerForXor(ast.NodeTransformer):
-    """`a ^ b` and `a ^= b` rewritten as `a ** b` and `a **= b`; counts what it rewrote."""
+def _identity_exponent(node: ast.AST) -> bool:
+    """A constant 0, 1, True or False: `x ** 1 == x` and `x ** 0 == 1`, so `^ 1` as a power proves nothing (and
+    `^ 1`, `^ True` flip a bit, which is what they mean more often)."""
+    return isinstance(node, ast.Constant) and type(node.value) in (int, bool) and node.value in (0, 1)
 
-    def __init__(self):
-        self.count = 0
+
+class _PowerForXor(ast.NodeTransformer):
+    """`a ^ b` and `a ^= b` rewritten as `a ** b` and `a **= b` (with ``drop``: as `a`, and the `a ^= b` statement
+    left out), but not where b is a constant 0, 1, True or False; counts what it rewrote."""
+
+    def __init__(self, drop: bool = False):
+        self.count, self.drop = 0, drop
 
     def visit_BinOp(self, node):
         self.generic_visit(node)
-        if isinstance(node.op, ast.BitXor):
-            node.op, self.count = ast.Pow(), self.count + 1
+        if isinstance(node.op, ast.BitXor) and not _identity_exponent(node.right):
+            self.count += 1
+            if self.drop:
+                return node.left
+            node.op = ast.Pow()
         return node
 
     def visit_AugAssign(self, node):
         self.generic_visit(node)
-        if isinstance(node.op, ast.BitXor):
-            node.op, self.count = ast.Pow(), self.count + 1
+        if isinstance(node.op, ast.BitXor) and not _identity_exponent(node.value):
+            self.count += 1
+            if self.drop:
+                return ast.copy_location(ast.Pass(), node)
+            node.op = ast.Pow()
         return node
 
 
@@ -216,29 +294,24 @@ def recompiled(fn: Callable, transformer: ast.NodeTransformer) -> Callable | Non
 
 
 def xor_power_hint(fn: Callable, err: BaseException | None = None, ex=None, case: tuple | None = None,
-                   expected=None) -> str | None:
+                   expected=None, call_as: Callable | None = None) -> str | None:
     """:data:`XOR_HINT` where ``^`` stands for a power: the error ``err`` is numpy's or torch's refusal of `^` on
-    floats, or ``fn`` with its `^` rewritten as `**` matches the reference (``expected``; run here where None) on
-    ``case`` of exercise ``ex``; else None."""
+    floats, or ``fn`` with its `^` rewritten as `**` (a constant 0, 1, True or False after it left alone: `x ** 1`
+    is x) matches the reference (``expected``; run here where None) on ``case`` of exercise ``ex`` while ``fn``
+    with that `^ b` removed does not, each called as the check calls ``fn`` (``call_as``: the notebook's form,
+    :func:`.signature.called_the_same_way`); else None."""
     if err is not None and any(w in str(err) for w in XOR_ERROR_WORDS):
         return XOR_HINT
-    if ex is None or case is None or _own(fn) is not fn:
+    if ex is None or case is None:
         return None
     rewrite = _PowerForXor()
     power = recompiled(fn, rewrite)
-    if power is None or not rewrite.count:
+    if power is None or not rewrite.count or not _matches_reference(power, ex, case, expected, call_as):
         return None
-    try:
-        if expected is None:
-            expected = run(ex.reference, case[0], case[1], ex.observe)
-        got = run(power, case[0], case[1], ex.observe)
-        if ex.compare is not None and ex.observe is None:
-            same = ex.compare(got, expected) is None
-        else:
-            same = compare_outputs(got, expected, ex.rtol, ex.atol) is None
-    except Exception:
-        return None
-    return XOR_HINT if same else None
+    dropped = recompiled(fn, _PowerForXor(drop=True))
+    if dropped is not None and _matches_reference(dropped, ex, case, expected, call_as):
+        return None             # `^ b` left out matches as well: the power is not what made the difference
+    return XOR_HINT
 
 
 def stub_raised(err: BaseException) -> bool:

@@ -19,13 +19,15 @@ called so throughout (:func:`.signature.notebook_caller`). Slips read off the le
 come first among the hints, and in a raised error's report before the guesses from the error's words: `^` for a
 power (the function with `**` in its place matches, or numpy's or torch's error refuses `^` on floats) and a default
 other than the stub's where an input leaves it out (with the stub's default passed, the input matches); the None of
-``b = b.sort()`` (:mod:`.learner_source`), named only where a None shows (the error's words, a traced call), comes
-after the exercise's own and the generic wrong versions. The order is the report's:
+``b = b.sort()`` (:mod:`.learner_source`), named only where the function with the method on a line of its own
+matches, comes after the exercise's own and the generic wrong versions and a reseeded generator, before the guesses
+read off the values. A hint read off the source never crashes the check (:func:`_safely`). The order is the report's:
 change it and other hints win. Returns (passed, headline, detail lines); printing is
 :func:`evinr_lite.teaching.exercises.check`'s.
 """
 from __future__ import annotations
 
+import functools
 from typing import Callable
 
 from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, fixed_size_hint, global_cache_hint,
@@ -41,7 +43,8 @@ from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
 from .protocol import ExerciseLike
-from .signature import called_as_notebook, learner_function, notebook_caller, signature_default_hint
+from .signature import (called_as_notebook, called_the_same_way, learner_function, notebook_caller,
+                        signature_default_hint)
 
 NOT_DONE = "not done yet"  # the headline's start for a stub that raises NotImplementedError
 
@@ -162,8 +165,10 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     kept between calls)."""
     args, kwargs = cases[k]
     details = [f"{type(err).__name__}: {err}"] + where_raised(err)
-    written = xor_power_hint(fn, err, ex, (args, kwargs)) or signature_default_hint(ex, fn, args, kwargs) \
-        or none_from_in_place_hint(fn, err, (args, kwargs), ex.observe)
+    same = functools.partial(called_the_same_way, fn)      # a proof's recompiled function, called as fn is
+    written = _safely(xor_power_hint, fn, err, ex, (args, kwargs), None, same) \
+        or _safely(signature_default_hint, ex, fn, args, kwargs) \
+        or _safely(none_from_in_place_hint, fn, ex, (args, kwargs), None, same)
     if written:                 # read off the learner's source: what the error's words would only guess at
         details.append(f"hint: {written}")
     elif isinstance(err, TypeError) and "unhashable type" in str(err) and cache_raised(fn, err):
@@ -219,6 +224,15 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     return False, f"raised {type(err).__name__} on {where}", details
 
 
+def _safely(hint: Callable, *args) -> str | None:
+    """``hint(*args)``, or None where it raises: a hint read off the learner's source (its globals' properties, a
+    module's ``__getattr__``) must never crash the check."""
+    try:
+        return hint(*args)
+    except Exception:
+        return None
+
+
 def _python_on_arrays_hints(err: Exception, line: str) -> list[str]:
     """Hints for Python's one-value tools used on whole arrays or tensors, from the error numpy or torch raised:
     `and` / `or` / `if` / a chained comparison (one truth value), `&` read before a comparison, the math module (one
@@ -262,6 +276,7 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     order. Each step may run the learner's function again (with its side effects), so a step runs only when the
     ones before it found nothing."""
     args, kwargs = cases[k]
+    same = functools.partial(called_the_same_way, fn)      # a proof's recompiled function, called as fn is
     # results kept in a notebook dict (or list) that the function fills: an input that shares an earlier
     # one's key gets that input's result. Named first when the kept data made the difference (run with the
     # variable emptied, the function answers otherwise), else only when no other hint applies (below): a list
@@ -269,7 +284,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     cache_hint, proven = global_cache_hint(fn, containers, ex, (args, kwargs), got) if k > 0 else (None, False)
     hint = cache_hint if proven else None
     if hint is None:            # slips read off the source, each proven: `^` for `**`, another default
-        hint = xor_power_hint(fn, None, ex, (args, kwargs), expected) or signature_default_hint(ex, fn, args, kwargs)
+        hint = _safely(xor_power_hint, fn, None, ex, (args, kwargs), expected, same) \
+            or _safely(signature_default_hint, ex, fn, args, kwargs)
     memory = None       # memory_explains' answer on this input, asked once (it runs the function four times)
     if hint is None:
         memory = memory_explains(fn, ex, args, kwargs, got)
@@ -286,13 +302,14 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
         hint = stale_argument_hint(ex, fn, cases, k, got, expected)
     if hint is None and ex.observe is None:
         hint = _generic_mistake_hint(ex, fn, cases, k, got, expected)
-    if hint is None:            # the None of `b = b.sort()`, where a traced call sees the None
-        hint = none_from_in_place_hint(fn, None, (args, kwargs), ex.observe)
     # a global generator seeded inside: random numbers, the same at every call (after the generic mistakes: a
     # seed that draws nothing explains no value, and is only noted)
     seed_note = None
     if hint is None:
         hint, seed_note = reseed_hint(ex, fn, args, kwargs)
+    if hint is None:            # the None of `b = b.sort()`, proven: the method on a line of its own, the function
+        # matches (or no longer fails but in its numbers); before the guesses read off the values (a NaN's)
+        hint = _safely(none_from_in_place_hint, fn, ex, (args, kwargs), expected, same, got)
     if hint is None:
         hint = size_from_events_hint(args, kwargs, got, expected)
     if hint is None:
