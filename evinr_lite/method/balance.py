@@ -143,8 +143,9 @@ class BalanceFit:
     Attributes:
         C: (c_pos, c_neg) log units per event, mean = the nominal C.
         imbalance: b applied, (C+ - C-) / (C+ + C-), capped: minmod(gradient_imbalance (or
-            raw_imbalance without slice counts), interval_imbalance) or slope_imbalance by the
-            consensus rule, shrink x raw_imbalance by the counts rule.
+            raw_imbalance without slice counts), interval_imbalance) or slope_imbalance (bounded by the
+            range of raw, gradient and interval imbalance where the gradient's is finite) by the consensus
+            rule, shrink x raw_imbalance by the counts rule.
         raw_imbalance: the counts' pooled b = sum(n- - n+) / sum(n- + n+) over the usable pixels.
         interval_imbalance: the intervals' b (NaN where not computed: the counts rule, no interval sums).
         shrink: the counts rule's weight for the raw value (0: nominal C kept, 1: raw value used).
@@ -154,7 +155,7 @@ class BalanceFit:
             disagree in sign, or no estimate); the counts rule says "counts".
         counts_error: the counts' error scale ``s = NET_CHANGE / (C mean_events)`` (NaN: no estimate).
         slope_imbalance: the counts' estimate with an intercept (:func:`slope_imbalance`), the one
-            taken alone (NaN where the counts do not vary).
+            taken alone, bounded by the other three (NaN where the counts do not vary).
         gradient_imbalance: the edges' estimate (:func:`gradient_imbalance`), the minmod's partner of
             the intervals (NaN without slice counts: the pooled counts stand in).
         mean_events: mean event count of the usable pixels. n_pixels: usable pixels.
@@ -477,8 +478,9 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
         sliced: (on, off) [K, H, W] counts per time slice (:func:`slice_counts`, or
             :attr:`PolarityCounts.sliced`) for the edges' estimate, the intervals' partner in the
             minmod; without them the pooled counts take its place.
-        rule: "consensus" (minmod of the counts' and the intervals' estimates, or the counts' slope
-            alone where their error scale is at most COUNTS_ALONE) or "counts" (the counts' pooled
+        rule: "consensus" (minmod of the edges' (or the pooled counts') and the intervals' estimates, or
+            the counts' slope alone, bounded by the range of the pooled counts, the edges and the intervals,
+            where their error scale is at most COUNTS_ALONE) or "counts" (the counts' pooled
             estimate shrunk by its evidence).
         min_events: pixels with fewer events are left out. max_imbalance: cap on |b| in [0, 1), and
             how far the intervals may lie from the counts for the counts to be taken alone.

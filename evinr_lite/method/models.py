@@ -151,10 +151,13 @@ class FrameINR(nn.Module):
                 # one time is a matrix-vector product, which BLAS may sum in another order than a product
                 # of two or more rows (MKL on AVX-512 does: 5e-3 apart where the head's weights cancel);
                 # computed as two equal rows, one time's frame is the same as in any batch of times
-                F = torch.baddbmm(self.head_bias, torch.cat([h, h], dim=1), self.head_weight)[:, :1]
+                # (in out's dtype, so that a wrong one is refused as it is for many times)
+                two = torch.empty((h.shape[0], 2, self.head_weight.shape[-1]), device=h.device,
+                                  dtype=self.head_weight.dtype if out is None else out.dtype)
+                torch.baddbmm(self.head_bias, torch.cat([h, h], dim=1), self.head_weight, out=two)
                 if out is None:
-                    return F.reshape(*F.shape[:2], *self.sensor_size)
-                out.view(*out.shape[:2], -1).copy_(F)
+                    return two[:, :1].reshape(h.shape[0], 1, *self.sensor_size)
+                out.view(*out.shape[:2], -1).copy_(two[:, :1])
                 return out
         if out is not None:
             torch.baddbmm(self.head_bias, h, self.head_weight, out=out.view(*out.shape[:2], -1))

@@ -19,11 +19,14 @@ notebook cell as well as a file; where there is none (a builtin, a lambda typed 
 from __future__ import annotations
 
 import ast
+import copy
 import dis
 import inspect
 import textwrap
 import types
 from typing import Callable
+
+import numpy as np
 
 from .learner_calls import learner_function, library_file, run
 from .outputs import compare_outputs, not_finite
@@ -108,11 +111,13 @@ class _ObjectForNone(ast.NodeTransformer):
     module's ``shuffle`` (``x = np.random.shuffle(x)``), the call on its own and the name given its argument.
     Counts what it rewrote."""
 
-    def __init__(self, namespace: dict):
-        self.namespace, self.count = namespace, 0
+    def __init__(self, namespace: dict, only: tuple | None = None):
+        self.namespace, self.count, self.only = namespace, 0, only    # only: the (line, column) of one use
 
     def _rewrite(self, node, call, keep):
         if _returns_none(call, self.namespace) is None:
+            return node
+        if self.only is not None and (node.lineno, node.col_offset) != self.only:
             return node
         receiver = call.func.value
         if isinstance(_resolve(receiver, self.namespace), types.ModuleType):       # random.shuffle(x)
@@ -182,12 +187,8 @@ def none_from_in_place_hint(fn: Callable, ex=None, case: tuple | None = None, ex
     raises or stops matching."""
     if ex is None or case is None:
         return None
-    uses = _in_place_uses(fn)
+    uses = sorted(_in_place_uses(fn), key=lambda u: (u[0].lineno, u[0].col_offset))
     if not uses:
-        return None
-    rewrite = _ObjectForNone(getattr(_own(fn), "__globals__", {}))
-    kept = recompiled(fn, rewrite)
-    if kept is None or not rewrite.count:
         return None
     try:
         if expected is None:
@@ -195,10 +196,23 @@ def none_from_in_place_hint(fn: Callable, ex=None, case: tuple | None = None, ex
         before = "raised" if got is _RAISED else _outcome(got, expected, ex)
     except Exception:
         return None
-    after = _run_outcome(kept, ex, case, expected, call_as)
-    if not (after == "match" or (after == "values" and before in ("raised", "other"))):
-        return None
-    node, method, target = uses[0]
+    namespace = getattr(_own(fn), "__globals__", {})
+
+    def proven(only) -> bool:
+        rewrite = _ObjectForNone(namespace, only)
+        kept = recompiled(fn, rewrite)
+        if kept is None or not rewrite.count:
+            return False
+        after = _run_outcome(kept, ex, case, expected, call_as)
+        return after == "match" or (after == "values" and before in ("raised", "other"))
+    # each use alone first, so that the one named is the one whose None made the failure (not a harmless
+    # `note = log.append(...)` before it); all of them together where it takes more than one
+    chosen = next((u for u in uses if proven((u[0].lineno, u[0].col_offset))), None) if len(uses) > 1 else None
+    if chosen is None:
+        if not proven(None):
+            return None
+        chosen = uses[0]
+    node, method, target = chosen
     what = f"`{target}` is None from there on" if target is not None else "the function returns None"
     line = ast.get_source_segment(textwrap.dedent(inspect.getsource(_own(fn))), node) or ""
     alternative = {"sort": " (for a sorted copy: `np.sort(a)`, `sorted(a)`)",
@@ -221,12 +235,32 @@ def _identity_exponent(node: ast.AST) -> bool:
     return isinstance(node, ast.Constant) and type(node.value) in (int, bool) and node.value in (0, 1)
 
 
+_GUARDED_POWER = "_evinr_guarded_power_"    # the name the proof's rewrite calls (a closure cell, not a global)
+
+
+def guarded_power(a, b):
+    """``a ** b`` for the `^`-as-power proof, refused (OverflowError) where both are whole numbers and the power
+    would be huge: a learner's `^` on integers (a hash's `seed ^= s + 0x9e3779b9`) is often a real exclusive or,
+    and as a power it could take longer than any check (2 ** 0x9e3779b9) or size a loop (``range(n ** 2)``)."""
+    whole = (int, np.integer)
+    if isinstance(a, whole) and isinstance(b, whole) and not isinstance(a, bool) and not isinstance(b, bool):
+        a_, b_ = int(a), int(b)
+        if b_ > 64 or (b_ > 0 and abs(a_).bit_length() * b_ > 31):
+            raise OverflowError("a power of whole numbers too large to try as the `^`'s meaning")
+    return a ** b
+
+
 class _PowerForXor(ast.NodeTransformer):
-    """`a ^ b` and `a ^= b` rewritten as `a ** b` and `a **= b` (with ``drop``: as `a`, and the `a ^= b` statement
-    left out), but not where b is a constant 0, 1, True or False; counts what it rewrote."""
+    """`a ^ b` and `a ^= b` rewritten as a guarded `a ** b` (:func:`guarded_power`: `a = power(a, b)` for the
+    statement; with ``drop``: as `a`, and the `a ^= b` statement left out), but not where b is a constant 0, 1, True
+    or False; counts what it rewrote."""
 
     def __init__(self, drop: bool = False):
         self.count, self.drop = 0, drop
+
+    @staticmethod
+    def _power(left, right):
+        return ast.Call(ast.Name(_GUARDED_POWER, ast.Load()), [left, right], [])
 
     def visit_BinOp(self, node):
         self.generic_visit(node)
@@ -234,7 +268,7 @@ class _PowerForXor(ast.NodeTransformer):
             self.count += 1
             if self.drop:
                 return node.left
-            node.op = ast.Pow()
+            return ast.copy_location(self._power(node.left, node.right), node)
         return node
 
     def visit_AugAssign(self, node):
@@ -243,13 +277,16 @@ class _PowerForXor(ast.NodeTransformer):
             self.count += 1
             if self.drop:
                 return ast.copy_location(ast.Pass(), node)
-            node.op = ast.Pow()
+            load = copy.deepcopy(node.target)
+            load.ctx = ast.Load()
+            return ast.copy_location(ast.Assign([node.target], self._power(load, node.value)), node)
         return node
 
 
-def recompiled(fn: Callable, transformer: ast.NodeTransformer) -> Callable | None:
+def recompiled(fn: Callable, transformer: ast.NodeTransformer, cells: dict | None = None) -> Callable | None:
     """``fn`` with its source's tree changed by ``transformer``, compiled again with ``fn``'s globals, closure and
-    defaults; None where it cannot be (no source, not a def, a closure that does not match)."""
+    defaults, and ``cells`` (name: value) as further closure variables (the learner's globals are not touched);
+    None where it cannot be (no source, not a def, a closure that does not match)."""
     tree = _tree(fn)
     if tree is None or not tree.body or not isinstance(tree.body[0], ast.FunctionDef):
         return None
@@ -259,7 +296,8 @@ def recompiled(fn: Callable, transformer: ast.NodeTransformer) -> Callable | Non
     fdef = tree.body[0]
     fdef.decorator_list = []
     fdef = transformer.visit(fdef)
-    free = f.__code__.co_freevars
+    extra = dict(cells or {})
+    free = tuple(f.__code__.co_freevars) + tuple(v for v in extra if v not in f.__code__.co_freevars)
     body: list = [fdef]
     if free:           # compiled inside an outer def that binds the same names, so that they stay free variables
         body = [ast.FunctionDef(name="__outer__", args=ast.arguments([], [], None, [], [], None, []),
@@ -284,8 +322,9 @@ def recompiled(fn: Callable, transformer: ast.NodeTransformer) -> Callable | Non
     if inner is None:
         return None
     try:
-        cells = dict(zip(free, f.__closure__ or ()))
-        closure = tuple(cells[v] for v in inner.co_freevars) or None
+        bound = dict(zip(f.__code__.co_freevars, f.__closure__ or ()))
+        bound.update({name: types.CellType(value) for name, value in extra.items()})
+        closure = tuple(bound[v] for v in inner.co_freevars) or None
         new = types.FunctionType(inner, f.__globals__, f.__name__, f.__defaults__, closure)
     except (KeyError, TypeError, ValueError):
         return None
@@ -305,8 +344,14 @@ def xor_power_hint(fn: Callable, err: BaseException | None = None, ex=None, case
     if ex is None or case is None:
         return None
     rewrite = _PowerForXor()
-    power = recompiled(fn, rewrite)
-    if power is None or not rewrite.count or not _matches_reference(power, ex, case, expected, call_as):
+    power = recompiled(fn, rewrite, {_GUARDED_POWER: guarded_power})
+    if power is None or not rewrite.count:
+        return None
+    try:                # the reference's answer once, for both proofs
+        expected = run(ex.reference, case[0], case[1], ex.observe) if expected is None else expected
+    except Exception:
+        return None
+    if not _matches_reference(power, ex, case, expected, call_as):
         return None
     dropped = recompiled(fn, _PowerForXor(drop=True))
     if dropped is not None and _matches_reference(dropped, ex, case, expected, call_as):
