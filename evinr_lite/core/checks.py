@@ -18,7 +18,7 @@ import numpy as np
 from .events import EventDataError
 from .guard import InputError, check_unmasked, dense_array, host_array
 
-__all__ = ["require", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
+__all__ = ["require", "numbers_array", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
            "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
            "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type"]
@@ -282,6 +282,16 @@ def _range(lo, hi, lo_open: bool = False) -> str:
 
 
 FLOAT_IMAGE_SLACK = 1.0 / 255.0   # float images may overshoot [0, 1] by rounding, not by a factor of 255
+
+
+def numbers_array(value, name: str, what: str, *, flags: bool = False) -> np.ndarray:
+    """``value`` as an array of numbers, its dtype kept (``what``: what it must be, in the message): text and None
+    refused by ``name``, booleans too unless ``flags`` (read as 0 and 1, as numpy reads them); values not checked."""
+    arr = None if value is None or isinstance(value, (str, bytes)) else \
+        dense_array(value, f"{name}=", error=EventDataError, want=what)
+    if arr is None or arr.dtype.kind not in ("biuf" if flags else "iuf"):
+        raise EventDataError(f"{name}= must be {what} (numbers), got {short_repr(value)}")
+    return arr
 
 
 def check_image_values(images, name: str = "images", *, clipped: bool = False) -> np.ndarray:

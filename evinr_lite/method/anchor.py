@@ -63,9 +63,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import real_number, short_repr, whole_number
+from ..core.checks import numbers_array, real_number, short_repr, whole_number
 from ..core.events import EventDataError
-from ..core.guard import dense_array
 from ..core.frames import Frames
 
 __all__ = ["FRAME_EPS", "ANCHOR_MODES", "AnchorFit", "frames_in_window", "select_anchors", "fit_anchor",
@@ -85,22 +84,12 @@ def check_frame_eps(eps) -> float:
                                                  "(FRAME_EPS = 1/255)")
 
 
-def _values(value, name: str, what: str, *, flags: bool = False) -> np.ndarray:
-    """``value`` as an array of numbers (text and None refused by ``name``, booleans too unless ``flags``, read as
-    0 and 1 as numpy reads them; its dtype kept)."""
-    arr = None if value is None or isinstance(value, (str, bytes)) else \
-        dense_array(value, f"{name}=", error=EventDataError, want=what)
-    if arr is None or arr.dtype.kind not in ("biuf" if flags else "iuf"):
-        raise EventDataError(f"{name}= must be {what} (numbers), got {short_repr(value)}")
-    return arr
-
-
 def frame_log(images, eps: float = FRAME_EPS) -> np.ndarray:
     """log(I + eps) of frames given as uint8 (0..255) or float in [0, 1]: float64, same shape (booleans are 0 and 1,
     a black and white image). NaN images and an eps that is no finite number >= 0 are refused (they gave NaN logs):
     :func:`check_frame_eps`."""
     eps_value = check_frame_eps(eps)
-    a = _values(images, "images", "frames, uint8 or floats in [0, 1]", flags=True)
+    a = numbers_array(images, "images", "frames, uint8 or floats in [0, 1]", flags=True)
     if a.dtype.kind == "f" and np.isnan(a).any():
         raise EventDataError(f"images= holds {int(np.isnan(a).sum()):,} NaN value(s); a frame's intensity must be "
                              "a number: repair or drop those frames")
@@ -114,7 +103,7 @@ def linear_frames(L, eps: float = FRAME_EPS) -> np.ndarray:
     ``L``: numbers (a NaN was a NaN frame, None a NaN "frame" of no shape); +-inf are the logs of saturation and 0;
     booleans are 0 and 1, as numpy reads them (they were taken before). ``eps``: :func:`check_frame_eps`."""
     eps_value = check_frame_eps(eps)
-    values = _values(L, "L", "log intensities", flags=True)
+    values = numbers_array(L, "L", "log intensities", flags=True)
     if values.dtype.kind == "f" and np.isnan(values).any():
         raise EventDataError(f"L= holds {int(np.isnan(values).sum()):,} NaN value(s); a log intensity must be a "
                              "number (NaN frames would come out)")
@@ -179,7 +168,7 @@ def smoothing_matrix(times: np.ndarray, smoothing: float) -> np.ndarray:
     of 10^8, two equal times one of 10^7 from the 1e-9 s floor of a gap)."""
     smoothing = real_number(smoothing, "smoothing", lo=0.0,
                             hint="seconds (EvINRConfig.anchor_smoothing, e.g. 0.03)")
-    times = _values(times, "times", "anchor times in seconds [K]")
+    times = numbers_array(times, "times", "anchor times in seconds [K]")
     if times.ndim != 1 or (times.dtype.kind == "f" and not np.isfinite(times).all()):
         raise EventDataError(f"times= must be finite seconds [K], increasing, got {short_repr(times)}")
     if (np.diff(times) <= 0).any():

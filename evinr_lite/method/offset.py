@@ -55,9 +55,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from ..core.checks import real_number, short_repr, whole_number
+from ..core.checks import numbers_array, real_number, whole_number
 from ..core.events import EventDataError
-from ..core.guard import dense_array
 from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues_unchecked
 
@@ -83,10 +82,7 @@ LEFT_OUT = 1e6           # +-M for a left-out frame's value (times the values' s
 def _numbers(value, name: str, what: str) -> np.ndarray:
     """``value`` as an array of finite numbers (any shape, its dtype kept; ``what``: what it must be, in the
     message); None, text, booleans, NaN or inf were numpy's or Python's errors, or came out as NaN without a word."""
-    arr = None if value is None or isinstance(value, (str, bytes)) else \
-        dense_array(value, f"{name}=", error=EventDataError, want=what)
-    if arr is None or arr.dtype.kind not in "iuf":
-        raise EventDataError(f"{name}= must be {what} (numbers), got {short_repr(value)}")
+    arr = numbers_array(value, name, what)
     if arr.dtype.kind == "f" and arr.size and not (np.isfinite(arr.min()) and np.isfinite(arr.max())):
         n_bad = int((~np.isfinite(arr)).sum())
         raise EventDataError(f"{name}= holds {n_bad:,} NaN or infinite value(s); the result would be NaN: repair "
