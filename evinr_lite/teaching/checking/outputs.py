@@ -101,6 +101,19 @@ class Problem:
     values: bool = False  # True when shapes/types agree and only the numbers differ
 
 
+def first_difference(ex, got, expected) -> Problem | None:
+    """The first difference between the learner's output and the reference's for exercise ``ex`` (an
+    :class:`~.protocol.ExerciseLike`): by its own comparison (``ex.compare``) when it has one, else by
+    :func:`compare_outputs` within its tolerances."""
+    if ex.compare is None:
+        return compare_outputs(got, expected, ex.rtol, ex.atol)
+    try:
+        msg = ex.compare(got, expected)
+    except Exception as err:     # a return value the comparison cannot read at all
+        msg = f"returned a {type(got).__name__} that cannot be compared ({type(err).__name__}: {err})"
+    return None if msg is None else Problem(msg, values=True)
+
+
 def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") -> Problem | None:
     at = f" in output {where}" if where else ""
     if got is None and expected is not None:

@@ -41,7 +41,8 @@ from .learner_calls import (cache_raised, changed_inputs, container_names, in_pl
                             module_flags_message, poison_freed_memory, run, watching, where_raised)
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
-from .outputs import BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf, not_finite
+from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
+                      first_difference, not_finite)
 from .protocol import ExerciseLike
 from .signature import (called_as_notebook, called_the_same_way, learner_function, notebook_caller,
                         signature_default_hint)
@@ -116,7 +117,7 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             if after and ref_after else None
         if model_changed:
             return False, f"changed the model's settings on {where}", [model_changed]
-        problem = _first_difference(ex, got, expected)
+        problem = first_difference(ex, got, expected)
         # inputs changed in place (a function with side effects says what to compare through `observe`)
         changed = changed_inputs((args, kwargs), after[0]) if ex.observe is None and after else []
         # the right values, but not what back-propagation from them reaches (a differentiable result)
@@ -256,18 +257,6 @@ def _python_on_arrays_hints(err: Exception, line: str) -> list[str]:
                 "the result off from the autograd graph, so nothing could be trained through it: use torch's "
                 "functions (torch.mean, torch.square, torch.exp) or the tensor's own methods (x.pow(2).mean())"]
     return []
-
-
-def _first_difference(ex: ExerciseLike, got, expected) -> Problem | None:
-    """The first difference between the learner's output and the reference's: by the exercise's own comparison
-    (``ex.compare``) when it has one, else by :func:`compare_outputs` within its tolerances."""
-    if ex.compare is None:
-        return compare_outputs(got, expected, ex.rtol, ex.atol)
-    try:
-        msg = ex.compare(got, expected)
-    except Exception as err:     # a return value the comparison cannot read at all
-        msg = f"returned a {type(got).__name__} that cannot be compared ({type(err).__name__}: {err})"
-    return None if msg is None else Problem(msg, values=True)
 
 
 def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected, problem: Problem, defaults: dict,

@@ -19,7 +19,7 @@ import inspect
 from typing import Callable
 
 from .learner_calls import learner_function, run
-from .outputs import compare_outputs
+from .outputs import first_difference
 from .protocol import ExerciseLike
 
 _ORDERED = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
@@ -155,12 +155,7 @@ def called_the_same_way(fn: Callable, other: Callable) -> Callable:
 
 
 def _matches(ex: ExerciseLike, got, expected) -> bool:
-    if ex.compare is not None and ex.observe is None:
-        try:
-            return ex.compare(got, expected) is None
-        except Exception:
-            return False
-    return compare_outputs(got, expected, ex.rtol, ex.atol) is None
+    return first_difference(ex, got, expected) is None
 
 
 def signature_default_hint(ex: ExerciseLike, fn: Callable, args: tuple, kwargs: dict) -> str | None:
