@@ -11,7 +11,9 @@ For each scene, on the events the kit trains on (hot pixels dropped, background 
 :mod:`evinr_lite.method.prepare` does): the simulated imbalance b = (C+ - C-) / (C+ + C-), the two
 estimates of :mod:`evinr_lite.method.balance` (the pooled counts, ``raw``, the counts fitted with an
 intercept, ``slope``, and the intervals between events of one polarity, ``interval``), the default's result (``applied``: the counts alone where
-their error scale is small, bounded by the range of the other three, else the minmod; ``chosen`` says which), and the
+their error scale is small, bounded by the range of the other three, else the minmod, or where the edges and the
+intervals disagree and the counts show no change of light the smallest of the three counts' estimates; ``chosen``
+says which), and the
 counts rule's (``counts_rule``: ``raw`` shrunk by ``shrink``), with the mean event count per usable
 pixel, the counts' error scale ``s = NET_CHANGE / (C mean n)`` (at most COUNTS_ALONE: the counts are
 taken alone) and the truth's change of mean log intensity from the first to the last scored frame (what the

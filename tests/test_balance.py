@@ -176,6 +176,7 @@ def test_interval_sums_time_the_runs_of_one_polarity():
 
 def test_minmod_and_bad_arguments():
     assert minmod(0.2, 0.1) == 0.1 and minmod(-0.05, -0.3) == -0.05 and minmod(0.2, -0.1) == 0.0
+    assert minmod(0.2, 0.1, 0.15) == 0.1 and minmod(-0.2, -0.3, -0.25) == -0.2 and minmod(-0.1, -0.2, 0.05) == 0.0
     n = np.ones((10, 10))
     with pytest.raises(EventDataError, match="rule must be one of"):
         balance_from_counts(n, n, 0.2, rule="frames")
@@ -313,6 +314,58 @@ def test_a_busy_shake_whose_slope_errs_gets_the_others_range():
     fit = estimate_balance(events, effective_C(z))
     assert fit.chosen == "counts" and abs(fit.slope_imbalance - imbalance(z)) > 0.04
     assert abs(fit.imbalance - imbalance(z)) < 0.01
+
+
+def test_counts_that_show_no_change_of_light_overrule_intervals_of_the_other_sign(monkeypatch):
+    """Between COUNTS_ALONE and COUNTS_OVER_INTERVALS, where the edges and the intervals disagree in sign
+    (the edges -0.12, the intervals +0.08, their scene's own bias): the pooled counts read a change of
+    light common to all pixels and the slope does not, so where the two agree (the span's mean log change
+    C mean n |pooled - slope| at most STEADY_LIGHT) no change of light pushed the estimates apart, and the
+    smallest of the edges, the slope and the pooled counts is taken. A change of light of 3 STEADY_LIGHT,
+    too few events (s above COUNTS_OVER_INTERVALS) or no slice counts keep the nominal C."""
+    from evinr_lite.method import balance
+    from evinr_lite.method.balance import COUNTS_ALONE, COUNTS_OVER_INTERVALS, NET_CHANGE, STEADY_LIGHT
+
+    C, b = 0.2, -0.1
+    rows = np.linspace(0.5, 1.5, 20)[:, None] * np.ones((1, 20))
+    ivl = _interval_arrays(rows.shape, 2 * np.arctanh(0.08), 0.0)
+    sliced = (np.ones((4,) + rows.shape), np.ones((4,) + rows.shape))
+    monkeypatch.setattr(balance, "gradient_imbalance", lambda *a: -0.12)
+    cases = ((12.0, 0.0, "agreement"), (12.0, -0.5 * STEADY_LIGHT, "agreement"),
+             (12.0, 3 * STEADY_LIGHT, "nominal"), (3.0, 0.0, "nominal"))
+    for mean_n, light, expect in cases:
+        n_on, n_off = _counts_with(b, mean_n * rows, light, C)
+        fit = balance_from_counts(n_on, n_off, C, intervals=ivl, sliced=sliced)
+        s = NET_CHANGE / (C * mean_n)
+        assert fit.counts_error == pytest.approx(s) and s > COUNTS_ALONE
+        assert fit.interval_imbalance == pytest.approx(0.08) and fit.gradient_imbalance == -0.12
+        assert C * mean_n * abs(fit.raw_imbalance - fit.slope_imbalance) == pytest.approx(abs(light), abs=1e-9)
+        assert fit.chosen == expect, (mean_n, light)
+        if expect == "agreement":
+            assert s <= COUNTS_OVER_INTERVALS
+            assert fit.imbalance == minmod(fit.gradient_imbalance, fit.slope_imbalance, fit.raw_imbalance)
+            # the slope (= b) where the light is steady, else the pooled counts, pulled towards 0 by it
+            assert fit.imbalance == pytest.approx(b - light / (C * mean_n) if light < 0 else b, abs=1e-9)
+        else:
+            assert fit.imbalance == 0.0 and fit.C == (C, C)
+    n_on, n_off = _counts_with(b, 12.0 * rows, 0.0, C)              # no slice counts: the pooled counts
+    fit = balance_from_counts(n_on, n_off, C, intervals=ivl)         # and the intervals disagree, as before
+    assert np.isnan(fit.gradient_imbalance) and fit.chosen == "nominal" and fit.imbalance == 0.0
+
+
+def test_a_pan_whose_intervals_flip_sign_gets_the_counts_estimate():
+    """fresh11_07_pan_gravel (C+ 0.184 and C- 0.226: b = -0.102; 2 s, about 22 events per pixel): the
+    intervals read about +0.1 (their scene's own bias) while the edges, the slope and the pooled counts
+    read about -0.1 and agree with each other, so no change of light explains the disagreement; the
+    consensus takes the counts' side instead of the nominal C."""
+    from evinr_lite.sim.zoo import effective_C, fresh, imbalance, simulate
+
+    z = fresh(11)[7]
+    _, events, _, _ = simulate(z)
+    events, _ = prepare_events(events, EvINRConfig(C=effective_C(z), balance="none", progress=False))
+    fit = estimate_balance(events, effective_C(z))
+    assert fit.interval_imbalance > 0.05 > -0.05 > fit.gradient_imbalance and fit.chosen == "agreement"
+    assert abs(fit.imbalance - imbalance(z)) < 0.02 < abs(imbalance(z)) - 0.05
 
 
 def test_a_long_change_of_light_is_not_read_as_an_imbalance():

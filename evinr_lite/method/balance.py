@@ -58,7 +58,19 @@ counts, the edges and the intervals read -0.066, -0.065 and -0.075. Those three 
 (a change of light pushes the first two one way and the intervals the other), so where all three lie
 on one side of the slope, the slope is **bounded by their range** (taken as the nearest of them);
 where they bracket it, it stands. Without slice counts (no edges' estimate) the slope stands alone.
-``BalanceFit.chosen`` says which was taken.
+
+Where the counts are not taken alone and the edges and the intervals disagree in sign, the minmod gives
+0. A change of light is what pushes those two apart, and the counts can tell whether the light changed:
+the pooled counts read a change of light common to all pixels as an imbalance, the slope does not, and
+their difference times ``C mean n`` is the span's mean log change. Where it is at most STEADY_LIGHT (0.1
+log units) and the counts' error scale at most COUNTS_OVER_INTERVALS (0.5), no change of light explains
+the disagreement: it is the intervals' own bias (+0.05 to +0.2 on natural scenes) that flips their sign
+where b < 0, and the **smallest of the edges, the slope and the pooled counts** is taken where the three
+agree in sign (``chosen == "agreement"``). fresh11_07_pan_gravel (b = -0.102): edges -0.107, slope
+-0.094, pooled counts -0.095, intervals +0.105; b = 0 before, -0.094 now. On the 39 rows of the balance
+benchmarks and fresh seeds 11-28 that take it, the error of b falls from 0.089 to 0.020 rms (37 nearer
+the truth, 2 farther), and on the 34 of them the zoo runs can score, the level's drift over the span (the
+last quarter's error less the first's) from 0.045 to 0.011 in the mean (docs/defaults.md). ``BalanceFit.chosen`` says which was taken.
 
 The edges' estimate took the pooled counts' place in the minmod on 2026-12-04: rms error of the applied
 b 0.104 -> 0.092 on the off-heavy short scenes, 0.069 -> 0.063 on 44 fresh random sensors
@@ -117,7 +129,8 @@ from .denoise import check_count_pair, hot_threshold
 __all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "interval_stride",
            "balance_from_counts", "estimate_balance", "pooled_imbalance", "slope_imbalance", "interval_imbalance", "minmod",
            "gradient_imbalance", "slice_counts", "span_slices", "BALANCE_MODES", "RULES", "HOT_PIXEL_MODES", "MIN_EVENTS",
-           "MAX_IMBALANCE", "PRIOR", "NET_CHANGE", "COUNTS_ALONE", "SLICES"]
+           "MAX_IMBALANCE", "PRIOR", "NET_CHANGE", "COUNTS_ALONE", "STEADY_LIGHT", "COUNTS_OVER_INTERVALS",
+           "SLICES"]
 
 BALANCE_MODES = ("none", "events", "counts")   # EvINRConfig.balance: "events" is the consensus rule
 RULES = ("consensus", "counts")
@@ -129,6 +142,8 @@ PRIOR = 0.1               # prior spread of real sensors' imbalance b (C+ / C- a
 OUTLIER_LOG = 4.0         # log units: a pixel's balanced net level beyond this (55x in intensity) is left out
 NET_CHANGE = 0.5          # log units: spread of the change of the mean log brightness over a span
 COUNTS_ALONE = 0.1        # the counts' error scale NET_CHANGE / (C mean n) at or below which they are used alone
+STEADY_LIGHT = 0.1        # log units: a span whose mean log change (C mean n |pooled - slope|) is at most this ...
+COUNTS_OVER_INTERVALS = 0.5   # ... and whose counts' error scale is at most this: the counts overrule the intervals
 MIN_INTERVAL = 1e-6       # s: intervals between events are floored here (the timestamp resolution)
 LOG_GRID = 2.0 ** 16      # log intervals are rounded to 1 / LOG_GRID (exact sums in any order)
 MAX_INTERVAL_PIXELS = 1 << 16   # pixels whose intervals are timed at most (interval_stride: a grid on larger sensors)
@@ -151,8 +166,10 @@ class BalanceFit:
         shrink: the counts rule's weight for the raw value (0: nominal C kept, 1: raw value used).
         rule: the rule that gave ``imbalance`` ("consensus" or "counts").
         chosen: what the consensus took: "counts" (the counts alone, their error scale at most
-            COUNTS_ALONE), "minmod" (the smaller estimate) or "nominal" (b = 0: the estimates
-            disagree in sign, or no estimate); the counts rule says "counts".
+            COUNTS_ALONE), "minmod" (the smaller estimate), "agreement" (the edges and the intervals
+            disagree, the counts show no change of light: the smallest of the edges, the slope and the
+            pooled counts) or "nominal" (b = 0: the estimates disagree in sign, or no estimate); the
+            counts rule says "counts".
         counts_error: the counts' error scale ``s = NET_CHANGE / (C mean_events)`` (NaN: no estimate).
         slope_imbalance: the counts' estimate with an intercept (:func:`slope_imbalance`), the one
             taken alone, bounded by the other three (NaN where the counts do not vary).
@@ -398,9 +415,12 @@ def interval_imbalance(intervals, usable) -> float:
     return float(np.tanh(r / 2))
 
 
-def minmod(a: float, b: float) -> float:
-    """The smaller in magnitude of two estimates that agree in sign, 0 when they disagree."""
-    return float(np.sign(a) * min(abs(a), abs(b))) if a * b > 0 else 0.0
+def minmod(a: float, b: float, *more: float) -> float:
+    """The smallest in magnitude of estimates that all agree in sign, 0 when any two disagree."""
+    values = (a, b) + more
+    if all(v > 0 for v in values) or all(v < 0 for v in values):
+        return float(np.sign(a) * min(abs(v) for v in values))
+    return 0.0
 
 
 def pooled_imbalance(n_on, n_off, usable) -> float:
@@ -547,6 +567,14 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
             # does not enter it, as it enters the pooled counts), else the pooled counts
             b = minmod(grad if np.isfinite(grad) else raw, ivl)
             chosen = "minmod" if b != 0.0 else "nominal"
+            if b == 0.0 and np.isfinite(grad) and np.isfinite(slope) and s <= COUNTS_OVER_INTERVALS \
+                    and c_pos * mean_n * abs(raw - slope) <= STEADY_LIGHT:
+                # the edges and the intervals disagree, and the counts show no change of light (the pooled
+                # counts, which read one, agree with the slope, which does not): a change of light is what
+                # pushes those two apart, so here it is the intervals' own bias (+0.05 to +0.2 on natural
+                # scenes) that flips their sign; the three counts' estimates agree, and the smallest is taken
+                b = minmod(grad, slope, raw)
+                chosen = "agreement" if b != 0.0 else "nominal"
     else:
         ivl, b, chosen = float("nan"), shrink * raw, "counts"
     b = float(np.clip(b, -max_imbalance, max_imbalance))

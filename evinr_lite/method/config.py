@@ -332,7 +332,8 @@ class EvINRConfig:
             polarity, and the counts alone (fitted with an intercept, so a change of light shared by all pixels
             does not count, and kept within the range of the other three estimates) where the span holds
             enough events that their error scale NET_CHANGE / (C events per pixel) is at most COUNTS_ALONE
-            (long or busy recordings);
+            (long or busy recordings); where the edges and the intervals disagree in sign and the counts
+            show no change of light, the smallest of the edges, the slope and the pooled counts;
             "counts": the counts' estimate alone, shrunk towards C as far as the span carries little
             evidence (the rule before the intervals). A given pair is used as it is.
         hot_pixels: "keep" or "drop": the events of pixels firing far above the sensor's robust rate
