@@ -1,8 +1,9 @@
 """Running a learner's function, and what the call did besides returning.
 
 :func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's
-function cannot change the exercise's data), and sets the notebook's global settings (torch's, numpy's error handling, the
-warning filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
+function cannot change the exercise's data), within a time limit (:func:`time_limit`, :data:`CALL_TIME_LIMIT_S`: a call
+that never returns is stopped with :class:`TooSlow`; sys.exit() becomes :class:`ExitCalled`), and sets the notebook's
+global settings (torch's, numpy's error handling, the warning filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
 check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
 :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
 Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a call,
@@ -10,7 +11,8 @@ Over a whole check, :func:`watching` gathers what the learner's function changed
 (:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern rather than
 zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that holds a list
 (rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call can leave
-changed in a model besides its parameters (its mode, which parameters require grad), and :func:`refill_in_place`
+changed in a model besides its parameters (its mode, which parameters require grad), :func:`tensor_flags` the same of
+the input tensors (requires_grad), and :func:`refill_in_place`
 writes one case's values into another case's objects without changing their identity (a cache keyed by id()).
 """
 from __future__ import annotations
@@ -20,9 +22,12 @@ import copy
 import dis
 import os
 import re
+import signal
 import site
 import sys
 import sysconfig
+import threading
+import time
 import traceback
 import types
 from typing import Any, Callable, Iterator
@@ -43,6 +48,8 @@ def learner_function(fn: Callable) -> Callable:
 def library_file(filename: str) -> bool:
     """A file of an installed library or of Python itself (numpy, torch, the standard library), not the learner's
     notebook or module (nor this kit, whose frames say which of its functions the learner's call broke)."""
+    if filename.startswith("<frozen "):          # Python's own modules frozen into the interpreter (_sitebuiltins)
+        return True
     path = os.path.realpath(filename)
     if path.startswith(KIT_ROOT + os.sep):          # the kit itself, installed into site-packages or not
         return False
@@ -143,12 +150,74 @@ def watching(fn: Callable) -> Iterator[dict]:
         _WATCHED.pop()
 
 
+# seconds one call of a function may take before the check stops it: every case is small (a reference takes at most
+# a few tens of milliseconds), so only a call that never ends (or waits for something) comes near
+CALL_TIME_LIMIT_S = 5.0
+
+
+class TooSlow(Exception):
+    """A call stopped after :data:`CALL_TIME_LIMIT_S` seconds (an endless loop, or a call that waits); its traceback
+    runs through the learner's frames to the line it was on when stopped."""
+
+    def __init__(self, seconds: float):
+        super().__init__(f"the call did not return within {seconds:g} s and was stopped")
+        self.seconds = seconds
+
+
+class ExitCalled(Exception):
+    """The learner's function called sys.exit(), exit() or quit() (a SystemExit, which `except Exception` lets
+    through: the check would stop with it and print a traceback); its traceback is the SystemExit's."""
+
+    def __init__(self, code):
+        super().__init__(f"SystemExit({code!r}): the function called sys.exit(), exit() or quit()")
+        self.code = code
+
+
+class _Stop(BaseException):
+    """Raised inside the call by :func:`time_limit`'s alarm: a BaseException, so that the learner's own
+    `except Exception:` around a loop does not swallow it."""
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float) -> Iterator[None]:
+    """Stop the block with :class:`TooSlow` after ``seconds`` (SIGALRM through setitimer; again every second after
+    that, in case the learner's code swallows the first). No limit where it cannot be set: not on the main thread,
+    no setitimer (Windows), a SIGALRM handler set outside Python, or an outer timer (the mutation tool's, pytest's)
+    that fires first; an outer timer that fires later is set again afterwards with the time it has left."""
+    if not seconds or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    outer_handler = signal.getsignal(signal.SIGALRM)
+    outer_left, outer_interval = signal.getitimer(signal.ITIMER_REAL)
+    if outer_handler is None or (outer_left and outer_left <= seconds):
+        yield
+        return
+
+    def stop(signum, frame):
+        raise _Stop()
+
+    start = time.monotonic()
+    signal.signal(signal.SIGALRM, stop)
+    signal.setitimer(signal.ITIMER_REAL, seconds, 1.0)
+    try:
+        yield
+    except _Stop as err:
+        raise TooSlow(seconds).with_traceback(err.__traceback__) from None
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0, 0)
+        signal.signal(signal.SIGALRM, outer_handler)
+        if outer_left:
+            signal.setitimer(signal.ITIMER_REAL, max(outer_left - (time.monotonic() - start), 1e-3), outer_interval)
+
+
 def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None,
         copy_inputs: bool = True):
     """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
     receives the copied ``(args, kwargs)`` as they are after the call.
 
+    A call that takes longer than :data:`CALL_TIME_LIMIT_S` is stopped with :class:`TooSlow`, and one that calls
+    sys.exit() raises :class:`ExitCalled`: both are Exceptions, reported like the learner's other errors.
     The global settings (torch's grad mode and default dtype, numpy's error handling, the warning filters) are set
     back after every call, whether it returns or
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
@@ -164,7 +233,10 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     settings = global_settings()
     with imports_watched() as imported:
         try:
-            result = fn(*args, **kwargs)
+            with time_limit(CALL_TIME_LIMIT_S):
+                result = fn(*args, **kwargs)
+        except SystemExit as err:        # sys.exit() or exit(): no Exception, so the check would stop with it
+            raise ExitCalled(err.code).with_traceback(err.__traceback__) from None
         finally:
             changed = restore_settings(settings, imported)
             if settings_changed is not None:
@@ -281,6 +353,35 @@ def module_flags(inputs: tuple[tuple, dict]) -> dict[str, tuple]:
             for name, v in named_inputs(*inputs) if not isinstance(v, type)      # a class (nn.Linear) is no model
             and callable(getattr(v, "modules", None)) and callable(getattr(v, "parameters", None))
             and type(v).__module__.split(".")[0] != "numpy"}
+
+
+def tensor_flags(inputs: tuple[tuple, dict]) -> dict[str, bool]:
+    """{input name: requires_grad} for the torch tensors among ``inputs`` (args, kwargs), and the tensor fields of
+    an input object (``events.t``): a flag a call can change on the caller's tensor without changing a value."""
+    return {f"{name}{field}": bool(a.requires_grad) for name, v in named_inputs(*inputs)
+            for field, a in _arrays_of(v) if is_tensor(a)}
+
+
+def tensor_flags_message(got: dict, expected: dict) -> str | None:
+    """What the learner's call changed of the inputs' requires_grad where the reference's left it (see
+    :func:`tensor_flags`), or None."""
+    on = [n for n in expected if n in got and got[n] and not expected[n]]
+    off = [n for n in expected if n in got and not got[n] and expected[n]]
+    if on:
+        names = ", ".join(f"`{n}`" for n in on)
+        return (f"set requires_grad on its input {names} (`.requires_grad_()`, or `.requires_grad = True`), and the "
+                "caller's tensor keeps it: later cells then record autograd graphs through the data, numpy refuses "
+                "it (`.numpy()` of a tensor that requires grad), and a loss back-propagates into it; the result "
+                "gets its gradients from the inputs that require grad already (the model's outputs): leave the "
+                "inputs as they are (for a tensor of your own that needs gradients, "
+                "`x = x.detach().clone().requires_grad_()`)")
+    if off:
+        names = ", ".join(f"`{n}`" for n in off)
+        return (f"switched requires_grad off on its input {names} (`.requires_grad_(False)`, `.detach_()`), and "
+                "the caller's tensor keeps it: it is cut off from the autograd graph for every later cell, so "
+                "nothing is trained through it; use `.detach()` (a new tensor) where you need values without "
+                "gradients, and leave the inputs as they are")
+    return None
 
 
 def module_flags_message(got: dict, expected: dict) -> str | None:
