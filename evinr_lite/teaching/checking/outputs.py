@@ -172,7 +172,7 @@ def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") ->
             return Problem(f"wrong shape{at}: got {g.shape}, expected {e.shape}" + _shape_note(g, e))
         if _kind(g) != _kind(e):
             return Problem(f"wrong dtype{at}: got {_kind(g)} ({g.dtype}), expected {_kind(e)} ({e.dtype})"
-                            + _dtype_note(g, e))
+                            + _dtype_note(g, e, rtol, atol))
         width = _tensor_width_message(got, expected, at)
         if width:
             return Problem(width)
@@ -295,14 +295,29 @@ def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
     return ""
 
 
-def _dtype_note(g: np.ndarray, e: np.ndarray) -> str:
-    """A word on a wrong dtype that names a common cause."""
+def _dtype_note(g: np.ndarray, e: np.ndarray, rtol: float = 1e-5, atol: float = 1e-8) -> str:
+    """A word on a wrong dtype that names a common cause (``rtol``, ``atol``: the exercise's tolerances, to tell
+    whether a complex result's real part is the answer)."""
     if e.dtype == bool and g.dtype.kind in "iuf":
         return ": return the comparison itself (a boolean mask), without .astype(int) or multiplying by 1"
     if e.dtype.kind in "iu" and g.dtype.kind == "f":
         return (": `/` (and np.trunc, np.floor, np.round) give floats: use integer division `//` "
                 "(torch.div(..., rounding_mode='floor')), or convert with .astype(np.int64) after rounding; an "
                 "array made without a dtype (np.zeros(n), np.full(n, p)) is float too: give dtype=")
+    if e.dtype.kind == "f" and g.dtype.kind == "c":
+        imag = float(np.max(np.abs(g.imag))) if g.size else 0.0
+        scale = float(np.max(np.abs(g.real))) if g.size else 0.0
+        cause = (": complex numbers come from an FFT (np.fft.ifft, np.fft.ifft2), np.emath / np.lib.scimath, a power "
+                 "or root of a negative number (`(-x) ** 0.5`), or `+ 0j`")
+        if imag <= 1e-9 * max(1.0, scale) and np.allclose(g.real, e, rtol=rtol, atol=atol, equal_nan=True):
+            return cause + f"; the imaginary parts here are all about 0 (at most {imag:.2g}) and the real parts are " \
+                "the expected values: return the real part (`.real`, or np.real_if_close) as a float array"
+        if imag <= 1e-9 * max(1.0, scale):
+            return cause + f"; the imaginary parts here are all about 0 (at most {imag:.2g}), but the real parts " \
+                "differ from the expected values too: `.real` alone would not fix the result (an FFT treats the data " \
+                "as periodic, wrapping round at its edges)"
+        return cause + f"; the imaginary parts here reach {imag:.3g}, so `.real` alone would not fix the result: " \
+            "the computation itself differs (an FFT treats the data as periodic, wrapping round at its edges)"
     if e.dtype.kind == "f" and g.dtype.kind in "iu":
         return (": the values were made whole numbers: no .astype(int) or int(...) on the result, and no integer "
                 "array to fill (np.zeros(..., dtype=int), or np.zeros_like of an integer input such as x or p)")
