@@ -331,8 +331,8 @@ def test_an_outer_timer_is_kept():
         assert signal.getsignal(signal.SIGALRM) is outer
         left = signal.getitimer(signal.ITIMER_REAL)[0]
         assert 50.0 < left <= 60.0, left
-        signal.setitimer(signal.ITIMER_REAL, 0.5)             # fires before the check's limit: the outer one stays
-        with learner_calls.time_limit(learner_calls.CALL_TIME_LIMIT_S):
+        signal.setitimer(signal.ITIMER_REAL, 5.0)             # fires before the check's limit: the outer one stays
+        with learner_calls.time_limit(10.0):
             assert signal.getsignal(signal.SIGALRM) is outer
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
@@ -346,3 +346,22 @@ def test_no_timer_is_left_behind(short_limit):
     _report("event_count_windows", ecw_while_no_assign)
     _report("reinhard_tonemap", R("reinhard_tonemap"))
     assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0) and signal.getsignal(signal.SIGALRM) is before
+
+
+def test_the_alarm_raises_only_in_the_calls_frames():
+    """The alarm at the limit's boundary: in a frame of the kit's time_limit or of contextlib (the call has returned)
+    it does nothing, so that it cannot escape the block or skip putting the outer handler back; in the call's own
+    frames it stops the call."""
+    import contextlib
+    before = signal.getsignal(signal.SIGALRM)
+    kit_frame = learner_calls.time_limit(0).gen.gi_frame
+    frames = []
+    with contextlib.ExitStack() as stack:                     # a frame of contextlib's: ExitStack's callback wrapper
+        stack.callback(lambda: frames.append(sys._getframe(1)))
+    assert frames[0].f_code.co_name == "_exit_wrapper"
+    with pytest.raises(learner_calls.TooSlow):
+        with learner_calls.time_limit(10.0):
+            stop = signal.getsignal(signal.SIGALRM)
+            assert stop(signal.SIGALRM, kit_frame) is None and stop(signal.SIGALRM, frames[0]) is None
+            stop(signal.SIGALRM, sys._getframe())
+    assert signal.getsignal(signal.SIGALRM) is before and signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)

@@ -178,12 +178,23 @@ class _Stop(BaseException):
     `except Exception:` around a loop does not swallow it."""
 
 
+def _drain_signals() -> None:
+    """Nothing: calling a Python function lets the interpreter run the handlers of signals that arrived (a
+    pending SIGALRM is handled here, in a frame of this file, where :func:`time_limit`'s handler raises nothing)."""
+
+
 @contextlib.contextmanager
 def time_limit(seconds: float) -> Iterator[None]:
     """Stop the block with :class:`TooSlow` after ``seconds`` (SIGALRM through setitimer; again every second after
     that, in case the learner's code swallows the first). No limit where it cannot be set: not on the main thread,
     no setitimer (Windows), a SIGALRM handler set outside Python, or an outer timer (the mutation tool's, pytest's)
-    that fires first; an outer timer that fires later is set again afterwards with the time it has left."""
+    that fires first; an outer timer that fires later is set again afterwards with the time it has left.
+
+    The alarm raises only in a frame of the call (the learner's code, or a library it called): in a frame of this
+    file or of contextlib (the call has returned, and the check is leaving the block) it does nothing, so that no
+    alarm at the limit's boundary escapes the block or skips the code that puts the outer handler back. That code
+    stops the timer first, lets a signal that already arrived be handled by the kit's handler (which does nothing
+    there), and only then puts the outer handler and timer back."""
     if not seconds or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -194,20 +205,29 @@ def time_limit(seconds: float) -> Iterator[None]:
         return
 
     def stop(signum, frame):
+        if frame is not None and frame.f_code.co_filename in _NO_STOP_FILES:
+            return                  # the call has returned: the check is leaving the block (re-fired in 1 s else)
         raise _Stop()
 
     start = time.monotonic()
     signal.signal(signal.SIGALRM, stop)
-    signal.setitimer(signal.ITIMER_REAL, seconds, 1.0)
     try:
-        yield
-    except _Stop as err:
-        raise TooSlow(seconds).with_traceback(err.__traceback__) from None
+        signal.setitimer(signal.ITIMER_REAL, seconds, 1.0)
+        try:
+            yield
+        except _Stop as err:
+            raise TooSlow(seconds).with_traceback(err.__traceback__) from None
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0, 0)
+        _drain_signals()
         signal.signal(signal.SIGALRM, outer_handler)
         if outer_left:
             signal.setitimer(signal.ITIMER_REAL, max(outer_left - (time.monotonic() - start), 1e-3), outer_interval)
+
+
+# the files in whose frames time_limit's alarm raises nothing: this one, and contextlib's (the `with` statement's
+# exit), as the interpreter names them in code objects
+_NO_STOP_FILES = frozenset({_drain_signals.__code__.co_filename, contextlib.contextmanager.__code__.co_filename})
 
 
 def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None,
