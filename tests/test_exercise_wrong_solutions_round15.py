@@ -179,6 +179,16 @@ def ig_fft_complex(gx, gy):                                   # a periodic FFT s
 def ect_complex(log_changes, net_counts):
     d = np.asarray(log_changes, float); n = np.asarray(net_counts, float)
     return np.sum(d * n) / np.sum(n * n) + 0j
+def ig_mirror_float32_complex(gx, gy):                        # the right solve (an even extension), in float32
+    div, H, W = _ig_divergence(gx, gy)
+    div = div.astype(np.float32)
+    ext = np.block([[div, div[:, ::-1]], [div[::-1, :], div[::-1, ::-1]]])
+    ky = np.fft.fftfreq(2 * H)[:, None]; kx = np.fft.fftfreq(2 * W)[None, :]
+    lam = ((2 - 2 * np.cos(2 * np.pi * ky)) + (2 - 2 * np.cos(2 * np.pi * kx))).astype(np.float32); lam[0, 0] = 1
+    G = np.fft.fft2(ext) / lam; G[0, 0] = 0
+    return np.fft.ifft2(G)[:H, :W]
+def tik_complex(dF_dx, dF_dy):
+    return torch.mean(dF_dx ** 2 + dF_dy ** 2).to(torch.complex128)
 
 
 # ---- correct alternatives
@@ -237,7 +247,14 @@ COMPLEX = "complex numbers come from an FFT"
 NAMED = [
     ("integrate_gradients", ig_dct_complex, "the real parts are the expected values: return the real part"),
     ("estimate_contrast_threshold", ect_complex, "return the real part (`.real`"),
-    ("integrate_gradients", ig_fft_complex, "`.real` alone would not fix the result"),
+    ("integrate_gradients", ig_fft_complex, "and `.real` gives a float result, but it does not match either: "
+                                            "wrong values: 20 of 20 differ"),
+]
+# after the review of round 15: the real part's own comparison is quoted (float32 here, no guess at an FFT's edges),
+# and a tensor's fix is `.real` alone (np.real_if_close takes no tensor)
+NAMED_REVIEW = [
+    ("integrate_gradients", ig_mirror_float32_complex, "does not match either: wrong values: the result is float32"),
+    ("tikhonov_autograd", tik_complex, "return the real part (`.real`) as a float array"),
 ]
 CORRECT = [
     ("reinhard_tonemap", tm_partial), ("reinhard_tonemap", tm_instance), ("reinhard_tonemap", tm_bound),
@@ -282,10 +299,11 @@ def test_hole_now_fails_and_names_the_mistake(name, wrong, words):
     assert_fails_naming(name, wrong, words)
 
 
-@pytest.mark.parametrize("name, wrong, words", NAMED, ids=_id(NAMED))
+@pytest.mark.parametrize("name, wrong, words", NAMED + NAMED_REVIEW, ids=_id(NAMED + NAMED_REVIEW))
 def test_complex_results_are_named(name, wrong, words):
-    assert_fails_naming(name, wrong, COMPLEX)
-    assert_fails_naming(name, wrong, words)
+    ok, text = _report(name, wrong)
+    assert not ok and "Traceback" not in text, text
+    assert COMPLEX in text and words in text and "periodic" not in text, text
 
 
 @pytest.mark.parametrize("name, fn", CORRECT, ids=_id(CORRECT))
