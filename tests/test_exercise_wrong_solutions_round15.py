@@ -299,6 +299,13 @@ def test_hole_now_fails_and_names_the_mistake(name, wrong, words):
     assert_fails_naming(name, wrong, words)
 
 
+def test_requires_grad_message_names_the_inputs_that_require_grad():
+    ok, text = _report("temporal_loss", tl_requires_grad_input)
+    assert "the inputs that require grad already (`dF_dt`)" in text and "model's outputs" not in text, text
+    ok, text = _report("sine_layer_derivative", sld_requires_grad_value)
+    assert "no input requires grad in the reference's call" in text and "model's outputs" not in text, text
+
+
 @pytest.mark.parametrize("name, wrong, words", NAMED + NAMED_REVIEW, ids=_id(NAMED + NAMED_REVIEW))
 def test_complex_results_are_named(name, wrong, words):
     ok, text = _report(name, wrong)

@@ -389,11 +389,14 @@ def tensor_flags_message(got: dict, expected: dict) -> str | None:
     off = [n for n in expected if n in got and not got[n] and expected[n]]
     if on:
         names = ", ".join(f"`{n}`" for n in on)
+        already = [n for n in expected if expected[n]]
+        source = (f"the result gets its gradients from the inputs that require grad already "
+                  f"({', '.join(f'`{n}`' for n in already)})" if already else
+                  "no input requires grad in the reference's call, so the result needs none through them")
         return (f"set requires_grad on its input {names} (`.requires_grad_()`, or `.requires_grad = True`), and the "
                 "caller's tensor keeps it: later cells then record autograd graphs through the data, numpy refuses "
-                "it (`.numpy()` of a tensor that requires grad), and a loss back-propagates into it; the result "
-                "gets its gradients from the inputs that require grad already (the model's outputs): leave the "
-                "inputs as they are (for a tensor of your own that needs gradients, "
+                "it (`.numpy()` of a tensor that requires grad), and a loss back-propagates into it; "
+                f"{source}: leave the inputs as they are (for a tensor of your own that needs gradients, "
                 "`x = x.detach().clone().requires_grad_()`)")
     if off:
         names = ", ".join(f"`{n}`" for n in off)
