@@ -231,10 +231,11 @@ _NO_STOP_FILES = frozenset({_drain_signals.__code__.co_filename, contextlib.cont
 
 
 def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None,
-        copy_inputs: bool = True):
+        copy_inputs: bool = True, seconds: list | None = None):
     """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
-    receives the copied ``(args, kwargs)`` as they are after the call.
+    receives the copied ``(args, kwargs)`` as they are after the call; ``seconds``, a list, the time the call
+    itself took (not the copy's), whether it returned or raised.
 
     A call that takes longer than :data:`CALL_TIME_LIMIT_S` is stopped with :class:`TooSlow`, and one that calls
     sys.exit() raises :class:`ExitCalled`: both are Exceptions, reported like the learner's other errors.
@@ -252,12 +253,15 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
             _WATCHED[-1][2].append((args, kwargs))        # kept alive: see watching()
     settings = global_settings()
     with imports_watched() as imported:
+        start = time.perf_counter()
         try:
             with time_limit(CALL_TIME_LIMIT_S):
                 result = fn(*args, **kwargs)
         except SystemExit as err:        # sys.exit() or exit(): no Exception, so the check would stop with it
             raise ExitCalled(err.code).with_traceback(err.__traceback__) from None
         finally:
+            if seconds is not None:
+                seconds.append(time.perf_counter() - start)
             changed = restore_settings(settings, imported)
             if settings_changed is not None:
                 settings_changed.update(changed)

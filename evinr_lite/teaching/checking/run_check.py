@@ -30,7 +30,6 @@ change it and other hints win. Returns (passed, headline, detail lines); printin
 from __future__ import annotations
 
 import functools
-import time
 from typing import Callable
 
 from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, fixed_size_hint, global_cache_hint,
@@ -97,13 +96,12 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         # the reference first, so that memory freed in the sizes of its result can be filled with a pattern before
         # the learner's call: an array started with np.empty then holds that pattern, not zeros by chance
         ref_after: list = []
-        ref_start = time.perf_counter()
+        ref_seconds: list = []              # the reference's call alone (not the inputs' copy, nor the poisoning)
         try:
-            expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after)
+            expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after, seconds=ref_seconds)
             poison_freed_memory(expected)
         except Exception:                   # run again below, where its error stops the check as it did before
             ref_after = []
-        ref_s = time.perf_counter() - ref_start
         try:
             got = run(fn, args, kwargs, ex.observe, inputs_after=after, settings_changed=changed_settings)
             if k == n - 1:
@@ -114,7 +112,8 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
         except TooSlow as err:              # no hint's search: each would run the endless call again
-            return False, f"did not return within {err.seconds:g} s on {where}", _too_slow_details(err, ref_s)
+            return False, f"did not return within {err.seconds:g} s on {where}", _too_slow_details(
+                err, ref_seconds[-1] if ref_seconds else None)
         except ExitCalled as err:
             return False, f"called sys.exit() on {where}", _exit_details(err)
         except Exception as err:
@@ -176,16 +175,26 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
 
 
-def _too_slow_details(err: TooSlow, ref_s: float) -> list[str]:
+def _too_slow_details(err: TooSlow, ref_s: float | None) -> list[str]:
     """What a report says of a call stopped after the time limit: the learner's line it was on, and the likely
     causes (the reference's time on the same input for scale)."""
     line = [w.replace("raised in", "stopped in", 1) for w in where_raised(err)]
     return line + [
-        f"hint: the reference takes {1000 * ref_s:.2g} ms on this input, and every input here is small: your function "
+        f"hint: {_reference_time(ref_s)}every input here is small: your function "
         "is too slow, most likely an endless loop: a `while` whose condition never changes (its counter or level "
         "not moved toward the end, `i += 1` outside the loop's body, `level += C` where the level goes down, a "
         "time step of 0), a loop that appends to the list it walks over, or a call that waits (input(), "
         "time.sleep); run it on a small input with a print inside the loop to see which values stop changing"]
+
+
+def _reference_time(seconds: float | None) -> str:
+    """"the reference takes 12 ms on this input, and " (whole milliseconds from 10 ms, two digits below), or nothing
+    where the reference's call was not timed (it raised)."""
+    if seconds is None:
+        return ""
+    ms = 1000 * seconds
+    return f"the reference takes {ms:.0f} ms on this input, and " if ms >= 10 else \
+        f"the reference takes {ms:.2g} ms on this input, and "
 
 
 def _exit_details(err: ExitCalled) -> list[str]:
