@@ -44,6 +44,13 @@ ig_fft_complex) got a bare "wrong dtype: got complex (complex128), expected floa
 complex numbers come from and, from the result itself, whether `.real` is all it needs (the imaginary parts about 0
 and the real parts the expected values) or would not fix it (outputs._dtype_note).
 
+After the review of this round: in a notebook exit() and quit() are IPython's and raise nothing (they set the shell's
+exit_now, and the kernel shut down once the cell had run), so er_exit passed there. During the check's calls the
+shell's ask_exit now raises at the learner's line instead, and an exit_now set another way is kept from the shell's
+observers, set back and reported (learner_calls.notebook_exit_refused; tested with a stand-in shell, and by hand in a
+real kernel). The time limit's alarm no longer escapes at its boundary; a complex result's note quotes the real
+part's own comparison instead of guessing a cause; the requires_grad message names the inputs that require grad.
+
 No case was changed or added: the counts the notebooks quote stand. Before this round's fixes all 16 wrong
 solutions failed the standard (6 passed the check, 7 hung it or stopped it with a traceback, 3 got a bare "wrong
 dtype"), and all 8 correct alternatives passed, before and after.
@@ -233,8 +240,8 @@ HANGS = [
     ("reinhard_tonemap", tm_endless_swallowed),
 ]
 EXITS = [
-    ("interval_imbalance", ii_sys_exit, "`sys.exit(\"too few events\")`"),
-    ("event_rate", er_exit, "raised in er_exit, line"),
+    ("interval_imbalance", ii_sys_exit, "called sys.exit()", "`sys.exit(\"too few events\")`"),
+    ("event_rate", er_exit, "called exit()", "raised in er_exit, line"),
 ]
 SETTINGS = "changed the notebook's global settings"
 HOLES = [
@@ -311,16 +318,85 @@ def test_a_call_that_never_returns_is_stopped_and_named(name, wrong, short_limit
     assert loop.get(int(found.group(1))) == found.group(2), (loop, text)
 
 
-@pytest.mark.parametrize("name, wrong, words", EXITS, ids=_id(EXITS))
-def test_sys_exit_is_an_error_not_the_end_of_the_check(name, wrong, words):
-    assert_fails_naming(name, wrong, words)
+@pytest.mark.parametrize("name, wrong, headline, words", EXITS, ids=_id(EXITS))
+def test_sys_exit_is_an_error_not_the_end_of_the_check(name, wrong, headline, words):
     ok, text = _report(name, wrong)
-    assert "called sys.exit()" in text and "ends the whole program, not the function" in text, text
+    assert not ok and "Traceback" not in text, text
+    assert headline in text and words in text and "ends the whole program, not the function" in text, text
 
 
-@pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))
-def test_hole_now_fails_and_names_the_mistake(name, wrong, words):
-    assert_fails_naming(name, wrong, words)
+def _er_notebook_exit(exit):
+    """event_rate with a notebook's exit() (IPython's ZMQExitAutocall, bound to ``exit``'s shell)."""
+    def er_notebook_exit(t, bin_s):
+        if len(t) < 5:                                        # in a notebook exit() raises nothing
+            exit()
+        return R("event_rate")(t, bin_s)
+    return er_notebook_exit
+
+
+@pytest.fixture
+def notebook_shell(monkeypatch):
+    """What exit() reaches of ipykernel's ZMQInteractiveShell, made get_ipython()'s shell: ask_exit (its code),
+    exit_now (a trait whose observer, in ipykernel, stops the kernel's event loop: here it records what it heard),
+    keepkernel_on_exit and IPython's payload manager."""
+    IPython = pytest.importorskip("IPython")
+    from IPython.core.payload import PayloadManager
+    from traitlets import Bool, HasTraits, observe
+
+    class NotebookShell(HasTraits):
+        exit_now = Bool(False)
+
+        def __init__(self):
+            super().__init__()
+            self.keepkernel_on_exit = None
+            self.payload_manager = PayloadManager()
+            self.heard = []
+
+        @observe("exit_now")
+        def _exit_now_changed(self, change):
+            self.heard.append(change["new"])
+
+        def ask_exit(self):                                   # ipykernel.zmqshell.ZMQInteractiveShell.ask_exit
+            self.exit_now = not self.keepkernel_on_exit
+            self.payload_manager.write_payload(dict(source="ask_exit", keepkernel=self.keepkernel_on_exit))
+    shell = NotebookShell()
+    monkeypatch.setattr(IPython, "get_ipython", lambda: shell)
+    return shell
+
+
+def test_exit_in_a_notebook_is_refused_and_named(notebook_shell):
+    """In a notebook exit() raises nothing: it sets the shell's exit_now and the kernel shuts down after the cell.
+    The check stops the call at that line instead, reports it, and leaves the shell as it was."""
+    from IPython.core.autocall import ZMQExitAutocall
+    notebook_shell.payload_manager.write_payload({"source": "page", "data": {}})
+    ok, text = _report("event_rate", _er_notebook_exit(ZMQExitAutocall(notebook_shell)))
+    assert not ok and "Traceback" not in text, text
+    assert "called exit() on input #" in text and "raised in er_notebook_exit, line" in text, text
+    assert ": `exit()`" in text and "asks Jupyter to shut the kernel down" in text, text
+    assert "SystemExit" not in text, text
+    assert notebook_shell.exit_now is False and notebook_shell.keepkernel_on_exit is None
+    assert notebook_shell.payload_manager.read_payload() == [{"source": "page", "data": {}}]
+    assert "ask_exit" not in vars(notebook_shell) and "notify_change" not in vars(notebook_shell)
+    assert notebook_shell.heard == []
+
+
+def test_exit_now_set_otherwise_in_a_notebook_is_set_back_and_named(notebook_shell):
+    """An ask_exit taken before the check (not the one it replaces during the call) still sets exit_now: the check
+    keeps the shell's observers from hearing it (ipykernel's would stop the kernel), sets it back after the call,
+    removes the payload, and reports it (with no line: the call went on after it)."""
+    ok, text = _report("event_rate", _er_notebook_exit(notebook_shell.ask_exit))
+    assert not ok and "Traceback" not in text, text
+    assert "called exit() on input #" in text and "asks Jupyter to shut the kernel down" in text, text
+    assert "raised in" not in text, text
+    assert notebook_shell.exit_now is False and notebook_shell.payload_manager.read_payload() == []
+    assert notebook_shell.heard == [] and "notify_change" not in vars(notebook_shell)
+    notebook_shell.exit_now = True                            # heard again after the check
+    assert notebook_shell.heard == [True]
+
+
+def test_the_correct_function_passes_in_a_notebook(notebook_shell):
+    assert_passes("event_rate", R("event_rate"))
+    assert notebook_shell.exit_now is False and "ask_exit" not in vars(notebook_shell)
 
 
 def test_requires_grad_message_names_the_inputs_that_require_grad():
@@ -328,6 +404,11 @@ def test_requires_grad_message_names_the_inputs_that_require_grad():
     assert "the inputs that require grad already (`dF_dt`)" in text and "model's outputs" not in text, text
     ok, text = _report("sine_layer_derivative", sld_requires_grad_value)
     assert "no input requires grad in the reference's call" in text and "model's outputs" not in text, text
+
+
+@pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))
+def test_hole_now_fails_and_names_the_mistake(name, wrong, words):
+    assert_fails_naming(name, wrong, words)
 
 
 @pytest.mark.parametrize("name, wrong, words", NAMED + NAMED_REVIEW, ids=_id(NAMED + NAMED_REVIEW))

@@ -1,19 +1,20 @@
 """Running a learner's function, and what the call did besides returning.
 
-:func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's
-function cannot change the exercise's data), within a time limit (:func:`time_limit`, :data:`CALL_TIME_LIMIT_S`: a call
-that never returns is stopped with :class:`TooSlow`; sys.exit() becomes :class:`ExitCalled`), and sets the notebook's
-global settings (torch's, numpy's error handling, the warning filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
-check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
-:func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
-Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a call,
-:func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with np.empty
-(:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern rather than
-zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that holds a list
-(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call can leave
-changed in a model besides its parameters (its mode, which parameters require grad), :func:`tensor_flags` the same of
-the input tensors (requires_grad), and :func:`refill_in_place`
-writes one case's values into another case's objects without changing their identity (a cache keyed by id()).
+:func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's function
+cannot change the exercise's data), within a time limit (:func:`time_limit`, :data:`CALL_TIME_LIMIT_S`: a call that
+never returns is stopped with :class:`TooSlow`; sys.exit(), and exit() in a notebook (:func:`notebook_exit_refused`),
+become :class:`ExitCalled`), and sets the notebook's global settings (torch's, numpy's error handling, the warning
+filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line
+(not numpy's or torch's, nor the check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When
+it returns, :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do
+instead. Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a
+call, :func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with
+np.empty (:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern
+rather than zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that
+holds a list (rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call
+can leave changed in a model besides its parameters (its mode, which parameters require grad), :func:`tensor_flags` the
+same of the input tensors (requires_grad), and :func:`refill_in_place` writes one case's values into another case's
+objects without changing their identity (a cache keyed by id()).
 """
 from __future__ import annotations
 
@@ -166,11 +167,104 @@ class TooSlow(Exception):
 
 class ExitCalled(Exception):
     """The learner's function called sys.exit(), exit() or quit() (a SystemExit, which `except Exception` lets
-    through: the check would stop with it and print a traceback); its traceback is the SystemExit's."""
+    through: the check would stop with it and print a traceback), or, in a notebook, IPython's exit() or quit(),
+    which raises nothing but asks the kernel to shut down once the cell has run (:func:`notebook_exit_refused`).
+    ``how`` names the call (``"sys.exit()"``, ``"exit()"``), ``notebook`` says it was IPython's; its traceback, where
+    there is one, runs through the learner's line that called it."""
 
-    def __init__(self, code):
-        super().__init__(f"SystemExit({code!r}): the function called sys.exit(), exit() or quit()")
+    def __init__(self, code, how: str = "sys.exit()", notebook: bool = False):
+        super().__init__(f"{how} in a notebook: the kernel was asked to shut down" if notebook else
+                         f"SystemExit({code!r}): the function called sys.exit(), exit() or quit()")
         self.code = code
+        self.how = how
+        self.notebook = notebook
+
+
+class _NotebookExit(SystemExit):
+    """Raised inside the call in place of IPython's ask_exit (see :func:`notebook_exit_refused`), so that the call
+    stops at the learner's exit() as it does in plain Python, with a traceback through that line."""
+
+
+def _exit_how(err: SystemExit) -> str:
+    """``"exit()"`` for Python's exit() or quit() (raised in their frozen module, _sitebuiltins) and IPython's,
+    ``"sys.exit()"`` otherwise."""
+    if isinstance(err, _NotebookExit):
+        return "exit()"
+    frames = traceback.extract_tb(err.__traceback__)
+    return "exit()" if frames and "_sitebuiltins" in frames[-1].filename else "sys.exit()"
+
+
+def _ipython_shell():
+    """The running IPython shell (a notebook's kernel, the terminal's), where IPython is imported already and one
+    runs; None otherwise (nothing is imported for it)."""
+    ipython = sys.modules.get("IPython")
+    get = getattr(ipython, "get_ipython", None)
+    try:
+        return get() if callable(get) else None
+    except Exception:
+        return None
+
+
+_UNSET = object()
+
+
+@contextlib.contextmanager
+def notebook_exit_refused() -> Iterator[list]:
+    """In IPython (a notebook's kernel), exit() and quit() raise nothing: they call the shell's ask_exit, which sets
+    ``exit_now`` (the kernel then shuts down once the cell has run, every variable lost) and adds an "ask_exit"
+    payload, and the function goes on. While the block runs, the shell's ask_exit raises :class:`_NotebookExit` (a
+    SystemExit) at the learner's exit() instead, and the keepkernel_on_exit that exit() sets first is put back.
+    A call that sets ``exit_now`` another way (an ask_exit taken before the block, ``get_ipython().exit_now =
+    True``; or terminal IPython's ``keep_running``) has it set back, with no notice to the shell's observers while
+    the block runs (ipykernel's stops the kernel's event loop on it), and the "ask_exit" payloads it added removed;
+    the list the block gets then holds True, for the caller to report. Outside IPython it does nothing."""
+    asked: list = []
+    shell = _ipython_shell()
+    if shell is None or not hasattr(shell, "__dict__"):
+        yield asked
+        return
+    own = {name: vars(shell).get(name, _UNSET) for name in ("ask_exit", "notify_change")}
+    exit_now = getattr(shell, "exit_now", _UNSET)
+    keep_running = getattr(shell, "keep_running", _UNSET)
+    keepkernel = getattr(shell, "keepkernel_on_exit", _UNSET)
+    payloads = getattr(shell, "payload_manager", None)
+    payloads_before = list(payloads.read_payload()) if hasattr(payloads, "read_payload") else None
+    notify = getattr(shell, "notify_change", None)
+
+    def refuse():
+        raise _NotebookExit(None)
+
+    def notify_but_exit_now(change):                # traitlets' notice of a change of one of the shell's traits
+        if getattr(change, "name", None) != "exit_now" and callable(notify):
+            notify(change)
+    try:
+        shell.ask_exit = refuse
+        shell.notify_change = notify_but_exit_now
+        yield asked
+    finally:
+        try:
+            if exit_now is not _UNSET and not exit_now and getattr(shell, "exit_now", False):
+                shell.exit_now = False                      # while the observers hear nothing of exit_now
+                asked.append(True)
+            if keep_running is not _UNSET and keep_running and not getattr(shell, "keep_running", True):
+                shell.keep_running = True
+                asked.append(True)
+            if keepkernel is not _UNSET and getattr(shell, "keepkernel_on_exit", keepkernel) is not keepkernel:
+                shell.keepkernel_on_exit = keepkernel
+            if payloads_before is not None:
+                now = list(payloads.read_payload())
+                if any(isinstance(p, dict) and p.get("source") == "ask_exit"
+                       and not any(p is q for q in payloads_before) for p in now):
+                    payloads.clear_payload()
+                    for p in payloads_before:
+                        payloads.write_payload(p, single=False)
+                    asked.append(True)
+        finally:
+            for name, value in own.items():
+                if value is _UNSET:
+                    vars(shell).pop(name, None)
+                else:
+                    setattr(shell, name, value)
 
 
 class _Stop(BaseException):
@@ -238,7 +332,8 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     itself took (not the copy's), whether it returned or raised.
 
     A call that takes longer than :data:`CALL_TIME_LIMIT_S` is stopped with :class:`TooSlow`, and one that calls
-    sys.exit() raises :class:`ExitCalled`: both are Exceptions, reported like the learner's other errors.
+    sys.exit() (or exit(), in a notebook too: :func:`notebook_exit_refused`) raises :class:`ExitCalled`: both are
+    Exceptions, reported like the learner's other errors.
     The global settings (torch's grad mode and default dtype, numpy's error handling, the warning filters) are set
     back after every call, whether it returns or
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
@@ -255,10 +350,13 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     with imports_watched() as imported:
         start = time.perf_counter()
         try:
-            with time_limit(CALL_TIME_LIMIT_S):
+            with notebook_exit_refused() as asked_exit, time_limit(CALL_TIME_LIMIT_S):
                 result = fn(*args, **kwargs)
+            if asked_exit:                  # a notebook's exit_now set otherwise than through exit(): no line to name
+                raise ExitCalled(None, "exit()", notebook=True)
         except SystemExit as err:        # sys.exit() or exit(): no Exception, so the check would stop with it
-            raise ExitCalled(err.code).with_traceback(err.__traceback__) from None
+            raise ExitCalled(err.code, _exit_how(err), isinstance(err, _NotebookExit)).with_traceback(
+                err.__traceback__) from None
         finally:
             if seconds is not None:
                 seconds.append(time.perf_counter() - start)

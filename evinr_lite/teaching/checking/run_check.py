@@ -11,10 +11,11 @@ patterns read off the values (:mod:`.hints`: axes in another order, indices from
 the rest), and last a notebook variable that only grew. A model among the inputs left in another mode, or with other
 parameters requiring grad, than the reference leaves it is named after each call, and so is an input tensor whose
 requires_grad the call changed. A call stopped at the time limit (:class:`.learner_calls.TooSlow`: an endless loop) or
-ended by sys.exit() is reported at once, at the learner's line, with no hint's search (which would run it again). After every input matched, the last
-one is run a second time from other states of the global generators (:func:`_second_call`, :mod:`.across_calls`,
-:mod:`.global_state`), and input #1's own objects are refilled in place with a later input's values and given again
-(:func:`.across_calls.same_objects_new_values`: a cache keyed by id()), and last the function is called as the
+ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
+(which would run it again). After every input matched, the last one is run a second time from other states of the
+global generators (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`), and input #1's own objects are
+refilled in place with a later input's values and given again (:func:`.across_calls.same_objects_new_values`: a cache
+keyed by id()), and last the function is called as the
 notebooks call it (:func:`.signature.called_as_notebook`, each exercise's recorded call, only where its signature
 differs from the stub's); a function that cannot take the inputs by name (a parameter renamed, or positional-only) is
 called so throughout (:func:`.signature.notebook_caller`). Slips read off the learner's source and proven by a call
@@ -115,7 +116,7 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             return False, f"did not return within {err.seconds:g} s on {where}", _too_slow_details(
                 err, ref_seconds[-1] if ref_seconds else None)
         except ExitCalled as err:
-            return False, f"called sys.exit() on {where}", _exit_details(err)
+            return False, f"called {err.how} on {where}", _exit_details(err)
         except Exception as err:
             return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
         if changed_settings:
@@ -197,12 +198,21 @@ def _reference_time(seconds: float | None) -> str:
         f"the reference takes {ms:.2g} ms on this input, and "
 
 
+_EXIT_FIX = ("to refuse an input raise an error (`raise ValueError(\"...\")`), and for a case the docstring gives a "
+             "value for (no events, no pairs) return that value")
+
+
 def _exit_details(err: ExitCalled) -> list[str]:
-    """What a report says of a call that ended with sys.exit(), exit() or quit()."""
+    """What a report says of a call that ended with sys.exit(), exit() or quit(): in plain Python a SystemExit; in a
+    notebook (IPython's exit()) a request to shut the kernel down, which the check refused."""
+    if err.notebook:
+        return where_raised(err) + [
+            "hint: exit() (quit()) in a notebook does not end the function: it asks Jupyter to shut the kernel down "
+            "once the cell has run, and every variable of the notebook is lost (the check undid that here); "
+            + _EXIT_FIX]
     return [f"SystemExit: {err.code!r}"] + where_raised(err) + [
         "hint: sys.exit() (exit(), quit()) ends the whole program, not the function: in a notebook it stops the "
-        "cell (and the check) with no result; to refuse an input raise an error (`raise ValueError(\"...\")`), "
-        "and for a case the docstring gives a value for (no events, no pairs) return that value"]
+        "cell (and the check) with no result; " + _EXIT_FIX]
 
 
 def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, k: int, where: str, defaults: dict,
