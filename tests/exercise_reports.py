@@ -45,5 +45,6 @@ def quoted_counts() -> dict:
 
 
 def case_ids(rows):
-    """pytest ids "exercise-k-function" for rows (exercise name, function, ...)."""
-    return [f"{r[0]}-{k}-{r[1].__name__}" for k, r in enumerate(rows)]
+    """pytest ids "exercise-k-function" for rows (exercise name, function, ...); a callable without a name (a
+    functools.partial, an object with __call__) by its type's."""
+    return [f"{r[0]}-{k}-{getattr(r[1], '__name__', type(r[1]).__name__)}" for k, r in enumerate(rows)]

@@ -29,11 +29,16 @@ from .outputs import is_tensor
 
 def global_settings() -> dict:
     """The global settings a function may change for the whole notebook: numpy's floating-point error handling,
-    the warning filters, and (once torch is imported) torch's gradients on or off and default float dtype."""
+    the warning filters, and (once torch is imported) torch's gradients on or off, default float dtype, autograd's
+    anomaly detection and deterministic algorithms (each with its second flag: NaN checks, warnings only)."""
     out = {"numpy errors": np.geterr(), "warning filters": tuple(warnings.filters)}
     torch = sys.modules.get("torch")
     if torch is not None:
         out.update(grad=torch.is_grad_enabled(), dtype=torch.get_default_dtype())
+        nan = getattr(torch, "is_anomaly_check_nan_enabled", lambda: True)
+        warn_only = getattr(torch, "is_deterministic_algorithms_warn_only_enabled", lambda: False)
+        out.update(anomaly=(torch.is_anomaly_enabled(), nan()),
+                   deterministic=(torch.are_deterministic_algorithms_enabled(), warn_only()))
     return out
 
 
@@ -227,6 +232,12 @@ def restore_settings(before: dict | None, imported: list = ()) -> dict:
         torch.set_grad_enabled(before["grad"])
     if "dtype" in changed and torch is not None:
         torch.set_default_dtype(before["dtype"])
+    if "anomaly" in changed and torch is not None:
+        mode, check_nan = before["anomaly"]
+        torch.autograd.set_detect_anomaly(mode, check_nan=check_nan)
+    if "deterministic" in changed and torch is not None:
+        mode, warn_only = before["deterministic"]
+        torch.use_deterministic_algorithms(mode, warn_only=warn_only)
     if "numpy errors" in changed:
         np.seterr(**before["numpy errors"])
     if "warning filters" in changed:
@@ -252,6 +263,21 @@ def settings_message(changed: dict) -> str:
                      "(torch.set_default_dtype) for the whole notebook, so every tensor made later (a model's "
                      "weights, torch.zeros, torch.tensor of floats) has the new dtype; give the dtype where you need "
                      "it (x.double(), torch.zeros(..., dtype=torch.float64)) and leave the default alone")
+    if "anomaly" in changed:
+        on = changed["anomaly"][1][0]
+        parts.append("it switched autograd's anomaly detection on for the whole notebook "
+                     "(torch.autograd.set_detect_anomaly(True)), so every later backward pass records a traceback for "
+                     "each operation and runs several times slower (and a NaN anywhere stops a training run with an "
+                     "error); use `with torch.autograd.detect_anomaly():` around the lines you are debugging, which "
+                     "switches it off at its end, and remove it once the NaN is found" if on else
+                     "it switched autograd's anomaly detection off for the whole notebook "
+                     "(torch.autograd.set_detect_anomaly(False)), where an earlier cell had switched it on; leave "
+                     "the notebook's setting alone")
+    if "deterministic" in changed:
+        parts.append(f"it changed torch's deterministic-algorithms setting for the whole notebook "
+                     f"(torch.use_deterministic_algorithms({changed['deterministic'][1][0]})), so later cells' "
+                     "operations that have no deterministic version raise an error (or run otherwise); nothing "
+                     "here asks for it: remove the call (results here are deterministic already)")
     if "numpy errors" in changed:
         old, new = changed["numpy errors"]
         diff = ", ".join(f"{k}={new[k]!r}" for k in new if new[k] != old.get(k))

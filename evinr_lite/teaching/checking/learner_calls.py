@@ -1,17 +1,20 @@
 """Running a learner's function, and what the call did besides returning.
 
-:func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's
-function cannot change the exercise's data), and sets the notebook's global settings (torch's, numpy's error handling, the
-warning filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line (not numpy's or torch's, nor the
-check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When it returns,
-:func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do instead.
-Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a call,
-:func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with np.empty
-(:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern rather than
-zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that holds a list
-(rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call can leave
-changed in a model besides its parameters (its mode, which parameters require grad), and :func:`refill_in_place`
-writes one case's values into another case's objects without changing their identity (a cache keyed by id()).
+:func:`run` calls a function on a deep copy of a case's inputs (so a case can be run again, and the learner's function
+cannot change the exercise's data), within a time limit (:func:`time_limit`, :data:`CALL_TIME_LIMIT_S`: a call that
+never returns is stopped with :class:`TooSlow`; sys.exit(), and exit() in a notebook (:func:`notebook_exit_refused`),
+become :class:`ExitCalled`), and sets the notebook's global settings (torch's, numpy's error handling, the warning
+filters) back after it, whether it returns or raises. When it raises, :func:`where_raised` names the learner's own line
+(not numpy's or torch's, nor the check's), and :func:`cache_raised` tells an unhashable argument given to a cache. When
+it returns, :func:`changed_inputs` lists the inputs it changed in place and :func:`in_place_message` says what to do
+instead. Over a whole check, :func:`watching` gathers what the learner's function changed of those settings. Before a
+call, :func:`poison_freed_memory` fills freed memory of the result's sizes with a pattern, so that an array made with
+np.empty (:func:`uses_uninitialised`, read off the bytecode: ``empty`` called on numpy or torch) holds that pattern
+rather than zeros by chance. :func:`multiplies_rows` reads off the bytecode whether a function multiplies a list that
+holds a list (rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call
+can leave changed in a model besides its parameters (its mode, which parameters require grad), :func:`tensor_flags` the
+same of the input tensors (requires_grad), and :func:`refill_in_place` writes one case's values into another case's
+objects without changing their identity (a cache keyed by id()).
 """
 from __future__ import annotations
 
@@ -20,9 +23,12 @@ import copy
 import dis
 import os
 import re
+import signal
 import site
 import sys
 import sysconfig
+import threading
+import time
 import traceback
 import types
 from typing import Any, Callable, Iterator
@@ -43,6 +49,8 @@ def learner_function(fn: Callable) -> Callable:
 def library_file(filename: str) -> bool:
     """A file of an installed library or of Python itself (numpy, torch, the standard library), not the learner's
     notebook or module (nor this kit, whose frames say which of its functions the learner's call broke)."""
+    if filename.startswith("<frozen "):          # Python's own modules frozen into the interpreter (_sitebuiltins)
+        return True
     path = os.path.realpath(filename)
     if path.startswith(KIT_ROOT + os.sep):          # the kit itself, installed into site-packages or not
         return False
@@ -143,12 +151,189 @@ def watching(fn: Callable) -> Iterator[dict]:
         _WATCHED.pop()
 
 
+# seconds one call of a function may take before the check stops it: every case is small (a reference takes at most
+# a few tens of milliseconds), so only a call that never ends (or waits for something) comes near
+CALL_TIME_LIMIT_S = 5.0
+
+
+class TooSlow(Exception):
+    """A call stopped after :data:`CALL_TIME_LIMIT_S` seconds (an endless loop, or a call that waits); its traceback
+    runs through the learner's frames to the line it was on when stopped."""
+
+    def __init__(self, seconds: float):
+        super().__init__(f"the call did not return within {seconds:g} s and was stopped")
+        self.seconds = seconds
+
+
+class ExitCalled(Exception):
+    """The learner's function called sys.exit(), exit() or quit() (a SystemExit, which `except Exception` lets
+    through: the check would stop with it and print a traceback), or, in a notebook, IPython's exit() or quit(),
+    which raises nothing but asks the kernel to shut down once the cell has run (:func:`notebook_exit_refused`).
+    ``how`` names the call (``"sys.exit()"``, ``"exit()"``), ``notebook`` says it was IPython's; its traceback, where
+    there is one, runs through the learner's line that called it."""
+
+    def __init__(self, code, how: str = "sys.exit()", notebook: bool = False):
+        super().__init__(f"{how} in a notebook: the kernel was asked to shut down" if notebook else
+                         f"SystemExit({code!r}): the function called sys.exit(), exit() or quit()")
+        self.code = code
+        self.how = how
+        self.notebook = notebook
+
+
+class _NotebookExit(SystemExit):
+    """Raised inside the call in place of IPython's ask_exit (see :func:`notebook_exit_refused`), so that the call
+    stops at the learner's exit() as it does in plain Python, with a traceback through that line."""
+
+
+def _exit_how(err: SystemExit) -> str:
+    """``"exit()"`` for Python's exit() or quit() (raised in their frozen module, _sitebuiltins) and IPython's,
+    ``"sys.exit()"`` otherwise."""
+    if isinstance(err, _NotebookExit):
+        return "exit()"
+    frames = traceback.extract_tb(err.__traceback__)
+    return "exit()" if frames and "_sitebuiltins" in frames[-1].filename else "sys.exit()"
+
+
+def _ipython_shell():
+    """The running IPython shell (a notebook's kernel, the terminal's), where IPython is imported already and one
+    runs; None otherwise (nothing is imported for it)."""
+    ipython = sys.modules.get("IPython")
+    get = getattr(ipython, "get_ipython", None)
+    try:
+        return get() if callable(get) else None
+    except Exception:
+        return None
+
+
+_UNSET = object()
+
+
+@contextlib.contextmanager
+def notebook_exit_refused() -> Iterator[list]:
+    """In IPython (a notebook's kernel), exit() and quit() raise nothing: they call the shell's ask_exit, which sets
+    ``exit_now`` (the kernel then shuts down once the cell has run, every variable lost) and adds an "ask_exit"
+    payload, and the function goes on. While the block runs, the shell's ask_exit raises :class:`_NotebookExit` (a
+    SystemExit) at the learner's exit() instead, and the keepkernel_on_exit that exit() sets first is put back.
+    A call that sets ``exit_now`` another way (an ask_exit taken before the block, ``get_ipython().exit_now =
+    True``; or terminal IPython's ``keep_running``) has it set back, with no notice to the shell's observers while
+    the block runs (ipykernel's stops the kernel's event loop on it), and the "ask_exit" payloads it added removed;
+    the list the block gets then holds True, for the caller to report. Outside IPython it does nothing."""
+    asked: list = []
+    shell = _ipython_shell()
+    if shell is None or not hasattr(shell, "__dict__"):
+        yield asked
+        return
+    own = {name: vars(shell).get(name, _UNSET) for name in ("ask_exit", "notify_change")}
+    exit_now = getattr(shell, "exit_now", _UNSET)
+    keep_running = getattr(shell, "keep_running", _UNSET)
+    keepkernel = getattr(shell, "keepkernel_on_exit", _UNSET)
+    payloads = getattr(shell, "payload_manager", None)
+    payloads_before = list(payloads.read_payload()) if hasattr(payloads, "read_payload") else None
+    notify = getattr(shell, "notify_change", None)
+
+    def refuse():
+        raise _NotebookExit(None)
+
+    def notify_but_exit_now(change):                # traitlets' notice of a change of one of the shell's traits
+        if getattr(change, "name", None) != "exit_now" and callable(notify):
+            notify(change)
+    try:
+        shell.ask_exit = refuse
+        shell.notify_change = notify_but_exit_now
+        yield asked
+    finally:
+        try:
+            if exit_now is not _UNSET and not exit_now and getattr(shell, "exit_now", False):
+                shell.exit_now = False                      # while the observers hear nothing of exit_now
+                asked.append(True)
+            if keep_running is not _UNSET and keep_running and not getattr(shell, "keep_running", True):
+                shell.keep_running = True
+                asked.append(True)
+            if keepkernel is not _UNSET and getattr(shell, "keepkernel_on_exit", keepkernel) is not keepkernel:
+                shell.keepkernel_on_exit = keepkernel
+            if payloads_before is not None:
+                now = list(payloads.read_payload())
+                if any(isinstance(p, dict) and p.get("source") == "ask_exit"
+                       and not any(p is q for q in payloads_before) for p in now):
+                    payloads.clear_payload()
+                    for p in payloads_before:
+                        payloads.write_payload(p, single=False)
+                    asked.append(True)
+        finally:
+            for name, value in own.items():
+                if value is _UNSET:
+                    vars(shell).pop(name, None)
+                else:
+                    setattr(shell, name, value)
+
+
+class _Stop(BaseException):
+    """Raised inside the call by :func:`time_limit`'s alarm: a BaseException, so that the learner's own
+    `except Exception:` around a loop does not swallow it."""
+
+
+def _drain_signals() -> None:
+    """Nothing: calling a Python function lets the interpreter run the handlers of signals that arrived (a
+    pending SIGALRM is handled here, in a frame of this file, where :func:`time_limit`'s handler raises nothing)."""
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float) -> Iterator[None]:
+    """Stop the block with :class:`TooSlow` after ``seconds`` (SIGALRM through setitimer; again every second after
+    that, in case the learner's code swallows the first). No limit where it cannot be set: not on the main thread,
+    no setitimer (Windows), a SIGALRM handler set outside Python, or an outer timer (the mutation tool's, pytest's)
+    that fires first; an outer timer that fires later is set again afterwards with the time it has left.
+
+    The alarm raises only in a frame of the call (the learner's code, or a library it called): in a frame of this
+    file or of contextlib (the call has returned, and the check is leaving the block) it does nothing, so that no
+    alarm at the limit's boundary escapes the block or skips the code that puts the outer handler back. That code
+    stops the timer first, lets a signal that already arrived be handled by the kit's handler (which does nothing
+    there), and only then puts the outer handler and timer back."""
+    if not seconds or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    outer_handler = signal.getsignal(signal.SIGALRM)
+    outer_left, outer_interval = signal.getitimer(signal.ITIMER_REAL)
+    if outer_handler is None or (outer_left and outer_left <= seconds):
+        yield
+        return
+
+    def stop(signum, frame):
+        if frame is not None and frame.f_code.co_filename in _NO_STOP_FILES:
+            return                  # the call has returned: the check is leaving the block (re-fired in 1 s else)
+        raise _Stop()
+
+    start = time.monotonic()
+    signal.signal(signal.SIGALRM, stop)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, seconds, 1.0)
+        try:
+            yield
+        except _Stop as err:
+            raise TooSlow(seconds).with_traceback(err.__traceback__) from None
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0, 0)
+        _drain_signals()
+        signal.signal(signal.SIGALRM, outer_handler)
+        if outer_left:
+            signal.setitimer(signal.ITIMER_REAL, max(outer_left - (time.monotonic() - start), 1e-3), outer_interval)
+
+
+# the files in whose frames time_limit's alarm raises nothing: this one, and contextlib's (the `with` statement's
+# exit), as the interpreter names them in code objects
+_NO_STOP_FILES = frozenset({_drain_signals.__code__.co_filename, contextlib.contextmanager.__code__.co_filename})
+
+
 def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settings_changed: dict | None = None,
-        copy_inputs: bool = True):
+        copy_inputs: bool = True, seconds: list | None = None):
     """``fn`` on a deep copy of the inputs (one copy, so objects shared between inputs stay shared,
     e.g. a model and its optimiser); with ``observe``, what it says to compare. ``inputs_after``, a list,
-    receives the copied ``(args, kwargs)`` as they are after the call.
+    receives the copied ``(args, kwargs)`` as they are after the call; ``seconds``, a list, the time the call
+    itself took (not the copy's), whether it returned or raised.
 
+    A call that takes longer than :data:`CALL_TIME_LIMIT_S` is stopped with :class:`TooSlow`, and one that calls
+    sys.exit() (or exit(), in a notebook too: :func:`notebook_exit_refused`) raises :class:`ExitCalled`: both are
+    Exceptions, reported like the learner's other errors.
     The global settings (torch's grad mode and default dtype, numpy's error handling, the warning filters) are set
     back after every call, whether it returns or
     raises, so that a function that changes them on one input changes nothing for the calls after it (the
@@ -163,9 +348,18 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
             _WATCHED[-1][2].append((args, kwargs))        # kept alive: see watching()
     settings = global_settings()
     with imports_watched() as imported:
+        start = time.perf_counter()
         try:
-            result = fn(*args, **kwargs)
+            with notebook_exit_refused() as asked_exit, time_limit(CALL_TIME_LIMIT_S):
+                result = fn(*args, **kwargs)
+            if asked_exit:                  # a notebook's exit_now set otherwise than through exit(): no line to name
+                raise ExitCalled(None, "exit()", notebook=True)
+        except SystemExit as err:        # sys.exit() or exit(): no Exception, so the check would stop with it
+            raise ExitCalled(err.code, _exit_how(err), isinstance(err, _NotebookExit)).with_traceback(
+                err.__traceback__) from None
         finally:
+            if seconds is not None:
+                seconds.append(time.perf_counter() - start)
             changed = restore_settings(settings, imported)
             if settings_changed is not None:
                 settings_changed.update(changed)
@@ -281,6 +475,38 @@ def module_flags(inputs: tuple[tuple, dict]) -> dict[str, tuple]:
             for name, v in named_inputs(*inputs) if not isinstance(v, type)      # a class (nn.Linear) is no model
             and callable(getattr(v, "modules", None)) and callable(getattr(v, "parameters", None))
             and type(v).__module__.split(".")[0] != "numpy"}
+
+
+def tensor_flags(inputs: tuple[tuple, dict]) -> dict[str, bool]:
+    """{input name: requires_grad} for the torch tensors among ``inputs`` (args, kwargs), and the tensor fields of
+    an input object (``events.t``): a flag a call can change on the caller's tensor without changing a value."""
+    return {f"{name}{field}": bool(a.requires_grad) for name, v in named_inputs(*inputs)
+            for field, a in _arrays_of(v) if is_tensor(a)}
+
+
+def tensor_flags_message(got: dict, expected: dict) -> str | None:
+    """What the learner's call changed of the inputs' requires_grad where the reference's left it (see
+    :func:`tensor_flags`), or None."""
+    on = [n for n in expected if n in got and got[n] and not expected[n]]
+    off = [n for n in expected if n in got and not got[n] and expected[n]]
+    if on:
+        names = ", ".join(f"`{n}`" for n in on)
+        already = [n for n in expected if expected[n]]
+        source = (f"the result gets its gradients from the inputs that require grad already "
+                  f"({', '.join(f'`{n}`' for n in already)})" if already else
+                  "no input requires grad in the reference's call, so the result needs none through them")
+        return (f"set requires_grad on its input {names} (`.requires_grad_()`, or `.requires_grad = True`), and the "
+                "caller's tensor keeps it: later cells then record autograd graphs through the data, numpy refuses "
+                "it (`.numpy()` of a tensor that requires grad), and a loss back-propagates into it; "
+                f"{source}: leave the inputs as they are (for a tensor of your own that needs gradients, "
+                "`x = x.detach().clone().requires_grad_()`)")
+    if off:
+        names = ", ".join(f"`{n}`" for n in off)
+        return (f"switched requires_grad off on its input {names} (`.requires_grad_(False)`, `.detach_()`), and "
+                "the caller's tensor keeps it: it is cut off from the autograd graph for every later cell, so "
+                "nothing is trained through it; use `.detach()` (a new tensor) where you need values without "
+                "gradients, and leave the inputs as they are")
+    return None
 
 
 def module_flags_message(got: dict, expected: dict) -> str | None:

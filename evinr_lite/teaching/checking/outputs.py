@@ -172,7 +172,7 @@ def compare_outputs(got, expected, rtol: float, atol: float, where: str = "") ->
             return Problem(f"wrong shape{at}: got {g.shape}, expected {e.shape}" + _shape_note(g, e))
         if _kind(g) != _kind(e):
             return Problem(f"wrong dtype{at}: got {_kind(g)} ({g.dtype}), expected {_kind(e)} ({e.dtype})"
-                            + _dtype_note(g, e))
+                            + _dtype_note(g, e, rtol, atol, is_tensor(got)))
         width = _tensor_width_message(got, expected, at)
         if width:
             return Problem(width)
@@ -295,18 +295,45 @@ def _shape_note(g: np.ndarray, e: np.ndarray) -> str:
     return ""
 
 
-def _dtype_note(g: np.ndarray, e: np.ndarray) -> str:
-    """A word on a wrong dtype that names a common cause."""
+def _dtype_note(g: np.ndarray, e: np.ndarray, rtol: float = 1e-5, atol: float = 1e-8,
+                tensor: bool = False) -> str:
+    """A word on a wrong dtype that names a common cause (``rtol``, ``atol``: the exercise's tolerances, to tell
+    whether a complex result's real part is the answer; ``tensor``: the result is a torch tensor)."""
     if e.dtype == bool and g.dtype.kind in "iuf":
         return ": return the comparison itself (a boolean mask), without .astype(int) or multiplying by 1"
     if e.dtype.kind in "iu" and g.dtype.kind == "f":
         return (": `/` (and np.trunc, np.floor, np.round) give floats: use integer division `//` "
                 "(torch.div(..., rounding_mode='floor')), or convert with .astype(np.int64) after rounding; an "
                 "array made without a dtype (np.zeros(n), np.full(n, p)) is float too: give dtype=")
+    if e.dtype.kind == "f" and g.dtype.kind == "c":
+        return _complex_note(g, e, rtol, atol, tensor)
     if e.dtype.kind == "f" and g.dtype.kind in "iu":
         return (": the values were made whole numbers: no .astype(int) or int(...) on the result, and no integer "
                 "array to fill (np.zeros(..., dtype=int), or np.zeros_like of an integer input such as x or p)")
     return ""
+
+
+def _complex_note(g: np.ndarray, e: np.ndarray, rtol: float, atol: float, tensor: bool) -> str:
+    """A complex result where floats are expected: where complex numbers come from, and whether the real part is the
+    answer. The imaginary parts count as about 0 where each is within the exercise's tolerance of 0 (``atol`` +
+    ``rtol`` times the expected value); then the real part is compared as any result is, and what that comparison
+    says is quoted, with no guess at its cause."""
+    cause = (": complex numbers come from an FFT (np.fft.ifft, np.fft.ifft2), np.emath / np.lib.scimath, a power "
+             "or root of a negative number (`(-x) ** 0.5`), or `+ 0j`")
+    fix = "`.real`" if tensor else "`.real`, or np.real_if_close"
+    imag = np.abs(g.imag)
+    largest = float(np.max(imag)) if g.size else 0.0
+    with np.errstate(invalid="ignore"):
+        about_0 = bool(np.all(imag <= atol + rtol * np.abs(e.astype(np.float64))))
+    if not about_0:
+        return cause + (f"; the imaginary parts here reach {largest:.3g}, beyond this exercise's tolerance, so "
+                        "`.real` alone would not fix the result: the computation itself differs")
+    real = compare_outputs(g.real, e, rtol, atol)
+    if real is None:
+        return cause + (f"; the imaginary parts here are all about 0 (at most {largest:.2g}) and the real parts are "
+                        f"the expected values: return the real part ({fix}) as a float array")
+    return cause + (f"; the imaginary parts here are all about 0 (at most {largest:.2g}), and `.real` gives a "
+                    f"float result, but it does not match either: {real.message}")
 
 
 def differing_leaf(got, expected, rtol: float, atol: float):

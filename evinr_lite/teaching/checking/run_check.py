@@ -9,10 +9,13 @@ exercise's own wrong versions, a swapped pair, state kept between calls, an argu
 generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
 patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
 the rest), and last a notebook variable that only grew. A model among the inputs left in another mode, or with other
-parameters requiring grad, than the reference leaves it is named after each call. After every input matched, the last
-one is run a second time from other states of the global generators (:func:`_second_call`, :mod:`.across_calls`,
-:mod:`.global_state`), and input #1's own objects are refilled in place with a later input's values and given again
-(:func:`.across_calls.same_objects_new_values`: a cache keyed by id()), and last the function is called as the
+parameters requiring grad, than the reference leaves it is named after each call, and so is an input tensor whose
+requires_grad the call changed. A call stopped at the time limit (:class:`.learner_calls.TooSlow`: an endless loop) or
+ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
+(which would run it again). After every input matched, the last one is run a second time from other states of the
+global generators (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`), and input #1's own objects are
+refilled in place with a later input's values and given again (:func:`.across_calls.same_objects_new_values`: a cache
+keyed by id()), and last the function is called as the
 notebooks call it (:func:`.signature.called_as_notebook`, each exercise's recorded call, only where its signature
 differs from the stub's); a function that cannot take the inputs by name (a parameter renamed, or positional-only) is
 called so throughout (:func:`.signature.notebook_caller`). Slips read off the learner's source and proven by a call
@@ -37,8 +40,9 @@ from .global_state import (global_settings, imports_watched, other_rng_states, r
                            rng_states, set_rng_states, settings_message)
 from .hints import (aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
-from .learner_calls import (cache_raised, changed_inputs, container_names, in_place_message, module_flags,
-                            module_flags_message, poison_freed_memory, run, watching, where_raised)
+from .learner_calls import (ExitCalled, TooSlow, cache_raised, changed_inputs, container_names, in_place_message,
+                            module_flags, module_flags_message, poison_freed_memory, run, tensor_flags,
+                            tensor_flags_message, watching, where_raised)
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
@@ -93,8 +97,9 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         # the reference first, so that memory freed in the sizes of its result can be filled with a pattern before
         # the learner's call: an array started with np.empty then holds that pattern, not zeros by chance
         ref_after: list = []
+        ref_seconds: list = []              # the reference's call alone (not the inputs' copy, nor the poisoning)
         try:
-            expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after)
+            expected = run(ex.reference, args, kwargs, ex.observe, inputs_after=ref_after, seconds=ref_seconds)
             poison_freed_memory(expected)
         except Exception:                   # run again below, where its error stops the check as it did before
             ref_after = []
@@ -107,6 +112,11 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
                 return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
             return False, f"{NOT_DONE}: the function raises NotImplementedError", [
                 "Replace `raise NotImplementedError` with your code, run the cell again, then re-check."]
+        except TooSlow as err:              # no hint's search: each would run the endless call again
+            return False, f"did not return within {err.seconds:g} s on {where}", _too_slow_details(
+                err, ref_seconds[-1] if ref_seconds else None)
+        except ExitCalled as err:
+            return False, f"called {err.how} on {where}", _exit_details(err)
         except Exception as err:
             return _raised_report(ex, fn, err, cases, k, where, defaults, containers)
         if changed_settings:
@@ -118,6 +128,9 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         if model_changed:
             return False, f"changed the model's settings on {where}", [model_changed]
         problem = first_difference(ex, got, expected)
+        # an input tensor's requires_grad changed, where the reference's call leaves it (a flag, not a value)
+        flags = tensor_flags_message(tensor_flags(after[0]), tensor_flags(ref_after[0])) \
+            if after and ref_after else None
         # inputs changed in place (a function with side effects says what to compare through `observe`)
         changed = changed_inputs((args, kwargs), after[0]) if ex.observe is None and after else []
         # the right values, but not what back-propagation from them reaches (a differentiable result)
@@ -128,10 +141,13 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             what = "back-propagates inside the function" if grads.message == BACKWARD_CALLED \
                 else "gives the right values, but not the reference's gradients,"
             return False, f"{what} on {where}", [grads.message] + extra
-        if problem is None and not changed:
+        if problem is None and not changed and not flags:
             continue
+        if problem is None and not changed:
+            return False, f"changed its input's requires_grad on {where}", [flags]
         if problem is None:
-            return False, f"changed its input on {where}", [in_place_message(changed, container_names(args, kwargs))]
+            return False, f"changed its input on {where}", [in_place_message(changed, container_names(args, kwargs))] \
+                + (["also: " + flags] if flags else [])
         details = [problem.message]
         hint, seed_note = _hint_for(ex, fn, cases, k, got, expected, problem, defaults, containers)
         if hint:
@@ -140,6 +156,8 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             details.append(f"also: {seed_note}")
         if changed:
             details.append("also: " + in_place_message(changed, container_names(args, kwargs)))
+        if flags:
+            details.append("also: " + flags)
         return False, f"does not match the reference on {where}", details
     if n:
         failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after)
@@ -156,6 +174,45 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
         if as_called is not None:
             return False, as_called[0], as_called[1]
     return True, f"matches the reference on {n} input{'s' if n != 1 else ''}", []
+
+
+def _too_slow_details(err: TooSlow, ref_s: float | None) -> list[str]:
+    """What a report says of a call stopped after the time limit: the learner's line it was on, and the likely
+    causes (the reference's time on the same input for scale)."""
+    line = [w.replace("raised in", "stopped in", 1) for w in where_raised(err)]
+    return line + [
+        f"hint: {_reference_time(ref_s)}every input here is small: your function "
+        "is too slow, most likely an endless loop: a `while` whose condition never changes (its counter or level "
+        "not moved toward the end, `i += 1` outside the loop's body, `level += C` where the level goes down, a "
+        "time step of 0), a loop that appends to the list it walks over, or a call that waits (input(), "
+        "time.sleep); run it on a small input with a print inside the loop to see which values stop changing"]
+
+
+def _reference_time(seconds: float | None) -> str:
+    """"the reference takes 12 ms on this input, and " (whole milliseconds from 10 ms, two digits below), or nothing
+    where the reference's call was not timed (it raised)."""
+    if seconds is None:
+        return ""
+    ms = 1000 * seconds
+    return f"the reference takes {ms:.0f} ms on this input, and " if ms >= 10 else \
+        f"the reference takes {ms:.2g} ms on this input, and "
+
+
+_EXIT_FIX = ("to refuse an input raise an error (`raise ValueError(\"...\")`), and for a case the docstring gives a "
+             "value for (no events, no pairs) return that value")
+
+
+def _exit_details(err: ExitCalled) -> list[str]:
+    """What a report says of a call that ended with sys.exit(), exit() or quit(): in plain Python a SystemExit; in a
+    notebook (IPython's exit()) a request to shut the kernel down, which the check refused."""
+    if err.notebook:
+        return where_raised(err) + [
+            "hint: exit() (quit()) in a notebook does not end the function: it asks Jupyter to shut the kernel down "
+            "once the cell has run, and every variable of the notebook is lost (the check undid that here); "
+            + _EXIT_FIX]
+    return [f"SystemExit: {err.code!r}"] + where_raised(err) + [
+        "hint: sys.exit() (exit(), quit()) ends the whole program, not the function: in a notebook it stops the "
+        "cell (and the check) with no result; " + _EXIT_FIX]
 
 
 def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, k: int, where: str, defaults: dict,
