@@ -44,6 +44,12 @@ def default_device(preference: str | None = None) -> "torch.device":
     """
     import torch   # here, not at the top: data_fetch and the command's --help stay light
 
+    if preference is not None and not isinstance(preference, str):   # a torch.device: its name, as torch takes it
+        if not isinstance(preference, torch.device):
+            # 5, True or a list were Python's "has no attribute 'startswith'", 0 and [] read as None
+            raise DeviceUnavailable(f"device= must be 'cpu', 'cuda', 'cuda:N', 'mps' or None (a GPU when present), "
+                                    f"got {type(preference).__name__} {preference!r}")
+        preference = str(preference)
     preference = preference or os.environ.get("EVINR_DEVICE") or "auto"
     if preference == "auto":
         if torch.cuda.is_available():
@@ -58,7 +64,11 @@ def default_device(preference: str | None = None) -> "torch.device":
     if preference == "mps" and not (hasattr(torch.backends, "mps") and torch.backends.mps.is_available()):
         raise DeviceUnavailable("device 'mps' requested but no Apple GPU (MPS) is available here; use device='cpu' "
                                 "(or None: a GPU when present)")
-    return torch.device(preference)
+    try:
+        return torch.device(preference)
+    except RuntimeError:   # "x" was torch's "Expected one of cpu, cuda, ipu, xpu, ..." naming no argument
+        raise DeviceUnavailable(f"device {preference!r} is no device name; use device='cpu', 'cuda', 'cuda:N', 'mps' "
+                                "or None (a GPU when present)") from None
 
 
 def cpu_threads() -> int:
