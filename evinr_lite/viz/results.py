@@ -1,18 +1,60 @@
 """Figures of scores: results bar charts, ablation panels, the time/quality trade-off, robustness sweeps."""
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
+
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..core.checks import ArgumentTypeError, numbers_array
+from ..core.events import EventDataError
 from ..evaluation.ablation import COLUMN_LABELS, pareto_front
 from .signals import axes_or_new
 
 __all__ = ["plot_results", "plot_ablation", "plot_tradeoff", "plot_robustness"]
 
 
+def _rows(rows, what: str) -> list:
+    """The rows as a list, each a dict (a Mapping); else an ArgumentTypeError naming rows= and ``what`` they are
+    (None or a number were "not iterable", a string was read letter by letter, a tuple of numbers "'int' object
+    is not subscriptable")."""
+    if isinstance(rows, (str, bytes, Mapping)) or not isinstance(rows, Iterable):
+        raise ArgumentTypeError(f"rows= must be a list of result rows ({what}), got {type(rows).__name__}"
+                                + ("; pass [row]" if isinstance(rows, Mapping) else ""))
+    rows = list(rows)
+    bad = next((r for r in rows if not isinstance(r, Mapping)), None)
+    if bad is not None:
+        raise ArgumentTypeError(f"rows= must be a list of result rows ({what}), but one is a {type(bad).__name__}: "
+                                f"{bad!r}"[:200])
+    return rows
+
+
+def _keys(keys, name: str) -> list:
+    """Row keys: one str, or a list / tuple of str (None or a number were "not iterable", a list unhashable)."""
+    keys = [keys] if isinstance(keys, str) else keys
+    if not isinstance(keys, (list, tuple)) or not all(isinstance(k, str) for k in keys):
+        raise ArgumentTypeError(f"{name}= must be the names of row keys (e.g. ('ssim_none', 'ssim_clahe')), got "
+                                f"{keys!r}"[:200])
+    return list(keys)
+
+
+def _column(rows: list, key, name: str, fix: str) -> np.ndarray:
+    """``row[key]`` of every row as float64 numbers (None: NaN, a missing score); a key no row holds is named
+    with ``fix`` (a KeyError before), and so is a value that is no number."""
+    if not isinstance(key, str):
+        raise ArgumentTypeError(f"{name}= must be the name of a row key (e.g. 'ssim_clahe'), got {key!r}"[:200])
+    missing = [i for i, r in enumerate(rows) if key not in r]
+    if missing:
+        raise EventDataError(f"row {missing[0]} has no {key!r} (its keys: {sorted(map(str, rows[missing[0]]))[:8]}); "
+                             f"{fix}")
+    values = [np.nan if r[key] is None else r[key] for r in rows]
+    return numbers_array(values, f"{name} {key!r}", "numbers, one per row").astype(np.float64)
+
+
 def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
     """Bar charts, one panel per metric: methods along x, one bar per equalisation. Returns the figure."""
-    rows = list(rows)
+    rows = _rows(rows, "dicts with 'method', as evaluate() returns")
+    metrics = _keys(metrics, "metrics")
     if not rows or not all(isinstance(r, dict) and "method" in r for r in rows):
         raise ValueError("plot_results needs the result rows evaluate() returns (dicts with 'method'), got "
                          + ("none" if not rows else repr(rows[0])[:80]))
@@ -59,8 +101,21 @@ def plot_ablation(rows: list[dict], metrics=("ssim_none", "ssim_clahe"), *, x=No
     Returns:
         The matplotlib figure.
     """
+    rows = _rows(rows, "dicts with 'name', 'train_time_s' and the metrics, as run_variants returns")
     if not rows:
         raise ValueError("no rows to plot")
+    metrics = _keys(metrics, "metrics")
+    if not metrics:
+        raise ValueError("metrics= is empty: pass the quality keys to draw (e.g. ('ssim_none', 'ssim_clahe'))")
+    if not isinstance(xscale, str) or xscale not in ("linear", "log", "symlog"):
+        raise EventDataError(f"xscale= must be 'linear', 'log' or 'symlog', got {xscale!r}")
+    fix = "pass the rows of run_variants (dicts with 'name', 'train_time_s' and the metrics)"
+    missing = [i for i, r in enumerate(rows) if "name" not in r]
+    if missing:   # a KeyError before
+        raise EventDataError(f"row {missing[0]} has no 'name'; {fix}")
+    _column(rows, "train_time_s", "rows", fix)
+    for m in metrics:
+        _column(rows, m, "metrics", "pass metrics= among the rows' keys")
     names = [r["name"] for r in rows]
     if fig is None:
         fig = plt.figure(figsize=(max(9.0, 1.3 * len(rows) + 4), 3.4))
@@ -112,20 +167,34 @@ def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = 
     Returns:
         The axes.
     """
-    rows = list(rows)
+    rows = _rows(rows, "dicts with 'name', the quality and the cost keys, as run_variants returns")
     if not rows:   # empty axes titled "time against quality"
         raise ValueError("no rows to plot: pass the rows of run_variants (dicts with 'name', the quality and the "
                          "cost keys)")
-    c = np.array([r[cost] for r in rows], dtype=np.float64)
-    q = np.array([r[quality] for r in rows], dtype=np.float64)
-    front = pareto_front(c, q) if front is None else np.asarray(front, bool)
+    # the keys, the front and the labels before anything is drawn (a key no row holds was a KeyError, a front of
+    # one number "iteration over a 0-d array", one of another length numpy's IndexError; labels were checked
+    # after the points were drawn)
+    c = _column(rows, cost, "cost", "pass cost= one of the rows' keys (e.g. 'train_time_s')")
+    q = _column(rows, quality, "quality", "pass quality= one of the rows' keys (e.g. 'ssim_clahe')")
+    missing = [i for i, r in enumerate(rows) if "name" not in r]
+    if missing:
+        raise EventDataError(f"row {missing[0]} has no 'name' (each point is labelled with it); pass the rows of "
+                             "run_variants")
+    if front is None:
+        front = pareto_front(c, q)
+    else:
+        given = numbers_array(front, "front", "flags, one per row (True: on the front)", flags=True)
+        if given.shape != (len(rows),) or not np.isin(given, (0, 1)).all():
+            raise EventDataError(f"front= must be {len(rows)} flags (one per row, True on the front), got "
+                                 f"{given.dtype} of shape {given.shape}")
+        front = given.astype(bool)
+    if not isinstance(labels, str) or labels not in ("front", "all"):
+        raise EventDataError(f"labels must be 'front' or 'all', got {labels!r}")
     ax = axes_or_new(ax, (8, 4.5))
     ax.scatter(c[~front], q[~front], color="0.6", s=18, label="dominated")
     ax.scatter(c[front], q[front], color="tab:red", s=30, label="Pareto front")
     order = np.flatnonzero(front)[np.argsort(c[front])]
     ax.step(c[order], q[order], where="post", color="tab:red", lw=1)
-    if labels not in ("front", "all"):
-        raise ValueError(f"labels must be 'front' or 'all', got {labels!r}")
     for r, ci, qi, on in zip(rows, c, q, front):
         if on or labels == "all":
             ax.annotate(r["name"], (ci, qi), fontsize=9, xytext=(4, -3), textcoords="offset points")
