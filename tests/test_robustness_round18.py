@@ -272,9 +272,19 @@ def test_show_frames_names_its_bad_argument(kw, name):
     ({"images": v}, "images") for v in ("x", IMG, [IMG], 3)] + [
     ({"cell_size": v}, "cell_size") for v in (None, "2", NAN, -2.0, 0)] + [
     ({"vmin": v}, "vmin") for v in ("0", NAN)] + [({"vmax": v}, "vmax") for v in ("1", INF)] + [
-    ({"vmin": 0.5, "vmax": 0.5}, "vmin")], ids=repr)
+    ({"vmin": 0.6, "vmax": 0.5}, "vmin=0.6 is above vmax=0.5; swap them")], ids=repr)
 def test_show_images_names_its_bad_argument(kw, name):
     _refused(show_images, **{"images": {"a": IMG}, **kw}, match=name)
+
+
+def test_equal_limits_draw_a_blank_frame_guard():
+    # vmin == vmax is a blank frame's scale (notebook 04's vmin=-m, vmax=m with m = 0): drawn in one colour, not
+    # refused; show_event_frames takes vmax=0 as its default does for blank frames (a scale of 1.0)
+    assert len(show_images({"a": np.zeros((12, 16))}, vmin=0.5, vmax=0.5).axes) == 1
+    assert len(show_frames({"a": np.zeros((2, 12, 16))}, cmap="RdBu_r", vmin=-0.0, vmax=0.0).axes) == 2
+    blank = events_to_frames(EV, np.linspace(2, 3, 3))
+    fig = show_event_frames(blank, vmax=0.0)
+    assert fig.axes[0].images[0].get_clim() == (-1.0, 1.0)
 
 
 @pytest.mark.parametrize("kw, name", [({"histories": v}, "histories") for v in ("x", 5, [1.0, 0.5], (1, 2))] + [

@@ -260,7 +260,7 @@ def show_event_frames(frames: EventFrames, indices=None, max_frames: int = 8, nc
         frames: :class:`~evinr_lite.method.binning.EventFrames`.
         indices: which bins to show; default ``max_frames`` bins evenly spread over all of them.
         ncols: panels per row.
-        vmax: colour scale limit (log units); default the largest |value| shown.
+        vmax: colour scale limit (log units); default the largest |value| shown (0, blank frames: 1.0).
         title: figure title.
 
     Returns:
@@ -277,9 +277,9 @@ def show_event_frames(frames: EventFrames, indices=None, max_frames: int = 8, nc
     ncols = whole_number(ncols, "ncols", lo=1)
     panel_size = real_number(panel_size, "panel_size", lo=0, hi=MAX_FIGSIZE, lo_open=True,
                              hint="inches per panel")
-    if vmax is not None:
-        vmax = real_number(vmax, "vmax", lo=0, lo_open=True, hint="the colour scale's limit in log units (None: "
-                                                                   "the largest |value| shown)")
+    if vmax is not None:   # 0 (the largest |value| of blank frames) falls back to 1.0, as the default does
+        vmax = real_number(vmax, "vmax", lo=0, hint="the colour scale's limit in log units (None: the largest "
+                                                    "|value| shown)") or 1.0
     if indices is None:
         indices = np.unique(np.linspace(0, B - 1, min(B, max_frames)).round().astype(int))
     elif isinstance(indices, (str, bytes)) or is_real_number(indices) or np.ndim(host_array(indices)) != 1:

@@ -95,12 +95,13 @@ def _cell_size(cell_size) -> float:
 
 
 def _limits(vmin, vmax) -> tuple:
-    """The grey scale's limits: each None (the image's own) or a finite number, vmin below vmax (text failed
-    inside matplotlib; NaN or a reversed range drew every pixel one grey without a word)."""
+    """The grey scale's limits: each None (the image's own) or a finite number, vmin not above vmax (text failed
+    inside matplotlib; NaN or a reversed range drew every pixel one grey without a word). Equal limits are taken:
+    a blank frame drawn with ``vmin=-m, vmax=m`` for m = 0 is one colour, as matplotlib draws it."""
     lo = None if vmin is None else real_number(vmin, "vmin", hint="the value drawn black (None: the data's)")
     hi = None if vmax is None else real_number(vmax, "vmax", hint="the value drawn white (None: the data's)")
-    if lo is not None and hi is not None and not lo < hi:
-        raise EventDataError(f"vmin={vmin!r} must be below vmax={vmax!r}; swap them")
+    if lo is not None and hi is not None and lo > hi:
+        raise EventDataError(f"vmin={vmin!r} is above vmax={vmax!r}; swap them")
     return vmin, vmax
 
 
