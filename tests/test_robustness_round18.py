@@ -123,7 +123,7 @@ def test_frame_inr_names_windows_that_are_no_time_windows(windows):
     ({"hidden_layers": v}, "hidden_layers") for v in (None, NAN, 2.5, -1)] + [
     ({"omega_0": v}, "omega_0") for v in (None, "30", NAN, INF, 0, -1.0, True)] + [
     ({"first_omega_0": v}, "first_omega_0") for v in ("10", NAN, 0, -1.0)] + [
-    ({"seed": v}, "seed") for v in (None, "0", NAN, 2.5, True, -1)] + [
+    ({"seed": v}, "seed") for v in (None, "0", NAN, 2.5, True, -1, 2**63)] + [
     ({"first_index": v}, "first_index") for v in (None, 2.5, -1, True)] + [
     ({"init_head": v}, "init_head") for v in ("no", None, 2)], ids=repr)
 def test_frame_inr_names_its_bad_argument(kw, name):
@@ -148,7 +148,7 @@ def test_frame_inr_takes_flat_windows_tensors_and_numpy_numbers_guard():
     {"n_iters": None}, {"n_iters": INF}, {"n_iters": True}, {"batch_size": "4096"}, {"batch_size": True},
     {"lr_decay": None}, {"lr_decay": "0.9"}, {"lr_decay": True}, {"lr_decay_every": "10"}, {"lr_decay_every": NAN},
     {"lr_decay_every": True}, {"display_mean": None}, {"display_mean": "0.5"},
-    {"seed": None}, {"seed": "0"}, {"seed": 2.5}, {"seed": -1}, {"seed": True},
+    {"seed": None}, {"seed": "0"}, {"seed": 2.5}, {"seed": -1}, {"seed": True}, {"seed": 2**63},
     {"device": 5}, {"device": True}, {"progress": "no"}, {"progress": None}, {"progress": 2},
 ], ids=repr)
 def test_coordinate_config_names_each_bad_field(kw):
@@ -156,9 +156,25 @@ def test_coordinate_config_names_each_bad_field(kw):
     _refused(CoordinateConfig, match=f"{name}=?", **kw)
 
 
-def test_coordinate_config_keeps_what_it_took_guard():
-    cfg = CoordinateConfig(C=1, n_iters=2.0, lam=0, first_omega_0=5, seed=np.int64(4), progress=False, device="cpu")
-    assert (cfg.C, cfg.n_iters, cfg.lam, cfg.seed) == (1, 2.0, 0, 4)
+def test_seeds_outside_evinr_configs_range_are_named_with_it():
+    # [0, 2**63), EvINRConfig's range, written as such (not "9.22337e+18"); FrameINR's seed 2**63 made the
+    # networks of seed 0 (network_seed works modulo 2**63)
+    for make in (lambda: CoordinateConfig(seed=2**63), lambda: FrameINR((3, 4), W1, 8, 1, seed=2**63)):
+        _refused(make, match=r"seed= must be a whole number in \[0, 2\*\*63\), got 9223372036854775808$")
+
+
+def test_coordinate_config_stores_whole_sizes_as_ints_and_trains_guard():
+    from evinr_lite.method.coordinate import train_coordinate_inr
+    cfg = CoordinateConfig(C=1, n_iters=2.0, batch_size=16.0, hidden_features=8.0, hidden_layers=np.int64(1),
+                           lr_decay_every=10.0, lam=0, first_omega_0=5, seed=np.int64(4), progress=np.False_,
+                           device="cpu")
+    assert (cfg.C, cfg.lam, cfg.n_iters, cfg.batch_size, cfg.hidden_features, cfg.hidden_layers, cfg.lr_decay_every,
+            cfg.seed, cfg.progress) == (1, 0, 2, 16, 8, 1, 10, 4, False)
+    assert all(type(getattr(cfg, k)) is int for k in ("n_iters", "batch_size", "hidden_features", "hidden_layers",
+                                                       "lr_decay_every", "seed")) and cfg.progress is False
+    # whole floats trained before they were stored as ints: "'float' object cannot be interpreted as an integer"
+    _, history = train_coordinate_inr(EV, cfg, (0.0, 1.0))
+    assert len(history["loss"]) == 2
 
 
 # ---- 4. events_to_frames_chunked, the colour helpers, default_device -------------------------------------------

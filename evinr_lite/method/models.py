@@ -22,7 +22,7 @@ import math
 import torch
 from torch import nn
 
-from ..core.checks import numbers_array, real_number, true_or_false, whole_number
+from ..core.checks import check_seed, numbers_array, real_number, true_or_false, whole_number
 from ..core.events import EventDataError, check_sensor_size
 
 __all__ = ["FrameINR", "network_seed"]
@@ -94,7 +94,7 @@ class FrameINR(nn.Module):
         omega_0 = real_number(omega_0, "omega_0", lo=0, lo_open=True, hint=hint)
         first_omega_0 = omega_0 if first_omega_0 is None else \
             real_number(first_omega_0, "first_omega_0", lo=0, lo_open=True, hint=hint + "; None: omega_0")
-        seed = whole_number(seed, "seed", lo=0)
+        seed = check_seed(seed)   # [0, 2**63), EvINRConfig's: network_seed works modulo 2**63
         first_index = whole_number(first_index, "first_index", lo=0)
         init_head = true_or_false(init_head, "init_head")
         self.sensor_size = (H, W)
