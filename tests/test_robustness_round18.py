@@ -255,11 +255,18 @@ def test_show_event_frames_names_its_bad_argument(kw, name):
     ({"n_frames": v}, "n_frames") for v in (None, "3", 2.5, True)] + [
     ({"window_s": v}, "window_s") for v in ("0.1", INF, [0.1], True)] + [
     ({"t_range": v}, "t_range") for v in (0.5, "01", [], (0.1, 0.5, 0.9), (0.9, 0.1), (0.1, NAN), (True, 0.5))] + [
-    ({"dpi": v}, "dpi") for v in ("72", NAN, 0, -1, 2.5, True)] + [
-    ({"interval": v}, "interval") for v in ("100", NAN, INF, 0)] + [
+    ({"dpi": v}, "dpi") for v in ("72", NAN, 0, -1, 2.5, True, 5000)] + [
+    ({"interval": v}, "interval") for v in ("100", NAN, INF, 0, -1)] + [
     ({"figsize": v}, "figsize") for v in ("x", 4, (4,), (4, NAN), (4, -3), (1e6, 3))], ids=repr)
 def test_animate_events_names_its_bad_argument(kw, name):
     _refused(animate_events, **{"events": EV, "n_frames": 2, **kw}, match=name)
+
+
+def test_animate_events_takes_a_high_dpi_guard():
+    # dpi has no cap of its own (1200 drew before round 18): only a frame over 2**27 pixels is refused (dpi=5000 at
+    # (4, 3) inches, above). interval=0 stays refused: to_jshtml() divided by it (ZeroDivisionError)
+    anim = animate_events(EV, n_frames=2, interval=0.5, dpi=1200, figsize=(1, 1))
+    assert anim._fig.dpi == 1200 and "<img" in anim.to_jshtml()
 
 
 @pytest.mark.parametrize("polarity", [True, np.True_, np.array([1, -1])], ids=repr)
@@ -358,6 +365,14 @@ def test_plot_tradeoff_names_its_bad_argument_before_drawing(kw, name):
 def test_plot_event_ticks_names_its_bad_argument(kw, name):
     fig, ax = plt.subplots()
     _refused(plot_event_ticks, **{"ax": ax, "t_events": [0.1, 0.2], "p_events": [1, -1], **kw}, match=name)
+
+
+def test_score_figures_take_any_iterable_of_metric_names_guard():
+    # numpy arrays of text, generators, sets and dict keys drew before round 18 (a list or tuple only, then)
+    for metrics in (np.array(["ssim", "mse"]), (m for m in ["ssim", "mse"]), {"ssim"}, {"ssim": 1, "mse": 2}.keys()):
+        fig = plot_results(RESULT_ROWS, metrics=metrics)
+        assert [ax.get_title().split()[0] for ax in fig.axes] == [m.upper() for m in ("ssim", "mse")][:len(fig.axes)]
+    assert plot_ablation(VARIANTS, metrics=np.array(["ssim_none"])) is not None
 
 
 def test_score_figures_take_tuples_and_flag_lists_guard():

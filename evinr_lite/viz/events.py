@@ -37,7 +37,9 @@ __all__ = ["ON_COLOR", "OFF_COLOR", "ON_RGB", "OFF_RGB", "subsample_index", "sub
 ON_RGB = to_rgb(ON_COLOR)     # (r, g, b) floats in [0, 1]
 OFF_RGB = to_rgb(OFF_COLOR)
 EVENT_FRAME_CMAP = "RdBu_r"   # red > 0 (more ON), blue < 0 (more OFF)
-MIN_DPI, MAX_DPI = 10.0, 1000.0   # below 10, FreeType has no font size to draw the titles with
+MIN_DPI = 10.0   # below 10, FreeType has no font size to draw the titles with
+MAX_FRAME_PIXELS = 2**27   # an animation frame's pixels (figsize x dpi): 512 MiB of RGBA per frame; (100, 100)
+#                            inches at 1000 dpi were C++'s bad_alloc, (4, 3) at 20000 dpi a minute per frame
 
 
 def _axes(ax, figsize=(6, 4)):
@@ -322,7 +324,8 @@ def animate_events(events: Events, n_frames: int = 20, window_s: float | None = 
         n_frames: number of frames (each is one PNG in the HTML: keep it small).
         window_s: window length (s); default ``(t1 - t0) / n_frames`` (consecutive windows).
         t_range: (t0, t1) seconds; default the first and last event times.
-        figsize, dpi: size of each frame. interval: milliseconds between frames when played.
+        figsize, dpi: size of each frame (dpi >= 10; at most 2**27 pixels a frame). interval: milliseconds
+            between frames when played (> 0: ``to_jshtml`` and ``save`` play 1000 / interval frames a second).
 
     Returns:
         A ``FuncAnimation``; show it in a notebook with
@@ -348,10 +351,16 @@ def animate_events(events: Events, n_frames: int = 20, window_s: float | None = 
         real_number(window_s, "window_s", lo=0, lo_open=True, hint="seconds (None: consecutive windows)")
     if not window > 0:
         raise EventDataError(f"window_s must be positive seconds, got {window_s}")
-    dpi = real_number(dpi, "dpi", lo=MIN_DPI, hi=MAX_DPI, hint="dots per inch (e.g. 72)") if dpi is not None else None
+    dpi = real_number(dpi, "dpi", lo=MIN_DPI, hint="dots per inch (e.g. 72)") if dpi is not None else None
+    # interval > 0: matplotlib takes 0, but to_jshtml() and save() divide by it (fps = 1000 / interval)
     interval = real_number(interval, "interval", lo=0, lo_open=True, hint="milliseconds between frames") \
         if interval is not None else interval
     figsize = check_figsize(figsize)
+    w, h = (plt.rcParams["figure.figsize"] if figsize is None else figsize)
+    pixels = float(w) * float(h) * (plt.rcParams["figure.dpi"] if dpi is None else dpi) ** 2
+    if pixels > MAX_FRAME_PIXELS:   # no cap on dpi alone: what runs out is the memory of one frame's image
+        raise EventDataError(f"figsize={figsize!r} at dpi={dpi!r} makes frames of {pixels:.3g} pixels, over "
+                             f"{MAX_FRAME_PIXELS:.3g} (2**27, 512 MiB of RGBA per frame); lower dpi= or figsize=")
     ends = t0 + window + (t1 - t0 - window) * np.linspace(0, 1, n_frames) if n_frames > 1 else np.array([t1])
     windows = np.stack([ends - window, ends], axis=1)
 

@@ -30,12 +30,17 @@ def _rows(rows, what: str) -> list:
 
 
 def _keys(keys, name: str) -> list:
-    """Row keys: one str, or a list / tuple of str (None or a number were "not iterable", a list unhashable)."""
-    keys = [keys] if isinstance(keys, str) else keys
-    if not isinstance(keys, (list, tuple)) or not all(isinstance(k, str) for k in keys):
+    """Row keys as a list of str: one str, or any iterable of str that is no mapping (a list, a tuple, a numpy
+    array of text, a generator, dict keys, a set: drawn in the order it gives them); None or a number were "not
+    iterable", a list of lists "unhashable"."""
+    if isinstance(keys, str):
+        return [keys]
+    given = keys
+    keys = None if isinstance(keys, (bytes, Mapping)) or not isinstance(keys, Iterable) else list(keys)
+    if keys is None or not all(isinstance(k, str) for k in keys):
         raise ArgumentTypeError(f"{name}= must be the names of row keys (e.g. ('ssim_none', 'ssim_clahe')), got "
-                                f"{keys!r}"[:200])
-    return list(keys)
+                                f"{given!r}"[:200])
+    return [str(k) for k in keys]   # numpy's str_ as str
 
 
 def _column(rows: list, key, name: str, fix: str) -> np.ndarray:
