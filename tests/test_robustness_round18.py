@@ -214,6 +214,32 @@ def test_default_device_names_what_is_no_device(device):
     _refused(default_device, device, match=r"device", error=InputError)
 
 
+@pytest.mark.parametrize("value, said", [("gpu", r"EVINR_DEVICE='gpu' is no device name; unset it or set it to cpu, "
+                                                 r"cuda, cuda:N or mps$"),
+                                         ("cuda", r"EVINR_DEVICE='cuda' requested but no CUDA GPU.*; unset EVINR_DEVICE "
+                                                  r"or set it to cpu$")])
+def test_default_device_names_the_environment_variable_a_bad_device_came_from(monkeypatch, value, said):
+    # "device 'gpu' is no device name; use device='cpu', ..." named an argument the caller never passed
+    monkeypatch.setenv("EVINR_DEVICE", value)
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    _refused(default_device, match=said, error=InputError)
+    _refused(default_device, None, match=said, error=InputError)
+
+
+def test_the_command_line_offers_no_device_choice_it_lacks(monkeypatch):
+    # --device takes cpu or cuda: "(or None: a GPU when present)" is leaving the flag out; EVINR_DEVICE's fix is kept
+    from evinr_lite.apps.cli import _message
+    monkeypatch.delenv("EVINR_DEVICE", raising=False)
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: False)
+    with pytest.raises(InputError) as info:
+        default_device("cuda")
+    assert _message(info.value).endswith("use --device cpu (or leave --device out: a GPU when present)")
+    monkeypatch.setenv("EVINR_DEVICE", "gpu")
+    with pytest.raises(InputError) as info:
+        default_device()
+    assert _message(info.value) == str(info.value)
+
+
 def test_default_device_takes_a_torch_device_guard():
     assert default_device(torch.device("cpu")) == default_device("cpu") == torch.device("cpu")
 
