@@ -393,6 +393,33 @@ def test_plot_event_ticks_names_its_bad_argument(kw, name):
     _refused(plot_event_ticks, **{"ax": ax, "t_events": [0.1, 0.2], "p_events": [1, -1], **kw}, match=name)
 
 
+TEXT_SCORE = r"rows' '{}' must be numbers, one per row \(None: missing\); row 0 \({}\) has '0.5' \(text\): convert with float\(\)"
+
+
+@pytest.mark.parametrize("fn, rows, said", [
+    (plot_ablation, [dict(VARIANTS[0], ssim_none=NAN), VARIANTS[1]], r"row 0 \(a\): ssim_none = nan, not a score"),
+    (plot_ablation, [VARIANTS[0], dict(VARIANTS[1], train_time_s=INF)], r"row 1 \(b\): train_time_s = inf, not a score"),
+    (plot_ablation, [dict(VARIANTS[0], ssim_clahe="0.5")], TEXT_SCORE.format("ssim_clahe", "a")),
+    (plot_results, [dict(RESULT_ROWS[0], ssim="0.5")], TEXT_SCORE.format("ssim", "evinr")),
+    (plot_tradeoff, [VARIANTS[0], dict(VARIANTS[1], ssim_clahe=None)], r"row 1 \(b\) has no ssim_clahe \(None\)"),
+], ids=["ablation NaN score", "ablation inf time", "ablation text score", "results text score", "tradeoff None"])
+def test_score_figures_refuse_broken_scores_alike(fn, rows, said):
+    # plot_ablation drew a NaN score as a missing bar without a word (plot_results refused it); text scores were
+    # parsed by numpy or drawn by matplotlib as categories; plot_tradeoff called a None quality "quality[1] is nan"
+    _refused(fn, rows, match=said)
+
+
+def test_score_figures_draw_a_missing_score_as_a_gap_guard():
+    # None is a missing score in both figures: a gap (plot_ablation's was a TypeError when drawn)
+    fig = plot_ablation([VARIANTS[0], dict(VARIANTS[1], ssim_clahe=None)])
+    heights = [p.get_height() for p in fig.axes[0].patches]
+    assert len(heights) == 4 and np.isnan(heights).sum() == 1
+    assert plot_ablation([VARIANTS[0], dict(VARIANTS[1], ssim_clahe=None)], x=[1, 2]) is not None
+    fig = plot_results(RESULT_ROWS + [dict(method="e2vid", equalization="none", mse=0.2, ssim=0.4, lpips=None)])
+    assert np.isnan([p.get_height() for p in fig.axes[2].patches]).sum() == 1
+    _refused(plot_results, [dict(RESULT_ROWS[0], ssim=NAN)], match=r"row 0 \(evinr\): ssim = nan, not a score")
+
+
 def test_score_figures_take_any_iterable_of_metric_names_guard():
     # numpy arrays of text, generators, sets and dict keys drew before round 18 (a list or tuple only, then)
     for metrics in (np.array(["ssim", "mse"]), (m for m in ["ssim", "mse"]), {"ssim"}, {"ssim": 1, "mse": 2}.keys()):

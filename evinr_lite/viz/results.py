@@ -6,7 +6,7 @@ from collections.abc import Iterable, Mapping
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, numbers_array
+from ..core.checks import ArgumentTypeError, host_array, is_real_number, numbers_array, short_repr
 from ..core.events import EventDataError
 from ..evaluation.ablation import COLUMN_LABELS, pareto_front
 from .signals import axes_or_new
@@ -43,17 +43,40 @@ def _keys(keys, name: str) -> list:
     return [str(k) for k in keys]   # numpy's str_ as str
 
 
-def _column(rows: list, key, name: str, fix: str) -> np.ndarray:
-    """``row[key]`` of every row as float64 numbers (None: NaN, a missing score); a key no row holds is named
-    with ``fix`` (a KeyError before), and so is a value that is no number."""
+def _score(value, key: str, where: str, *, finite: bool) -> float:
+    """One row's ``key`` as a float: None is NaN (a missing score, drawn as a gap); text, a bool or anything else
+    that is no number is refused (text was parsed, or drawn as categories), and so is NaN or inf when ``finite`` (a
+    broken score, drawn as a gap without a word before)."""
+    if value is None:
+        return np.nan
+    if not is_real_number(value):
+        kind = "text" if isinstance(value, (str, bytes)) else type(value).__name__
+        raise EventDataError(f"rows' {key!r} must be numbers, one per row (None: missing); {where} has "
+                             f"{short_repr(value)} ({kind})" + (": convert with float()" if kind == "text" else ""))
+    v = float(host_array(value))
+    if finite and not np.isfinite(v):
+        raise EventDataError(f"{where}: {key} = {v}, not a score; rescore it (or drop the row); None marks a "
+                             "missing score, drawn as a gap")
+    return v
+
+
+def _column(rows: list, key, name: str, fix: str, *, finite: bool = False) -> np.ndarray:
+    """``row[key]`` of every row as float64 numbers (None: NaN, a missing score; ``finite``: NaN or inf given is
+    refused, see :func:`_score`); a key no row holds is named with ``fix`` (a KeyError before), and so is a value
+    that is no number."""
     if not isinstance(key, str):
         raise ArgumentTypeError(f"{name}= must be the name of a row key (e.g. 'ssim_clahe'), got {key!r}"[:200])
     missing = [i for i, r in enumerate(rows) if key not in r]
     if missing:
         raise EventDataError(f"row {missing[0]} has no {key!r} (its keys: {sorted(map(str, rows[missing[0]]))[:8]}); "
                              f"{fix}")
-    values = [np.nan if r[key] is None else r[key] for r in rows]
-    return numbers_array(values, f"{name} {key!r}", "numbers, one per row").astype(np.float64)
+    return np.array([_score(r[key], key, _where(r, i), finite=finite) for i, r in enumerate(rows)], np.float64)
+
+
+def _where(row, i: int) -> str:
+    """A row as the message names it: its index and, when it has one, its name or method."""
+    label = row.get("name", row.get("method"))
+    return f"row {i}" + ("" if label is None else f" ({label})")
 
 
 def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
@@ -66,11 +89,9 @@ def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
     metrics = [m for m in metrics if any(r.get(m) is not None for r in rows)]
     if not metrics:
         raise ValueError("no row holds any of the metrics asked for; pass metrics= among the rows' keys")
-    for r in rows:     # a NaN score drew no bar: read as a missing method, not as a broken score
-        for m in metrics:
-            v = r.get(m)
-            if v is not None and not np.isfinite(float(v)):
-                raise ValueError(f"{r['method']}: {m} = {v}, not a score; rescore it (or drop the row)")
+    # None (or no key) is a missing score, drawn as a gap; a NaN score drew no bar: read as a missing method, not
+    # as a broken score, so it is refused (as plot_ablation does); text was drawn as categories
+    scores = {m: [_score(r.get(m), m, _where(r, i), finite=True) for i, r in enumerate(rows)] for m in metrics}
     methods = list(dict.fromkeys(r["method"] for r in rows))
     eqs = list(dict.fromkeys(r.get("equalization", "") for r in rows))
     fig = fig or plt.figure(figsize=(3.6 * len(metrics), 3.0))
@@ -81,8 +102,8 @@ def plot_results(rows, *, metrics=("mse", "ssim", "lpips"), fig=None):
         for k, eq in enumerate(eqs):
             vals = []
             for m in methods:
-                hit = [r.get(metric) for r in rows if r["method"] == m and r.get("equalization", "") == eq]
-                vals.append(np.nan if not hit or hit[0] is None else hit[0])
+                hit = [v for r, v in zip(rows, scores[metric]) if r["method"] == m and r.get("equalization", "") == eq]
+                vals.append(hit[0] if hit else np.nan)
             ax.bar(np.arange(len(methods)) + (k - (len(eqs) - 1) / 2) * width, vals, width, label=eq)
         ax.set_xticks(np.arange(len(methods)), methods)
         ax.set_title(f"{metric.upper()} ({better.get(metric, '')})")
@@ -118,21 +139,21 @@ def plot_ablation(rows: list[dict], metrics=("ssim_none", "ssim_clahe"), *, x=No
     missing = [i for i, r in enumerate(rows) if "name" not in r]
     if missing:   # a KeyError before
         raise EventDataError(f"row {missing[0]} has no 'name'; {fix}")
-    _column(rows, "train_time_s", "rows", fix)
-    for m in metrics:
-        _column(rows, m, "metrics", "pass metrics= among the rows' keys")
+    # None is a missing score (or time), drawn as a gap; NaN or inf is refused, as plot_results refuses it (a None
+    # metric was a TypeError when drawn, a NaN one a bar missing without a word)
+    times = _column(rows, "train_time_s", "rows", fix, finite=True)
+    scores = {m: _column(rows, m, "metrics", "pass metrics= among the rows' keys", finite=True) for m in metrics}
     names = [r["name"] for r in rows]
     if fig is None:
         fig = plt.figure(figsize=(max(9.0, 1.3 * len(rows) + 4), 3.4))
     else:
         fig.clf()
     ax_q, ax_t = fig.subplots(1, 2, gridspec_kw={"width_ratios": [3, 2]})
-    times = [r["train_time_s"] for r in rows]
     if x is None:
         pos = np.arange(len(rows))
         width = 0.8 / len(metrics)
         for k, m in enumerate(metrics):
-            ax_q.bar(pos + (k - (len(metrics) - 1) / 2) * width, [r[m] for r in rows], width,
+            ax_q.bar(pos + (k - (len(metrics) - 1) / 2) * width, scores[m], width,
                      label=COLUMN_LABELS.get(m, (m,))[0])
         ax_t.bar(pos, times, 0.6, color="0.5")
         for ax in (ax_q, ax_t):
@@ -142,7 +163,7 @@ def plot_ablation(rows: list[dict], metrics=("ssim_none", "ssim_clahe"), *, x=No
         if x.shape != (len(rows),):
             raise ValueError(f"x must hold one number per row ({len(rows)}), got shape {x.shape}")
         for m in metrics:
-            ax_q.plot(x, [r[m] for r in rows], "o-", label=COLUMN_LABELS.get(m, (m,))[0])
+            ax_q.plot(x, scores[m], "o-", label=COLUMN_LABELS.get(m, (m,))[0])
         ax_t.plot(x, times, "o-", color="0.4")
         for ax in (ax_q, ax_t):
             ax.set_xscale(xscale)
@@ -181,6 +202,11 @@ def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = 
     # after the points were drawn)
     c = _column(rows, cost, "cost", "pass cost= one of the rows' keys (e.g. 'train_time_s')")
     q = _column(rows, quality, "quality", "pass quality= one of the rows' keys (e.g. 'ssim_clahe')")
+    for key in (cost, quality):   # a point has no gap to draw: None (a missing score) was "quality[1] is nan"
+        gap = next((i for i, r in enumerate(rows) if r[key] is None), None)
+        if gap is not None:
+            raise EventDataError(f"{_where(rows[gap], gap)} has no {key} (None); every point needs its cost and its "
+                                 "quality: drop that row")
     missing = [i for i, r in enumerate(rows) if "name" not in r]
     if missing:
         raise EventDataError(f"row {missing[0]} has no 'name' (each point is labelled with it); pass the rows of "
