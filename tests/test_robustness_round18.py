@@ -6,15 +6,19 @@ method's config (``CoordinateConfig``), the chunked event frames (``events_to_fr
 call (evinr_lite.viz: ``show_event_frames``, ``animate_events``, ``count_map``, ``show_frames``, ``show_images``,
 ``plot_histories``, ``plot_results``, ``plot_ablation``, ``plot_tradeoff``, ``plot_event_ticks``).
 
-384 cases; 378 failed before the fixes: the 376 bad-input cases and two guards (``Siren`` of a whole float as a
-size, torch's "must be tuple of ints"; ``default_device(torch.device("cpu"))``, an AttributeError); the other 6 guards
-(named ``..._guard``) passed before and must keep their outcome. Every bad-input case failed before its fix: with Python's, numpy's, torch's or matplotlib's
-own error (None, text and lists through int() / float(), "not iterable", "has no attribute 'items'", a KeyError for a
-key no row holds, "figure size must be positive finite", a ZeroDivisionError for ncols=0), or by taking the value
-without a word (True as 1, 2.5 hidden features as 2, hidden_layers -1 as a network without layers, NaN or infinite
-frequencies, radii and edges, a t_range of three numbers, a NaN vmax). Valid calls give the same bytes as before
-(50 calls compared by the round's session script, not committed: networks' weights, event frames, scenes' log
-intensities, colour offsets and the figures' PNGs).
+401 cases; 394 failed before the fixes: the 389 bad-input cases and five guards (``Siren`` of a whole float as a
+size, torch's "must be tuple of ints"; ``default_device(torch.device("cpu"))``, an AttributeError; a CoordinateConfig
+of n_iters=2.0 trained, "'float' object cannot be interpreted as an integer"; ``show_event_frames(vmax=0)`` of blank
+frames on the default's scale of 1.0, not one colour; a None score in ``plot_ablation`` a gap, not a TypeError); the
+other 7 guards (named ``..._guard``) passed before and must keep their outcome. Every bad-input case failed before its
+fix: with Python's, numpy's, torch's or matplotlib's own error (None, text and lists through int() / float(), "not
+iterable", "has no attribute 'items'", a KeyError for a key no row holds, "figure size must be positive finite", a
+ZeroDivisionError for ncols=0), with a message naming what the caller never passed (EVINR_DEVICE's value as
+device=), or by taking the value without a word (True as 1, 2.5 hidden features as 2, hidden_layers -1 as a network
+without layers, NaN or infinite frequencies, radii and edges, a t_range of three numbers, a NaN vmax, a NaN score as
+a missing bar, text scores, a seed of 2**63 as seed 0). Valid calls give the same bytes as before (50 calls compared
+by the round's session script, not committed: networks' weights, event frames, scenes' log intensities, colour
+offsets and the figures' PNGs; the review's fixes: 6 score figures' PNGs).
 """
 import numpy as np
 import pytest
