@@ -241,7 +241,7 @@ def test_exercise_references_pass_and_hints_fire(capsys):
 
 @pytest.mark.parametrize("kwargs, match", [
     (dict(batch_size=0), "batch_size"), (dict(n_iters=0), "n_iters"), (dict(lam=-1.0), "lam"),
-    (dict(C=0.0), "C must be a positive"), (dict(lr_decay=1.5), "lr_decay"), (dict(display_mean=1.0), "display_mean"),
+    (dict(C=0.0), "C= must be a finite number > 0"), (dict(lr_decay=1.5), "lr_decay"), (dict(display_mean=1.0), "display_mean"),
     (dict(lr_decay_every=0), "lr_decay_every"),
 ])
 def test_bad_config(kwargs, match):

@@ -371,6 +371,7 @@ FLAG_FOR = [
     (re.compile(r"\bt_start=/t_end="), "--start/--end"),
     (re.compile(r"\boverwrite=True"), "--overwrite"),
     (re.compile(r"\bdevice='(\w+)'"), r"--device \1"),
+    (re.compile(r"(--device \w+) \(or None: a GPU when present\)"), r"\1 (or leave --device out: a GPU when present)"),
     (re.compile(r"\btime_unit='(\w+)'"), r"--time-unit \1"),
     (re.compile(r"\bcamera='(left|right)'"), r"--camera \1"),
     (re.compile(r"\bleave camera= out"), "leave --camera out"),

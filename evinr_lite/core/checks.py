@@ -21,7 +21,8 @@ from .guard import InputError, check_unmasked, dense_array, host_array
 __all__ = ["require", "numbers_array", "whole_number", "real_number", "check_image_values", "check_result_frames", "ResultError",
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
            "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
-           "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type"]
+           "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type",
+           "SEED_LIMIT", "check_seed"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -212,6 +213,21 @@ def whole_number(value, name: str, *, lo: int | None = None, hi: int | None = No
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         raise EventDataError(f"{name}= must be a whole number{_range(lo, hi)}, got {value}")
     return value
+
+
+SEED_LIMIT = 2**63   # seeds are whole numbers in [0, 2**63): EvINRConfig's range (network_seed works modulo 2**63)
+
+
+def check_seed(value, name: str = "seed") -> int:
+    """``value`` as an int when it is a whole number in [0, 2**63) (whole floats and numpy's too, as
+    :func:`whole_number` takes them); else an InputError naming ``name`` and the range as EvINRConfig's says it."""
+    try:
+        seed = whole_number(value, name)
+    except EventDataError:
+        seed = None
+    if seed is None or not 0 <= seed < SEED_LIMIT:
+        raise EventDataError(f"{name}= must be a whole number in [0, 2**63), got {short_repr(value)}")
+    return seed
 
 
 def true_or_false(value, name: str) -> bool:

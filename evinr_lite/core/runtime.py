@@ -35,8 +35,9 @@ def default_device(preference: str | None = None) -> "torch.device":
 
     Args:
         preference: "cpu", "cuda" or None (auto: cuda when available, else cpu). The
-            environment variable ``EVINR_DEVICE`` overrides auto. (Apple's "mps" can be asked for
-            explicitly, but it has no float64, which event timestamps need, so auto never picks it.)
+            environment variable ``EVINR_DEVICE`` overrides auto (a bad value there is named as
+            EVINR_DEVICE's). (Apple's "mps" can be asked for explicitly, but it has no float64, which
+            event timestamps need, so auto never picks it.)
 
     Raises:
         DeviceUnavailable (an InputError and a RuntimeError): a device this machine does not have
@@ -44,21 +45,41 @@ def default_device(preference: str | None = None) -> "torch.device":
     """
     import torch   # here, not at the top: data_fetch and the command's --help stay light
 
+    if preference is not None and not isinstance(preference, str):   # a torch.device: its name, as torch takes it
+        if not isinstance(preference, torch.device):
+            # 5, True or a list were Python's "has no attribute 'startswith'", 0 and [] read as None
+            raise DeviceUnavailable(f"device= must be 'cpu', 'cuda', 'cuda:N', 'mps' or None (a GPU when present), "
+                                    f"got {type(preference).__name__} {preference!r}")
+        preference = str(preference)
+    from_env = not preference and bool(os.environ.get("EVINR_DEVICE"))
     preference = preference or os.environ.get("EVINR_DEVICE") or "auto"
     if preference == "auto":
         if torch.cuda.is_available():
             return torch.device("cuda")
         return torch.device("cpu")
+    # a value from the environment is named as such, with the fix there (device= is not what the caller passed)
+    asked = f"EVINR_DEVICE={preference!r}" if from_env else f"device {preference!r}"
+
+    def fix(use: str) -> str:
+        return f"unset EVINR_DEVICE or set it to {use}" if from_env else \
+            f"use device='{use}' (or None: a GPU when present)"
+
     if preference.startswith("cuda") and not torch.cuda.is_available():
-        raise DeviceUnavailable(f"device {preference!r} requested but no CUDA GPU is available here; use device='cpu' "
-                                "(or None: a GPU when present)")
+        raise DeviceUnavailable(f"{asked} requested but no CUDA GPU is available here; {fix('cpu')}")
     if preference.startswith("cuda:") and preference[5:].isdigit() and int(preference[5:]) >= torch.cuda.device_count():
-        raise DeviceUnavailable(f"device {preference!r} requested but this machine has {torch.cuda.device_count()} CUDA "
-                                f"GPU(s), numbered from 0; use device='cuda:0' (or 'cuda')")
+        raise DeviceUnavailable(f"{asked} requested but this machine has {torch.cuda.device_count()} CUDA "
+                                f"GPU(s), numbered from 0; " + ("unset EVINR_DEVICE or set it to cuda:0 (or cuda)"
+                                                                 if from_env else "use device='cuda:0' (or 'cuda')"))
     if preference == "mps" and not (hasattr(torch.backends, "mps") and torch.backends.mps.is_available()):
-        raise DeviceUnavailable("device 'mps' requested but no Apple GPU (MPS) is available here; use device='cpu' "
-                                "(or None: a GPU when present)")
-    return torch.device(preference)
+        raise DeviceUnavailable(f"{asked} requested but no Apple GPU (MPS) is available here; {fix('cpu')}")
+    try:
+        return torch.device(preference)
+    except RuntimeError:   # "x" was torch's "Expected one of cpu, cuda, ipu, xpu, ..." naming no argument
+        if from_env:
+            raise DeviceUnavailable(f"EVINR_DEVICE={preference!r} is no device name; unset it or set it to cpu, cuda, "
+                                    "cuda:N or mps") from None
+        raise DeviceUnavailable(f"device {preference!r} is no device name; use device='cpu', 'cuda', 'cuda:N', 'mps' "
+                                "or None (a GPU when present)") from None
 
 
 def cpu_threads() -> int:

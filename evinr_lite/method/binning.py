@@ -7,12 +7,13 @@ fired in between. Events outside [b[0], b[-1]] are not counted.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.checks import host_array, real_number, require, whole_number
-from ..core.events import EventDataError, Events
+from ..core.checks import ArgumentTypeError, host_array, real_number, require, whole_number
+from ..core.events import EventDataError, Events, check_sensor_size
 from ..core.guard import dense_array
 
 __all__ = ["EventFrames", "fixed_duration_boundaries", "equal_count_boundaries", "events_to_frames",
@@ -240,11 +241,21 @@ def events_to_frames_chunked(chunks, boundaries, C: float | tuple = 1.0, sensor_
     """
     b = _check_boundaries(boundaries)
     c_pos, c_neg = as_thresholds(C)
+    # checked before the first chunk is read (a sensor_size of 5 or (2.5, 3) was Python's unpack error or a frame
+    # of 2 rows; chunks of None, a number or text were "not iterable" or "'str' object has no attribute")
+    sensor_size = None if sensor_size is None else check_sensor_size(sensor_size)
+    if isinstance(chunks, Events):
+        raise ArgumentTypeError("chunks= must be an iterable of Events (chunks in time order), got one Events; pass "
+                                "[events], or events_to_frames(events, boundaries, C)")
+    if isinstance(chunks, (str, bytes)) or not isinstance(chunks, Iterable):
+        raise ArgumentTypeError(f"chunks= must be an iterable of Events (chunks in time order, e.g. "
+                                f"iter_canonical_events(path)), got {type(chunks).__name__}")
     split = c_pos != c_neg       # asymmetric: OFF counts kept apart in `off` (ON counts in `sums`)
     B = b.size - 1
     sums = counts = off = None
     t_last = -np.inf
-    for events in chunks:
+    for k, events in enumerate(chunks):
+        require(events, Events, f"chunks[{k}]")
         if sums is None:
             H, W = events.sensor_size if sensor_size is None else sensor_size
             sums = np.zeros((B, H, W), np.int32)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.cfa import CHANNELS, QUAD_BAYER, effective_thresholds
-from ..core.checks import require, seconds_array
+from ..core.checks import numbers_array, require, seconds_array
 from ..core.events import EventDataError, Events
 from .solver import EvINRConfig, reconstruct
 from .tonemap import to_display
@@ -59,7 +59,7 @@ def channel_offsets_from(rgb) -> np.ndarray:
     log(mean of channel c) minus the mean of those three logs, so that the offsets sum to zero
     and leave the overall brightness anchor alone. ``rgb``: [..., 3] positive linear intensities.
     """
-    rgb = np.asarray(rgb, dtype=np.float64)
+    rgb = numbers_array(rgb, "rgb", "linear intensities [..., 3]").astype(np.float64)   # text: numpy's error
     if rgb.ndim < 2 or rgb.shape[-1] != 3 or not np.all((rgb > 0) & np.isfinite(rgb)):   # inf gave NaN offsets
         raise EventDataError(f"rgb must be positive finite intensities of shape [..., 3], got {rgb.shape}")
     logs = np.log(rgb.reshape(-1, 3).mean(axis=0))
@@ -128,7 +128,8 @@ def chroma_correlation(L_rgb, L_rgb_true) -> dict:
     Returns:
         {"R-G": float, "B-G": float}, each in [-1, 1] (1: the colour pattern is right; 0: none of it).
     """
-    est, true = np.asarray(L_rgb, np.float64), np.asarray(L_rgb_true, np.float64)
+    est = numbers_array(L_rgb, "L_rgb", "log intensities [Q, H, W, 3]").astype(np.float64)   # text: numpy's error
+    true = numbers_array(L_rgb_true, "L_rgb_true", "log intensities [Q, H, W, 3]").astype(np.float64)
     if est.shape != true.shape or est.ndim != 4 or est.shape[-1] != 3:
         raise EventDataError(f"expected two [Q, H, W, 3] stacks of one shape, got {est.shape} and {true.shape}")
     if not (np.all(np.isfinite(est)) and np.all(np.isfinite(true))):      # a correlation of NaN is NaN

@@ -48,7 +48,7 @@ import torch
 from torch import nn
 
 from .binning import events_to_frames, fixed_duration_boundaries
-from ..core.checks import seconds_array
+from ..core.checks import check_seed, real_number, seconds_array, true_or_false, whole_number
 from ..core.runtime import default_device
 from ..core.events import EventDataError, Events, check_sensor_size, check_time_range
 from .siren import Siren
@@ -290,23 +290,31 @@ class CoordinateConfig:
     progress: bool = True
 
     def __post_init__(self):
-        for name in ("C", "bin_duration", "lr", "gamma"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise ValueError(f"{name} must be a positive number, got {v!r}")
-        if not (math.isfinite(self.lam) and self.lam >= 0):
-            raise ValueError(f"lam must be >= 0, got {self.lam!r}")
-        for name in ("n_iters", "batch_size", "hidden_features"):
-            v = getattr(self, name)
-            if int(v) != v or v < 1:
-                raise ValueError(f"{name} must be a positive integer, got {v!r}")
-        if not 0 < self.lr_decay <= 1:
-            raise ValueError(f"lr_decay must be in (0, 1], got {self.lr_decay!r}")
-        every = self.lr_decay_every
-        if every is not None and (int(every) != every or every < 1):
-            raise ValueError(f"lr_decay_every must be a positive integer or None, got {self.lr_decay_every!r}")
-        if not 0 < self.display_mean < 1:
-            raise ValueError(f"display_mean must be in (0, 1), got {self.display_mean!r}")
+        # Every field checked by name before any training (EventDataError, a ValueError as before): lam, the
+        # sizes, lr_decay and display_mean of None, text or a list were Python's TypeErrors; True was taken as 1
+        # for C, lr, lam and every size; hidden_layers, omega_0, first_omega_0, seed, device and progress were
+        # not checked at all (NaN, -1 or text failed inside the training, or trained a network of NaN). Numbers
+        # are kept as given; the sizes and the seed are stored as the ints they hold (n_iters=2.0 or
+        # batch_size=16.0 were taken and then failed inside the training: "'float' object cannot be interpreted
+        # as an integer", torch.randint's error), the flag as a bool.
+        for name, hint in (("C", "log intensity per event"), ("bin_duration", "seconds"), ("lr", "Adam's step"),
+                           ("gamma", "Reinhard's exponent (paper: 0.6)"), ("omega_0", "SIREN's frequency (30)")):
+            real_number(getattr(self, name), name, lo=0, lo_open=True, hint=hint)
+        if self.first_omega_0 is not None:
+            real_number(self.first_omega_0, "first_omega_0", lo=0, lo_open=True, hint="None: omega_0")
+        real_number(self.lam, "lam", lo=0, hint="the Tikhonov weight (paper: 0.05)")
+        for name, lo in (("n_iters", 1), ("batch_size", 1), ("hidden_features", 1), ("hidden_layers", 0)):
+            setattr(self, name, whole_number(getattr(self, name), name, lo=lo))
+        real_number(self.lr_decay, "lr_decay", lo=0, hi=1, lo_open=True)
+        if self.lr_decay_every is not None:
+            self.lr_decay_every = whole_number(self.lr_decay_every, "lr_decay_every", lo=1)
+        if not 0 < real_number(self.display_mean, "display_mean", lo=0, hi=1, lo_open=True) < 1:
+            raise EventDataError(f"display_mean= must be in (0, 1), got {self.display_mean!r}")
+        self.seed = check_seed(self.seed)
+        if self.device is not None and not isinstance(self.device, (str, torch.device)):
+            raise EventDataError(f"device= must be 'cpu', 'cuda', 'cuda:N', 'mps' or None (a GPU when present), got "
+                                 f"{type(self.device).__name__} {self.device!r}")
+        self.progress = true_or_false(self.progress, "progress")
 
     @property
     def decay_every(self) -> int:

@@ -22,7 +22,8 @@ import math
 import torch
 from torch import nn
 
-from ..core.events import check_sensor_size
+from ..core.checks import check_seed, numbers_array, real_number, true_or_false, whole_number
+from ..core.events import EventDataError, check_sensor_size
 
 __all__ = ["FrameINR", "network_seed"]
 
@@ -40,6 +41,22 @@ def network_seed(seed: int, k: int) -> int:
     one-network model is initialised as before; each network's own seed makes network k the same
     whether it is built alone (streaming, one window at a time) or inside an N-network model."""
     return (int(seed) + int(k) * 0x9E3779B97F4A7C15) % 2**63
+
+
+def _check_windows(windows) -> torch.Tensor:
+    """The networks' windows as float64 [N, 2] seconds: finite numbers, two per network (a flat [2 * N] is N
+    windows, as before), at least one, each with t_hi > t_lo; else an EventDataError naming windows=."""
+    arr = numbers_array(windows, "windows", "time windows [N, 2] in seconds (t_lo, t_hi) per network")
+    if arr.size == 0 or arr.size % 2 or (arr.ndim > 1 and arr.shape[-1] != 2):
+        raise EventDataError(f"windows= must be time windows [N, 2] in seconds, one (t_lo, t_hi) per network and at "
+                             f"least one, got shape {arr.shape}")
+    windows = torch.as_tensor(windows, dtype=torch.float64).reshape(-1, 2)
+    if not torch.isfinite(windows).all():
+        raise EventDataError("windows= holds NaN or infinite seconds; every network window [t_lo, t_hi] needs "
+                             "finite times")
+    if torch.any(windows[:, 1] <= windows[:, 0]):
+        raise EventDataError("every network window [t_lo, t_hi] needs t_hi > t_lo (seconds)")
+    return windows
 
 
 class FrameINR(nn.Module):
@@ -67,15 +84,24 @@ class FrameINR(nn.Module):
                  first_index: int = 0, init_head: bool = True):
         super().__init__()
         H, W = check_sensor_size(sensor_size)
-        windows = torch.as_tensor(windows, dtype=torch.float64).reshape(-1, 2)
-        if torch.any(windows[:, 1] <= windows[:, 0]):
-            raise ValueError("every network window [t_lo, t_hi] needs t_hi > t_lo (seconds)")
+        windows = _check_windows(windows)
+        # the sizes, frequencies, seed and flag by name before any weight is drawn (None and text were Python's
+        # int() / float() errors, hidden_features 2.5 a network of 2, 0 a ZeroDivisionError, hidden_layers -1 a
+        # model without layers, a NaN or negative omega_0 NaN or flipped weights, True a width of 1)
+        d = whole_number(hidden_features, "hidden_features", lo=1)
+        hidden_layers = whole_number(hidden_layers, "hidden_layers", lo=0)
+        hint = "a SIREN frequency factor (SIREN: 30)"
+        omega_0 = real_number(omega_0, "omega_0", lo=0, lo_open=True, hint=hint)
+        first_omega_0 = omega_0 if first_omega_0 is None else \
+            real_number(first_omega_0, "first_omega_0", lo=0, lo_open=True, hint=hint + "; None: omega_0")
+        seed = check_seed(seed)   # [0, 2**63), EvINRConfig's: network_seed works modulo 2**63
+        first_index = whole_number(first_index, "first_index", lo=0)
+        init_head = true_or_false(init_head, "init_head")
         self.sensor_size = (H, W)
         self.n_models = N = windows.shape[0]
-        self.omega_0 = float(omega_0)
-        self.first_omega_0 = float(omega_0 if first_omega_0 is None else first_omega_0)
+        self.omega_0 = omega_0
+        self.first_omega_0 = first_omega_0
         self.register_buffer("windows", windows)
-        d = int(hidden_features)
         hidden_bound = math.sqrt(6 / d) / self.omega_0
         # (name, shape per network, bound) in SIREN's drawing order; biases as PyTorch's Linear
         layout = [("w0", (1, d), 1.0), ("b0", (1, d), 1.0)]   # first layer: U(-1/in, 1/in), in = 1

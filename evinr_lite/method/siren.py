@@ -21,6 +21,8 @@ import math
 import torch
 from torch import nn
 
+from ..core.checks import real_number, true_or_false, whole_number
+
 __all__ = ["SineLayer", "Siren", "input_gradient"]
 
 
@@ -37,8 +39,12 @@ class SineLayer(nn.Module):
 
     def __init__(self, in_features: int, out_features: int, omega_0: float = 30.0, is_first: bool = False):
         super().__init__()
-        self.omega_0 = float(omega_0)
-        self.is_first = bool(is_first)
+        # checked by name (None, text and 2.5 were Python's or torch's errors, or a layer of 2; a NaN or 0 omega_0
+        # and True as a size were taken): a whole number of features >= 1, a finite frequency > 0, a flag
+        in_features = whole_number(in_features, "in_features", lo=1)
+        out_features = whole_number(out_features, "out_features", lo=1)
+        self.omega_0 = real_number(omega_0, "omega_0", lo=0, lo_open=True, hint="the sine's frequency factor (SIREN: 30)")
+        self.is_first = true_or_false(is_first, "is_first")
         self.linear = nn.Linear(in_features, out_features)
         with torch.no_grad():
             bound = 1.0 / in_features if is_first else math.sqrt(6.0 / in_features) / self.omega_0
@@ -83,24 +89,28 @@ class Siren(nn.Module):
                  hidden_layers: int = 3, omega_0: float = 30.0, first_omega_0: float | None = None,
                  outermost_linear: bool = True):
         super().__init__()
-        for name, value in (("in_features", in_features), ("out_features", out_features),
-                            ("hidden_features", hidden_features)):
-            if int(value) != value or value < 1:
-                raise ValueError(f"{name} must be a positive integer, got {value!r}")
-        if int(hidden_layers) != hidden_layers or hidden_layers < 0:
-            raise ValueError(f"hidden_layers must be a non-negative integer, got {hidden_layers!r}")
-        if not omega_0 > 0 or (first_omega_0 is not None and not first_omega_0 > 0):
-            raise ValueError(f"omega_0 and first_omega_0 must be positive, got {omega_0}, {first_omega_0}")
-        self.in_features = int(in_features)
-        self.out_features = int(out_features)
-        self.omega_0 = float(omega_0)
-        self.first_omega_0 = float(omega_0 if first_omega_0 is None else first_omega_0)
-        self.outermost_linear = bool(outermost_linear)
+        # every argument checked by name before any layer is made (None, text, NaN and lists were Python's int() /
+        # float() errors or "'>' not supported"; True was a width of 1 or torch's "must be tuple of ints"; an
+        # infinite omega_0 built a network of NaN): whole numbers (>= 1, hidden_layers >= 0), finite
+        # frequencies > 0, outermost_linear a flag. EventDataError is a ValueError, as the checks before were.
+        in_features = whole_number(in_features, "in_features", lo=1)
+        out_features = whole_number(out_features, "out_features", lo=1)
+        hidden_features = whole_number(hidden_features, "hidden_features", lo=1)
+        hidden_layers = whole_number(hidden_layers, "hidden_layers", lo=0)
+        hint = "a SIREN frequency factor (SIREN: 30)"
+        omega_0 = real_number(omega_0, "omega_0", lo=0, lo_open=True, hint=hint)
+        first_omega_0 = omega_0 if first_omega_0 is None else \
+            real_number(first_omega_0, "first_omega_0", lo=0, lo_open=True, hint=hint + "; None: omega_0")
+        self.in_features = in_features
+        self.out_features = out_features
+        self.omega_0 = omega_0
+        self.first_omega_0 = first_omega_0
+        self.outermost_linear = true_or_false(outermost_linear, "outermost_linear")
 
         layers: list[nn.Module] = [SineLayer(in_features, hidden_features, self.first_omega_0, is_first=True)]
-        for _ in range(int(hidden_layers)):
+        for _ in range(hidden_layers):
             layers.append(SineLayer(hidden_features, hidden_features, self.omega_0))
-        if outermost_linear:
+        if self.outermost_linear:
             head = nn.Linear(hidden_features, out_features)
             with torch.no_grad():
                 bound = math.sqrt(6.0 / hidden_features) / self.omega_0

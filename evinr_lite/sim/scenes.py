@@ -449,10 +449,11 @@ class ObjectOverBackgroundScene(Scene):
                  radius=None, edge=2.0, start=None, end=None, blur=0.75, intensity_range=(0.05, 1.0)):
         super().__init__(sensor_size, duration)
         H, W = self.sensor_size
-        self.radius = float(min(H, W) / 4 if radius is None else radius)
-        self.edge = float(edge)
-        if not (self.radius > 0 and self.edge > 0):
-            raise EventDataError(f"radius and edge must be positive pixels, got {radius!r}, {edge!r}")
+        # finite pixels > 0 by name (None and text were Python's float() errors, an infinite radius or edge made
+        # start/end of inf and a NaN scene, True a disc of 1 pixel)
+        self.radius = float(min(H, W) / 4) if radius is None else \
+            real_number(radius, "radius", lo=0, lo_open=True, hint="the disc's radius in pixels (None: a quarter of the sensor)")
+        self.edge = real_number(edge, "edge", lo=0, lo_open=True, hint="the disc's soft edge in pixels")
         what = "(x, y): finite pixels from the sensor centre"
         try:   # 3 numbers were numpy's broadcast error, NaN gave NaN frames
             self.start = np.asarray((-W / 2 + self.radius, -H / 6) if start is None else _pair(start, "start", what))
@@ -500,10 +501,9 @@ class LightingScene(Scene):
     def __init__(self, base: Scene, global_change: float = 0.4, vignette: float = -0.5):
         super().__init__(_check_base(base).sensor_size, base.duration)
         self.base = base
-        self.global_change, self.vignette = float(global_change), float(vignette)
-        if not (np.isfinite(self.global_change) and np.isfinite(self.vignette)):
-            raise EventDataError(f"global_change and vignette must be finite log intensities, got "
-                                 f"{global_change!r}, {vignette!r}")
+        # finite numbers by name (None, text and lists were Python's float() errors; True was a change of 1)
+        self.global_change = real_number(global_change, "global_change", hint="a log intensity added over the duration")
+        self.vignette = real_number(vignette, "vignette", hint="a log intensity added at the corners over the duration")
         x, y = self._grid()
         self._shape = self.global_change + self.vignette * (x ** 2 + y ** 2) / (x ** 2 + y ** 2).max()
 

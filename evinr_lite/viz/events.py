@@ -23,11 +23,12 @@ from matplotlib.animation import FuncAnimation
 from matplotlib.colors import to_rgb
 from matplotlib.transforms import blended_transform_factory
 
-from ..core.checks import (ArgumentTypeError, host_array, is_real_number, optional_seconds, real_number, require,
-                           whole_number)
+from ..core.checks import (ArgumentTypeError, checked_span, host_array, is_real_number, optional_seconds, real_number,
+                           require, whole_number)
 from ..core.events import EventDataError, Events
 from ..method.binning import EventFrames, event_rate
 from .signals import OFF_COLOR, ON_COLOR, axes_or_new
+from .widgets import MAX_FIGSIZE, check_figsize
 
 __all__ = ["ON_COLOR", "OFF_COLOR", "ON_RGB", "OFF_RGB", "subsample_index", "subsample", "count_map",
            "polarity_image", "plot_xyt", "plot_count_map", "plot_polarity", "plot_event_rate",
@@ -36,6 +37,9 @@ __all__ = ["ON_COLOR", "OFF_COLOR", "ON_RGB", "OFF_RGB", "subsample_index", "sub
 ON_RGB = to_rgb(ON_COLOR)     # (r, g, b) floats in [0, 1]
 OFF_RGB = to_rgb(OFF_COLOR)
 EVENT_FRAME_CMAP = "RdBu_r"   # red > 0 (more ON), blue < 0 (more OFF)
+MIN_DPI = 10.0   # below 10, FreeType has no font size to draw the titles with
+MAX_FRAME_PIXELS = 2**27   # an animation frame's pixels (figsize x dpi): 512 MiB of RGBA per frame; (100, 100)
+#                            inches at 1000 dpi were C++'s bad_alloc, (4, 3) at 20000 dpi a minute per frame
 
 
 def _axes(ax, figsize=(6, 4)):
@@ -105,7 +109,7 @@ def _open_end(t, name: str):
 def count_map(events: Events, polarity: int | None = None) -> np.ndarray:
     """Events per pixel: int64 [H, W]. ``polarity`` +1 or -1 counts only ON or only OFF events."""
     require(events, Events, "events")
-    if polarity not in (None, 1, -1):
+    if polarity is not None and (not is_real_number(polarity) or polarity not in (1, -1)):   # True was +1
         raise EventDataError(f"polarity must be None (all), +1 (ON) or -1 (OFF), got {polarity!r}")
     H, W = events.sensor_size
     keep = slice(None) if polarity is None else events.p == polarity
@@ -258,7 +262,7 @@ def show_event_frames(frames: EventFrames, indices=None, max_frames: int = 8, nc
         frames: :class:`~evinr_lite.method.binning.EventFrames`.
         indices: which bins to show; default ``max_frames`` bins evenly spread over all of them.
         ncols: panels per row.
-        vmax: colour scale limit (log units); default the largest |value| shown.
+        vmax: colour scale limit (log units); default the largest |value| shown (0, blank frames: 1.0).
         title: figure title.
 
     Returns:
@@ -268,9 +272,22 @@ def show_event_frames(frames: EventFrames, indices=None, max_frames: int = 8, nc
         raise ArgumentTypeError(f"frames must be EventFrames, got {type(frames).__name__}; make them with "
                                 "events_to_frames(events, boundaries, C) (evinr_lite.method.binning) first")
     B = len(frames)
+    # the counts, sizes and scale by name before the figure is made (None, text and 2.5 were Python's or numpy's
+    # errors, ncols 0 a ZeroDivisionError, -1 or a NaN panel_size matplotlib's "figure size must be positive",
+    # indices of a number "not iterable", 7 for 4 bins an IndexError, a NaN vmax a blank colour scale)
+    max_frames = whole_number(max_frames, "max_frames", lo=1)
+    ncols = whole_number(ncols, "ncols", lo=1)
+    panel_size = real_number(panel_size, "panel_size", lo=0, hi=MAX_FIGSIZE, lo_open=True,
+                             hint="inches per panel")
+    if vmax is not None:   # 0 (the largest |value| of blank frames) falls back to 1.0, as the default does
+        vmax = real_number(vmax, "vmax", lo=0, hint="the colour scale's limit in log units (None: the largest "
+                                                    "|value| shown)") or 1.0
     if indices is None:
         indices = np.unique(np.linspace(0, B - 1, min(B, max_frames)).round().astype(int))
-    indices = [int(i) for i in indices]
+    elif isinstance(indices, (str, bytes)) or is_real_number(indices) or np.ndim(host_array(indices)) != 1:
+        raise EventDataError(f"indices= must be a list of bin indices (e.g. [0, 2, 5]) or None, got "
+                             f"{type(indices).__name__} {indices!r}"[:200])
+    indices = [whole_number(i, "indices[]", lo=-B, hi=B - 1) for i in indices]
     if not indices:
         raise EventDataError("no event frames to show")
     shown = frames.frames[indices]
@@ -307,7 +324,8 @@ def animate_events(events: Events, n_frames: int = 20, window_s: float | None = 
         n_frames: number of frames (each is one PNG in the HTML: keep it small).
         window_s: window length (s); default ``(t1 - t0) / n_frames`` (consecutive windows).
         t_range: (t0, t1) seconds; default the first and last event times.
-        figsize, dpi: size of each frame. interval: milliseconds between frames when played.
+        figsize, dpi: size of each frame (dpi >= 10; at most 2**27 pixels a frame). interval: milliseconds
+            between frames when played (> 0: ``to_jshtml`` and ``save`` play 1000 / interval frames a second).
 
     Returns:
         A ``FuncAnimation``; show it in a notebook with
@@ -315,16 +333,34 @@ def animate_events(events: Events, n_frames: int = 20, window_s: float | None = 
         back ends show no extra static copy. ``anim.windows`` is float64 [n_frames, 2] (the
         windows) and ``anim.draw_frame(k)`` draws frame k.
     """
-    if n_frames < 1:
-        raise EventDataError(f"n_frames must be at least 1, got {n_frames}")
+    # every argument by name before the figure is made (events None were "has no len()", n_frames None or 2.5
+    # Python's or numpy's errors, a t_range of one number "not subscriptable", [] an IndexError, a NaN window
+    # NaN frames, a dpi of 0, 2.5 or True matplotlib's or FreeType's errors when drawn, interval text too)
+    require(events, Events, "events")
+    n_frames = whole_number(n_frames, "n_frames", lo=1)
     if t_range is None:
         if len(events) < 2:
             raise EventDataError("animate_events needs t_range when there are fewer than 2 events")
-        t_range = (events.t[0], events.t[-1])
-    t0, t1 = float(t_range[0]), float(t_range[1])
-    window = (t1 - t0) / n_frames if window_s is None else float(window_s)
+        t0, t1 = float(events.t[0]), float(events.t[-1])
+    else:
+        if isinstance(t_range, (str, bytes)) or is_real_number(t_range) or np.shape(host_array(t_range)) != (2,):
+            raise EventDataError(f"t_range= must be (t0, t1) seconds or None (the first and last event), got "
+                                 f"{t_range!r}"[:200])
+        t0, t1 = checked_span(t_range[0], t_range[1], "t_range")
+    window = (t1 - t0) / n_frames if window_s is None else \
+        real_number(window_s, "window_s", lo=0, lo_open=True, hint="seconds (None: consecutive windows)")
     if not window > 0:
         raise EventDataError(f"window_s must be positive seconds, got {window_s}")
+    dpi = real_number(dpi, "dpi", lo=MIN_DPI, hint="dots per inch (e.g. 72)") if dpi is not None else None
+    # interval > 0: matplotlib takes 0, but to_jshtml() and save() divide by it (fps = 1000 / interval)
+    interval = real_number(interval, "interval", lo=0, lo_open=True, hint="milliseconds between frames") \
+        if interval is not None else interval
+    figsize = check_figsize(figsize)
+    w, h = (plt.rcParams["figure.figsize"] if figsize is None else figsize)
+    pixels = float(w) * float(h) * (plt.rcParams["figure.dpi"] if dpi is None else dpi) ** 2
+    if pixels > MAX_FRAME_PIXELS:   # no cap on dpi alone: what runs out is the memory of one frame's image
+        raise EventDataError(f"figsize={figsize!r} at dpi={dpi!r} makes frames of {pixels:.3g} pixels, over "
+                             f"{MAX_FRAME_PIXELS:.3g} (2**27, 512 MiB of RGBA per frame); lower dpi= or figsize=")
     ends = t0 + window + (t1 - t0 - window) * np.linspace(0, 1, n_frames) if n_frames > 1 else np.array([t1])
     windows = np.stack([ends - window, ends], axis=1)
 

@@ -6,10 +6,15 @@ redraw. The method modules never import this one.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import matplotlib.pyplot as plt
 
+from ..core.checks import ArgumentTypeError, numbers_array, real_number
+from ..core.events import EventDataError
 from .signals import axes_or_new
+from .widgets import MAX_FIGSIZE
 
 __all__ = ["show_frames", "show_images", "plot_histories"]
 
@@ -32,8 +37,13 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
     Returns:
         The figure.
     """
+    _mapping(rows, "rows", "{label: frames [Q, H, W]}")
     if not rows:
         raise ValueError("rows is empty: pass {label: frames [Q, H, W]}")
+    cell_size = _cell_size(cell_size)
+    vmin, vmax = _limits(vmin, vmax)
+    if row_titles is not None:
+        _mapping(row_titles, "row_titles", "{label: extra text} (or None)")
     stacks = {k: np.asarray(v) for k, v in rows.items()}
     shapes = {v.shape[0] for v in stacks.values()}
     if len(shapes) != 1 or any(v.ndim != 3 for v in stacks.values()):
@@ -44,7 +54,7 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
         raise ValueError("rows hold no frames (Q = 0): pass stacks [Q, H, W] of at least one frame")
     _drawable(stacks, "rows")
     if times is not None:
-        times = np.ravel(np.asarray(times, dtype=np.float64))
+        times = np.ravel(numbers_array(times, "times", "one time per frame, seconds").astype(np.float64))
         if times.size != Q:   # was an IndexError at the first missing title, or titles for the wrong frames
             raise ValueError(f"times has {times.size} value(s) for {Q} frame(s) per row; pass one time per frame")
     H, W = next(iter(stacks.values())).shape[1:]
@@ -71,6 +81,30 @@ def show_frames(rows: dict, times=None, *, fig=None, cmap: str = "gray", vmin: f
     return fig
 
 
+def _mapping(value, name: str, what: str) -> None:
+    """Refuse what is no mapping (a string, a list, a number: "has no attribute 'items'" before)."""
+    if not isinstance(value, Mapping):
+        raise ArgumentTypeError(f"{name}= must be a dict {what}, got {type(value).__name__}"
+                                + ("; put the array in a dict: {'label': array}" if hasattr(value, "shape") else ""))
+
+
+def _cell_size(cell_size) -> float:
+    """Inches per image: a finite number in (0, MAX_FIGSIZE] (None or text were Python's TypeErrors, -1 or NaN
+    matplotlib's "figure size must be positive finite", 0 a figure of no width)."""
+    return real_number(cell_size, "cell_size", lo=0, hi=MAX_FIGSIZE, lo_open=True, hint="inches per image")
+
+
+def _limits(vmin, vmax) -> tuple:
+    """The grey scale's limits: each None (the image's own) or a finite number, vmin not above vmax (text failed
+    inside matplotlib; NaN or a reversed range drew every pixel one grey without a word). Equal limits are taken:
+    a blank frame drawn with ``vmin=-m, vmax=m`` for m = 0 is one colour, as matplotlib draws it."""
+    lo = None if vmin is None else real_number(vmin, "vmin", hint="the value drawn black (None: the data's)")
+    hi = None if vmax is None else real_number(vmax, "vmax", hint="the value drawn white (None: the data's)")
+    if lo is not None and hi is not None and lo > hi:
+        raise EventDataError(f"vmin={vmin!r} is above vmax={vmax!r}; swap them")
+    return vmin, vmax
+
+
 def _drawable(arrays: dict, name: str) -> None:
     """Refuse arrays holding NaN or inf: imshow draws them as blank pixels, a wrong picture without a word."""
     for k, a in arrays.items():
@@ -95,8 +129,11 @@ def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=N
     Returns:
         The figure.
     """
+    _mapping(images, "images", "{title: image [H, W]}")
     if not images:
         raise ValueError("images is empty: pass {title: image [H, W]}")
+    cell_size = _cell_size(cell_size)
+    vmin, vmax = _limits(vmin, vmax)
     arrays = {k: np.asarray(v, dtype=np.float64) for k, v in images.items()}
     bad = {k: a.shape for k, a in arrays.items() if a.ndim != 2 or a.size == 0}
     if bad:
@@ -125,8 +162,12 @@ def show_images(images: dict, *, fig=None, cmap: str = "gray", vmin=None, vmax=N
 def plot_histories(histories: dict, key: str = "loss", *, ax=None, xlabel: str = "iteration"):
     """Training curves (log scale): ``{label: history dict or sequence of floats}``; ``key`` picks
     the curve inside a history dict. Returns the axes."""
+    _mapping(histories, "histories", "{label: history dict or sequence of floats}")
     if not histories:   # an empty figure with an empty legend
         raise ValueError("histories is empty: pass {label: history dict or sequence of floats}")
+    if not isinstance(key, str):   # a list was "unhashable type"
+        raise ArgumentTypeError(f"key= must be the name of a curve in the histories (e.g. 'loss'), got "
+                                f"{type(key).__name__} {key!r}")
     missing = [label for label, h in histories.items() if isinstance(h, dict) and key not in h]
     if missing:
         raise ValueError(f"no {key!r} in the history of {missing}; pass key= one of its curves "

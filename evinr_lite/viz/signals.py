@@ -12,7 +12,7 @@ from matplotlib.transforms import blended_transform_factory
 from matplotlib.axes import Axes
 from matplotlib.figure import FigureBase
 
-from ..core.checks import ArgumentTypeError, host_array, short_repr
+from ..core.checks import ArgumentTypeError, host_array, numbers_array, real_number, short_repr, true_or_false
 from ..core.events import EventDataError
 from ..sim.simulate import pixel_events
 
@@ -74,8 +74,13 @@ def _times(t) -> np.ndarray:
 def plot_event_ticks(ax, t_events, p_events, height: float = 0.08, legend: bool = True):
     """Short vertical ticks at the bottom of ``ax`` (axes fraction ``height``), one per event,
     red for ON and blue for OFF."""
-    t_events = np.ravel(np.asarray(t_events, dtype=np.float64))
-    p_events = np.ravel(np.asarray(p_events))
+    # checked by name before any tick is drawn (None was "1 event times", text numpy's conversion error, a height
+    # of None or text drew no tick without a word, a list of 3 numpy's broadcast error inside matplotlib)
+    ax = axes_or_new(ax)
+    t_events = np.ravel(numbers_array(t_events, "t_events", "event times in seconds").astype(np.float64))
+    p_events = np.ravel(numbers_array(p_events, "p_events", "polarities (+1 ON, -1 OFF; or 1 / 0)", flags=True))
+    height = real_number(height, "height", lo=0, hi=1, lo_open=True, hint="the ticks' height, a fraction of the axes")
+    legend = true_or_false(legend, "legend")
     if t_events.shape != p_events.shape:   # numpy's boolean-index error before
         raise ValueError(f"{t_events.size} event times but {p_events.size} polarities; pass one polarity per event")
     trans = blended_transform_factory(ax.transData, ax.transAxes)

@@ -29,6 +29,7 @@ import numbers
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from ..core.events import EventDataError
 from ..core.runtime import fast_mode
 
 __all__ = ["Control", "parse_controls", "interact", "Interactive", "live_frontend"]
@@ -174,8 +175,9 @@ def _make_widget(c: Control):
 MAX_FIGSIZE = 100.0   # inches per side: wider than any screen at matplotlib's 100 dpi
 
 
-def _figsize(figsize):
-    """(width, height) in inches, each a finite number in (0, MAX_FIGSIZE]; None: matplotlib's default."""
+def check_figsize(figsize):
+    """(width, height) in inches, each a finite number in (0, MAX_FIGSIZE]; None: matplotlib's default. Else an
+    EventDataError (a ValueError, as before) naming figsize= (the figures' one check of a figure size)."""
     if figsize is None:
         return None
     try:
@@ -184,7 +186,7 @@ def _figsize(figsize):
     except (TypeError, ValueError):
         ok = False
     if not ok:
-        raise ValueError(f"figsize= must be (width, height) in inches, two numbers in (0, {MAX_FIGSIZE:g}] "
+        raise EventDataError(f"figsize= must be (width, height) in inches, two numbers in (0, {MAX_FIGSIZE:g}] "
                          f"(e.g. (8, 4)), or None for matplotlib's default; got {figsize!r}")
     return figsize
 
@@ -203,7 +205,7 @@ def interact(draw: Callable, *, figsize=(8, 4), **controls) -> Interactive:
     """
     if not callable(draw):
         raise TypeError(f"draw must be a function draw(fig, **values), got {type(draw).__name__}")
-    figsize = _figsize(figsize)
+    figsize = check_figsize(figsize)
     parsed = parse_controls(**controls)
     import matplotlib.pyplot as plt
 
