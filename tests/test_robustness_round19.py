@@ -95,7 +95,7 @@ CALLS = {
                                                 torch.zeros(2, 1), regularizer=v), "regularizer"),
     "offset_image": (lambda v: offset.offset_image(LOG, v), "offset method"),
     "offset_grid": (lambda v: offset.offset_grid(0.0, 1.0, 3, v), "offset_solve"),
-    "normalize_polarity": (lambda v: normalize_polarity(np.array([0, 1]), v), "encoding"),
+    "normalize_polarity": (lambda v: normalize_polarity(np.array([0, 1]), v), "polarity"),
     "RunOptions.tonemap": (lambda v: RunOptions(tonemap=v), "tonemap="),
     "RunOptions.anchor": (lambda v: RunOptions(anchor=v), "anchor="),
     "RunOptions.recipe": (lambda v: RunOptions(recipe=v), "recipe="),
@@ -129,7 +129,7 @@ def test_an_option_that_is_none_a_number_or_unknown_text_is_named(call, value):
         fn(value)
 
 
-@pytest.mark.parametrize("value", [torch.tensor(1), True, 1.0, "Banded"], ids=repr)
+@pytest.mark.parametrize("value", [torch.tensor(1), True, 1.5, "Banded"], ids=repr)
 def test_spatial_order_is_1_2_or_banded_itself(value):
     with pytest.raises(EventDataError, match=r"spatial_order must be one of \(1, 2, 'banded'\)"):
         EvINRConfig(spatial_order=value)
@@ -163,6 +163,9 @@ def test_numpy_text_scalars_are_text_guard():
 
 def test_numpy_whole_numbers_are_spatial_orders_guard():
     assert EvINRConfig(spatial_order=np.int64(2)).spatial_order == 2
+    for whole in (2.0, np.float64(1.0)):   # a whole float is that order, stored as the int (as sizes are)
+        got = EvINRConfig(spatial_order=whole).spatial_order
+        assert got == int(whole) and type(got) is int
     assert EvINRConfig(spatial_order="banded").spatial_order == "banded"
 
 

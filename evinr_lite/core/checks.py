@@ -220,8 +220,11 @@ def _same_option(value, option) -> bool:
         return value is None
     if isinstance(option, (bool, np.bool_)):
         return isinstance(value, (bool, np.bool_)) and bool(value) == bool(option)
-    if isinstance(option, numbers.Integral):
-        return isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_)) and int(value) == option
+    if isinstance(option, numbers.Integral):   # a whole float (2.0) is that whole number, as sizes are (whole_number)
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+            return False
+        return (isinstance(value, numbers.Integral) or (math.isfinite(value) and float(value).is_integer())) \
+            and int(value) == option
     return type(value) is type(option) and value == option
 
 

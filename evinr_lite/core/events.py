@@ -97,7 +97,7 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
     """
     from .checks import choice   # checks imports this module
 
-    encoding = choice(encoding, POLARITY_ENCODINGS, "encoding", hint="the polarity encoding")   # an array was numpy's
+    encoding = choice(encoding, POLARITY_ENCODINGS, "polarity", hint="the polarity encoding")   # an array was numpy's
     p = np.asarray(p)                                                                          # "truth value" error
     if p.ndim != 1:
         raise EventDataError(f"polarity must be a 1-D array, got shape {p.shape}")

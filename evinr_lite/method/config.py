@@ -426,7 +426,7 @@ class EvINRConfig:
                    "background": BACKGROUND_MODES, "tonemap": TONEMAPS, "camera": CAMERAS}
         for name, allowed in choices.items():   # an array was numpy's "truth value ... is ambiguous"
             choice(getattr(self, name), allowed, name)
-        choice(self.spatial_order, (1, 2, "banded"), "spatial_order", hint="1: the gradient's energy, 2: the "
+        self.spatial_order = choice(self.spatial_order, (1, 2, "banded"), "spatial_order", hint="1: the gradient's energy, 2: the "
                "Laplacian's, 'banded': order 1 coarser than 8 px, a third-order roll-off finer")   # a tensor was taken
         if self.head_solve and self.regularizer == "tv":
             raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
