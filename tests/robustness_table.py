@@ -30,7 +30,8 @@ LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustn
          "test_robustness_round8.py", "test_robustness_round9.py", "test_robustness_round10.py",
          "test_robustness_round11.py", "test_robustness_round12.py", "test_robustness_round13.py",
          "test_robustness_round14.py", "test_robustness_round15.py", "test_robustness_round16.py",
-         "test_robustness_round17.py", "test_robustness_round18.py"]
+         "test_robustness_round17.py", "test_robustness_round18.py",
+         "test_robustness_round19.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
@@ -78,6 +79,9 @@ CLASSES = [
      "frames, the colour helpers, two scenes, the device choice and the figures notebooks call (event frames, "
      "animations, frame grids, histories, score charts, event ticks): sizes, frequencies, seeds, flags, windows, "
      "round 18", "test_robustness_round18.py", r"test_"),
+    ("enumerated options (equalisation, tone maps, the denoiser's rule and window, the config's and run options' option "
+     "fields, anchors, baselines' loops, offset solves, polarity encodings, figure options) given arrays, lists, dicts, "
+     "tensors, None or numbers: one shared check, round 19", "test_robustness_round19.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"

@@ -182,7 +182,7 @@ def test_stages_can_be_switched_off_and_empty_input(noisy_scene):
     (lambda ev: correlation_filter(ev, 1e-3, neighbourhood=6), r"neighbourhood must be 8 .* or 4"),
     (lambda ev: correlation_filter(ev, 1e-3, min_neighbours=9), r"min_neighbours must be an integer in \[1, 8\]"),
     (lambda ev: correlation_filter(ev, 1e-3, window="after"), r"window must be one of"),
-    (lambda ev: hot_pixel_mask(ev, rule="mean"), r"unknown hot-pixel rule 'mean'; use one of"),
+    (lambda ev: hot_pixel_mask(ev, rule="mean"), r"rule must be one of \('mad', 'median'\) \(the hot-pixel rule\), got 'mean'"),
     (lambda ev: hot_pixel_mask(ev, rule="median", factor=1.0), r"must exceed 1"),
     (lambda ev: hot_pixel_mask(ev, factor=-2), r"must be > 0"),
     (lambda ev: remove_hot_pixels(ev, np.zeros((3, 3), bool)), r"mask must be a bool array of the sensor's shape"),

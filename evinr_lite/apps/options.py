@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.checks import choice
 from ..core.events import TIME_UNITS, EventDataError
 from ..method.anchor import ANCHOR_MODES
 from ..method.tempo import MIN_SCALE, SCALE_RANGE, scale_floor_message
@@ -235,10 +236,9 @@ class RunOptions:
 
     def __post_init__(self):
         checked = {"C": contrast_option(self.C)}
-        if self.tonemap is not None and self.tonemap not in TONEMAPS:
-            raise EventDataError(f"tonemap= must be one of {TONEMAPS} (or None: the recipe's own), got {self.tonemap!r}")
-        if self.anchor not in ANCHOR_MODES:
-            raise EventDataError(f"anchor= must be one of {ANCHOR_MODES}, got {self.anchor!r}")
+        if self.tonemap is not None:   # arrays were numpy's "truth value ... is ambiguous", lists "unhashable type"
+            choice(self.tonemap, TONEMAPS, "tonemap=", hint="or None: the recipe's own")
+        choice(self.anchor, ANCHOR_MODES, "anchor=")
         if self.fps is not None and self.at is not None:
             raise EventDataError("give either fps= or at=, not both")
         if _finite("fps=", self.fps) is not None and not self.fps > 0:
@@ -261,14 +261,13 @@ class RunOptions:
                                          not isinstance(self.n_iters, (int, np.integer)) or self.n_iters < 1):
             raise EventDataError(f"n_iters= must be a whole number of at least 1 (or None: the recipe's own), "
                                  f"got {self.n_iters!r}")
-        if self.recipe not in RECIPES:
-            raise EventDataError(f"recipe= must be one of {tuple(RECIPES)}, got {self.recipe!r}")
+        choice(self.recipe, tuple(RECIPES), "recipe=")
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or not 0 <= self.seed < 2**63:
             raise EventDataError(f"seed must be a whole number in [0, 2**63), got {self.seed!r}")
-        if self.camera is not None and self.camera not in CAMERAS:
-            raise EventDataError(f"camera= must be one of {CAMERAS} (an MVSEC stereo file's cameras), got {self.camera!r}")
-        if self.time_unit is not None and self.time_unit not in TIME_UNITS:
-            raise EventDataError(f"time_unit= must be one of {', '.join(TIME_UNITS)}, got {self.time_unit!r}")
+        if self.camera is not None:
+            choice(self.camera, CAMERAS, "camera=", hint="an MVSEC stereo file's cameras")
+        if self.time_unit is not None:
+            choice(self.time_unit, TIME_UNITS, "time_unit=")
         if self.device is not None and not isinstance(self.device, str):
             raise EventDataError(f"device= must be 'cpu', 'cuda' or None (a GPU when present), got {self.device!r}")
         if self.sensor_size is not None:

@@ -81,6 +81,9 @@ class EventDataError(InputError):
     """Event data that cannot be used as given. The message names the problem and the fix."""
 
 
+POLARITY_ENCODINGS = ("auto", "pm1", "01", "bool")   # normalize_polarity's encodings
+
+
 def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
     """Return polarities as int8 in {-1, +1}.
 
@@ -92,7 +95,10 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
     Raises:
         EventDataError: values outside the encoding, or a mix of encodings.
     """
-    p = np.asarray(p)
+    from .checks import choice   # checks imports this module
+
+    encoding = choice(encoding, POLARITY_ENCODINGS, "polarity", hint="the polarity encoding")   # an array was numpy's
+    p = np.asarray(p)                                                                          # "truth value" error
     if p.ndim != 1:
         raise EventDataError(f"polarity must be a 1-D array, got shape {p.shape}")
     if p.size == 0:

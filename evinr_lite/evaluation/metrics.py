@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from skimage.metrics import structural_similarity
 
-from ..core.checks import check_image_values, host_array, image_stack
+from ..core.checks import check_image_values, choice, host_array, image_stack
 from ..core.events import EventDataError
 from ..core.frames import to_uint8
 
@@ -49,13 +49,7 @@ PROTOCOLS = {
 
 def protocol_description(equalization: str = "none") -> str:
     """The full scoring protocol (equalisation and metric parameters) as one line of text."""
-    try:
-        known = equalization in PROTOCOLS
-    except TypeError:   # a list or a set: unhashable, so no key
-        known = False
-    if not known:
-        raise EventDataError(f"equalization must be one of {EQUALIZATIONS}, got {equalization!r}")
-    return PROTOCOLS[equalization]
+    return PROTOCOLS[choice(equalization, EQUALIZATIONS, "equalization")]
 
 
 def _image(a, name: str) -> np.ndarray:
@@ -144,8 +138,7 @@ def equalize(img, method: str = "none") -> np.ndarray:
     Returns:
         float64 [H, W] in [0, 1].
     """
-    if method not in EQUALIZATIONS:
-        raise EventDataError(f"equalization must be one of {EQUALIZATIONS}, got {method!r}")
+    method = choice(method, EQUALIZATIONS, "equalization")   # an array was numpy's "truth value ... is ambiguous"
     img = np.asarray(img)
     if img.ndim != 2:
         raise EventDataError(f"equalize takes one grey image [H, W], got shape {img.shape}")

@@ -75,7 +75,7 @@ def resolve_lpips(lpips_model=None):
     if isinstance(lpips_model, (str, bytes)) and lpips_model != "auto":   # a name is no model ("none" is False)
         raise EventDataError(f"lpips_model must be None or 'auto' (the cached weights), False (skip LPIPS) or an LPIPS "
                              f"model, got the text {lpips_model!r}")
-    if lpips_model is not None and lpips_model != "auto":
+    if lpips_model is not None and not isinstance(lpips_model, str):   # != "auto" of an array was numpy's "truth value"
         import torch
 
         if not isinstance(lpips_model, torch.nn.Module):   # True, 5 or a dict failed inside the first distance

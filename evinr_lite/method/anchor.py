@@ -63,7 +63,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import numbers_array, real_number, short_repr, whole_number
+from ..core.checks import choice, numbers_array, real_number, short_repr, whole_number
 from ..core.events import EventDataError
 from ..core.frames import Frames
 
@@ -142,6 +142,7 @@ def select_anchors(n_frames: int, mode: str, every: int = 2) -> np.ndarray:
     [0, every, 2 every, ...] for "all" (every = 1: all of them, nothing left to score). ``n_frames``: a whole
     number >= 0 in both modes (-3 or None gave [0] for "first" and no anchor or Python's error for "all"); of no
     frame there is no anchor ([] in both modes: "first" gave [0], the index of a frame that is not there)."""
+    mode = choice(mode, ANCHOR_MODES, "anchor")   # an array was numpy's "truth value ... is ambiguous"
     if mode in ("first", "all"):
         n_frames = whole_number(n_frames, "n_frames", lo=0)
     if mode == "first":

@@ -121,7 +121,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.checks import checked_span, decimal_as_float, is_real_number, real_number, require, whole_number
+from ..core.checks import checked_span, choice, decimal_as_float, is_real_number, real_number, require, whole_number
 from ..core.events import EventDataError, Events, check_sensor_size
 from .binning import as_thresholds
 from .denoise import check_count_pair, hot_threshold
@@ -509,8 +509,7 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
     Returns:
         :class:`BalanceFit` with C = (C (1 + b), C (1 - b)).
     """
-    if rule not in RULES:
-        raise EventDataError(f"rule must be one of {RULES}, got {rule!r}")
+    rule = choice(rule, RULES, "rule")   # an array was numpy's "truth value ... is ambiguous"
     if not (is_real_number(max_imbalance) and 0 <= max_imbalance < 1):
         raise EventDataError(f"max_imbalance must be a number in [0, 1) (|b| = |C+ - C-| / (C+ + C-) < 1), "
                              f"got {max_imbalance!r}")

@@ -160,6 +160,9 @@ def leaky_integration(events: Events, query_times, C=0.2, leak_hz: float = 0.0, 
     return _per_query(lambda u: L0 + _decayed_sums(events, u, C_pos, C_neg, leak, t0), tq)
 
 
+LOOPS = ("vectorised", "per_event")   # how highpass_filter and complementary_filter run
+
+
 def highpass_filter(events: Events, query_times, C=0.2, cutoff_hz: float = DEFAULT_CUTOFF_HZ, L0=None,
                     method: str = "vectorised", *, t_start: float | None = None) -> np.ndarray:
     """The high-pass filter of Scheerlinck et al. (ACCV 2018): log intensity from events alone.
@@ -183,14 +186,13 @@ def highpass_filter(events: Events, query_times, C=0.2, cutoff_hz: float = DEFAU
     alpha = 2 * math.pi * _rate(cutoff_hz, "cutoff_hz")
     L0 = _initial(L0, events.sensor_size)
     t0 = _start_time(events, tq, t_start)
+    method = choice(method, LOOPS, "method")   # an array was numpy's "truth value ... is ambiguous"
     if method == "vectorised":
         def fn(u):
             return np.exp(-alpha * (u - t0))[:, None, None] * L0 + _decayed_sums(events, u, C_pos, C_neg, alpha, t0)
     elif method == "per_event":
         def fn(u):
             return _highpass_loop(events, u, C_pos, C_neg, alpha, t0, L0)
-    else:
-        raise EventDataError(f"method must be 'vectorised' or 'per_event', got {method!r}")
     return _per_query(fn, tq)
 
 
@@ -294,14 +296,13 @@ def complementary_filter(events: Events, frames, query_times, C=0.2, gain: float
     if tq.min() < t0:
         raise EventDataError(f"query time {tq.min()} s is before the filter's start {t0} s (the first frame); "
                              "query at or after it")
+    method = choice(method, LOOPS, "method")   # an array was numpy's "truth value ... is ambiguous"
     if method == "vectorised":
         def fn(u):
             return _frame_part(ft, LF, u, alpha, t0) + _decayed_sums(events, u, C_pos, C_neg, alpha, t0)
     elif method == "per_event":
         def fn(u):
             return _complementary_loop(events, ft, LF, u, C_pos, C_neg, alpha, t0)
-    else:
-        raise EventDataError(f"method must be 'vectorised' or 'per_event', got {method!r}")
     return _per_query(fn, tq)
 
 

@@ -16,6 +16,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from ..core.checks import choice
 from ..core.events import EventDataError
 from .anchor import ANCHOR_MODES
 from .balance import BALANCE_MODES, HOT_PIXEL_MODES
@@ -423,12 +424,10 @@ class EvINRConfig:
                    "regularizer": ("tikhonov", "tv", "none"), "offset_solve": OFFSET_SOLVES,
                    "balance": BALANCE_MODES, "hot_pixels": HOT_PIXEL_MODES,
                    "background": BACKGROUND_MODES, "tonemap": TONEMAPS, "camera": CAMERAS}
-        for name, allowed in choices.items():
-            if getattr(self, name) not in allowed:
-                raise EventDataError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
-        if isinstance(self.spatial_order, bool) or self.spatial_order not in (1, 2, "banded"):
-            raise EventDataError(f"spatial_order must be 1 (the gradient's energy), 2 (the Laplacian's) or 'banded' "
-                                 f"(order 1 coarser than 8 px, a third-order roll-off finer), got {self.spatial_order!r}")
+        for name, allowed in choices.items():   # an array was numpy's "truth value ... is ambiguous"
+            choice(getattr(self, name), allowed, name)
+        self.spatial_order = choice(self.spatial_order, (1, 2, "banded"), "spatial_order", hint="1: the gradient's energy, 2: the "
+               "Laplacian's, 'banded': order 1 coarser than 8 px, a third-order roll-off finer")   # a tensor was taken
         if self.head_solve and self.regularizer == "tv":
             raise EventDataError("head_solve=True needs regularizer 'tikhonov' or 'none' (TV has no closed form); "
                                  "pass head_solve=False to train the head with Adam")
@@ -436,8 +435,7 @@ class EvINRConfig:
             raise EventDataError(f"camera='static' solves the offset from the frames where something moved, which "
                                  f"needs offset_solve='l1_gradient', got {self.offset_solve!r}; pass "
                                  "offset_solve='l1_gradient' or camera='moving'")
-        if self.anchor not in ANCHOR_MODES:
-            raise EventDataError(f"anchor must be one of {ANCHOR_MODES}, got {self.anchor!r}")
+        choice(self.anchor, ANCHOR_MODES, "anchor")
         if isinstance(self.anchor_every, bool) or not isinstance(self.anchor_every, (int, np.integer)) or \
                 self.anchor_every < 1:
             raise EventDataError(f"anchor_every must be a whole number >= 1, got {self.anchor_every!r}")

@@ -58,7 +58,7 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from ..core.checks import require, short_repr, whole_number
+from ..core.checks import choice, require, short_repr, whole_number
 from ..core.events import EventDataError, Events
 from ..core.frames import Frames
 from ..core.guard import dense_array
@@ -326,8 +326,7 @@ def fit_contrast_arrays(dL, n_on, n_off, *, offsets=None, instruments=None, grou
         ContrastFit. Raises EventDataError when too few samples hold ON or OFF events, or the fit
         is not positive.
     """
-    if method not in FIT_METHODS:
-        raise EventDataError(f"method must be one of {FIT_METHODS}, got {method!r}")
+    method = choice(method, FIT_METHODS, "method")   # an array was numpy's "truth value ... is ambiguous"
     if method == "iv" and instruments is None:
         raise EventDataError("method 'iv' needs instruments=(z_on, z_off)")
     y = np.asarray(dL, dtype=np.float64).ravel()
@@ -446,10 +445,8 @@ def fit_contrast(frames: Frames, events: Events, *, method: str = "iv", span: st
     """
     require(frames, Frames, "frames")          # every argument checked where it enters
     require(events, Events, "events")
-    if method not in FIT_METHODS:
-        raise EventDataError(f"method must be one of {FIT_METHODS}, got {method!r}")
-    if span not in SPANS:
-        raise EventDataError(f"span must be one of {SPANS}, got {span!r}")
+    method = choice(method, FIT_METHODS, "method")   # an array was numpy's "truth value ... is ambiguous"
+    span = choice(span, SPANS, "span")
     min_events = whole_number(min_events, "min_events", lo=0)
     max_frames = whole_number(max_frames, "max_frames", lo=2)
     block = whole_number(block, "block", lo=1)

@@ -60,6 +60,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.events import EventDataError, Events
+from ..core.checks import choice
 from ..core.guard import dense_array
 
 __all__ = ["hot_pixel_mask", "hot_threshold", "check_counts", "check_count_pair",
@@ -88,8 +89,7 @@ def _pixel_counts(events: Events) -> np.ndarray:
 
 
 def _check_factor(factor, rule: str) -> float:
-    if rule not in HOT_RULES:
-        raise EventDataError(f"unknown hot-pixel rule {rule!r}; use one of {HOT_RULES}")
+    choice(rule, HOT_RULES, "rule", hint="the hot-pixel rule")   # an array was numpy's "truth value ... is ambiguous"
     if isinstance(factor, (bool, np.bool_)) or not (np.isscalar(factor) and np.isreal(factor)
                                                     and np.isfinite(factor)):
         raise EventDataError(f"hot-pixel factor must be a finite number, got {factor!r}")
@@ -248,8 +248,7 @@ def correlation_filter(events: Events, dt: float = DEFAULT_DT, *, neighbourhood:
             or not 1 <= min_neighbours <= len(offsets):
         raise EventDataError(f"min_neighbours must be an integer in [1, {len(offsets)}] for neighbourhood="
                              f"{neighbourhood}, got {min_neighbours!r}")
-    if window not in WINDOWS:
-        raise EventDataError(f"window must be one of {WINDOWS} ('before': Delbruck's causal filter), got {window!r}")
+    window = choice(window, WINDOWS, "window", hint="'before': Delbruck's causal filter")
     n = t.size
     if n == 0:
         return np.zeros(0, bool)

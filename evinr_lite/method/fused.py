@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import torch
 
+from ..core.checks import choice
 from .losses import spatial_differences
 
 __all__ = ["head_losses"]
+
+REGULARIZERS = ("tikhonov", "tv", "none")
 
 _CHUNK_CELLS = 1 << 20   # frames x pixels per elementwise chunk on a CPU: a few MB, so each chunk stays in cache
 
@@ -47,8 +50,8 @@ def head_losses(h: torch.Tensor, dh: torch.Tensor | None, weight: torch.Tensor, 
     Returns:
         (temporal, regularizer) scalars; the regularizer is 0 for "none".
     """
-    if regularizer not in ("tikhonov", "tv", "none"):
-        raise ValueError(f"regularizer must be 'tikhonov', 'tv' or 'none', got {regularizer!r}")
+    if type(regularizer) is not str or regularizer not in REGULARIZERS:   # each training step: the shared check
+        regularizer = choice(regularizer, REGULARIZERS, "regularizer")    # only when it is no plain str option
     if dh is not None and durations is None:
         raise ValueError("the derivative form needs the bin durations [N, B] (seconds)")
     return _HeadLosses.apply(h, dh, weight, bias, event_frames, durations, regularizer, buffers)

@@ -41,7 +41,7 @@ import scipy.fft
 import scipy.linalg
 import torch
 
-from ..core.checks import real_number, short_repr, whole_number
+from ..core.checks import choice, real_number, short_repr, whole_number
 from ..core.events import EventDataError
 from ..core.runtime import cpu_threads
 
@@ -216,11 +216,9 @@ def solve_head(model, boundaries: torch.Tensor, event_frames: torch.Tensor, temp
     """
     import time
 
-    if regularizer not in ("tikhonov", "none"):
-        raise ValueError(f"the closed-form head needs regularizer 'tikhonov' or 'none', got {regularizer!r}; "
-                         "use head_solve=False with TV")
-    if temporal_loss not in ("difference", "derivative"):
-        raise ValueError(f"temporal_loss must be 'difference' or 'derivative', got {temporal_loss!r}")
+    regularizer = choice(regularizer, ("tikhonov", "none"), "regularizer",
+                         hint="the closed-form head's; use head_solve=False with TV")
+    temporal_loss = choice(temporal_loss, ("difference", "derivative"), "temporal_loss")
     t0 = time.perf_counter()
     H, W = model.sensor_size
     P = H * W

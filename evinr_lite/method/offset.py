@@ -55,7 +55,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from ..core.checks import numbers_array, real_number, whole_number
+from ..core.checks import choice, numbers_array, real_number, whole_number
 from ..core.events import EventDataError
 from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues_unchecked
@@ -415,12 +415,11 @@ def offset_image(frames, method: str, rest: float | None = None) -> np.ndarray:
     seen, but its large-scale level is tied to the untouched background around it only through the
     path's rim, and a long path carries the Poisson step's error along (static_gravel_astronaut's MSE
     0.0308 -> 0.0629 with the rest solve alone, 0.0324 so; ``python benchmarks/static_camera.py``)."""
+    method = choice(method, ("median_gradient", "l1_gradient"), "offset method")
     if rest is not None and method != "l1_gradient":
         raise ValueError(f"rest= (a static camera) needs the 'l1_gradient' offset solve, got {method!r}")
     if method == "median_gradient":
         return _median_gradient(frames)
-    if method != "l1_gradient":
-        raise ValueError(f"offset method must be 'median_gradient' or 'l1_gradient', got {method!r}")
     plain = _l1_gradient(frames)
     if rest is None:
         return plain
@@ -510,6 +509,7 @@ def offset_trend(times, frames, window: float | None, method: str = "l1_gradient
 def offset_grid(t_start: float, t_end: float, n_windows: int, offset_solve: str) -> np.ndarray:
     """float64 [G] times (s) at which the offset solve and the level anchor look at a span of
     ``n_windows`` network windows (the whole-sequence solve and streaming share it)."""
+    offset_solve = choice(offset_solve, OFFSET_SOLVES, "offset_solve")   # a list or None was taken as a solve
     n_grid = min(64, 8 * n_windows)          # the level anchor's times (as the paper's recipe always had them)
     if offset_solve != "none":
         n_grid = max(64, 8 * n_windows)      # an offset solve wants many frames; the level anchor shares them

@@ -41,7 +41,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from ..core.checks import check_reach, optional_seconds, require, seconds_array
+from ..core.checks import check_reach, choice, optional_seconds, require, seconds_array
 from ..core.events import EventDataError, Events
 from ..core.runtime import default_device
 from .memory import check_memory
@@ -231,8 +231,7 @@ def _check(source, query_times, config, t_start, t_end, offset_from):
     if cfg.anchor != "none":
         raise EventDataError(f"streaming does not take anchored configs (anchor={cfg.anchor!r}): the APS frames fit "
                              "the offset over the whole span; use reconstruct(...) for them")
-    if offset_from not in OFFSET_FROM:
-        raise EventDataError(f"offset_from must be one of {OFFSET_FROM}, got {offset_from!r}")
+    offset_from = choice(offset_from, OFFSET_FROM, "offset_from")   # an array was numpy's "truth value ... is ambiguous"
     q = seconds_array(query_times, "query_times")     # True, text, ragged or complex times were numpy's errors
     if np.any(np.diff(q) < 0):
         raise EventDataError("query_times must be sorted (increasing seconds) for streaming; pass np.sort(times)")

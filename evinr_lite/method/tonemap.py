@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from ..core.checks import host_array, is_real_number, real_number
+from ..core.checks import choice, host_array, is_real_number, real_number
 from ..core.events import EventDataError
 
 __all__ = ["TONEMAPS", "DEFAULT_TONEMAP", "DEFAULT_DISPLAY_MEAN", "DISPLAY_MEANS", "tonemap_reinhard", "tonemap_linear", "to_display", "display_formula", "display_shift", "anchor_level",
@@ -100,6 +100,7 @@ def linear_unchecked(L):
 def to_display(L, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6):
     """Frames in [0, 1] from log intensity ``L`` (any shape) by the tone map ``tonemap``
     ("linear" or "reinhard"; gamma is Reinhard's exponent)."""
+    tonemap = choice(tonemap, TONEMAPS, "tonemap")
     if tonemap == "linear":
         return linear_unchecked(L)
     if tonemap == "reinhard":
@@ -119,6 +120,7 @@ def _check_gamma(gamma) -> float:
 
 def display_formula(tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6) -> str:
     """:func:`to_display` in words, for files that keep the log intensity L (``log_intensity.h5``)."""
+    tonemap = choice(tonemap, TONEMAPS, "tonemap")
     if tonemap == "linear":
         return "frames = clip(exp(L), 0, 1)"
     if tonemap == "reinhard":
@@ -137,8 +139,7 @@ def display_shift(reference, tonemap: str = DEFAULT_TONEMAP, gamma: float = 0.6,
       sorted values (at most SHIFT_SAMPLES of them, an even stride through ``reference``).
     """
     display_mean = _check_display_mean(display_mean)
-    if tonemap not in TONEMAPS:
-        raise EventDataError(f"tonemap must be one of {TONEMAPS}, got {tonemap!r}")
+    tonemap = choice(tonemap, TONEMAPS, "tonemap")   # an array was numpy's "truth value ... is ambiguous"
     reference = np.asarray(reference)
     if reference.dtype.kind not in "iuf" or reference.dtype == bool:
         raise EventDataError(f"reference must be log intensities (numbers), got dtype {reference.dtype}")

@@ -6,7 +6,7 @@ from collections.abc import Iterable, Mapping
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, host_array, is_real_number, numbers_array, short_repr
+from ..core.checks import ArgumentTypeError, choice, host_array, is_real_number, numbers_array, short_repr
 from ..core.events import EventDataError
 from ..evaluation.ablation import COLUMN_LABELS, pareto_front
 from .signals import axes_or_new
@@ -133,8 +133,7 @@ def plot_ablation(rows: list[dict], metrics=("ssim_none", "ssim_clahe"), *, x=No
     metrics = _keys(metrics, "metrics")
     if not metrics:
         raise ValueError("metrics= is empty: pass the quality keys to draw (e.g. ('ssim_none', 'ssim_clahe'))")
-    if not isinstance(xscale, str) or xscale not in ("linear", "log", "symlog"):
-        raise EventDataError(f"xscale= must be 'linear', 'log' or 'symlog', got {xscale!r}")
+    xscale = choice(xscale, ("linear", "log", "symlog"), "xscale=")
     fix = "pass the rows of run_variants (dicts with 'name', 'train_time_s' and the metrics)"
     missing = [i for i, r in enumerate(rows) if "name" not in r]
     if missing:   # a KeyError before
@@ -219,8 +218,7 @@ def plot_tradeoff(rows: list[dict], quality: str = "ssim_clahe", *, cost: str = 
             raise EventDataError(f"front= must be {len(rows)} flags (one per row, True on the front), got "
                                  f"{given.dtype} of shape {given.shape}")
         front = given.astype(bool)
-    if not isinstance(labels, str) or labels not in ("front", "all"):
-        raise EventDataError(f"labels must be 'front' or 'all', got {labels!r}")
+    labels = choice(labels, ("front", "all"), "labels")
     ax = axes_or_new(ax, (8, 4.5))
     ax.scatter(c[~front], q[~front], color="0.6", s=18, label="dominated")
     ax.scatter(c[front], q[front], color="tab:red", s=30, label="Pareto front")
