@@ -268,6 +268,9 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
         details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
                        "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
                        "`np.zeros((H, W))`, `frame[y, x]`")
+    listed = _list_inputs_hint(ex, err, args, kwargs)
+    if listed and not any(d.startswith("hint:") for d in details):
+        details.append(f"hint: {listed}")
     state = mutable_default_hint(fn, defaults) if k > 0 else None
     if state is None and k > 0:
         cache, proven = global_cache_hint(fn, containers, ex, (args, kwargs), raised=True)
@@ -280,6 +283,23 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     if state:
         details.append(f"hint: {state}")
     return False, f"raised {type(err).__name__} on {where}", details
+
+
+def _list_inputs_hint(ex: ExerciseLike, err: Exception, args, kwargs) -> str | None:
+    """An error that an array method or array indexing raised on a Python list among the inputs (``cost[:, None]``,
+    ``cost.argsort()``, ``quality * 2.0``): where the notebook passes lists too, name them and how to convert."""
+    if not isinstance(err, (TypeError, AttributeError)) or "list" not in str(err):
+        return None
+    names = [f"`{name}`" for name, value in kwargs.items() if isinstance(value, list)]
+    names += [f"argument {k + 1}" for k, value in enumerate(args) if isinstance(value, list)]
+    if not names:
+        return None
+    call = getattr(ex, "call", None)
+    where = f" as {call.where()} passes them (`{call.text}`)" if call is not None else ""
+    first = names[0].strip("`") if names[0].startswith("`") else "x"
+    return (f"{', '.join(names)} {'is a Python list' if len(names) == 1 else 'are Python lists'} on this input,"
+            f"{where}: a list has no array methods, no [:, None] indexing and no element-wise arithmetic; convert "
+            f"first, `{first} = np.asarray({first}, dtype=float)`")
 
 
 def _safely(hint: Callable, *args) -> str | None:
