@@ -14,6 +14,8 @@ on every input among them) in :mod:`.across_calls`.
 """
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from .learner_calls import multiplies_rows
@@ -214,17 +216,29 @@ def size_from_events_hint(args, kwargs, got, expected) -> str | None:
     return None
 
 
+SWAPPED = "the two outputs are swapped: return them in the order the docstring gives"
+REORDERED = "the outputs are right, but in another order: "   # the start of a hint for three or four outputs
+
+
 def swapped_pair_hint(ex: ExerciseLike, got, expected) -> str | None:
-    """A pair of outputs returned in the other order."""
-    if not (isinstance(expected, (tuple, list)) and len(expected) == 2 and isinstance(got, (tuple, list))
-            and len(got) == 2):
+    """Outputs returned in another order: a pair swapped, or three or four outputs (esim_interval's times,
+    polarities and level) in any other order, said output by output."""
+    if not (isinstance(expected, (tuple, list)) and 2 <= len(expected) <= 4 and isinstance(got, (tuple, list))
+            and len(got) == len(expected)):
         return None
-    try:
-        if compare_outputs(got[::-1], expected, ex.rtol, ex.atol) is None or (
-                ex.compare is not None and ex.compare(tuple(got[::-1]), expected) is None):
-            return "the two outputs are swapped: return them in the order the docstring gives"
-    except Exception:
-        return None
+    for order in itertools.permutations(range(len(got))):
+        if order == tuple(range(len(got))):
+            continue
+        moved = tuple(got[j] for j in order)          # moved[i] = got[order[i]]: is it expected[i]?
+        try:
+            if compare_outputs(moved, expected, ex.rtol, ex.atol) is None or (
+                    ex.compare is not None and ex.compare(moved, expected) is None):
+                if len(got) == 2:
+                    return SWAPPED
+                where = ", ".join(f"output [{j}] is the expected [{i}]" for i, j in enumerate(order) if i != j)
+                return REORDERED + where + ": return them in the order the docstring gives"
+        except Exception:
+            continue
     return None
 
 

@@ -732,3 +732,61 @@ def multiplies_rows(fn) -> bool:
                 stack.extend(["other"] * max(effect, 0))
         codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
     return False
+
+
+# ---- errors the learner's own code caught -------------------------------------------------------------------------
+
+SWALLOWED = "an error was raised inside your function and caught by its own `except`"   # a hint's start
+
+
+# errors that code catches on purpose (a key not there yet, an optional import, the end of an iterator): never named
+_EXPECTED_ERRORS = (StopIteration, StopAsyncIteration, GeneratorExit, KeyError, ImportError)
+
+
+def _learner_file(filename: str) -> bool:
+    """A frame of the learner's code: not a library's, not the kit's (its reference, its check)."""
+    if library_file(filename) or _check_file(filename):
+        return False
+    return not os.path.realpath(filename).startswith(KIT_ROOT + os.sep)
+
+
+def caught_errors(fn: Callable, args, kwargs) -> list[tuple[BaseException, str, int, str]] | None:
+    """The errors raised in the learner's own frames during a call of ``fn`` on a copy of the inputs, that the call
+    did not let out (its own ``try``/``except`` caught them): (error, file, line, function) each, the first frame it
+    was seen in; None where the call raised, or could not be traced (a tracer of another tool's is kept, and then
+    nothing is traced)."""
+    if sys.gettrace() is not None:
+        return None
+    seen: list = []
+    ids: set = set()
+
+    def local(frame, event, arg):
+        if event == "exception" and id(arg[1]) not in ids and not isinstance(arg[1], _EXPECTED_ERRORS):
+            ids.add(id(arg[1]))
+            seen.append((arg[1], frame.f_code.co_filename, frame.f_lineno, frame.f_code.co_name))
+        return local
+
+    def calls(frame, event, arg):
+        return local if _learner_file(frame.f_code.co_filename) else None
+
+    sys.settrace(calls)
+    try:
+        run(fn, args, kwargs)
+    except Exception:
+        return None
+    finally:
+        sys.settrace(None)
+    return seen
+
+
+def swallowed_message(errors: list) -> str | None:
+    """A hint naming the last error the learner's code caught (the one nearest its return), or None."""
+    if not errors:
+        return None
+    import linecache
+    err, filename, line, name = errors[-1]
+    text = linecache.getline(filename, line).strip()
+    code = f": `{text}`" if text else ""
+    more = f" ({len(errors)} errors caught in all)" if len(errors) > 1 else ""
+    return (f"{SWALLOWED} ({type(err).__name__}: {err}, in {name}, line {line}{code}){more}, and what it handed back "
+            "is not the answer: remove the `try`/`except` (or let it `raise`) to see the error, and fix that line")

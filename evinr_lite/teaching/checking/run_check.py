@@ -38,11 +38,11 @@ from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, 
                            same_objects_new_values, scalar_factor_hint, shares_output, stale_argument_hint, state_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
                            rng_states, set_rng_states, settings_message)
-from .hints import (aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
+from .hints import (REORDERED, aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
-from .learner_calls import (ExitCalled, TooSlow, cache_raised, changed_inputs, container_names, in_place_message,
-                            module_flags, module_flags_message, poison_freed_memory, run, tensor_flags,
-                            tensor_flags_message, watching, where_raised)
+from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught_errors, changed_inputs,
+                            container_names, in_place_message, module_flags, module_flags_message, poison_freed_memory,
+                            run, swallowed_message, tensor_flags, tensor_flags_message, watching, where_raised)
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
@@ -150,6 +150,13 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
                 + (["also: " + flags] if flags else [])
         details = [problem.message]
         hint, seed_note = _hint_for(ex, fn, cases, k, got, expected, problem, defaults, containers)
+        if hint is None:            # a placeholder an `except` of the learner's own handed back (zeros, 0.0)
+            hint = _safely(_swallowed_hint, fn, args, kwargs)
+        if hint and hint.startswith(SWALLOWED) and got is None:
+            details = ["returned None"]           # not a `return` forgotten: the function has one
+        if hint and hint.startswith(REORDERED) and not problem.values:
+            # a dtype's or a shape's own advice ("no .astype(int)") would name a slip the function did not make
+            details = [f"the outputs are in another order ({problem.message.split(':')[0]})"]
         if hint:
             details.append(f"hint: {hint}")
         if seed_note:
@@ -302,6 +309,11 @@ def _list_inputs_hint(ex: ExerciseLike, err: Exception, args, kwargs) -> str | N
             f"first, `{first} = np.asarray({first}, dtype=float)`")
 
 
+def _swallowed_hint(fn: Callable, args, kwargs) -> str | None:
+    """The error the learner's own `except` caught on this input (:func:`.learner_calls.caught_errors`), named."""
+    return swallowed_message(caught_errors(fn, args, kwargs))
+
+
 def _safely(hint: Callable, *args) -> str | None:
     """``hint(*args)``, or None where it raises: a hint read off the learner's source (its globals' properties, a
     module's ``__getattr__``) must never crash the check."""
@@ -342,6 +354,10 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     order. Each step may run the learner's function again (with its side effects), so a step runs only when the
     ones before it found nothing."""
     args, kwargs = cases[k]
+    if got is None and expected is not None:        # the None an `except` of the learner's own handed back
+        swallowed = _safely(_swallowed_hint, fn, args, kwargs)
+        if swallowed:
+            return swallowed, None
     same = functools.partial(called_the_same_way, fn)      # a proof's recompiled function, called as fn is
     # results kept in a notebook dict (or list) that the function fills: an input that shares an earlier
     # one's key gets that input's result. Named first when the kept data made the difference (run with the
