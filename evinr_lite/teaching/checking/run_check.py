@@ -46,7 +46,7 @@ from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
-                      first_difference, not_finite)
+                      first_difference, input_name, not_finite)
 from .protocol import ExerciseLike
 from .signature import (called_as_notebook, called_the_same_way, learner_function, notebook_caller,
                         signature_default_hint)
@@ -295,10 +295,10 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
 def _list_inputs_hint(ex: ExerciseLike, err: Exception, args, kwargs) -> str | None:
     """An error that an array method or array indexing raised on a Python list among the inputs (``cost[:, None]``,
     ``cost.argsort()``, ``quality * 2.0``): where the notebook passes lists too, name them and how to convert."""
-    if not isinstance(err, (TypeError, AttributeError)) or "list" not in str(err):
+    if not isinstance(err, (TypeError, AttributeError)) or ("list" not in str(err) and "sequence" not in str(err)):
         return None
     names = [f"`{name}`" for name, value in kwargs.items() if isinstance(value, list)]
-    names += [f"argument {k + 1}" for k, value in enumerate(args) if isinstance(value, list)]
+    names += [input_name(k) for k, value in enumerate(args) if isinstance(value, list)]
     if not names:
         return None
     call = getattr(ex, "call", None)
