@@ -14,7 +14,9 @@ rather than zeros by chance. :func:`multiplies_rows` reads off the bytecode whet
 holds a list (rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call
 can leave changed in a model besides its parameters (its mode, which parameters require grad), :func:`tensor_flags` the
 same of the input tensors (requires_grad), and :func:`refill_in_place` writes one case's values into another case's
-objects without changing their identity (a cache keyed by id()).
+objects without changing their identity (a cache keyed by id()). :func:`caught_errors` runs a call again under a
+tracer of the learner's own frames and lists the errors its own `try`/`except` caught (:func:`swallowed_message`
+names the last one).
 """
 from __future__ import annotations
 

@@ -5,10 +5,12 @@
 learner's call), compares the outputs (:mod:`.outputs`; where the values match, the gradients of a differentiable
 result too), and at the first difference looks for a hint (:func:`_hint_for`), in a fixed order: data kept in a
 notebook variable (when it made the difference), np.empty (a rerun on zeroed memory answers otherwise), the
-exercise's own wrong versions, a swapped pair, state kept between calls, an argument taken from input #1, the
+exercise's own wrong versions, outputs in another order, state kept between calls, an argument taken from input #1, the
 generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
 patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
-the rest), and last a notebook variable that only grew. A model among the inputs left in another mode, or with other
+the rest), and last a notebook variable that only grew. A None, or a wrong value no hint explains, that an `except`
+of the learner's own handed back names the error it caught (:func:`.learner_calls.caught_errors`); an error raised on a
+Python list among the inputs (where the notebook passes lists) says how to convert. A model among the inputs left in another mode, or with other
 parameters requiring grad, than the reference leaves it is named after each call, and so is an input tensor whose
 requires_grad the call changed. A call stopped at the time limit (:class:`.learner_calls.TooSlow`: an endless loop) or
 ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
