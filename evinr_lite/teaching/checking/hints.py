@@ -3,8 +3,8 @@
 Given the learner's output and the expected one on the failing input, each hint here returns a sentence naming a
 likely mistake, or None, and runs no function: :func:`generic_hint` (a flipped sign, a constant factor or offset,
 exp or log once too often, a shift by one position, a pair of outputs swapped, a scatter-add that kept one
-contribution per repeated index), :func:`one_based_hint` (indices counted from 1), :func:`swapped_pair_hint` (two to four
-outputs in another order) and
+contribution per repeated index), :func:`one_based_hint` (indices counted from 1),
+:func:`swapped_pair_hint` (two to four outputs in another order) and
 :func:`size_from_events_hint` (an image sized by the events, not the sensor) and :func:`aliased_rows_hint` (every row
 the same: the row index not used, or, where the function's code multiplies a list of lists, a nested list made with
 ``[[0.0] * W] * H``). Two conditions read off the inputs

@@ -10,7 +10,8 @@ generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken fr
 patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
 the rest), and last a notebook variable that only grew. A None, or a wrong value no hint explains, that an `except`
 of the learner's own handed back names the error it caught (:func:`.learner_calls.caught_errors`); an error raised on a
-Python list among the inputs (where the notebook passes lists) says how to convert. A model among the inputs left in another mode, or with other
+Python list among the inputs (where the notebook passes lists) says how to convert. A model among the inputs left
+in another mode, or with other
 parameters requiring grad, than the reference leaves it is named after each call, and so is an input tensor whose
 requires_grad the call changed. A call stopped at the time limit (:class:`.learner_calls.TooSlow`: an endless loop) or
 ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
