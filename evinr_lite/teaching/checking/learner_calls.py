@@ -23,6 +23,7 @@ from __future__ import annotations
 import contextlib
 import copy
 import dis
+import functools
 import os
 import re
 import signal
@@ -745,8 +746,11 @@ SWALLOWED = "an error was raised inside your function and caught by its own `exc
 _EXPECTED_ERRORS = (StopIteration, StopAsyncIteration, GeneratorExit, KeyError, ImportError)
 
 
+@functools.lru_cache(maxsize=4096)
 def _learner_file(filename: str) -> bool:
-    """A frame of the learner's code: not a library's, not the kit's (its reference, its check)."""
+    """A frame of the learner's code: not a library's, not the kit's (its reference, its check). Kept per file
+    name: the tracer asks it at every call, numpy's and torch's too (os.path.realpath on each one made a traced
+    call some 35 times slower than a plain one)."""
     if library_file(filename) or _check_file(filename):
         return False
     return not os.path.realpath(filename).startswith(KIT_ROOT + os.sep)
