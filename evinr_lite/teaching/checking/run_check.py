@@ -8,8 +8,9 @@ notebook variable (when it made the difference), np.empty (a rerun on zeroed mem
 exercise's own wrong versions, outputs in another order, state kept between calls, an argument taken from input #1, the
 generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
 patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
-the rest), and last a notebook variable that only grew. A None, or a wrong value no hint explains, that an `except`
-of the learner's own handed back names the error it caught (:func:`.learner_calls.caught_errors`); an error raised on a
+the rest), and last a notebook variable that only grew. A None that no in-place method explains
+(``return out.sort()``), or a wrong value no hint explains, that an `except` of the learner's own made (returned, or
+set a name the return uses) names the error it caught (:func:`.learner_calls.caught_errors`); an error raised on a
 Python list among the inputs (where the notebook passes lists) says how to convert. A model among the inputs left
 in another mode, or with other
 parameters requiring grad, than the reference leaves it is named after each call, and so is an input tensor whose
@@ -357,11 +358,14 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     order. Each step may run the learner's function again (with its side effects), so a step runs only when the
     ones before it found nothing."""
     args, kwargs = cases[k]
-    if got is None and expected is not None:        # the None an `except` of the learner's own handed back
-        swallowed = _safely(_swallowed_hint, fn, args, kwargs)
-        if swallowed:
-            return swallowed, None
     same = functools.partial(called_the_same_way, fn)      # a proof's recompiled function, called as fn is
+    if got is None and expected is not None:
+        # the None of `return out.sort()`, read off the source and proven, else the None that an `except` of the
+        # learner's own handed back (the function has a `return`): an `except` that only went on explains nothing
+        hint = _safely(none_from_in_place_hint, fn, ex, (args, kwargs), expected, same, got) \
+            or _safely(_swallowed_hint, fn, args, kwargs)
+        if hint:
+            return hint, None
     # results kept in a notebook dict (or list) that the function fills: an input that shares an earlier
     # one's key gets that input's result. Named first when the kept data made the difference (run with the
     # variable emptied, the function answers otherwise), else only when no other hint applies (below): a list
