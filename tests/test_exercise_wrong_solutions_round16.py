@@ -3,10 +3,10 @@ not try, and nine correct alternatives (in 4 exercises).
 
 Mistake classes: a function right only for the containers the check passed, where the notebook passes others
 (pareto_front: notebook 07 calls `front_of(cost, quality)` with Python lists built by a list comprehension, and every
-input of the check was a numpy array: `cost[:, None]`, `cost.argsort()` and `quality * 1.0` work on arrays and fail on
-lists); three outputs in another order (esim_interval's times, polarities and level); an error hidden by the learner's
-own `try`/`except` (returning None, printing and returning nothing, or handing back a placeholder: zeros, 0.0, a
-zero tensor cut off from the graph).
+input of the check was a numpy array: `cost[:, None]`, `cost.astype(float)` and `quality * 1.0` work on arrays and
+fail on lists); three outputs in another order (esim_interval's times, polarities and level); an error hidden by the
+learner's own `try`/`except` (returning None, printing and returning nothing, or handing back a placeholder: zeros,
+0.0, a zero tensor cut off from the graph).
 
 Correct alternatives: np.asarray first and then vectorised, a plain Python loop over the lists, a sweep by
 np.lexsort of the lists, esim_interval's outputs as a list, an optional import in a `try`/`except ImportError`, a
@@ -18,7 +18,7 @@ Holes (these passed a check before this round; each now fails and its report nam
   TypeError or AttributeError in notebook 07, cell 47, where the learner's function runs on lists. The fourth input
   now holds Python lists (ablation_exercises._inputs_front; the count of 5 inputs that the notebook quotes stands),
   and an error raised on a list input says so and how to convert (run_check._list_inputs_hint); the stub's comment
-  says "lists or arrays (the cell below passes lists)".
+  says "lists or arrays (the cell after the check passes lists)".
 
 Misreported (these failed, with a report that named another mistake):
 - esim_interval's outputs in another order (esim_pols_first, esim_level_first) got a dtype's or a shape's advice ("the
@@ -28,6 +28,14 @@ Misreported (these failed, with a report that named another mistake):
   statement?": the function has one. A placeholder from such an `except` (tm_swallow_zeros, ie_swallow_index,
   tv_swallow_zero) got a bare "wrong values". The call is now run again under a tracer of the learner's own frames
   (learner_calls.caught_errors), and the report names the error that was caught, at its line.
+
+Its review found the hint blaming an `except` that had nothing to do with the result (a `return out.sort()` told to
+remove an unrelated `try: [][0] except IndexError: pass`, an off value told to remove a `try: t = t.numpy() except
+AttributeError: pass`), and the traced call some 35 times slower than a plain one (each frame's file looked up
+again). An error is now named only where it reached the function the check called, and that function's `except`
+whose body ran for it made the result: returned from that body (then "remove the `try`/`except`"), or set a name
+from which the returned value is computed (then "this may be why", with no advice to remove it); a None is first
+read for an in-place method (`.sort()`). The tracer's tests are skipped where another tool's tracer runs.
 
 Before this round's fixes all 10 wrong solutions failed the standard (3 passed the check, 7 failed with a report
 that named another mistake or none), and all 9 correct alternatives passed, before and after.

@@ -50,7 +50,7 @@ from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
-                      first_difference, input_name, not_finite)
+                      first_difference, not_finite)
 from .protocol import ExerciseLike
 from .signature import (called_as_notebook, called_the_same_way, learner_function, notebook_caller,
                         signature_default_hint)
@@ -298,17 +298,17 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
 
 def _list_inputs_hint(ex: ExerciseLike, err: Exception, args, kwargs) -> str | None:
     """An error that an array method or array indexing raised on a Python list among the inputs (``cost[:, None]``,
-    ``cost.argsort()``, ``quality * 2.0``): where the notebook passes lists too, name them and how to convert."""
+    ``cost.astype(float)``, ``quality * 2.0``): where the notebook passes lists too, name them and how to convert.
+    The check passes every input by name (no exercise's case has a positional one), so only keywords are read."""
     if not isinstance(err, (TypeError, AttributeError)) or ("list" not in str(err) and "sequence" not in str(err)):
         return None
-    names = [f"`{name}`" for name, value in kwargs.items() if isinstance(value, list)]
-    names += [input_name(k) for k, value in enumerate(args) if isinstance(value, list)]
+    names = [name for name, value in kwargs.items() if isinstance(value, list)]
     if not names:
         return None
     call = getattr(ex, "call", None)
     where = f" as {call.where()} passes them (`{call.text}`)" if call is not None else ""
-    first = names[0].strip("`") if names[0].startswith("`") else "x"
-    return (f"{', '.join(names)} {'is a Python list' if len(names) == 1 else 'are Python lists'} on this input,"
+    first = names[0]
+    return (f"{', '.join(f'`{name}`' for name in names)} {'is a Python list' if len(names) == 1 else 'are Python lists'} on this input,"
             f"{where}: a list has no array methods, no [:, None] indexing and no element-wise arithmetic; convert "
             f"first, `{first} = np.asarray({first}, dtype=float)`")
 
