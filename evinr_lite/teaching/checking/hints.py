@@ -3,7 +3,8 @@
 Given the learner's output and the expected one on the failing input, each hint here returns a sentence naming a
 likely mistake, or None, and runs no function: :func:`generic_hint` (a flipped sign, a constant factor or offset,
 exp or log once too often, a shift by one position, a pair of outputs swapped, a scatter-add that kept one
-contribution per repeated index), :func:`one_based_hint` (indices counted from 1), :func:`swapped_pair_hint` and
+contribution per repeated index), :func:`one_based_hint` (indices counted from 1),
+:func:`swapped_pair_hint` (two to four outputs in another order) and
 :func:`size_from_events_hint` (an image sized by the events, not the sensor) and :func:`aliased_rows_hint` (every row
 the same: the row index not used, or, where the function's code multiplies a list of lists, a nested list made with
 ``[[0.0] * W] * H``). Two conditions read off the inputs
@@ -13,6 +14,8 @@ axis among them) are in :mod:`.mistakes`; those that show only across inputs (on
 on every input among them) in :mod:`.across_calls`.
 """
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 
@@ -214,17 +217,29 @@ def size_from_events_hint(args, kwargs, got, expected) -> str | None:
     return None
 
 
+SWAPPED = "the two outputs are swapped: return them in the order the docstring gives"
+REORDERED = "the outputs are right, but in another order: "   # the start of a hint for three or four outputs
+
+
 def swapped_pair_hint(ex: ExerciseLike, got, expected) -> str | None:
-    """A pair of outputs returned in the other order."""
-    if not (isinstance(expected, (tuple, list)) and len(expected) == 2 and isinstance(got, (tuple, list))
-            and len(got) == 2):
+    """Outputs returned in another order: a pair swapped, or three or four outputs (esim_interval's times,
+    polarities and level) in any other order, said output by output."""
+    if not (isinstance(expected, (tuple, list)) and 2 <= len(expected) <= 4 and isinstance(got, (tuple, list))
+            and len(got) == len(expected)):
         return None
-    try:
-        if compare_outputs(got[::-1], expected, ex.rtol, ex.atol) is None or (
-                ex.compare is not None and ex.compare(tuple(got[::-1]), expected) is None):
-            return "the two outputs are swapped: return them in the order the docstring gives"
-    except Exception:
-        return None
+    for order in itertools.permutations(range(len(got))):
+        if order == tuple(range(len(got))):
+            continue
+        moved = tuple(got[j] for j in order)          # moved[i] = got[order[i]]: is it expected[i]?
+        try:
+            if compare_outputs(moved, expected, ex.rtol, ex.atol) is None or (
+                    ex.compare is not None and ex.compare(moved, expected) is None):
+                if len(got) == 2:
+                    return SWAPPED
+                where = ", ".join(f"output [{j}] is the expected [{i}]" for i, j in enumerate(order) if i != j)
+                return REORDERED + where + ": return them in the order the docstring gives"
+        except Exception:
+            continue
     return None
 
 

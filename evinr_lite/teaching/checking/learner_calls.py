@@ -14,24 +14,31 @@ rather than zeros by chance. :func:`multiplies_rows` reads off the bytecode whet
 holds a list (rows aliased by ``[[0.0] * W] * H``), for the wording of that hint. :func:`module_flags` reads what a call
 can leave changed in a model besides its parameters (its mode, which parameters require grad), :func:`tensor_flags` the
 same of the input tensors (requires_grad), and :func:`refill_in_place` writes one case's values into another case's
-objects without changing their identity (a cache keyed by id()).
+objects without changing their identity (a cache keyed by id()). :func:`caught_errors` runs a call again under a
+tracer of the learner's own frames and lists the errors that the function the check called caught with its own
+`try`/`except`, and whether that `except` made the result (returned it, or set a name the return uses, read off the
+source); :func:`swallowed_message` names the last one that did.
 """
 from __future__ import annotations
 
+import ast
 import contextlib
 import copy
 import dis
+import functools
+import inspect
 import os
 import re
 import signal
 import site
 import sys
 import sysconfig
+import textwrap
 import threading
 import time
 import traceback
 import types
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterator, NamedTuple
 
 import numpy as np
 
@@ -732,3 +739,228 @@ def multiplies_rows(fn) -> bool:
                 stack.extend(["other"] * max(effect, 0))
         codes.extend(c for c in code.co_consts if hasattr(c, "co_names"))
     return False
+
+
+# ---- errors the learner's own code caught -------------------------------------------------------------------------
+
+SWALLOWED = "an error was raised inside your function and caught by its own `except`"   # a hint's start
+
+
+# errors that code catches on purpose (a key not there yet, an optional import, the end of an iterator): never named
+_EXPECTED_ERRORS = (StopIteration, StopAsyncIteration, GeneratorExit, KeyError, ImportError)
+
+
+@functools.lru_cache(maxsize=4096)
+def _learner_file(filename: str) -> bool:
+    """A frame of the learner's code: not a library's, not the kit's (its reference, its check). Kept per file
+    name: the tracer asks it at every call, numpy's and torch's too (os.path.realpath on each one made a traced
+    call some 35 times slower than a plain one)."""
+    if library_file(filename) or _check_file(filename):
+        return False
+    return not os.path.realpath(filename).startswith(KIT_ROOT + os.sep)
+
+
+class Caught(NamedTuple):
+    """An error the learner's function caught itself (:func:`caught_errors`)."""
+    error: BaseException
+    filename: str
+    line: int                   # where it was raised: the first of the learner's frames it was seen in
+    function: str
+    handler: int | None         # the line of the function's `except` clause whose body ran for it (None: none)
+    how: str | None             # "return": the function returned from that body; a name: the body set it, and the
+    #                             function's return uses it (or a name computed from it); None: neither
+    returned: int | None        # the line the function returned from
+
+
+class _Handler(NamedTuple):
+    clause: range               # the lines of the `except ...:` clause itself
+    body: range                 # the lines of an `except` clause's body (the clause's own line not among them)
+    sets: dict                  # the names its body sets or changes, and those computed from them in the function:
+    #                             for each, the name of the body's it came from
+
+
+def _names(node: ast.AST, ctx=ast.Load) -> set:
+    """The names that ``node`` reads (ctx Load) or binds (ctx Store) outside nested functions and classes."""
+    found, stack = set(), [node]
+    while stack:
+        n = stack.pop()
+        if isinstance(n, ast.Name) and isinstance(n.ctx, ctx):
+            found.add(n.id)
+        if n is node or not isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            stack.extend(ast.iter_child_nodes(n))
+    return found
+
+
+def _base(target: ast.AST) -> str | None:
+    """The name an assignment's target changes: ``out`` of ``out``, ``out[j]``, ``out.data``, ``out[j].x``."""
+    while isinstance(target, (ast.Subscript, ast.Attribute, ast.Starred)):
+        target = target.value
+    return target.id if isinstance(target, ast.Name) else None
+
+
+def _bindings(tree: ast.AST) -> list[tuple[set, set]]:
+    """(names set or changed, names read) of each assignment, loop, `with` and method call in ``tree``, outside
+    nested functions: ``out[j] = v`` changes ``out`` from ``v``, ``out.append(v)`` too."""
+    pairs, stack = [], list(ast.iter_child_nodes(tree))
+    while stack:
+        n = stack.pop()
+        if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            continue
+        stack.extend(ast.iter_child_nodes(n))
+        if isinstance(n, (ast.Assign, ast.AugAssign, ast.AnnAssign)) and n.value is not None:
+            targets = n.targets if isinstance(n, ast.Assign) else [n.target]
+            bound = {b for t in targets for b in [_base(t), *_names(t, ast.Store)] if b}
+            pairs.append((bound, _names(n.value) | (bound if isinstance(n, ast.AugAssign) else set())))
+        elif isinstance(n, ast.NamedExpr):
+            pairs.append(({n.target.id}, _names(n.value)))
+        elif isinstance(n, (ast.For, ast.AsyncFor)):
+            pairs.append((_names(n.target, ast.Store), _names(n.iter)))
+        elif isinstance(n, ast.withitem) and n.optional_vars is not None:
+            pairs.append((_names(n.optional_vars, ast.Store), _names(n.context_expr)))
+        elif isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) and _base(n.func):
+            pairs.append(({_base(n.func)}, {m for a in [*n.args, *n.keywords] for m in _names(a)}))
+    return pairs
+
+
+def _function_tree(code: types.CodeType):
+    """The def of ``code`` (its lines numbered as in its file), or None where its source cannot be read."""
+    try:
+        lines, start = inspect.getsourcelines(code)
+        tree = ast.parse(textwrap.dedent("".join(lines)))
+    except (OSError, TypeError, SyntaxError, ValueError):
+        return None
+    node = tree.body[0] if tree.body else None
+    if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+        return None
+    ast.increment_lineno(tree, max(start, 1) - 1)
+    return node
+
+
+def _except_handlers(code: types.CodeType) -> tuple[list[_Handler], dict[int, set]] | None:
+    """The `except` clauses of the function of ``code`` (not of the functions it defines), and the names each
+    `return` reads, by its lines; None where its source cannot be read."""
+    node = _function_tree(code)
+    if node is None:
+        return None
+    handlers, returns, stack = [], {}, list(ast.iter_child_nodes(node))
+    while stack:
+        n = stack.pop()
+        if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda, ast.ClassDef)):
+            continue
+        stack.extend(ast.iter_child_nodes(n))
+        if isinstance(n, ast.Return):
+            for line in range(n.lineno, (n.end_lineno or n.lineno) + 1):
+                returns[line] = _names(n.value) if n.value is not None else set()
+        if isinstance(n, ast.ExceptHandler) and n.body:
+            sets = {b: b for bound, _ in _bindings(n) for b in bound}
+            everywhere = _bindings(node)
+            while True:         # the names computed from them anywhere in the function (the order of lines aside)
+                more = {b: sets[min(read & sets.keys())] for bound, read in everywhere if read & sets.keys()
+                        for b in bound if b not in sets}
+                if not more:
+                    break
+                sets.update(more)
+            handlers.append(_Handler(range(n.lineno, n.body[0].lineno),
+                                     range(n.body[0].lineno, (n.end_lineno or n.body[-1].lineno) + 1), sets))
+    return handlers, returns
+
+
+def caught_errors(fn: Callable, args, kwargs) -> list[Caught] | None:
+    """The errors that the function the check calls caught with its own ``try``/``except``, during a call of ``fn``
+    on a copy of the inputs: each error raised in the learner's frames (not numpy's or torch's, nor the kit's) that
+    reached that function's frame, where the call let it go no further, with the `except` whose body ran for it and
+    whether that body made the result (:class:`Caught`). None where the call raised, or could not be traced (a
+    tracer of another tool's, a debugger's or coverage's, is kept, and then nothing is traced).
+
+    The tracer sees the calls of the learner's files only (a file's answer is kept), and the lines of that function
+    only between an error and the `except` body it reached: a traced call takes about the time of one under a
+    tracer that does nothing."""
+    if sys.gettrace() is not None:
+        return None
+    own = learner_function(fn)
+    with contextlib.suppress(ValueError, TypeError):
+        own = inspect.unwrap(own)
+    top_code = getattr(own, "__code__", None)
+    read = _except_handlers(top_code) if top_code is not None else None
+    handlers, returns = read if read is not None else ([], {})
+    origin: dict = {}           # id(error) -> (error, file, line, function), where first seen
+    in_top: list = []           # the errors seen in the function's frame, in order
+    seen_in_top: set = set()
+    ran: dict = {}              # id(error) -> the handler whose body ran for it
+    pending: list = []          # errors seen in the function's frame, their handler not yet known
+    state = {"top": None, "returned": None}
+
+    def local(frame, event, arg):
+        if event == "exception":
+            err = arg[1]
+            if isinstance(err, _EXPECTED_ERRORS):
+                return local
+            if id(err) not in origin:
+                origin[id(err)] = (err, frame.f_code.co_filename, frame.f_lineno, frame.f_code.co_name)
+            if frame is state["top"] and id(err) not in ran:
+                if id(err) not in seen_in_top:
+                    seen_in_top.add(id(err))
+                    in_top.append(err)
+                pending.append(err)
+                frame.f_trace_lines = True          # which `except` body runs next
+        elif frame is state["top"]:
+            if event == "line" and pending:
+                inside = [h for h in handlers if frame.f_lineno in h.body]
+                if inside or not any(frame.f_lineno in h.clause for h in handlers):   # not yet at a clause's body
+                    handler = max(inside, key=lambda h: h.body.start) if inside else None
+                    for err in pending:
+                        ran[id(err)] = handler
+                    pending.clear()
+                    frame.f_trace_lines = False
+            elif event == "return":
+                state["returned"] = frame.f_lineno
+        return local
+
+    def calls(frame, event, arg):
+        if not _learner_file(frame.f_code.co_filename):
+            return None
+        if state["top"] is None and (top_code is None or frame.f_code is top_code):
+            state["top"] = frame
+        frame.f_trace_lines = False
+        return local
+
+    sys.settrace(calls)
+    try:
+        run(fn, args, kwargs)
+    except Exception:
+        return None
+    finally:
+        sys.settrace(None)
+    found, back = [], state["returned"]
+    for err in in_top:
+        handler = ran.get(id(err))
+        how = None
+        if handler is not None and back is not None:
+            if back in handler.body:
+                how = "return"
+            else:
+                used = sorted(handler.sets.keys() & returns.get(back, set()))
+                how = handler.sets[used[0]] if used else None
+        found.append(Caught(*origin[id(err)], handler.clause.start if handler is not None else None, how,
+                            back))
+    return found
+
+
+def swallowed_message(errors: list[Caught] | None) -> str | None:
+    """A hint naming the last error the learner's function caught whose `except` made its result (returned it, or
+    set a name that its return uses), or None: an `except` that only went on (``pass``, a fallback the result does
+    not use) is never named."""
+    made = [c for c in errors or [] if c.how is not None]
+    if not made:
+        return None
+    import linecache
+    err, filename, line, name, handler, how, back = made[-1]
+    text = linecache.getline(filename, line).strip()
+    code = f": `{text}`" if text else ""
+    more = f" ({len(made)} errors caught in all)" if len(made) > 1 else ""
+    said = f"{SWALLOWED} ({type(err).__name__}: {err}, in {name}, line {line}{code}){more}"
+    if how == "return":
+        return (f"{said}, and what its `except` (line {handler}) handed back is not the answer: remove the "
+                "`try`/`except` (or let it `raise`) to see the error, and fix that line")
+    return (f"{said}, and its `except` (line {handler}) set `{how}`, from which what the function returns (line "
+            f"{back}) is computed: this may be why the result is wrong; look at the line that raised")

@@ -5,10 +5,14 @@
 learner's call), compares the outputs (:mod:`.outputs`; where the values match, the gradients of a differentiable
 result too), and at the first difference looks for a hint (:func:`_hint_for`), in a fixed order: data kept in a
 notebook variable (when it made the difference), np.empty (a rerun on zeroed memory answers otherwise), the
-exercise's own wrong versions, a swapped pair, state kept between calls, an argument taken from input #1, the
+exercise's own wrong versions, outputs in another order, state kept between calls, an argument taken from input #1, the
 generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
 patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
-the rest), and last a notebook variable that only grew. A model among the inputs left in another mode, or with other
+the rest), and last a notebook variable that only grew. A None that no in-place method explains
+(``return out.sort()``), or a wrong value no hint explains, that an `except` of the learner's own made (returned, or
+set a name the return uses) names the error it caught (:func:`.learner_calls.caught_errors`); an error raised on a
+Python list among the inputs (where the notebook passes lists) says how to convert. A model among the inputs left
+in another mode, or with other
 parameters requiring grad, than the reference leaves it is named after each call, and so is an input tensor whose
 requires_grad the call changed. A call stopped at the time limit (:class:`.learner_calls.TooSlow`: an endless loop) or
 ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
@@ -38,11 +42,11 @@ from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, 
                            same_objects_new_values, scalar_factor_hint, shares_output, stale_argument_hint, state_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
                            rng_states, set_rng_states, settings_message)
-from .hints import (aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
+from .hints import (REORDERED, aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
-from .learner_calls import (ExitCalled, TooSlow, cache_raised, changed_inputs, container_names, in_place_message,
-                            module_flags, module_flags_message, poison_freed_memory, run, tensor_flags,
-                            tensor_flags_message, watching, where_raised)
+from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught_errors, changed_inputs,
+                            container_names, in_place_message, module_flags, module_flags_message, poison_freed_memory,
+                            run, swallowed_message, tensor_flags, tensor_flags_message, watching, where_raised)
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
@@ -150,6 +154,13 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
                 + (["also: " + flags] if flags else [])
         details = [problem.message]
         hint, seed_note = _hint_for(ex, fn, cases, k, got, expected, problem, defaults, containers)
+        if hint is None:            # a placeholder an `except` of the learner's own handed back (zeros, 0.0)
+            hint = _safely(_swallowed_hint, fn, args, kwargs)
+        if hint and hint.startswith(SWALLOWED) and got is None:
+            details = ["returned None"]           # not a `return` forgotten: the function has one
+        if hint and hint.startswith(REORDERED) and not problem.values:
+            # a dtype's or a shape's own advice ("no .astype(int)") would name a slip the function did not make
+            details = [f"the outputs are in another order ({problem.message.split(':')[0]})"]
         if hint:
             details.append(f"hint: {hint}")
         if seed_note:
@@ -268,6 +279,9 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
         details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
                        "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
                        "`np.zeros((H, W))`, `frame[y, x]`")
+    listed = _list_inputs_hint(ex, err, args, kwargs)
+    if listed and not any(d.startswith("hint:") for d in details):
+        details.append(f"hint: {listed}")
     state = mutable_default_hint(fn, defaults) if k > 0 else None
     if state is None and k > 0:
         cache, proven = global_cache_hint(fn, containers, ex, (args, kwargs), raised=True)
@@ -280,6 +294,28 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
     if state:
         details.append(f"hint: {state}")
     return False, f"raised {type(err).__name__} on {where}", details
+
+
+def _list_inputs_hint(ex: ExerciseLike, err: Exception, args, kwargs) -> str | None:
+    """An error that an array method or array indexing raised on a Python list among the inputs (``cost[:, None]``,
+    ``cost.astype(float)``, ``quality * 2.0``): where the notebook passes lists too, name them and how to convert.
+    The check passes every input by name (no exercise's case has a positional one), so only keywords are read."""
+    if not isinstance(err, (TypeError, AttributeError)) or ("list" not in str(err) and "sequence" not in str(err)):
+        return None
+    names = [name for name, value in kwargs.items() if isinstance(value, list)]
+    if not names:
+        return None
+    call = getattr(ex, "call", None)
+    where = f" as {call.where()} passes them (`{call.text}`)" if call is not None else ""
+    first = names[0]
+    return (f"{', '.join(f'`{name}`' for name in names)} {'is a Python list' if len(names) == 1 else 'are Python lists'} on this input,"
+            f"{where}: a list has no array methods, no [:, None] indexing and no element-wise arithmetic; convert "
+            f"first, `{first} = np.asarray({first}, dtype=float)`")
+
+
+def _swallowed_hint(fn: Callable, args, kwargs) -> str | None:
+    """The error the learner's own `except` caught on this input (:func:`.learner_calls.caught_errors`), named."""
+    return swallowed_message(caught_errors(fn, args, kwargs))
 
 
 def _safely(hint: Callable, *args) -> str | None:
@@ -323,6 +359,13 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
     ones before it found nothing."""
     args, kwargs = cases[k]
     same = functools.partial(called_the_same_way, fn)      # a proof's recompiled function, called as fn is
+    if got is None and expected is not None:
+        # the None of `return out.sort()`, read off the source and proven, else the None that an `except` of the
+        # learner's own handed back (the function has a `return`): an `except` that only went on explains nothing
+        hint = _safely(none_from_in_place_hint, fn, ex, (args, kwargs), expected, same, got) \
+            or _safely(_swallowed_hint, fn, args, kwargs)
+        if hint:
+            return hint, None
     # results kept in a notebook dict (or list) that the function fills: an input that shares an earlier
     # one's key gets that input's result. Named first when the kept data made the difference (run with the
     # variable emptied, the function answers otherwise), else only when no other hint applies (below): a list
