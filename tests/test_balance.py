@@ -354,7 +354,7 @@ def test_counts_that_show_no_change_of_light_overrule_intervals_of_the_other_sig
 
 
 def test_a_pan_whose_intervals_flip_sign_gets_the_counts_estimate():
-    """fresh11_07_pan_gravel (C+ 0.184 and C- 0.226: b = -0.102; 2 s, about 22 events per pixel): the
+    """fresh11_07_pan_gravel (C+ 0.269 and C- 0.331 given as 0.3: b = -0.102; 2.5 s, about 15 events per pixel): the
     intervals read about +0.1 (their scene's own bias) while the edges, the slope and the pooled counts
     read about -0.1 and agree with each other, so no change of light explains the disagreement; the
     consensus takes the counts' side instead of the nominal C."""

@@ -95,10 +95,16 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
     Raises:
         EventDataError: values outside the encoding, or a mix of encodings.
     """
-    from .checks import choice   # checks imports this module
-
-    encoding = choice(encoding, POLARITY_ENCODINGS, "polarity", hint="the polarity encoding")   # an array was numpy's
-    p = np.asarray(p)                                                                          # "truth value" error
+    # checks.choice's rule (text only; an array was numpy's "truth value" error), written out here: core.checks
+    # imports this module, so importing it back would make a circle
+    if not (isinstance(encoding, str) and encoding in POLARITY_ENCODINGS):
+        text = repr(encoding)
+        close = [e for e in POLARITY_ENCODINGS if isinstance(encoding, str) and e == encoding.strip().lower()]
+        fix = f"did you mean {close[0]!r}?" if close else "pass one of them as text (e.g. polarity='auto')"
+        raise EventDataError(f"polarity must be one of {POLARITY_ENCODINGS} (the polarity encoding), got "
+                             f"{text if len(text) <= 60 else type(encoding).__name__}; {fix}")
+    encoding = str(encoding)
+    p = np.asarray(p)
     if p.ndim != 1:
         raise EventDataError(f"polarity must be a 1-D array, got shape {p.shape}")
     if p.size == 0:

@@ -68,9 +68,10 @@ the disagreement: it is the intervals' own bias (+0.05 to +0.2 on natural scenes
 where b < 0, and the **smallest of the edges, the slope and the pooled counts** is taken where the three
 agree in sign (``chosen == "agreement"``). fresh11_07_pan_gravel (b = -0.102): edges -0.107, slope
 -0.094, pooled counts -0.095, intervals +0.105; b = 0 before, -0.094 now. On the 39 rows of the balance
-benchmarks and fresh seeds 11-28 that take it, the error of b falls from 0.089 to 0.020 rms (37 nearer
-the truth, 2 farther), and on the 34 of them the zoo runs can score, the level's drift over the span (the
-last quarter's error less the first's) from 0.045 to 0.011 in the mean (docs/defaults.md). ``BalanceFit.chosen`` says which was taken.
+benchmarks, fresh seeds 11-28 and the stress set that take it, the error of b falls from 0.089 to 0.020
+rms (37 nearer the truth, 2 farther), and on the 34 of them the zoo runs can score, the level's drift
+over the span (the last quarter's error less the first's) from 0.045 to 0.011 in the mean
+(docs/defaults.md). ``BalanceFit.chosen`` says which was taken.
 
 The edges' estimate took the pooled counts' place in the minmod on 2026-12-04: rms error of the applied
 b 0.104 -> 0.092 on the off-heavy short scenes, 0.069 -> 0.063 on 44 fresh random sensors
@@ -160,7 +161,8 @@ class BalanceFit:
         imbalance: b applied, (C+ - C-) / (C+ + C-), capped: minmod(gradient_imbalance (or
             raw_imbalance without slice counts), interval_imbalance) or slope_imbalance (bounded by the
             range of raw, gradient and interval imbalance where the gradient's is finite) by the consensus
-            rule, shrink x raw_imbalance by the counts rule.
+            rule, or minmod(gradient, slope, raw imbalance) where the minmod of the first two is 0 and the
+            counts show a steady light (``chosen == "agreement"``); shrink x raw_imbalance by the counts rule.
         raw_imbalance: the counts' pooled b = sum(n- - n+) / sum(n- + n+) over the usable pixels.
         interval_imbalance: the intervals' b (NaN where not computed: the counts rule, no interval sums).
         shrink: the counts rule's weight for the raw value (0: nominal C kept, 1: raw value used).
@@ -500,11 +502,14 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
             minmod; without them the pooled counts take its place.
         rule: "consensus" (minmod of the edges' (or the pooled counts') and the intervals' estimates, or
             the counts' slope alone, bounded by the range of the pooled counts, the edges and the intervals,
-            where their error scale is at most COUNTS_ALONE) or "counts" (the counts' pooled
-            estimate shrunk by its evidence).
+            where their error scale is at most COUNTS_ALONE; where the edges and the intervals disagree
+            and the counts show a steady light, the smallest of the edges, the slope and the pooled counts)
+            or "counts" (the counts' pooled estimate shrunk by its evidence).
         min_events: pixels with fewer events are left out. max_imbalance: cap on |b| in [0, 1), and
             how far the intervals may lie from the counts for the counts to be taken alone.
-        prior, net_change: the counts rule's prior spread of b and plausible mean log change (log units).
+        prior, net_change: the counts rule's prior spread of b and plausible mean log change (log units);
+            net_change also sets the counts' error scale s = net_change / (C mean n) that the consensus
+            compares with COUNTS_ALONE and COUNTS_OVER_INTERVALS.
 
     Returns:
         :class:`BalanceFit` with C = (C (1 + b), C (1 - b)).
