@@ -22,8 +22,9 @@ import math
 import torch
 from torch import nn
 
-from ..core.checks import check_seed, numbers_array, real_number, true_or_false, whole_number
+from ..core.checks import check_seed, numbers_array, true_or_false, whole_number
 from ..core.events import EventDataError, check_sensor_size
+from .siren import check_siren_shape
 
 __all__ = ["FrameINR", "network_seed"]
 
@@ -85,15 +86,9 @@ class FrameINR(nn.Module):
         super().__init__()
         H, W = check_sensor_size(sensor_size)
         windows = _check_windows(windows)
-        # the sizes, frequencies, seed and flag by name before any weight is drawn (None and text were Python's
-        # int() / float() errors, hidden_features 2.5 a network of 2, 0 a ZeroDivisionError, hidden_layers -1 a
-        # model without layers, a NaN or negative omega_0 NaN or flipped weights, True a width of 1)
-        d = whole_number(hidden_features, "hidden_features", lo=1)
-        hidden_layers = whole_number(hidden_layers, "hidden_layers", lo=0)
-        hint = "a SIREN frequency factor (SIREN: 30)"
-        omega_0 = real_number(omega_0, "omega_0", lo=0, lo_open=True, hint=hint)
-        first_omega_0 = omega_0 if first_omega_0 is None else \
-            real_number(first_omega_0, "first_omega_0", lo=0, lo_open=True, hint=hint + "; None: omega_0")
+        # the sizes, frequencies, seed and flag by name before any weight is drawn
+        d, hidden_layers, omega_0, first_omega_0 = check_siren_shape(hidden_features, hidden_layers, omega_0,
+                                                                     first_omega_0)
         seed = check_seed(seed)   # [0, 2**63), EvINRConfig's: network_seed works modulo 2**63
         first_index = whole_number(first_index, "first_index", lo=0)
         init_head = true_or_false(init_head, "init_head")

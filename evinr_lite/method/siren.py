@@ -23,7 +23,22 @@ from torch import nn
 
 from ..core.checks import real_number, true_or_false, whole_number
 
-__all__ = ["SineLayer", "Siren", "input_gradient"]
+__all__ = ["SineLayer", "Siren", "input_gradient", "check_siren_shape"]
+
+
+def check_siren_shape(hidden_features, hidden_layers, omega_0, first_omega_0) -> tuple:
+    """A SIREN's width (whole number >= 1), hidden layers (>= 0) and frequencies (finite, > 0; ``first_omega_0``
+    None: ``omega_0``), checked by name before any weight is drawn (None and text were Python's int() / float()
+    errors, 2.5 a network of width 2, 0 a ZeroDivisionError, -1 layers a model without layers, a NaN or negative
+    omega_0 NaN or flipped weights, True a width of 1), for :class:`Siren` and
+    :class:`~evinr_lite.method.models.FrameINR`. Returns them as (int, int, float, float)."""
+    hidden_features = whole_number(hidden_features, "hidden_features", lo=1)
+    hidden_layers = whole_number(hidden_layers, "hidden_layers", lo=0)
+    hint = "a SIREN frequency factor (SIREN: 30)"
+    omega_0 = real_number(omega_0, "omega_0", lo=0, lo_open=True, hint=hint)
+    first_omega_0 = omega_0 if first_omega_0 is None else \
+        real_number(first_omega_0, "first_omega_0", lo=0, lo_open=True, hint=hint + "; None: omega_0")
+    return hidden_features, hidden_layers, omega_0, first_omega_0
 
 
 class SineLayer(nn.Module):
@@ -95,12 +110,8 @@ class Siren(nn.Module):
         # frequencies > 0, outermost_linear a flag. EventDataError is a ValueError, as the checks before were.
         in_features = whole_number(in_features, "in_features", lo=1)
         out_features = whole_number(out_features, "out_features", lo=1)
-        hidden_features = whole_number(hidden_features, "hidden_features", lo=1)
-        hidden_layers = whole_number(hidden_layers, "hidden_layers", lo=0)
-        hint = "a SIREN frequency factor (SIREN: 30)"
-        omega_0 = real_number(omega_0, "omega_0", lo=0, lo_open=True, hint=hint)
-        first_omega_0 = omega_0 if first_omega_0 is None else \
-            real_number(first_omega_0, "first_omega_0", lo=0, lo_open=True, hint=hint + "; None: omega_0")
+        hidden_features, hidden_layers, omega_0, first_omega_0 = check_siren_shape(
+            hidden_features, hidden_layers, omega_0, first_omega_0)
         self.in_features = in_features
         self.out_features = out_features
         self.omega_0 = omega_0
