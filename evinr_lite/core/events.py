@@ -23,7 +23,8 @@ import numpy as np
 
 import math
 
-from .guard import InputError, dense_array, host_array   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
+from .guard import EventDataError, InputError, dense_array, host_array   # the guard maps it to exit status 2; defined there so that the guard needs no numpy
+from .options import choice
 
 __all__ = ["Events", "EventDataError", "InputError", "normalize_polarity", "check_sensor_size", "relative_seconds", "TIME_UNITS", "LARGE_T",
            "TimeUnitWarning", "check_t_origin", "resolve_time_unit", "check_time_span", "check_time_range", "MAX_SPAN_S",
@@ -77,10 +78,6 @@ LARGE_T = 1e5  # seconds; clocks whose first timestamp is at least this large ge
 MAX_SENSOR_SIDE = 1 << 16   # pixels per side; no event camera is larger (headers, file attributes, --sensor)
 
 
-class EventDataError(InputError):
-    """Event data that cannot be used as given. The message names the problem and the fix."""
-
-
 POLARITY_ENCODINGS = ("auto", "pm1", "01", "bool")   # normalize_polarity's encodings
 
 
@@ -95,15 +92,7 @@ def normalize_polarity(p, encoding: str = "auto") -> np.ndarray:
     Raises:
         EventDataError: values outside the encoding, or a mix of encodings.
     """
-    # checks.choice's rule (text only; an array was numpy's "truth value" error), written out here: core.checks
-    # imports this module, so importing it back would make a circle
-    if not (isinstance(encoding, str) and encoding in POLARITY_ENCODINGS):
-        text = repr(encoding)
-        close = [e for e in POLARITY_ENCODINGS if isinstance(encoding, str) and e == encoding.strip().lower()]
-        fix = f"did you mean {close[0]!r}?" if close else "pass one of them as text (e.g. polarity='auto')"
-        raise EventDataError(f"polarity must be one of {POLARITY_ENCODINGS} (the polarity encoding), got "
-                             f"{text if len(text) <= 60 else type(encoding).__name__}; {fix}")
-    encoding = str(encoding)
+    encoding = choice(encoding, POLARITY_ENCODINGS, "polarity", hint="the polarity encoding")   # an array: "truth value"
     p = np.asarray(p)
     if p.ndim != 1:
         raise EventDataError(f"polarity must be a 1-D array, got shape {p.shape}")

@@ -110,6 +110,12 @@ class InputError(ValueError):
     with the guard that maps it to its exit status; :mod:`evinr_lite.core.events` exports it.)"""
 
 
+class EventDataError(InputError):
+    """Event data that cannot be used as given. The message names the problem and the fix. (Defined here, beside
+    :class:`InputError`, so that :mod:`evinr_lite.core.options` can raise it below :mod:`evinr_lite.core.events`,
+    which exports it.)"""
+
+
 class Interrupted(KeyboardInterrupt):
     """SIGINT, SIGTERM or SIGHUP arrived; ``signum`` says which (the exit status is 128 + signum)."""
 
