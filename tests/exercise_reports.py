@@ -48,3 +48,16 @@ def case_ids(rows):
     """pytest ids "exercise-k-function" for rows (exercise name, function, ...); a callable without a name (a
     functools.partial, an object with __call__) by its type's."""
     return [f"{r[0]}-{k}-{getattr(r[1], '__name__', type(r[1]).__name__)}" for k, r in enumerate(rows)]
+
+
+@contextlib.contextmanager
+def seeded_numpy(seed: int = 7):
+    """numpy's global generator seeded for one check (the reports compare calls) and set back afterwards."""
+    import numpy as np
+
+    state = np.random.get_state()
+    np.random.seed(seed)
+    try:
+        yield
+    finally:
+        np.random.set_state(state)

@@ -55,7 +55,7 @@ import pytest
 import torch
 
 from evinr_lite.teaching import exercises
-from exercise_reports import quoted_counts, report as _report
+from exercise_reports import quoted_counts, report as _report, seeded_numpy
 
 
 def R(n): return exercises.reference(n)
@@ -365,10 +365,8 @@ CORRECT = [
 
 @pytest.fixture(autouse=True)
 def _seeded():
-    state = np.random.get_state()
-    np.random.seed(7)
-    yield
-    np.random.set_state(state)
+    with seeded_numpy():
+        yield
 
 
 from exercise_reports import case_ids as _id   # noqa: E402

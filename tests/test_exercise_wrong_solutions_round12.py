@@ -79,7 +79,7 @@ import torch.nn.functional as Fn
 
 from evinr_lite.teaching import exercises
 from evinr_lite.teaching.checking.hints import aliased_rows_hint
-from exercise_reports import assert_fails_naming, assert_passes, case_ids as _id, report as _report
+from exercise_reports import assert_fails_naming, assert_passes, case_ids as _id, report as _report, seeded_numpy
 
 
 def R(n): return exercises.reference(n)
@@ -375,10 +375,8 @@ CORRECT = [
 
 @pytest.fixture(autouse=True)
 def _seeded():
-    state = np.random.get_state()
-    np.random.seed(7)
-    yield
-    np.random.set_state(state)
+    with seeded_numpy():
+        yield
 
 
 @pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))

@@ -90,7 +90,7 @@ import pytest
 import torch
 
 from evinr_lite.teaching import exercises
-from exercise_reports import assert_fails_naming, assert_passes, case_ids as _id, report as _report
+from exercise_reports import assert_fails_naming, assert_passes, case_ids as _id, report as _report, seeded_numpy
 
 
 def R(n): return exercises.reference(n)
@@ -353,12 +353,10 @@ CORRECT = [
 
 @pytest.fixture(autouse=True)
 def _fresh():
-    state = np.random.get_state()
-    np.random.seed(7)
     for d in (_BY_ID, _GF, _HPM, _EF, _LAST, _PF, _BIS, _TFP, _BYTES, _KEPT):
         d.clear()
-    yield
-    np.random.set_state(state)
+    with seeded_numpy():
+        yield
 
 
 @pytest.mark.parametrize("name, wrong, words", HOLES, ids=_id(HOLES))

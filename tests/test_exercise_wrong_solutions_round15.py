@@ -73,7 +73,7 @@ import torch
 
 from evinr_lite.teaching import exercises
 from evinr_lite.teaching.checking import learner_calls
-from exercise_reports import assert_fails_naming, assert_passes, case_ids as _id, report as _report
+from exercise_reports import assert_fails_naming, assert_passes, case_ids as _id, report as _report, seeded_numpy
 
 
 def R(n): return exercises.reference(n)
@@ -275,10 +275,8 @@ CORRECT = [
 
 @pytest.fixture(autouse=True)
 def _fresh():
-    state = np.random.get_state()
-    np.random.seed(7)
-    yield
-    np.random.set_state(state)
+    with seeded_numpy():
+        yield
     torch.autograd.set_detect_anomaly(False)
     torch.use_deterministic_algorithms(False)
 
