@@ -251,6 +251,19 @@ def test_lam_reaches_every_task_and_a_rerun_with_another_is_refused(recordings, 
         run_batch([subset], out, sequential=True, lam=0.01, progress=False, log=_quiet)
 
 
+def test_a_rerun_with_another_temporal_scale_is_refused(recordings, tmp_path):
+    """batch --temporal-scale changes the bins and so the frames: a rerun into the same folder with another scale
+    is refused, as with lam (it reported "already finished" and kept the old frames under the new setting)."""
+    subset = tmp_path / "one"
+    subset.mkdir()
+    os.symlink(recordings / "rec_camera", subset / "rec_camera")
+    out = tmp_path / "out"
+    summary = run_batch([subset], out, sequential=True, temporal_scale=1, progress=False, log=_quiet)
+    assert [r["status"] for r in summary["recordings"]] == ["done"]
+    with pytest.raises(EventDataError, match="other settings.*temporal_scale"):
+        run_batch([subset], out, sequential=True, temporal_scale=2, progress=False, log=_quiet)
+
+
 def test_ros_bags_among_the_inputs_are_named_with_their_conversion(tmp_path):
     """A ROS2 bag's folder given to batch is refused with the data_fetch command; ROS bags inside a folder of
     recordings are skipped with it (the other recordings still run), not as 'not a recording'."""

@@ -241,8 +241,12 @@ def test_batch_task_estimate_takes_plain_arguments():
 
     cfg = EvINRConfig(binning="equal_count", progress=False)
     mb = estimate_task_memory_mb((24, 32), 2.0, 10**6, n_frames=5, config=cfg)
-    solver = estimate_memory((24, 32), 0.0, 2.0, 10**6, 5, cfg)["total"]
-    assert mb == pytest.approx(PROCESS_MIB + (2 * 17 * 10**6 + solver) / 2**20)
+    est = estimate_memory((24, 32), 0.0, 2.0, 10**6, 5, cfg)
+    # the estimate's own process and events parts are the worker's and the read events' (not counted twice)
+    assert mb == pytest.approx(PROCESS_MIB + (2 * 17 * 10**6 + est["total"] - est["parts"]["process"]
+                                              - est["parts"]["events"]) / 2**20)
+    streamed = estimate_task_memory_mb((24, 32), 60.0, 10**8, n_frames=5, config=cfg, streaming=True)
+    assert streamed < estimate_task_memory_mb((24, 32), 60.0, 10**8, n_frames=5, config=cfg) / 4
 
 
 def test_the_command_lines_choices_are_the_librarys():

@@ -60,7 +60,7 @@ SUMMARY_FILES = ("summary.json", "summary.csv", "summary.md")
 SCHEDULER_ADDRESS = re.compile(r"^((tcp|tls|inproc|ucx|ws|wss)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9_.\-]+)(:\d{1,5})?/?$")
 DATASET_NAME = re.compile(r"^([a-z][a-z0-9_]*)(?::([A-Za-z0-9_.\-]+))?$")
 KILLED_NOTE = ("its worker died on every try (killed, or out of memory: see the memory one task needs in "
-               "the README's batch section)")
+               "docs/batch.md)")
 
 
 # ---- inputs ----------------------------------------------------------------------------------
@@ -436,22 +436,28 @@ PROCESS_MIB = 900.0   # a worker with Python, torch and the libraries loaded, re
 
 
 def estimate_task_memory_mb(sensor_size, duration_s: float, n_events: int, *, n_frames: int = 0,
-                            config=None) -> float:
-    """A rough upper estimate of one task's memory in MiB (the README's batch section explains it).
+                            config=None, streaming: bool = False) -> float:
+    """A rough upper estimate of one task's memory in MiB (docs/batch.md explains it).
 
-    The process itself (PROCESS_MIB: Python, torch, the libraries, a reader and the scoring), the
-    events in memory (17 bytes each: t float64, x and y int32, p int8; twice while they are read),
-    and the reconstruction as :func:`evinr_lite.method.memory.estimate_memory` counts it (each
-    network's weights, gradients and Adam moments with its H*W head, one network per window of
-    ``tau`` seconds; the event bins; the ``n_frames`` queried frames) for ``config`` (default: the kit's).
+    The worker process itself (PROCESS_MIB: Python, torch, the libraries, a reader and the scoring), the
+    events while they are read (17 bytes each: t float64, x and y int32, p int8; twice while they are
+    read), and the reconstruction as :func:`evinr_lite.method.memory.estimate_memory` counts it beside
+    them (each network's weights, gradients and Adam moments with its H*W head, one network per window
+    of ``tau`` seconds; the event bins; the ``n_frames`` queried frames) for ``config`` (default: the
+    kit's); its own process and events parts are left out, PROCESS_MIB and the read events covering
+    them. ``streaming``: the run goes window by window (an events-only run without denoise or a fit of
+    C, :func:`evinr_lite.apps.stream_job.streamable`), so one window's events and network count.
     """
     from ..method.config import EvINRConfig
-    from ..method.memory import estimate_memory
+    from ..method.memory import PROCESS_BYTES, estimate_memory
 
     size = tuple(int(v) for v in sensor_size)
-    solver = estimate_memory(size, 0.0, float(duration_s), int(n_events), max(int(n_frames), 1),
-                             config or EvINRConfig(progress=False))["total"]
-    return PROCESS_MIB + (2 * 17 * n_events + solver) / 1024.0 ** 2
+    est = estimate_memory(size, 0.0, float(duration_s), int(n_events), max(int(n_frames), 1),
+                          config or EvINRConfig(progress=False), streaming=bool(streaming))
+    if streaming:   # one window's events, read twice, are in the estimate already
+        return PROCESS_MIB + (est["total"] - PROCESS_BYTES) / 1024.0 ** 2
+    # the whole solve holds every event once; reading holds them twice
+    return PROCESS_MIB + (2 * 17 * n_events + est["total"] - PROCESS_BYTES - est["parts"]["events"]) / 1024.0 ** 2
 
 
 # ---- the whole batch -------------------------------------------------------------------------
@@ -557,9 +563,11 @@ def check_scheduler_address(address: str) -> str:
 
 
 RESULT_SETTINGS = ("C", "fps", "n_iters", "recipe", "seed", "sensor_size", "denoise", "anchor",
-                   "keep_background", "static_camera", "lam", "tonemap", "display_mean")   # change the frames and scores
+                   "keep_background", "static_camera", "lam", "temporal_scale", "tonemap",
+                   "display_mean")   # change the frames and scores
 SETTING_DEFAULTS = {"denoise": False, "anchor": "none", "keep_background": False, "static_camera": False,
-                    "lam": None, "tonemap": None, "display_mean": None}   # what a batch.json written before these options meant
+                    "lam": None, "temporal_scale": None, "tonemap": None,
+                    "display_mean": None}   # what a batch.json written before these options meant
 
 
 def run_batch(inputs, out_dir, options: RunOptions | None = None, *, scheduler: str | None = None,

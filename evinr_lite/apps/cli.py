@@ -268,7 +268,7 @@ def build_parser() -> argparse.ArgumentParser:
                            description="Reconstruct and score every recording of INPUTS, one dask.distributed "
                                        "task each, into DIR/<name>/; a rerun skips finished recordings; at the end "
                                        "DIR/summary.json|csv|md pool the scores per dataset (frame-weighted, as "
-                                       "EVREAL). See the README's batch section for real clusters.")
+                                       "EVREAL). See docs/batch.md for real clusters.")
     batch.add_argument("inputs", nargs="+", metavar="INPUT",
                        help="recordings, folders of recordings, or data_fetch names (ijrr, ijrr:slider_depth, "
                             "hqf:all) looked up in the cache folder ($EVINR_DATA)")
