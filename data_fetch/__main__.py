@@ -35,7 +35,7 @@ def _fmt_window(w) -> str:
 
 def _cmd_list(args) -> int:
     from . import list_datasets
-    from .registry import DATASETS, get_dataset
+    from .registry import DATASETS, ECD_NAMES, get_dataset
 
     print(f"cache folder: {cache_dir()}  (set EVINR_DATA to move it)")
     if args.dataset is None:
@@ -69,8 +69,11 @@ def _cmd_list(args) -> int:
         check = (r["known_hash"] or "none published").split(":")[0]
         print(f"  {r['sequence']:38s} {_fmt_window(r['eval_window']):16s} {state:10s} {check}")
     hidden = sum(1 for r in list_datasets(ds.name) if not r["evaluation"])
-    if hidden and not args.all:
-        print(f"  (+{hidden} sequences outside the evaluation protocol: --all)")
+    by_name = [n for n in ECD_NAMES if n not in ds.sequences] if ds.name == "ijrr" else []
+    if args.all and by_name:   # `get` builds these from the URL pattern: no evaluation window, scored whole
+        print(f"  also fetched by name (whole sequence, no evaluation window): {', '.join(by_name)}")
+    elif (hidden or by_name) and not args.all:
+        print(f"  (+{hidden + len(by_name)} sequences outside the evaluation protocol: --all)")
     return 0
 
 

@@ -673,7 +673,10 @@ def test_command_line(tmp_path, cache, small_sensor, capsys):
     out = capsys.readouterr().out
     assert str(cache) in out and "NOT downloadable" in out and "Google Drive" in out
     assert cli(["list", "ijrr"]) == 0
-    assert "[1, 2.5] s" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "[1, 2.5] s" in out and "shapes_rotation" not in out and "sequences outside the evaluation protocol" in out
+    assert cli(["list", "ijrr", "--all"]) == 0   # the ECD names `get` also takes (from the URL pattern) are listed
+    assert "shapes_rotation" in capsys.readouterr().out
     assert cli(["convert", str(z), "--out", str(tmp_path / "o"), "--quiet"]) == 0
     written = Path(capsys.readouterr().out.strip())
     assert written == tmp_path / "o" / "shapes_6dof.h5"
