@@ -23,7 +23,7 @@ __all__ = ["require", "numbers_array", "whole_number", "real_number", "check_ima
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
            "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
            "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type",
-           "SEED_LIMIT", "check_seed"]
+           "SEED_LIMIT", "check_seed", "pixel_mask"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -78,6 +78,19 @@ def image_stack(a, name: str) -> np.ndarray:
                if a.ndim == 4 and a.shape[-1] in (3, 4) else "")
         raise EventDataError(f"{name} must be a stack [F, H, W] (or [F, H, W, 1]), got shape {a.shape}{fix}")
     return a
+
+def pixel_mask(mask, shape, name: str = "mask", fix: str = "") -> np.ndarray:
+    """``mask`` as a bool array [H, W] of ``shape`` (one value per pixel: True where the pixel is meant); a list or a
+    tensor of bools is taken. Else an EventDataError naming ``name``, the shape wanted, what was given and ``fix``
+    (numbers were taken as indices, a mask of another shape numpy's IndexError)."""
+    arr = None if mask is None or isinstance(mask, (str, bytes)) else \
+        dense_array(mask, f"{name}=", error=EventDataError, want=f"a bool array of shape (H, W) = {tuple(shape)}")
+    if arr is None or arr.dtype != bool or arr.shape != tuple(shape):
+        got = f"{arr.dtype} array of shape {arr.shape}" if arr is not None else short_repr(mask)
+        raise EventDataError(f"{name}= must be a bool array of the sensor's shape (H, W) = {tuple(shape)} (True where "
+                             f"a pixel is meant), got {got}" + (f"; {fix}" if fix else ""))
+    return arr
+
 
 # (expected class name, given class name) -> how to turn the one into the other
 TypeFix = {

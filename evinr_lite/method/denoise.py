@@ -60,7 +60,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.events import EventDataError, Events
-from ..core.checks import choice
+from ..core.checks import ArgumentTypeError, choice
 from ..core.guard import dense_array
 
 __all__ = ["hot_pixel_mask", "hot_threshold", "check_counts", "check_count_pair",
@@ -179,6 +179,10 @@ def remove_hot_pixels(events: Events, mask: np.ndarray | None = None, **kw) -> E
     ``hot_pixel_mask(events, **kw)``)."""
     _check_events(events)
     H, W = events.sensor_size
+    unknown = sorted(set(kw) - {"factor", "rule"})
+    if unknown:   # was hot_pixel_mask's TypeError, named as another function's
+        raise ArgumentTypeError(f"remove_hot_pixels got an unknown keyword {unknown[0]!r}; it takes mask= or "
+                                "hot_pixel_mask's factor= and rule=")
     if mask is None:
         mask = hot_pixel_mask(events, **kw)
     elif kw:
