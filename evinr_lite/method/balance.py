@@ -421,7 +421,7 @@ def interval_imbalance(intervals, usable) -> float:
 def minmod(a: float, b: float, *more: float) -> float:
     """The smallest in magnitude of estimates that all agree in sign, 0 when any two disagree (a NaN estimate
     agrees with none: 0)."""
-    values = (a, b) + more
+    values = tuple(decimal_as_float(v) for v in (a, b) + more)   # a Decimal as its float, as before
     for k, v in enumerate(values):   # None or text was Python's "'>' not supported", an array numpy's "ambiguous"
         if not is_real_number(v):
             raise EventDataError(f"minmod: estimate {k + 1} must be a number (an imbalance b), got {v!r:.60}; pass "
@@ -436,9 +436,17 @@ def minmod(a: float, b: float, *more: float) -> float:
 def _check_usable(n_on, n_off, usable, name: str, *, grid: bool = False) -> tuple:
     """The balance estimates' arguments: two counts of one shape (``grid``: [K, H, W] slices) and ``usable``, a
     bool mask of their pixels' shape; None, text, lists of another shape or a 0/1 mask were Python's or numpy's
-    errors, or taken (an int mask indexed pixels 0 and 1)."""
+    errors, or taken (an int mask indexed pixels 0 and 1). Bool counts are refused; whole-number counts come back
+    as int64 (unsigned ones wrapped around in the differences), float counts in their dtype."""
     names = ("on", "off") if grid else ("n_on", "n_off")
-    on, off = (check_counts(a, f"{name}: {k}") for a, k in zip((n_on, n_off), names))   # dtypes kept
+    on, off = (check_counts(a, f"{name}: {k}") for a, k in zip((n_on, n_off), names))   # float dtypes kept
+    for arr, k in zip((on, off), names):   # bool counts were numpy's "boolean subtract" error (or read as 0/1)
+        if arr.dtype == bool:
+            raise EventDataError(f"{name}: {k} must be event counts per pixel (numbers >= 0), got a bool array; "
+                                 f"pass the counts themselves (e.g. from polarity_counts), or {k}.astype(int) if "
+                                 "the 0/1 values are meant as counts")
+    # whole-number counts as int64: uint16 counts wrapped around in n- - n+ (3210.6 for an estimate in [-1, 1])
+    on, off = (a.astype(np.int64) if a.dtype.kind in "iu" else a for a in (on, off))
     if on.shape != off.shape or (grid and on.ndim != 3):
         raise EventDataError(f"{name}: {names[0]} and {names[1]} must be counts of one shape"
                              + (" per time slice [K, H, W] (as slice_counts gives them)" if grid else

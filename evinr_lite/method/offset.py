@@ -55,7 +55,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from ..core.checks import ArgumentTypeError, choice, numbers_array, real_number, seconds_array, whole_number
+from ..core.checks import (ArgumentTypeError, choice, decimal_as_float, numbers_array, real_number, seconds_array,
+                           whole_number)
 from ..core.events import EventDataError
 from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues_unchecked
@@ -460,14 +461,15 @@ def _trend_window(window):
     """``window`` (seconds between the offset trend's knots) checked: None, or a finite number > 0."""
     if window is None:
         return None
-    return real_number(window, "window", lo=0, lo_open=True,
+    return real_number(decimal_as_float(window), "window", lo=0, lo_open=True,
                        hint="seconds between the offset's knots (EvINRConfig.offset_window), or None for one image")
 
 
 def trend_intervals(span: float, window: float | None) -> int:
     """How many intervals between knots :func:`offset_trend` puts over ``span`` seconds: 1 (one image)
     for ``window`` None or a span under 1.5 windows, else round(span / window)."""
-    span = real_number(span, "span", lo=0, hint="the span's length in seconds (t_end - t_start)")
+    # a Decimal (taken before, as in the readers' windows) as its float
+    span = real_number(decimal_as_float(span), "span", lo=0, hint="the span's length in seconds (t_end - t_start)")
     window = _trend_window(window)
     if window is None:
         return 1
