@@ -23,7 +23,7 @@ __all__ = ["require", "numbers_array", "whole_number", "real_number", "check_ima
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
            "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
            "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type",
-           "SEED_LIMIT", "check_seed", "pixel_mask"]
+           "SEED_LIMIT", "check_seed", "pixel_mask", "value_list"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -78,6 +78,29 @@ def image_stack(a, name: str) -> np.ndarray:
                if a.ndim == 4 and a.shape[-1] in (3, 4) else "")
         raise EventDataError(f"{name} must be a stack [F, H, W] (or [F, H, W, 1]), got shape {a.shape}{fix}")
     return a
+
+
+
+def value_list(values, name: str, what: str, *, text: bool = False) -> list:
+    """``values`` as a list: any iterable but text (a name is no list of its letters), bytes, a dict, None or a 0-d
+    array or tensor (which numpy and torch call iterable, then refuse to iterate: "iteration over a 0-d array").
+    ``text``: each value must be a str. Else an EventDataError naming ``name`` and ``what`` the list holds; a 0-d
+    array or tensor (and, with ``text``, one name) is told to pass ``[value]``."""
+    zero_d = not isinstance(values, (str, bytes, dict)) and getattr(values, "ndim", None) == 0
+    one = f"; for one, pass [{values.item()!r}]" if zero_d else \
+        f"; for one, pass [{values!r}]" if text and isinstance(values, str) else ""
+    if values is None or isinstance(values, (str, bytes, dict)) or zero_d:
+        raise EventDataError(f"{name}= must be a list of {what}, got {values!r:.60}{one}")
+    try:
+        values = list(values)
+    except TypeError:   # a number, or an object that is not iterable
+        raise EventDataError(f"{name}= must be a list of {what}, got {values!r:.60}") from None
+    if text:
+        bad = [v for v in values if not isinstance(v, str)]
+        if bad:
+            raise EventDataError(f"{name}= must hold text ({what}), got {bad[0]!r:.60}")
+    return values
+
 
 def pixel_mask(mask, shape, name: str = "mask", fix: str = "") -> np.ndarray:
     """``mask`` as a bool array [H, W] of ``shape`` (one value per pixel: True where the pixel is meant); a list or a

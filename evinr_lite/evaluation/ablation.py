@@ -34,11 +34,12 @@ from __future__ import annotations
 
 import hashlib
 import time
+from collections.abc import Mapping
 from dataclasses import asdict, replace
 
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, check_image_values, real_number, require, whole_number
+from ..core.checks import ArgumentTypeError, check_image_values, real_number, require, value_list, whole_number
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 from ..core.runtime import default_device
@@ -107,19 +108,6 @@ def ensemble_variants(duration: float, n_networks=(1, 2, 4), *, overlap: float =
             for n in n_networks}
 
 
-def _names_list(values, name: str, what: str, *, text: bool = False) -> list:
-    """``values`` as a list: any iterable but text (a name is no list of its letters), a dict or None."""
-    if values is None or isinstance(values, (str, bytes, dict)) or not hasattr(values, "__iter__"):
-        one = f"; for one, pass [{values!r}]" if text and isinstance(values, str) else ""
-        raise EventDataError(f"{name}= must be a list of {what}, got {values!r:.60}{one}")
-    values = list(values)
-    if text:
-        bad = [v for v in values if not isinstance(v, str)]
-        if bad:
-            raise EventDataError(f"{name}= must hold text ({what}), got {bad[0]!r:.60}")
-    return values
-
-
 def _check_common(common: dict, own, name: str) -> None:
     """Refuse a keyword in ``common`` that the variants set themselves: it was overwritten in some rows (or in
     all) without a word, so a table labelled one way was run another."""
@@ -133,8 +121,8 @@ def lambda_variants(lams, regularizers=("tikhonov",), **common) -> dict[str, EvI
     """The Full recipe with each regularizer weight in ``lams``, for each regularizer ("tikhonov", "tv")."""
     _check_common(common, ("regularizer", "lam"), "lambda_variants")
     lams = [real_number(lam, f"lams[{k}]", lo=0, hint="a regularizer weight (e.g. 0.05)")   # True was lambda = 1
-            for k, lam in enumerate(_names_list(lams, "lams", "weights, e.g. [0.01, 0.05, 0.2]"))]
-    regularizers = _names_list(regularizers, "regularizers", "names, e.g. ('tikhonov', 'tv')", text=True)
+            for k, lam in enumerate(value_list(lams, "lams", "weights, e.g. [0.01, 0.05, 0.2]"))]
+    regularizers = value_list(regularizers, "regularizers", "names, e.g. ('tikhonov', 'tv')", text=True)
     return {f"{reg}, lambda = {lam:g}": EvINRConfig.v0_1(**{**common, "regularizer": reg, "lam": float(lam)})
             for reg in regularizers for lam in lams}
 
@@ -341,8 +329,8 @@ def _run_one(name, variant, events, times, t_start, t_end, repeats, n_inference)
 def rows_by_name(rows: list[dict]) -> dict[str, dict]:
     """``{row["name"]: row}``."""
     out = {}
-    for k, r in enumerate(_names_list(rows, "rows", "rows (dicts with a 'name'), as run_variants returns them")):
-        if not isinstance(r, dict) or "name" not in r:
+    for k, r in enumerate(value_list(rows, "rows", "rows (dicts with a 'name'), as run_variants returns them")):
+        if not isinstance(r, Mapping) or "name" not in r:   # a Mapping row (a mappingproxy) was taken before: taken
             raise EventDataError(f"rows[{k}] must be a dict with a 'name' (a row of run_variants), got {r!r:.60}")
         if r["name"] in out:   # the first was dropped without a word
             raise EventDataError(f"rows hold the name {r['name']!r} twice (rows {list(out).index(r['name'])} and {k}); "
@@ -499,17 +487,17 @@ def compare_with_paper(ours: dict[str, dict], paper: dict[str, dict], pairs, met
                                 f"None for relative_change, got {type(change).__name__}")
     small_pct = real_number(small_pct, "small_pct", lo=0, hint="percent: smaller changes count as no change")
     for name, table in (("ours", ours), ("paper", paper)):
-        if not isinstance(table, dict):
+        if not isinstance(table, Mapping):   # a mappingproxy or other Mapping was taken before: taken
             raise EventDataError(f"{name}= must be a dict {{name: row}} (rows_by_name(rows) for ours, e.g. PAPER_TABLE2 "
                                  f"for the paper), got {type(table).__name__}")
-    pairs = _names_list(pairs, "pairs", "(variant, baseline) name pairs, e.g. [('Full', 'Base')]")
-    metrics = _names_list(metrics, "metrics", "(paper_key, our_key) pairs, e.g. [('ssim', 'ssim_clahe')]")
+    pairs = value_list(pairs, "pairs", "(variant, baseline) name pairs, e.g. [('Full', 'Base')]")
+    metrics = value_list(metrics, "metrics", "(paper_key, our_key) pairs, e.g. [('ssim', 'ssim_clahe')]")
     for k, pair in enumerate(pairs):
         if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
             raise EventDataError(f"pairs[{k}] must be (variant, baseline), two names, got {pair!r:.60}")
         for name in pair:
             for side, table in (("ours", ours), ("paper", paper)):
-                if name not in table:
+                if not _holds(table, name):
                     raise EventDataError(f"pairs[{k}] names {name!r}, which {side} has no row of (it has "
                                          f"{sorted(map(str, table))[:6]}); pass names present in both")
     for k, metric in enumerate(metrics):
@@ -521,7 +509,10 @@ def compare_with_paper(ours: dict[str, dict], paper: dict[str, dict], pairs, met
         for variant, baseline in pairs:
             for side, table, key in (("ours", ours, metric[1]), ("paper", paper, metric[0])):
                 for name in (variant, baseline):
-                    if not isinstance(table[name], dict) or key not in table[name]:
+                    if not isinstance(table[name], Mapping):   # was "has no 'mse_clahe'" for a row that held it
+                        raise EventDataError(f"{side}[{name!r}] must be a dict of metrics ({{metric: value}}), got "
+                                             f"{type(table[name]).__name__}")
+                    if not _holds(table[name], key):
                         raise EventDataError(f"{side}[{name!r}] has no {key!r} (metrics[{k}]); pass rows that hold it, "
                                              "or leave that metric out")
     out = []
@@ -542,15 +533,23 @@ def compare_with_paper(ours: dict[str, dict], paper: dict[str, dict], pairs, met
     return out
 
 
+def _holds(table, key) -> bool:
+    """Whether the Mapping ``table`` has ``key`` (an unhashable key, a list, is in none: Python's TypeError)."""
+    try:
+        return key in table
+    except TypeError:
+        return False
+
+
 def comparison_table(comparisons: list[dict]) -> str:
     """Markdown table of :func:`compare_with_paper`'s output, with a line counting the disagreements."""
-    comparisons = _names_list(comparisons, "comparisons", "compare_with_paper's dicts")
+    comparisons = value_list(comparisons, "comparisons", "compare_with_paper's dicts")
     if not comparisons:
         raise EventDataError("no comparisons to tabulate: pass compare_with_paper's output (one dict per pair and "
                              "metric)")
     keys = ("variant", "baseline", "metric", "paper_pct", "ours_pct", "agree", "small_pct")
     for k, c in enumerate(comparisons):
-        missing = [key for key in keys if not isinstance(c, dict) or key not in c]
+        missing = [key for key in keys if not isinstance(c, Mapping) or key not in c]
         if missing:
             raise EventDataError(f"comparisons[{k}] must be a dict of compare_with_paper's (it has no {missing[0]!r}), "
                                  f"got {c!r:.60}")
