@@ -213,8 +213,10 @@ def check_time_range(value, name: str, error=None) -> tuple[float, float]:
     error = error or EventDataError
     try:
         # text ("0", "1") was parsed, True taken as 1 s and a dict's keys as the range: none is a pair of seconds
-        if isinstance(value, (str, bytes, dict, set, frozenset)) or \
-                any(isinstance(v, (str, bytes, bool, np.bool_)) for v in value):
+        if isinstance(value, (str, bytes, dict, set, frozenset)):
+            raise TypeError
+        value = tuple(value)   # a generator or other one-pass iterable: read once (the scan below consumed it)
+        if any(isinstance(v, (str, bytes, bool, np.bool_)) for v in value):
             raise TypeError
         lo, hi = (float(v) for v in value)
     except (TypeError, ValueError):

@@ -553,8 +553,9 @@ def save_json(path, obj) -> None:
     """``obj`` as indented JSON text in the file ``path``. The text is made before the file is opened, so an object
     JSON cannot hold (a numpy number, a tensor, a Path) leaves no half-written file; that is an ArgumentTypeError
     naming the fix (``apps.results.jsonable`` makes numpy values and tuples plain), and a folder that cannot be written
-    an OutputError."""
-    check_path_type(path, "path", "the JSON file to write")   # 5 was written to file descriptor 5
+    an OutputError. ``path``: a str, a Path or bytes (as ``open`` takes them); None or a number is refused."""
+    if not isinstance(path, bytes):   # bytes paths are os.open's and were written before: taken as they were
+        check_path_type(path, "path", "the JSON file to write")   # 5 was written to file descriptor 5
     try:
         text = json.dumps(obj, indent=2) + "\n"
     except (TypeError, ValueError) as err:   # the file had been opened and half written

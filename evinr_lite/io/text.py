@@ -560,6 +560,18 @@ def _check_origin_ns(origin_ns):
                              f"from the first timestamp, got {origin_ns!r:.60}") from None
 
 
+def _byte_buffer(data) -> bool:
+    """Whether ``data`` holds bytes one by one (bytes, bytearray, memoryview, mmap, a 1-D uint8 array: what
+    np.frombuffer reads as the file's bytes); text and arrays of wider numbers do not."""
+    if isinstance(data, str):
+        return False
+    try:
+        view = memoryview(data)
+    except TypeError:
+        return False
+    return view.itemsize == 1 and view.ndim == 1
+
+
 def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto", data: bytes | bytearray | None = None,
                      layout: TextLayout = TXT_LAYOUT) -> EventBlock:
     """A whole `t x y p` text file (optionally after a `W H` header), block by block.
@@ -573,9 +585,10 @@ def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "au
     """
     check_path_type(path, "path", "the event text file")   # None or 5 was Python's "expected str, bytes or os.PathLike"
     origin_ns = _check_origin_ns(origin_ns)
-    if data is not None and not isinstance(data, (bytes, bytearray, memoryview)):   # text was np.frombuffer's error
-        raise ArgumentTypeError(f"data= must be the file's bytes (bytes or bytearray; text: data.encode()) or None to "
-                                f"read the file, got {type(data).__name__}")
+    if data is not None and not _byte_buffer(data):   # text was np.frombuffer's error
+        raise ArgumentTypeError(f"data= must be the file's bytes (bytes, bytearray, memoryview, mmap or a 1-D uint8 "
+                                f"array; text: data.encode()) or None to read the file, got {type(data).__name__}"
+                                + (f" of {data.dtype} {data.shape}" if isinstance(data, np.ndarray) else ""))
     if not isinstance(layout, TextLayout):   # None was "has no attribute 'size_line'"
         raise ArgumentTypeError(f"layout= must be a TextLayout (e.g. TXT_LAYOUT, the default), got "
                                 f"{type(layout).__name__}")

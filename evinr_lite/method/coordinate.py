@@ -39,6 +39,7 @@ The reference solutions of notebook 03's exercises live here and are registered 
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Callable
@@ -180,11 +181,14 @@ def split_index(index: torch.Tensor, sensor_size) -> tuple[torch.Tensor, torch.T
     """
     H, W = check_sensor_size(sensor_size)   # (0, W) was torch's ZeroDivisionError, (12.5, W) float indices
     # a type test per call (the training loop's): no pass over the values, no device sync
-    if not isinstance(index, (torch.Tensor, np.ndarray)) or index.dtype in (torch.bool, np.bool_) or \
+    if isinstance(index, (numbers.Integral, np.integer)) and not isinstance(index, bool):
+        pass   # one whole index (5, np.int64(5)): taken before, split as such
+    elif not isinstance(index, (torch.Tensor, np.ndarray)) or index.dtype in (torch.bool, np.bool_) or \
             (index.is_floating_point() or index.is_complex() if isinstance(index, torch.Tensor)
              else index.dtype.kind not in "iu"):
-        raise EventDataError(f"index= must be a tensor (or numpy array) of whole flat indices (torch.long), got "
-                             f"{type(index).__name__}{' of ' + str(index.dtype) if hasattr(index, 'dtype') else ''}; "
+        array = isinstance(index, (torch.Tensor, np.ndarray))
+        raise EventDataError(f"index= must be a tensor (or numpy array) of whole flat indices (torch.long), or one "
+                             f"whole index, got {type(index).__name__}{' of ' + str(index.dtype) if array else ''}; "
                              "e.g. torch.randint(B * H * W, (M,))")
     return index // (H * W), (index // W) % H, index % W
 
