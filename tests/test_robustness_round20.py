@@ -172,9 +172,9 @@ CASES = {
     "highpass_per_event-alpha-None": (lambda: _hpe(alpha=None), r"alpha= must be a finite number.*rad/s"),
     "highpass_per_event-alpha-NaN": (lambda: _hpe(alpha=np.nan), r"alpha= must be a finite number"),
     "highpass_per_event-t_end-None": (lambda: _hpe(t_end=None), r"t_end= must be a finite number"),
-    "highpass_per_event-t_end-early": (lambda: _hpe(t_end=0.5), r"t_start and t_end must hold the events"),
+    "highpass_per_event-t_end-early": (lambda: _hpe(t_end=0.5), r"t_end=0.5 s is before the last event.*pass t_start <= t\[0\] and t_end >= t\[-1\]"),
     "highpass_per_event-t_start-None": (lambda: _hpe(t_start=None), r"t_start= must be a finite number"),
-    "highpass_per_event-t_start-late": (lambda: _hpe(t_start=0.5), r"t_start and t_end must hold the events"),
+    "highpass_per_event-t_start-late": (lambda: _hpe(t_start=0.5), r"t_start=0.5 s is after the first event.*pass t_start <= t\[0\]"),
     "highpass_per_event-unsorted": (lambda: _hpe(t=EV.t[::-1]), r"t= must be finite seconds in time order .*sort"),
     "highpass_per_event-t-NaN": (lambda: _hpe(t=EV.t * np.nan), r"t= must be finite seconds in time order"),
     # ---- method.coordinate / siren -----------------------------------------------------------------------------

@@ -146,8 +146,12 @@ def jsonable(obj):
         return obj.item()
     if isinstance(obj, torch.Tensor):   # kept as a tensor, json.dump's "not JSON serializable" when written
         return obj.tolist()
-    if isinstance(obj, (set, frozenset)):
-        return [jsonable(v) for v in sorted(obj, key=repr)]
+    if isinstance(obj, (set, frozenset)):   # a set has no order: sorted, numbers as numbers ({10, 9, 2}: [2, 9, 10])
+        try:
+            ordered = sorted(obj)
+        except TypeError:   # mixed kinds (1 and "a"): in the order of their repr
+            ordered = sorted(obj, key=repr)
+        return [jsonable(v) for v in ordered]
     if isinstance(obj, PurePath):
         return str(obj)
     return obj

@@ -23,7 +23,8 @@ __all__ = ["require", "numbers_array", "whole_number", "real_number", "check_ima
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
            "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
            "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type",
-           "SEED_LIMIT", "check_seed", "pixel_mask", "value_list"]
+           "SEED_LIMIT", "check_seed", "pixel_mask", "value_list",
+           "blank_path"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -110,8 +111,11 @@ def pixel_mask(mask, shape, name: str = "mask", fix: str = "") -> np.ndarray:
         dense_array(mask, f"{name}=", error=EventDataError, want=f"a bool array of shape (H, W) = {tuple(shape)}")
     if arr is None or arr.dtype != bool or arr.shape != tuple(shape):
         got = f"{arr.dtype} array of shape {arr.shape}" if arr is not None else short_repr(mask)
+        arg = name.rsplit(": ", 1)[-1]
+        numeric = (f"; for a 0/1 (or 0/255) mask pass {arg} != 0" if arr is not None and arr.dtype.kind in "iuf"
+                   and arr.shape == tuple(shape) else "")
         raise EventDataError(f"{name}= must be a bool array of the sensor's shape (H, W) = {tuple(shape)} (True where "
-                             f"a pixel is meant), got {got}" + (f"; {fix}" if fix else ""))
+                             f"a pixel is meant), got {got}{numeric}" + (f"; {fix}" if fix else ""))
     return arr
 
 
@@ -275,6 +279,16 @@ def check_path_type(value, name: str, what: str, hint: str = ""):
         raise ArgumentTypeError(f"{name}= must be {what} (a str or Path), got {type(value).__name__}"
                                 + (f"; {hint}" if hint else ""))
     return value
+
+
+def blank_path(value) -> bool:
+    """Whether a path (checked by :func:`check_path_type`) names nothing: blank text, or a Path whose text is "."
+    (``Path("")`` is ``Path(".")``, so the two cannot be told apart; the text "." stays a path: the current folder
+    named on purpose). Callers that take "" as a mistake refuse both."""
+    if isinstance(value, str):
+        return not value.strip()
+    text = os.fspath(value) if isinstance(value, os.PathLike) else value
+    return isinstance(text, str) and text in ("", ".")
 
 
 def is_real_number(value) -> bool:

@@ -27,7 +27,7 @@ import numpy as np
 import torch
 from torch import nn
 
-from ..core.checks import check_image_values, check_path_type, numbers_array
+from ..core.checks import blank_path, check_image_values, check_path_type, numbers_array
 from ..core.events import EventDataError
 from ..core.runtime import weights_dir
 
@@ -135,9 +135,9 @@ def lpips_paths(cache_dir=None) -> tuple[Path, Path]:
     if cache_dir is not None:   # a number or a list was Python's "expected str, bytes or os.PathLike object"
         check_path_type(cache_dir, "cache_dir", "a folder holding the LPIPS weights",
                         "or None for the kit's cache (where `python -m data_fetch get lpips all` puts them)")
-        if not str(cache_dir).strip():   # "" was the current folder
-            raise EventDataError("cache_dir= is empty; pass the folder holding the LPIPS weights, or None for the kit's "
-                                 "cache")
+        if blank_path(cache_dir):   # "" (and Path(""), which reads ".") was the current folder
+            raise EventDataError(f"cache_dir= is empty ({cache_dir!r}; '' and Path('') both mean the current folder): pass the folder holding the LPIPS weights "
+                                 "(Path.cwd() for the current folder), or None for the kit's cache")
     cache_dir = Path(weights_dir("lpips") if cache_dir is None else cache_dir)
     return cache_dir / ALEXNET_FILE, cache_dir / LINEAR_FILE
 

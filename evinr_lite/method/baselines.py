@@ -242,10 +242,15 @@ def highpass_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
 
 def _check_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start) -> tuple:
     """highpass_per_event's arguments, checked before its loop: columns of one length (t numbers in time order, its
-    dtype kept; x, y whole pixels on the sensor; p numbers), C, alpha and the times finite numbers, t_start at or
+    dtype kept; x, y whole pixels on the sensor; p finite numbers, not bools), C, alpha and the times finite numbers, t_start at or
     before the first event and t_end at or after the last (a t_end before it grew the state). alpha may be any finite
     number: the exercise's wrong solutions pass -alpha."""
     H, W = check_sensor_size(sensor_size)
+    if getattr(host_array(p), "dtype", None) == bool or (isinstance(p, (list, tuple)) and p and
+                                                          all(isinstance(v, (bool, np.bool_)) for v in p)):
+        # bfcd363 added C for True and nothing for False: OFF events were lost without a word
+        raise EventDataError("p= must be polarities +1/-1 (one number per event), got bools (ON/OFF flags); pass "
+                             "np.where(p, 1, -1)")
     cols = []
     for name, col in (("t", t), ("x", x), ("y", y), ("p", p)):
         arr = numbers_array(col, name, "one number per event (a 1-D array)")
@@ -263,13 +268,20 @@ def _check_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start) -> tuple
             raise EventDataError(f"{name}= must be whole pixel indices in [0, {n - 1}] for sensor_size {(H, W)} (H, W); "
                                  f"got values in [{col.min() if len(col) else 0}, {col.max() if len(col) else 0}]")
     x, y = x.astype(np.int64), y.astype(np.int64)
+    if not np.all(np.isfinite(p)):   # the state became NaN (or inf) at that pixel, without a word
+        bad = int(np.flatnonzero(~np.isfinite(p))[0])
+        raise EventDataError(f"p= must be finite polarities (+1/-1), but p[{bad}] = {p[bad]}; drop those events or "
+                             "give them their polarity")
     C = real_number(C, "C", hint="the contrast threshold in log units (e.g. 0.2)")
     alpha = real_number(alpha, "alpha", hint="the cut-off in rad/s")
     t_start = real_number(t_start, "t_start", hint="seconds: every pixel starts at 0 then")
     t_end = real_number(t_end, "t_end", hint="seconds: the time of the returned state")
-    if len(t) and (t_start > t[0] or t_end < t[-1]):
-        raise EventDataError(f"t_start and t_end must hold the events: t_start={t_start:g} <= t[0]={t[0]:g} and "
-                             f"t_end={t_end:g} >= t[-1]={t[-1]:g} s")
+    if len(t) and t_start > t[0]:
+        raise EventDataError(f"t_start={t_start:g} s is after the first event (t[0]={t[0]:g} s): pass t_start <= t[0] "
+                             "and t_end >= t[-1] (the span the events lie in)")
+    if len(t) and t_end < t[-1]:   # the state grew: the last events' decay ran backwards
+        raise EventDataError(f"t_end={t_end:g} s is before the last event (t[-1]={t[-1]:g} s): pass t_start <= t[0] "
+                             "and t_end >= t[-1] (the span the events lie in)")
     if t_end < t_start:
         raise EventDataError(f"t_end={t_end:g} s comes before t_start={t_start:g} s; t_end must not come first")
     return t, x, y, p, (H, W), C, alpha, t_end, t_start

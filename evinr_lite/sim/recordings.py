@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.checks import check_path_type, real_number, whole_number
+from ..core.checks import blank_path, check_path_type, real_number, whole_number
 from ..core.events import EventDataError
 from ..io.output import atomic_output_dir, save_png
 from ..io.readers import read_recording
@@ -78,8 +78,9 @@ def find_recording(path=None, scratch=None, *, start=None) -> tuple[Path, str]:
     """
     if path is not None:
         check_path_type(path, "path", "a recording (a file or a folder)", "or None to find one")
-        if not str(path).strip():   # "" was the current folder, "given"
-            raise EventDataError("path= is empty; pass the recording's path, or None to find one")
+        if blank_path(path):   # "" (and Path(""), which reads ".") was the current folder, "given"
+            raise EventDataError(f"path= is empty ({path!r}; '' and Path('') both mean the current folder): pass the recording's path (Path.cwd() for the "
+                                 "current folder), or None to find one")
         path = Path(path)
         if not path.exists():
             raise EventDataError(f"no such recording: {path}; check the path")
