@@ -186,7 +186,8 @@ def check_time_span(t, source, time_unit: str, *, flag: str = "time_unit") -> No
     arr = None if t is None or isinstance(t, (str, bytes)) else np.asarray(host_array(t))
     if arr is None or arr.dtype.kind not in "iuf":   # None and text passed unchecked, bools were numpy's subtract error
         raise EventDataError(f"{source}: timestamps must be numbers (seconds), got "
-                             f"{type(t).__name__ if arr is None else arr.dtype}")
+                             f"{type(t).__name__ if arr is None else arr.dtype}; pass the events' times as an array of "
+                             f"numbers (e.g. np.asarray(t, dtype=np.float64))")
     t = arr
     if t.size < 2:
         return
@@ -260,7 +261,8 @@ def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
     per_s = round(1 / TIME_UNITS[time_unit])  # 1, 1000, 10**6, 10**9 units per second
     t = np.asarray(host_array(t))
     if t.dtype.kind not in "iuf":
-        raise EventDataError(f"timestamps must be numbers, got dtype {t.dtype}")
+        raise EventDataError(f"timestamps must be numbers, got dtype {t.dtype}; pass them as an array of numbers "
+                             f"(float seconds, or whole units with time_unit=, e.g. 'us')")
     if t.ndim != 1:   # a 0-d array came back as a number, [N, 2] as rows of "times"
         raise EventDataError(f"timestamps must be a 1-D array [N], got shape {t.shape}; flatten one time per row with "
                              "np.ravel(t)")
