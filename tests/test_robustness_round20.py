@@ -549,3 +549,171 @@ def test_core_checks_keep_what_they_took_guard():
     cevents.check_time_span(np.array([0.0, 1.0]), "src", "s")   # plausible: no error
     assert to_grey_uint8(np.full((2, 2), 0.5), "img").tolist() == [[128, 128], [128, 128]]
     assert to_grey_uint8(np.full((2, 2), 1.002), "img").max() == 255   # rounding over 1 stays clipped
+
+
+# ---- the review's fixes (/tmp/s36/review20.md: D1-D4, O1-O2, N1-N4, N6) --------------------------------------
+# Bad inputs still taken, or refused with another's words, after the round's first fixes; each refused by name now.
+
+def _mmap_of(path):
+    import mmap
+    with open(path, "rb") as f:
+        return mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
+
+
+HOT = np.zeros((12, 16), bool)
+HOT[3, 4] = HOT[5, 6] = True
+
+REVIEW_CASES = {
+    # D1: bool counts were numpy's "boolean subtract" error (pooled) or read as 0/1 (slope, gradient)
+    "pooled-bool-counts": (lambda: balance.pooled_imbalance(ON > 4, OFF > 4, USE),
+                           r"pooled_imbalance: n_on must be event counts .*got a bool array; .*astype\(int\)"),
+    "slope-bool-counts": (lambda: balance.slope_imbalance(ON > 4, OFF, USE), r"slope_imbalance: n_on .*bool array"),
+    "slope-bool-off": (lambda: balance.slope_imbalance(ON, OFF > 4, USE), r"slope_imbalance: n_off .*bool array"),
+    "gradient-bool-counts": (lambda: balance.gradient_imbalance(SL[0] > 1, SL[1] > 1, USE),
+                             r"gradient_imbalance: on must be event counts .*bool array"),
+    # D2: a 0-d array or tensor was "iteration over a 0-d array/tensor"
+    "lambda_variants-0d": (lambda: ablation.lambda_variants(np.array(0.1)), r"lams= must be a list .*pass \[0\.1\]"),
+    "lambda_variants-0d-tensor": (lambda: ablation.lambda_variants(torch.tensor(0.5)), r"lams= must be a list"),
+    "lambda_variants-regularizers-0d": (lambda: ablation.lambda_variants([0.1], np.array("tv")),
+                                        r"regularizers= must be a list .*pass \['tv'\]"),
+    "rows_by_name-0d": (lambda: ablation.rows_by_name(np.array(1)), r"rows= must be a list of rows"),
+    "comparison_table-0d-tensor": (lambda: ablation.comparison_table(torch.tensor(1.0)), r"comparisons= must be a list"),
+    "compare_with_paper-pairs-0d": (lambda: ablation.compare_with_paper(OURS, PAPER, np.array(1)),
+                                    r"pairs= must be a list"),
+    "compare_with_paper-metrics-0d": (lambda: ablation.compare_with_paper(OURS, PAPER, [("A", "B")], np.array(1)),
+                                      r"metrics= must be a list"),
+    # D3: a row that is no Mapping was "'int' object is not subscriptable" (round 20: "has no 'mse_clahe'")
+    "compare_with_paper-row-number": (lambda: ablation.compare_with_paper({"A": 5, "B": OURS["B"]}, PAPER, [("A", "B")]),
+                                      r"ours\['A'\] must be a dict of metrics .*got int"),
+    "compare_with_paper-paper-row-list": (lambda: ablation.compare_with_paper(OURS, {"A": [1], "B": PAPER["B"]},
+                                                                              [("A", "B")]),
+                                          r"paper\['A'\] must be a dict of metrics .*got list"),
+    "compare_with_paper-pair-unhashable": (lambda: ablation.compare_with_paper(OURS, PAPER, [(["A"], "B")]),
+                                           r"pairs\[0\] names \['A'\], which ours has no row of"),
+    # D4: NaN or inf polarities gave a NaN (inf) state; bool polarities added nothing for OFF (silently wrong)
+    "highpass_per_event-p-NaN": (lambda: _hpe(p=np.where(np.arange(N) == 3, np.nan, EV.p)),
+                                 r"p= must be finite polarities \(\+1/-1\), but p\[3\] = nan"),
+    "highpass_per_event-p-inf": (lambda: _hpe(p=np.where(np.arange(N) == 7, -np.inf, EV.p)), r"p\[7\] = -inf"),
+    "highpass_per_event-p-bool": (lambda: _hpe(p=EV.p > 0), r"got bools \(ON/OFF flags\); pass np.where\(p, 1, -1\)"),
+    "highpass_per_event-p-bool-list": (lambda: _hpe(p=(EV.p > 0).tolist()), r"np.where\(p, 1, -1\)"),
+    "highpass_per_event-p-bool-tensor": (lambda: _hpe(p=torch.as_tensor(EV.p > 0)), r"np.where\(p, 1, -1\)"),
+    # N3: a 0/1 or 0/255 mask: the message names mask != 0
+    "pooled-usable-uint8": (lambda: balance.pooled_imbalance(ON, OFF, USE.astype(np.uint8)), r"pass usable != 0"),
+    "remove_hot_pixels-mask-0/255": (lambda: denoise.remove_hot_pixels(EV, HOT.astype(np.uint8) * 255),
+                                     r"remove_hot_pixels: mask= must be a bool array .*pass mask != 0"),
+    "remove_hot_pixels-mask-shape": (lambda: denoise.remove_hot_pixels(EV, HOT[:3]), r"got bool array of shape \(3, 16\)"),
+    "drop_pixels-mask-float": (lambda: prepare.drop_pixels(EV, HOT.astype(float)), r"mask= must be a bool .*mask != 0"),
+    # N4: Path("") is Path("."): it was the current folder, "given"
+    "find_recording-Path-empty": (lambda: recordings.find_recording(__import__("pathlib").Path("")),
+                                  r"path= is empty .*Path\.cwd\(\)"),
+    "lpips_paths-Path-empty": (lambda: lpips.lpips_paths(__import__("pathlib").Path("")), r"cache_dir= is empty"),
+    # O2: the message of a numpy scalar of the wrong kind said "float64 of float64"; True is no index
+    "split_index-float-scalar": (lambda: coordinate.split_index(np.float64(5), (12, 16)),
+                                 r"or one whole index, got float64; e\.g\."),
+    "split_index-bool": (lambda: coordinate.split_index(True, (12, 16)), r"index= .*got bool"),
+    "parse_event_text-data-float-array": (lambda: text.parse_event_text("e.txt", data=np.zeros(3)),
+                                          r"data= must be the file's bytes .*got ndarray of float64"),
+    "check_time_range-generator-text": (lambda: cevents.check_time_range((v for v in ("0", "1")), "r"),
+                                        r"r must be \(start, end\) in seconds"),
+    "minmod-Decimal-NaN": (lambda: balance.minmod(__import__("decimal").Decimal("NaN"), 0.1),
+                           r"estimate 1 must be a number"),
+    "trend_intervals-Decimal-NaN": (lambda: offset.trend_intervals(__import__("decimal").Decimal("NaN"), 2.0),
+                                    r"span= must be a finite number"),
+    # messages that now name the fix
+    "relative_seconds-bool": (lambda: cevents.relative_seconds(np.array([True, False])),
+                              r"got dtype bool; pass them as an array of numbers"),
+    "check_time_span-None-fix": (lambda: cevents.check_time_span(None, "src", "s"), r"got NoneType; pass the events'"),
+    # refused on purpose (documented in docs/reliability.md): float32 seconds at 16 s or later, repeated grid times
+    "score_predictions-float32-late": (lambda: results.score_predictions(
+        GT.images, np.array([20.1, 20.5, 20.9], np.float32), Frames(GT.images, np.array([20.1, 20.5, 20.9]))),
+        r"pred_times= are float32 seconds"),
+    "offset_trend-float32-late": (lambda: offset.offset_trend(np.linspace(20, 21, 8).astype(np.float32), LOGF, 0.2),
+                                  r"times= are float32 seconds"),
+    "predict_anchored-float32-late": (lambda: coordinate.predict_anchored(MODEL, np.array([20.1], np.float32)),
+                                      r"query_times= are float32 seconds"),
+    "coarse_times-float32-late": (lambda: coarse.coarse_times(np.linspace(100, 101, 64).astype(np.float32)),
+                                  r"times= are float32 seconds"),
+    "coarse_times-repeated": (lambda: coarse.coarse_times(np.zeros(3)), r"strictly increasing .*np\.unique"),
+}
+
+
+@pytest.mark.parametrize("case", list(REVIEW_CASES))
+def test_review_a_bad_argument_is_named_with_its_fix(case, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    fn, match = REVIEW_CASES[case]
+    with pytest.raises(InputError, match=match):
+        fn()
+    assert not list(tmp_path.iterdir()), "a refused call left files behind"
+
+
+# Inputs taken at bfcd363 that the round's first fixes refused or changed: taken again, with bfcd363's results.
+
+def test_review_counts_of_any_whole_dtype_give_the_int64_estimate_guard():
+    on, off = ON.astype(np.int64), OFF.astype(np.int64)
+    pooled, slope = -0.02084446819882416, 0.026803368128577414   # bfcd363's values on int64 counts
+    assert balance.pooled_imbalance(on, off, USE) == pooled and balance.slope_imbalance(on, off, USE) == slope
+    for dtype in (np.uint8, np.uint16, np.uint32, np.uint64, np.int8, np.int16, np.int32):
+        assert balance.pooled_imbalance(on.astype(dtype), off.astype(dtype), USE) == pooled, dtype   # uint16: 3187.46
+        assert balance.slope_imbalance(on.astype(dtype), off.astype(dtype), USE) == slope, dtype
+    big = np.full((12, 16), 100, np.int8)   # 100 + 100 wrapped in int8 at bfcd363
+    assert balance.pooled_imbalance(big, big, USE) == 0.0
+    assert balance.pooled_imbalance(ON.astype(np.float32), OFF.astype(np.float32), USE) == -0.020844468846917152
+    g = balance.gradient_imbalance(SL[0].astype(np.uint16), SL[1].astype(np.uint16), USE)
+    assert g == balance.gradient_imbalance(*SL, USE)
+
+
+def test_review_decimal_numbers_are_taken_again_guard():
+    from decimal import Decimal
+    assert balance.minmod(Decimal("0.1"), 0.2) == 0.1
+    assert balance.minmod(Decimal("-0.1"), Decimal("-0.3"), -0.2) == -0.1
+    assert balance.minmod(Decimal("0.1"), -0.2) == 0.0
+    assert offset.trend_intervals(Decimal(10), Decimal(2)) == 5
+    assert offset.trend_intervals(Decimal("10.5"), Decimal("2.5")) == 4
+    assert offset.trend_knots(Decimal(10), Decimal(2)) == 6
+
+
+def test_review_scalar_indices_generators_buffers_and_bytes_paths_guard(tmp_path):
+    assert coordinate.split_index(5, (12, 16)) == (0, 0, 5)
+    assert coordinate.split_index(np.int64(12 * 16 + 17), (12, 16)) == (1, 1, 1)
+    assert cevents.check_time_range((v for v in (0.0, 1.0)), "r") == (0.0, 1.0)
+    assert cevents.check_time_range(iter([np.float64(2), 3]), "r") == (2.0, 3.0)
+    path = tmp_path / "ev.txt"
+    path.write_text("0.1 1 2 1\n0.2 3 4 0\n0.3 0 0 1\n")
+    want = text.parse_event_text(path)
+    for data in (_mmap_of(path), np.frombuffer(path.read_bytes(), np.uint8), memoryview(path.read_bytes())):
+        got = text.parse_event_text(path, data=data)
+        assert got.t.tolist() == want.t.tolist() == [0.1, 0.2, 0.3] and got.x.tolist() == [1, 3, 0]
+        assert got.p.tolist() == want.p.tolist()
+    output.save_json(bytes(tmp_path / "b.json"), {"a": [1, 2]})
+    assert (tmp_path / "b.json").read_text() == '{\n  "a": [\n    1,\n    2\n  ]\n}\n'
+
+
+def test_review_mapping_tables_and_rows_are_taken_again_guard():
+    from types import MappingProxyType as Proxy
+    metrics = [("ssim", "ssim_clahe"), ("mse", "mse_clahe")]
+    want = ablation.compare_with_paper(OURS, PAPER, [("A", "B")], metrics)
+    assert ablation.compare_with_paper({k: Proxy(v) for k, v in OURS.items()}, PAPER, [("A", "B")], metrics) == want
+    assert ablation.compare_with_paper(Proxy(OURS), Proxy(PAPER), [("A", "B")], metrics) == want
+    assert [c["agree"] for c in want] == ["yes", "yes"]
+    row = Proxy({"name": "a", "mse_clahe": 0.1})
+    assert ablation.rows_by_name([row]) == {"a": row}
+    assert ablation.comparison_table([Proxy(c) for c in COMPARED]) == ablation.comparison_table(COMPARED)
+
+
+def test_review_the_per_event_filter_keeps_bfcd363s_values_guard():
+    a = baselines.highpass_per_event(*HPE)
+    assert float(a.sum()) == pytest.approx(1.3125518562465963, rel=1e-12, abs=0)   # bfcd363's values
+    assert float(np.abs(a).max()) == pytest.approx(0.5682666027917622, rel=1e-12, abs=0)
+    assert np.array_equal(baselines.highpass_per_event(EV.t, EV.x, EV.y, EV.p.astype(np.int8), *HPE[4:]), a)
+    # a tensor p: bfcd363 summed in float32 (C * tensor); float64 now, as for arrays: the same to float32's precision
+    assert np.allclose(baselines.highpass_per_event(EV.t, EV.x, EV.y, torch.as_tensor(EV.p), *HPE[4:]), a,
+                       rtol=1e-6, atol=1e-7)
+
+
+def test_review_masks_sets_and_paths_guard(tmp_path):
+    want = int((~HOT[EV.y, EV.x]).sum())
+    for mask in (HOT, HOT.tolist(), torch.as_tensor(HOT)):   # remove_hot_pixels took these at bfcd363 too
+        assert len(denoise.remove_hot_pixels(EV, mask)) == want == len(prepare.drop_pixels(EV, mask))
+    assert results.jsonable({10, 9, 2}) == [2, 9, 10] and results.jsonable(frozenset({2.5, 1, 10})) == [1, 2.5, 10]
+    assert results.jsonable({"b", "a"}) == ["a", "b"] and results.jsonable({1, "a"}) == ["a", 1]
+    assert recordings.find_recording(tmp_path) == (tmp_path, "given")   # a real folder stays a path
