@@ -85,7 +85,9 @@ CLASSES = [
     ("public functions that take data and no round had named (the balance's estimates, the offset trend, the coarse "
      "correction's helpers, pixel masks, the per-event filter, the coordinate method's pieces, the ablation helpers, "
      "LPIPS, the apps' scorers and writers, the text parsers, JSON and paths): None, text, NaN, shapes, masks, "
-     "counts, keywords a helper sets itself, half-written files, round 20", "test_robustness_round20.py", r"test_"),
+     "counts, keywords a helper sets itself, half-written files, round 20 and its review (uint and bool counts, 0-d "
+     "lists, Mapping rows, NaN and bool polarities, restored buffers, scalars, generators, bytes paths and Decimal)",
+     "test_robustness_round20.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"
