@@ -31,7 +31,7 @@ LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustn
          "test_robustness_round11.py", "test_robustness_round12.py", "test_robustness_round13.py",
          "test_robustness_round14.py", "test_robustness_round15.py", "test_robustness_round16.py",
          "test_robustness_round17.py", "test_robustness_round18.py",
-         "test_robustness_round19.py"]
+         "test_robustness_round19.py", "test_robustness_round20.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
@@ -82,6 +82,12 @@ CLASSES = [
     ("enumerated options (equalisation, tone maps, the denoiser's rule and window, the config's and run options' option "
      "fields, anchors, baselines' loops, offset solves, polarity encodings, figure options) given arrays, lists, dicts, "
      "tensors, None or numbers: one shared check, round 19", "test_robustness_round19.py", r"test_"),
+    ("public functions that take data and no round had named (the balance's estimates, the offset trend, the coarse "
+     "correction's helpers, pixel masks, the per-event filter, the coordinate method's pieces, the ablation helpers, "
+     "LPIPS, the apps' scorers and writers, the text parsers, JSON and paths): None, text, NaN, shapes, masks, "
+     "counts, keywords a helper sets itself, half-written files, round 20 and its review (uint and bool counts, 0-d "
+     "lists, Mapping rows, NaN and bool polarities, restored buffers, scalars, generators, bytes paths and Decimal)",
+     "test_robustness_round20.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"

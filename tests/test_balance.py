@@ -293,7 +293,7 @@ def test_the_counts_alone_are_bounded_by_the_three_other_estimates(monkeypatch):
     sliced = (np.ones((4,) + n.shape), np.ones((4,) + n.shape))
     assert balance_from_counts(n_on, n_off, C, intervals=ivl).imbalance == pytest.approx(b, abs=1e-9)
     for grad, expect in ((-0.2, b), (-0.12, None), (-0.01, None)):
-        monkeypatch.setattr(balance, "gradient_imbalance", lambda *a, g=grad: g)
+        monkeypatch.setattr(balance, "_gradient_imbalance", lambda *a, g=grad: g)   # the fit's unchecked call
         fit = balance_from_counts(n_on, n_off, C, intervals=ivl, sliced=sliced)
         assert fit.chosen == "counts" and fit.slope_imbalance == pytest.approx(b, abs=1e-9)
         nearest = min(fit.raw_imbalance, fit.gradient_imbalance, fit.interval_imbalance)   # all above b
@@ -330,7 +330,7 @@ def test_counts_that_show_no_change_of_light_overrule_intervals_of_the_other_sig
     rows = np.linspace(0.5, 1.5, 20)[:, None] * np.ones((1, 20))
     ivl = _interval_arrays(rows.shape, 2 * np.arctanh(0.08), 0.0)
     sliced = (np.ones((4,) + rows.shape), np.ones((4,) + rows.shape))
-    monkeypatch.setattr(balance, "gradient_imbalance", lambda *a: -0.12)
+    monkeypatch.setattr(balance, "_gradient_imbalance", lambda *a: -0.12)   # the fit's unchecked call
     cases = ((12.0, 0.0, "agreement"), (12.0, -0.5 * STEADY_LIGHT, "agreement"),
              (12.0, 3 * STEADY_LIGHT, "nominal"), (3.0, 0.0, "nominal"))
     for mean_n, light, expect in cases:

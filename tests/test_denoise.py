@@ -185,7 +185,7 @@ def test_stages_can_be_switched_off_and_empty_input(noisy_scene):
     (lambda ev: hot_pixel_mask(ev, rule="mean"), r"rule must be one of \('mad', 'median'\) \(the hot-pixel rule\), got 'mean'"),
     (lambda ev: hot_pixel_mask(ev, rule="median", factor=1.0), r"must exceed 1"),
     (lambda ev: hot_pixel_mask(ev, factor=-2), r"must be > 0"),
-    (lambda ev: remove_hot_pixels(ev, np.zeros((3, 3), bool)), r"mask must be a bool array of the sensor's shape"),
+    (lambda ev: remove_hot_pixels(ev, np.zeros((3, 3), bool)), r"mask= must be a bool array of the sensor's shape"),
     (lambda ev: denoise_fn(ev.to_array()), r"expected an Events"),
     (lambda ev: correlation_filter(Events(ev.t + 1e5, ev.x, ev.y, ev.p, ev.sensor_size), 1e-9),
      r"below the resolution of these timestamps"),

@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.checks import check_log, true_or_false
+from ..core.checks import check_log, check_path_type, true_or_false
 from ..core.events import EventDataError
 from ..core.runtime import cache_dir
 from ..evaluation.scoring import pool
@@ -307,7 +307,15 @@ def evaluate_recording(item: dict, out_dir, settings: dict) -> dict:
         failure is returned (status "failed", "error"), never raised, so one bad recording does not
         stop the batch.
     """
-    out = Path(out_dir) / item["name"]
+    # None, text or a dict without its keys was Python's "not subscriptable" or a KeyError, raised (the failures this
+    # returns are the recording's, not a call's)
+    if not isinstance(item, dict) or any(not isinstance(item.get(k), str) for k in ("name", "dataset", "path")):
+        raise EventDataError(f"item= must be a dict with the text 'name', 'dataset' and 'path' (one of resolve_inputs' "
+                             f"items), got {item!r:.80}")
+    if not isinstance(settings, dict):
+        raise EventDataError(f"settings= must be a dict of the batch's settings (e.g. {{'C': 0.2, 'fps': 30}}; {{}} for "
+                             f"the defaults), got {type(settings).__name__}")
+    out = Path(check_path_type(out_dir, "out_dir", "the batch's output folder")) / item["name"]
     if "identity" not in item:
         item = {**item, "identity": input_identity(item["path"])}
     state, done = result_state(out, item, settings, claimed=bool(item.get("claimed")))

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.cfa import BAYER, cfa_phase
+from ..core.checks import ArgumentTypeError, require
 from ..core.events import EventDataError, Events
 from ..core.frames import GREY_WEIGHTS, Frames
 from ..core.recording import Recording
@@ -41,6 +42,7 @@ __all__ = ["check_colour_recording", "split_colour_events", "colour_frames", "Co
 
 def check_colour_recording(rec: Recording) -> str:
     """The recording's colour filter name, or an EventDataError naming the fix when it has none."""
+    require(rec, Recording, "rec")   # None or Events was "has no attribute 'meta'"
     cfa = rec.meta.get("cfa")
     source = rec.meta.get("path") or "the recording"
     if cfa is None:
@@ -71,6 +73,7 @@ def split_colour_events(rec: Recording):
 def colour_frames(rec: Recording) -> np.ndarray | None:
     """The colour ground-truth frames uint8 [F, H, W, 3], one per frame of ``rec.frames`` (matched by
     time: ``meta["frames_rgb_t"]``), or None when the recording has no colour frames."""
+    require(rec, Recording, "rec")
     rgb, t = rec.meta.get("frames_rgb"), rec.meta.get("frames_rgb_t")
     if rgb is None or t is None or rec.frames is None or not len(rec.frames):
         return None
@@ -151,6 +154,11 @@ def score_colour_recording(result: ColourResult, rec: Recording, score_predictio
     frames; ``colour`` = {"chroma_correlation": {"R-G", "B-G"}, "chroma_correlation_mean",
     "n_frames"} when the frames are colour, else None.
     """
+    require(result, ColourResult, "result")
+    require(rec, Recording, "rec")
+    if not callable(score_predictions):
+        raise ArgumentTypeError(f"score_predictions= must be the grey scorer (evinr_lite.apps.results."
+                                f"score_predictions), got {type(score_predictions).__name__}")
     gt = rec.frames
     if gt is None or not len(gt):
         return None, None

@@ -7,10 +7,12 @@ protocols (:data:`evinr_lite.evaluation.metrics.SCORE_PROTOCOLS`), ``write_resul
 """
 from __future__ import annotations
 
-from pathlib import Path
+from pathlib import Path, PurePath
 
 import numpy as np
+import torch
 
+from ..core.checks import check_path_type, require, seconds_array
 from ..core.events import EventDataError
 from ..core.frames import Frames
 from ..core.recording import Recording
@@ -43,7 +45,8 @@ def score_predictions(pred_frames, pred_times, gt: Frames) -> dict:
     mse_at_level (the frames times the one gain over the scored frames that gives them the truth's
     mean: the level events never give), level_gain (that gain; above 1: shown too dark) and
     static_coarse (of mse_at_level, the part the same in every frame and coarser than 8 px)."""
-    pred_times = np.asarray(pred_times, np.float64)
+    require(gt, Frames, "gt")   # None or an array was "has no attribute 'images'"
+    pred_times = seconds_array(pred_times, "pred_times", allow_empty=True)   # text was numpy's ValueError
     pred_frames = np.asarray(pred_frames)
     scores = {eq: _score_one(pred_frames, pred_times, gt, eq) for eq in SCORE_PROTOCOLS}
     for s in scores.values():
@@ -64,6 +67,8 @@ def score_recording(result: Reconstruction, gt: Frames | None) -> dict | None:
     Returns None when no other frame lies in the reconstructed span. ``per_frame_index`` counts in
     ``gt`` as given (the frames export writes to ``gt/``), anchors included.
     """
+    require(result, Reconstruction, "result")   # None was "has no attribute 'windows'"
+    require(gt, Frames, "gt", none_ok=True)
     if gt is None or not len(gt):
         return None
     lo, hi = result.windows[0, 0], result.windows[-1, 1]
@@ -89,8 +94,15 @@ def write_results(tmp: Path, rec: Recording, times, history: dict, scores: dict 
     from ..io.export import save_csv, save_frames_png, save_timestamps
     from ..io.output import save_json
 
+    check_path_type(tmp, "tmp", "the run's (temporary) folder")
+    require(rec, Recording, "rec")   # None was "has no attribute 'meta'"
+    if not isinstance(history, dict) or (scores is not None and not isinstance(scores, dict)) or \
+            (settings is not None and not isinstance(settings, dict)):
+        raise EventDataError(f"history must be a dict (the reconstruction's), scores a dict or None, settings a dict "
+                             f"or None; got {type(history).__name__}, {type(scores).__name__} and "
+                             f"{type(settings).__name__}")
     written = list(written)
-    times = np.asarray(times, np.float64)
+    times = seconds_array(times, "times", allow_empty=True)
     run = {"input": rec.meta.get("path"), "format": rec.meta.get("format"),
            "sensor_size": list(rec.events.sensor_size), "t_origin": rec.events.t_origin,
            "window_s": list(rec.meta["window"]), "n_events": len(rec.events) if n_events is None else int(n_events),
@@ -132,4 +144,14 @@ def jsonable(obj):
         return obj.tolist()
     if isinstance(obj, np.generic):
         return obj.item()
+    if isinstance(obj, torch.Tensor):   # kept as a tensor, json.dump's "not JSON serializable" when written
+        return obj.tolist()
+    if isinstance(obj, (set, frozenset)):   # a set has no order: sorted, numbers as numbers ({10, 9, 2}: [2, 9, 10])
+        try:
+            ordered = sorted(obj)
+        except TypeError:   # mixed kinds (1 and "a"): in the order of their repr
+            ordered = sorted(obj, key=repr)
+        return [jsonable(v) for v in ordered]
+    if isinstance(obj, PurePath):
+        return str(obj)
     return obj

@@ -23,7 +23,8 @@ __all__ = ["require", "numbers_array", "whole_number", "real_number", "check_ima
            "TypeFix", "ArgumentTypeError", "seconds_array", "optional_seconds", "choice", "is_real_number",
            "host_array", "short_repr", "check_seconds_precision", "check_reach", "image_stack", "checked_span",
            "true_or_false", "check_reader_window", "decimal_as_float", "check_log", "check_path_type",
-           "SEED_LIMIT", "check_seed"]
+           "SEED_LIMIT", "check_seed", "pixel_mask", "value_list",
+           "blank_path"]
 
 
 SECONDS_STEP = 1e-6   # seconds; the events' resolution: times stored more coarsely than this lose information
@@ -78,6 +79,45 @@ def image_stack(a, name: str) -> np.ndarray:
                if a.ndim == 4 and a.shape[-1] in (3, 4) else "")
         raise EventDataError(f"{name} must be a stack [F, H, W] (or [F, H, W, 1]), got shape {a.shape}{fix}")
     return a
+
+
+
+def value_list(values, name: str, what: str, *, text: bool = False) -> list:
+    """``values`` as a list: any iterable but text (a name is no list of its letters), bytes, a dict, None or a 0-d
+    array or tensor (which numpy and torch call iterable, then refuse to iterate: "iteration over a 0-d array").
+    ``text``: each value must be a str. Else an EventDataError naming ``name`` and ``what`` the list holds; a 0-d
+    array or tensor (and, with ``text``, one name) is told to pass ``[value]``."""
+    zero_d = not isinstance(values, (str, bytes, dict)) and getattr(values, "ndim", None) == 0
+    one = f"; for one, pass [{values.item()!r}]" if zero_d else \
+        f"; for one, pass [{values!r}]" if text and isinstance(values, str) else ""
+    if values is None or isinstance(values, (str, bytes, dict)) or zero_d:
+        raise EventDataError(f"{name}= must be a list of {what}, got {values!r:.60}{one}")
+    try:
+        values = list(values)
+    except TypeError:   # a number, or an object that is not iterable
+        raise EventDataError(f"{name}= must be a list of {what}, got {values!r:.60}") from None
+    if text:
+        bad = [v for v in values if not isinstance(v, str)]
+        if bad:
+            raise EventDataError(f"{name}= must hold text ({what}), got {bad[0]!r:.60}")
+    return values
+
+
+def pixel_mask(mask, shape, name: str = "mask", fix: str = "") -> np.ndarray:
+    """``mask`` as a bool array [H, W] of ``shape`` (one value per pixel: True where the pixel is meant); a list or a
+    tensor of bools is taken. Else an EventDataError naming ``name``, the shape wanted, what was given and ``fix``
+    (numbers were taken as indices, a mask of another shape numpy's IndexError)."""
+    arr = None if mask is None or isinstance(mask, (str, bytes)) else \
+        dense_array(mask, f"{name}=", error=EventDataError, want=f"a bool array of shape (H, W) = {tuple(shape)}")
+    if arr is None or arr.dtype != bool or arr.shape != tuple(shape):
+        got = f"{arr.dtype} array of shape {arr.shape}" if arr is not None else short_repr(mask)
+        arg = name.rsplit(": ", 1)[-1]
+        numeric = (f"; for a 0/1 (or 0/255) mask pass {arg} != 0" if arr is not None and arr.dtype.kind in "iuf"
+                   and arr.shape == tuple(shape) else "")
+        raise EventDataError(f"{name}= must be a bool array of the sensor's shape (H, W) = {tuple(shape)} (True where "
+                             f"a pixel is meant), got {got}{numeric}" + (f"; {fix}" if fix else ""))
+    return arr
+
 
 # (expected class name, given class name) -> how to turn the one into the other
 TypeFix = {
@@ -239,6 +279,16 @@ def check_path_type(value, name: str, what: str, hint: str = ""):
         raise ArgumentTypeError(f"{name}= must be {what} (a str or Path), got {type(value).__name__}"
                                 + (f"; {hint}" if hint else ""))
     return value
+
+
+def blank_path(value) -> bool:
+    """Whether a path (checked by :func:`check_path_type`) names nothing: blank text, or a Path whose text is "."
+    (``Path("")`` is ``Path(".")``, so the two cannot be told apart; the text "." stays a path: the current folder
+    named on purpose). Callers that take "" as a mistake refuse both."""
+    if isinstance(value, str):
+        return not value.strip()
+    text = os.fspath(value) if isinstance(value, os.PathLike) else value
+    return isinstance(text, str) and text in ("", ".")
 
 
 def is_real_number(value) -> bool:

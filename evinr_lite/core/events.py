@@ -183,7 +183,12 @@ def check_time_span(t, source, time_unit: str, *, flag: str = "time_unit") -> No
     """Refuse timestamps (seconds, sorted or not) whose span is implausible for an event recording:
     longer than :data:`MAX_SPAN_S`, at least 1000 events at under :data:`MIN_RATE_PER_S` per second, or
     a mean rate over :data:`MAX_RATE_PER_S`; each means the unit is wrong. The message names the unit used and the option to change it."""
-    t = np.asarray(t)
+    arr = None if t is None or isinstance(t, (str, bytes)) else np.asarray(host_array(t))
+    if arr is None or arr.dtype.kind not in "iuf":   # None and text passed unchecked, bools were numpy's subtract error
+        raise EventDataError(f"{source}: timestamps must be numbers (seconds), got "
+                             f"{type(t).__name__ if arr is None else arr.dtype}; pass the events' times as an array of "
+                             f"numbers (e.g. np.asarray(t, dtype=np.float64))")
+    t = arr
     if t.size < 2:
         return
     finite = t[np.isfinite(t)]
@@ -208,6 +213,12 @@ def check_time_range(value, name: str, error=None) -> tuple[float, float]:
     """
     error = error or EventDataError
     try:
+        # text ("0", "1") was parsed, True taken as 1 s and a dict's keys as the range: none is a pair of seconds
+        if isinstance(value, (str, bytes, dict, set, frozenset)):
+            raise TypeError
+        value = tuple(value)   # a generator or other one-pass iterable: read once (the scan below consumed it)
+        if any(isinstance(v, (str, bytes, bool, np.bool_)) for v in value):
+            raise TypeError
         lo, hi = (float(v) for v in value)
     except (TypeError, ValueError):
         raise error(f"{name} must be (start, end) in seconds, two numbers; got {value!r}") from None
@@ -248,7 +259,13 @@ def relative_seconds(t, time_unit: str = "s") -> tuple[np.ndarray, float]:
     if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):
         raise EventDataError(f"unknown time_unit {time_unit!r}; use one of {sorted(TIME_UNITS)}")
     per_s = round(1 / TIME_UNITS[time_unit])  # 1, 1000, 10**6, 10**9 units per second
-    t = np.asarray(t)
+    t = np.asarray(host_array(t))
+    if t.dtype.kind not in "iuf":
+        raise EventDataError(f"timestamps must be numbers, got dtype {t.dtype}; pass them as an array of numbers "
+                             f"(float seconds, or whole units with time_unit=, e.g. 'us')")
+    if t.ndim != 1:   # a 0-d array came back as a number, [N, 2] as rows of "times"
+        raise EventDataError(f"timestamps must be a 1-D array [N], got shape {t.shape}; flatten one time per row with "
+                             "np.ravel(t)")
     if t.size == 0:
         return t.astype(np.float64), 0.0
     if t.dtype.kind in "iu":
@@ -291,6 +308,8 @@ def check_t_origin(t_origin) -> float:
 def check_sensor_size(sensor_size) -> tuple[int, int]:
     """(H, W) as two positive ints, or an EventDataError that says what is wrong."""
     try:
+        if isinstance(sensor_size, (dict, set, frozenset)):   # a dict's keys (or a set's order) were taken as (H, W)
+            raise ValueError
         values = list(sensor_size)
         if len(values) != 2:
             raise ValueError

@@ -121,6 +121,7 @@ def to_grey_uint8(img: np.ndarray, source) -> np.ndarray:
     if img.dtype == np.uint16:
         img = img / 257.0
     elif img.dtype.kind == "f":
+        check_image_values(img, f"{source}: images", clipped=True)   # NaN became 0, floats in 0..255 white
         img = np.clip(img, 0.0, 1.0) * 255.0
     elif img.dtype != np.uint8:
         raise EventDataError(f"{source}: images must be 8- or 16-bit grey or RGB, got dtype {img.dtype}")

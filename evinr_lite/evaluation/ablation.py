@@ -34,11 +34,12 @@ from __future__ import annotations
 
 import hashlib
 import time
+from collections.abc import Mapping
 from dataclasses import asdict, replace
 
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, check_image_values, real_number, require, whole_number
+from ..core.checks import ArgumentTypeError, check_image_values, real_number, require, value_list, whole_number
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 from ..core.runtime import default_device
@@ -107,8 +108,21 @@ def ensemble_variants(duration: float, n_networks=(1, 2, 4), *, overlap: float =
             for n in n_networks}
 
 
+def _check_common(common: dict, own, name: str) -> None:
+    """Refuse a keyword in ``common`` that the variants set themselves: it was overwritten in some rows (or in
+    all) without a word, so a table labelled one way was run another."""
+    clash = [k for k in own if k in common]
+    if clash:
+        raise EventDataError(f"{name} sets {clash[0]}= in its rows itself; drop {clash[0]}= from the shared settings "
+                             f"(it would be overwritten, and the rows' labels would not say what ran)")
+
+
 def lambda_variants(lams, regularizers=("tikhonov",), **common) -> dict[str, EvINRConfig]:
     """The Full recipe with each regularizer weight in ``lams``, for each regularizer ("tikhonov", "tv")."""
+    _check_common(common, ("regularizer", "lam"), "lambda_variants")
+    lams = [real_number(lam, f"lams[{k}]", lo=0, hint="a regularizer weight (e.g. 0.05)")   # True was lambda = 1
+            for k, lam in enumerate(value_list(lams, "lams", "weights, e.g. [0.01, 0.05, 0.2]"))]
+    regularizers = value_list(regularizers, "regularizers", "names, e.g. ('tikhonov', 'tv')", text=True)
     return {f"{reg}, lambda = {lam:g}": EvINRConfig.v0_1(**{**common, "regularizer": reg, "lam": float(lam)})
             for reg in regularizers for lam in lams}
 
@@ -116,6 +130,7 @@ def lambda_variants(lams, regularizers=("tikhonov",), **common) -> dict[str, EvI
 def temporal_loss_variants(**common) -> dict[str, EvINRConfig]:
     """Derivative (Eq. 5-6, dF/dt at bin mid-points) versus boundary difference (F(b_{i+1}) - F(b_i)),
     each on Base and on Full."""
+    _check_common(common, ("temporal_loss",), "temporal_loss_variants")
     out = {}
     for recipe, make in (("Base", EvINRConfig.base), ("Full", EvINRConfig.v0_1)):
         for loss in ("derivative", "difference"):
@@ -145,9 +160,13 @@ def recipe_variants(n_events: int, span_s: float, **common) -> dict[str, EvINRCo
         common: EvINRConfig fields shared by every row (C, n_iters, sizes, ...); tau must be None or
             at least span_s (one network), since equal-count bins are counted per network.
     """
+    n_events = whole_number(n_events, "n_events", lo=1)   # -5 or 1.5 were taken, NaN "cannot convert float NaN"
+    span_s = real_number(span_s, "span_s", lo=0, lo_open=True, hint="the span's length in seconds")
+    # the fields a step's label names (c2f_iters and events_per_bin of the rows before the last are the caller's)
+    _check_common(common, ("regularizer", "binning", "temporal_loss", "omega_0", "head_lr_scale"), "recipe_variants")
     base = EvINRConfig.v0_1(**common)
     if base.tau is not None and base.tau < span_s:
-        raise ValueError(f"recipe_variants counts bins over one window: use tau=None or tau >= span_s ({span_s} s)")
+        raise EventDataError(f"recipe_variants counts bins over one window: use tau=None or tau >= span_s ({span_s} s)")
     n_fixed = max(1, int(round(span_s / base.bin_duration)))
     code_bins = {"events_per_bin": max(1, int(round(n_events / 100))), "c2f_iters": (base.n_iters // 2,)}
     steps = [("Full (v0_1)", {}),
@@ -309,7 +328,15 @@ def _run_one(name, variant, events, times, t_start, t_end, repeats, n_inference)
 
 def rows_by_name(rows: list[dict]) -> dict[str, dict]:
     """``{row["name"]: row}``."""
-    return {r["name"]: r for r in rows}
+    out = {}
+    for k, r in enumerate(value_list(rows, "rows", "rows (dicts with a 'name'), as run_variants returns them")):
+        if not isinstance(r, Mapping) or "name" not in r:   # a Mapping row (a mappingproxy) was taken before: taken
+            raise EventDataError(f"rows[{k}] must be a dict with a 'name' (a row of run_variants), got {r!r:.60}")
+        if r["name"] in out:   # the first was dropped without a word
+            raise EventDataError(f"rows hold the name {r['name']!r} twice (rows {list(out).index(r['name'])} and {k}); "
+                                 "give each variant its own name")
+        out[r["name"]] = r
+    return out
 
 
 # ---- tables ---------------------------------------------------------------------------------------
@@ -422,7 +449,18 @@ def _scores(value, name: str) -> np.ndarray:
 def paper_frame_counts(table: dict) -> dict[str, float]:
     """Time x FPS of each row of a paper table: the frames the FPS column counts (constant per table
     when FPS = frames / training time)."""
-    return {name: row["time_s"] * row["fps"] for name, row in table.items()}
+    if not isinstance(table, dict):
+        raise EventDataError(f"table= must be a dict {{name: {{'time_s': ..., 'fps': ...}}}} (e.g. PAPER_TABLE2), got "
+                             f"{type(table).__name__}")
+    out = {}
+    for name, row in table.items():
+        if not isinstance(row, dict) or not {"time_s", "fps"} <= set(row):
+            raise EventDataError(f"table[{name!r}] must be a dict with 'time_s' and 'fps' (a paper table's row), got "
+                                 f"{row!r:.60}")
+        # text was repeated ("1" * 2 = "11"), True taken as 1 s, a negative time counted negative frames
+        out[name] = (real_number(row["time_s"], f"table[{name!r}]['time_s']", lo=0) *
+                     real_number(row["fps"], f"table[{name!r}]['fps']", lo=0))
+    return out
 
 
 def compare_with_paper(ours: dict[str, dict], paper: dict[str, dict], pairs, metrics=(("mse", "mse_clahe"),
@@ -444,6 +482,39 @@ def compare_with_paper(ours: dict[str, dict], paper: dict[str, dict], pairs, met
         changed and the other did not) or "both small" (both within ``small_pct``).
     """
     change = relative_change if change is None else change
+    if not callable(change):
+        raise ArgumentTypeError(f"change= must be a function change(value, baseline, higher_is_better) -> percent, or "
+                                f"None for relative_change, got {type(change).__name__}")
+    small_pct = real_number(small_pct, "small_pct", lo=0, hint="percent: smaller changes count as no change")
+    for name, table in (("ours", ours), ("paper", paper)):
+        if not isinstance(table, Mapping):   # a mappingproxy or other Mapping was taken before: taken
+            raise EventDataError(f"{name}= must be a dict {{name: row}} (rows_by_name(rows) for ours, e.g. PAPER_TABLE2 "
+                                 f"for the paper), got {type(table).__name__}")
+    pairs = value_list(pairs, "pairs", "(variant, baseline) name pairs, e.g. [('Full', 'Base')]")
+    metrics = value_list(metrics, "metrics", "(paper_key, our_key) pairs, e.g. [('ssim', 'ssim_clahe')]")
+    for k, pair in enumerate(pairs):
+        if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+            raise EventDataError(f"pairs[{k}] must be (variant, baseline), two names, got {pair!r:.60}")
+        for name in pair:
+            for side, table in (("ours", ours), ("paper", paper)):
+                if not _holds(table, name):
+                    raise EventDataError(f"pairs[{k}] names {name!r}, which {side} has no row of (it has "
+                                         f"{sorted(map(str, table))[:6]}); pass names present in both")
+    for k, metric in enumerate(metrics):
+        if isinstance(metric, (str, bytes)) or not hasattr(metric, "__len__") or len(metric) != 2:
+            raise EventDataError(f"metrics[{k}] must be (paper_key, our_key), got {metric!r:.60}")
+        if metric[0] not in HIGHER_IS_BETTER:
+            raise EventDataError(f"metrics[{k}]: {metric[0]!r} is no metric with a known direction; use one of "
+                                 f"{sorted(HIGHER_IS_BETTER)}")
+        for variant, baseline in pairs:
+            for side, table, key in (("ours", ours, metric[1]), ("paper", paper, metric[0])):
+                for name in (variant, baseline):
+                    if not isinstance(table[name], Mapping):   # was "has no 'mse_clahe'" for a row that held it
+                        raise EventDataError(f"{side}[{name!r}] must be a dict of metrics ({{metric: value}}), got "
+                                             f"{type(table[name]).__name__}")
+                    if not _holds(table[name], key):
+                        raise EventDataError(f"{side}[{name!r}] has no {key!r} (metrics[{k}]); pass rows that hold it, "
+                                             "or leave that metric out")
     out = []
     for variant, baseline in pairs:
         for p_key, o_key in metrics:
@@ -462,10 +533,28 @@ def compare_with_paper(ours: dict[str, dict], paper: dict[str, dict], pairs, met
     return out
 
 
+def _holds(table, key) -> bool:
+    """Whether the Mapping ``table`` has ``key`` (an unhashable key, a list, is in none: Python's TypeError)."""
+    try:
+        return key in table
+    except TypeError:
+        return False
+
+
 def comparison_table(comparisons: list[dict]) -> str:
     """Markdown table of :func:`compare_with_paper`'s output, with a line counting the disagreements."""
+    comparisons = value_list(comparisons, "comparisons", "compare_with_paper's dicts")
     if not comparisons:
-        raise ValueError("no comparisons to tabulate")
+        raise EventDataError("no comparisons to tabulate: pass compare_with_paper's output (one dict per pair and "
+                             "metric)")
+    keys = ("variant", "baseline", "metric", "paper_pct", "ours_pct", "agree", "small_pct")
+    for k, c in enumerate(comparisons):
+        missing = [key for key in keys if not isinstance(c, Mapping) or key not in c]
+        if missing:
+            raise EventDataError(f"comparisons[{k}] must be a dict of compare_with_paper's (it has no {missing[0]!r}), "
+                                 f"got {c!r:.60}")
+        for key in ("paper_pct", "ours_pct", "small_pct"):
+            real_number(c[key], f"comparisons[{k}][{key!r}]", hint="percent, as compare_with_paper gives")
     lines = ["| change | metric | paper | ours | same direction |", "|---|---|---:|---:|---|"]
     for c in comparisons:
         lines.append(f"| {c['baseline']} → {c['variant']} | {c['metric']} | {c['paper_pct']:+.0f} % | "

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.checks import host_array, real_number, require
+from ..core.checks import ArgumentTypeError, host_array, real_number, require
 from ..core.events import EventDataError, Events
 from ..core.guard import dense_array
 from ..method.binning import check_boundaries
@@ -42,6 +42,9 @@ def render_event_counts(L_boundaries, C: float) -> np.ndarray:
     return render_counts(L_boundaries, C, np.trunc)
 
 
+MAX_STEPS = 2.0**53   # render_counts: counts beyond float64's whole numbers (and int64's range) are no counts
+
+
 def render_counts(L_boundaries, C, whole_steps=np.trunc):
     """Counts from a moving reference: n_k = whole_steps((L(b_{k+1}) - r_k) / C), r_{k+1} = r_k + n_k C."""
     # C 0 or NaN gave garbage counts (inf or NaN cast to int64), a negative C counts of the wrong sign
@@ -57,6 +60,13 @@ def render_counts(L_boundaries, C, whole_steps=np.trunc):
     if not finite.all():
         raise EventDataError(f"L_boundaries contain {int(L.size - finite.sum()):,} NaN or inf value(s); log "
                              "intensities must be finite to count events")
+    if not callable(whole_steps):   # was "'str' object is not callable" at the first step
+        raise ArgumentTypeError(f"whole_steps= must be a function rounding to whole steps (np.trunc, np.floor, "
+                                f"np.round), got {type(whole_steps).__name__}")
+    if L.size and (float(L.max()) - float(L.min())) / C > MAX_STEPS:   # int64's wrap: -9223372036854775808 events
+        raise EventDataError(f"L_boundaries span {float(L.max()) - float(L.min()):.3g} log units, over {MAX_STEPS:.3g} "
+                             f"steps of C = {C:g}: no count of events is that large; check C (log units per event, "
+                             "e.g. 0.2) and that L holds log intensities")
     ref = L[0].copy()
     out = np.empty((L.shape[0] - 1,) + L.shape[1:], dtype=np.int64)
     for k in range(1, L.shape[0]):

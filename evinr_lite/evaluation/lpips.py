@@ -27,6 +27,8 @@ import numpy as np
 import torch
 from torch import nn
 
+from ..core.checks import blank_path, check_image_values, check_path_type, numbers_array
+from ..core.events import EventDataError
 from ..core.runtime import weights_dir
 
 __all__ = ["LPIPS", "LPIPSUnavailable", "load_lpips", "lpips_distance", "lpips_distances", "lpips_paths",
@@ -97,7 +99,7 @@ class LPIPS(nn.Module):
             raise ValueError(f"LPIPS takes two RGB batches [B, 3, H, W] of one shape, got {tuple(x0.shape)} "
                              f"and {tuple(x1.shape)}")
         if min(x0.shape[-2:]) < MIN_SIZE:
-            raise ValueError(f"LPIPS needs images of at least {MIN_SIZE} x {MIN_SIZE} pixels, got {tuple(x0.shape[-2:])}")
+            raise EventDataError(f"LPIPS needs images of at least {MIN_SIZE} x {MIN_SIZE} pixels, got {tuple(x0.shape[-2:])}")
         total = 0
         for k, (f0, f1) in enumerate(zip(self.layer_features(x0), self.layer_features(x1))):
             n0 = f0 / (f0.pow(2).sum(dim=1, keepdim=True).sqrt() + EPS)
@@ -130,6 +132,12 @@ class LPIPS(nn.Module):
 def lpips_paths(cache_dir=None) -> tuple[Path, Path]:
     """(AlexNet file, linear-heads file) in ``cache_dir`` (default: ``<cache>/weights/lpips``, where
     ``python -m data_fetch get lpips all`` puts them)."""
+    if cache_dir is not None:   # a number or a list was Python's "expected str, bytes or os.PathLike object"
+        check_path_type(cache_dir, "cache_dir", "a folder holding the LPIPS weights",
+                        "or None for the kit's cache (where `python -m data_fetch get lpips all` puts them)")
+        if blank_path(cache_dir):   # "" (and Path(""), which reads ".") was the current folder
+            raise EventDataError(f"cache_dir= is empty ({cache_dir!r}; '' and Path('') both mean the current folder): pass the folder holding the LPIPS weights "
+                                 "(Path.cwd() for the current folder), or None for the kit's cache")
     cache_dir = Path(weights_dir("lpips") if cache_dir is None else cache_dir)
     return cache_dir / ALEXNET_FILE, cache_dir / LINEAR_FILE
 
@@ -183,7 +191,13 @@ def lpips_distances(pred, gt, model: LPIPS, batch_size: int = 8) -> np.ndarray:
 
 def lpips_distance(pred, gt, model: LPIPS) -> float:
     """LPIPS of two grey images [H, W] in [0, 1] (copied to 3 channels, mapped to [-1, 1])."""
-    pred, gt = np.asarray(pred), np.asarray(gt)
+    if not isinstance(model, LPIPS):   # None was "has no attribute 'parameters'"
+        raise EventDataError(f"model= must be the LPIPS network, got {type(model).__name__}; load it with "
+                             f"load_lpips() (its weights: `{FETCH_COMMAND}`)")
+    pred, gt = (numbers_array(a, name, "a grey image [H, W] in [0, 1]") for a, name in ((pred, "pred"), (gt, "gt")))
     if pred.ndim != 2 or pred.shape != gt.shape:
-        raise ValueError(f"expected two grey images [H, W] of one shape, got {pred.shape} and {gt.shape}")
+        raise EventDataError(f"expected two grey images [H, W] of one shape, got {pred.shape} and {gt.shape}; "
+                             "pass pred and gt as grey images [H, W] of one size")
+    for a, name in ((pred, "pred"), (gt, "gt")):   # NaN gave NaN; floats in 0..255 were clipped to white
+        check_image_values(a, name, clipped=True)
     return float(lpips_distances(pred[None], gt[None], model)[0])

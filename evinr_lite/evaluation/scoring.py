@@ -21,7 +21,8 @@ import time
 
 import numpy as np
 
-from ..core.checks import check_image_values, image_stack, real_number, require, seconds_array, whole_number
+from ..core.checks import (check_image_values, image_stack, real_number, require, seconds_array, value_list,
+                           whole_number)
 from ..core.events import EventDataError, Events
 from ..method.baselines import BASELINE_PARAMS, BASELINES, reconstruct_baseline
 from .metrics import EQUALIZATIONS, SCORE_PROTOCOLS, protocol_description, score_pairs
@@ -303,10 +304,8 @@ def _names(value, allowed, name: str) -> tuple:
     """A non-empty tuple of names, each one of ``allowed``; else an InputError (one name alone is a tuple of one)."""
     if isinstance(value, str):
         raise EventDataError(f"{name} must be a tuple of names, got the text {value!r}; pass ({value!r},)")
-    try:
-        value = tuple(value)
-    except TypeError:
-        raise EventDataError(f"{name} must be a tuple of names among {allowed}, got {value!r}") from None
+    # None, 5 or a 0-d array: refused by name; a dict's keys were taken as the names (as tuple() reads them): kept
+    value = tuple(value) if isinstance(value, dict) else tuple(value_list(value, name, f"names among {allowed}"))
     if not value:
         raise EventDataError(f"{name} is empty: nothing would be scored; pass one or more of {allowed}")
     unknown = [v for v in value if not isinstance(v, str) or v not in allowed]

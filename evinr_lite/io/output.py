@@ -89,6 +89,7 @@ def check_writable(folder, what: str, fix: str) -> Path:
 def resolve_path(path, what: str = "the path") -> Path:
     """``Path(path).resolve()``, with a symbolic-link loop or an unreadable link as an OutputError naming
     the path (Python raises RuntimeError or OSError there, which would read as an internal error)."""
+    check_path_type(path, "path", f"{what} (a file or folder)")   # None was Python's "expected str, bytes or os.PathLike"
     try:
         return Path(path).resolve()
     except (RuntimeError, OSError) as err:
@@ -535,7 +536,10 @@ def written_beside(path):
     """A temporary name beside ``path`` to write to (hidden, unique, with the same suffix: writers pick the
     format by it); renamed onto ``path`` when the block ends, removed when it fails, so ``path`` is never
     half-written (an interrupted or failed write leaves the file that was there, or none)."""
+    check_path_type(path, "path", "the file to write")   # None was Python's "expected str, bytes or os.PathLike"
     path = Path(path)
+    if not path.name:   # "" or "/": no name to write beside (pathlib's "has an empty name")
+        raise OutputError(f"path= {str(path)!r} names no file; pass the file to write (e.g. out/run.json)")
     tmp = path.with_name(f".{path.stem}.partial-{os.getpid()}-{secrets.token_hex(4)}{path.suffix}")
     try:
         yield tmp
@@ -546,6 +550,20 @@ def written_beside(path):
 
 
 def save_json(path, obj) -> None:
-    with open(path, "w") as f:
-        json.dump(obj, f, indent=2)
-        f.write("\n")
+    """``obj`` as indented JSON text in the file ``path``. The text is made before the file is opened, so an object
+    JSON cannot hold (a numpy number, a tensor, a Path) leaves no half-written file; that is an ArgumentTypeError
+    naming the fix (``apps.results.jsonable`` makes numpy values and tuples plain), and a folder that cannot be written
+    an OutputError. ``path``: a str, a Path or bytes (as ``open`` takes them); None or a number is refused."""
+    if not isinstance(path, bytes):   # bytes paths are os.open's and were written before: taken as they were
+        check_path_type(path, "path", "the JSON file to write")   # 5 was written to file descriptor 5
+    try:
+        text = json.dumps(obj, indent=2) + "\n"
+    except (TypeError, ValueError) as err:   # the file had been opened and half written
+        raise ArgumentTypeError(f"cannot write {path} as JSON: {err}; make the values plain Python numbers, text, lists "
+                             "and dicts first (e.g. float(x), x.tolist(), str(path))") from None
+    try:
+        with open(path, "w") as f:
+            f.write(text)
+    except (IsADirectoryError, FileNotFoundError, NotADirectoryError, PermissionError) as err:
+        raise OutputError(f"cannot write {path}: {err.strerror}; choose a file in a folder that exists and can be "
+                          "written") from None

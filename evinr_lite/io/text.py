@@ -25,6 +25,7 @@ import numpy as np
 
 from ..core.events import (LARGE_T, MAX_SENSOR_SIDE, TIME_UNITS, EventDataError, auto_origin, check_t_origin,
                            resolve_time_unit, wrap_hint)
+from ..core.checks import ArgumentTypeError, check_path_type, whole_number
 from ..core.guard import host_array
 
 __all__ = ["EventBlock", "TextLayout", "TXT_LAYOUT", "parse_event_block", "parse_event_text", "blank_leading_comments",
@@ -547,6 +548,30 @@ def blank_leading_comments(data: bytes) -> tuple[bytes | bytearray, list[int]]:
     return data, lines
 
 
+def _check_origin_ns(origin_ns):
+    """The text parsers' ``origin_ns``: None (from the first timestamp) or whole nanoseconds (text was Python's "//"
+    error, 1.5 or True taken as an origin)."""
+    if origin_ns is None:
+        return None
+    try:
+        return whole_number(origin_ns, "origin_ns")
+    except EventDataError:
+        raise EventDataError(f"origin_ns= must be whole nanoseconds (the clock's origin, an int) or None to take it "
+                             f"from the first timestamp, got {origin_ns!r:.60}") from None
+
+
+def _byte_buffer(data) -> bool:
+    """Whether ``data`` holds bytes one by one (bytes, bytearray, memoryview, mmap, a 1-D uint8 array: what
+    np.frombuffer reads as the file's bytes); text and arrays of wider numbers do not."""
+    if isinstance(data, str):
+        return False
+    try:
+        view = memoryview(data)
+    except TypeError:
+        return False
+    return view.itemsize == 1 and view.ndim == 1
+
+
 def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "auto", data: bytes | bytearray | None = None,
                      layout: TextLayout = TXT_LAYOUT) -> EventBlock:
     """A whole `t x y p` text file (optionally after a `W H` header), block by block.
@@ -558,6 +583,15 @@ def parse_event_text(path, origin_ns: int | None = None, *, time_unit: str = "au
     prepared) them already; ``layout``: the columns' order and separators, and whether a `W H` line
     may open the file (:class:`TextLayout`). Raises EventDataError naming the file and line.
     """
+    check_path_type(path, "path", "the event text file")   # None or 5 was Python's "expected str, bytes or os.PathLike"
+    origin_ns = _check_origin_ns(origin_ns)
+    if data is not None and not _byte_buffer(data):   # text was np.frombuffer's error
+        raise ArgumentTypeError(f"data= must be the file's bytes (bytes, bytearray, memoryview, mmap or a 1-D uint8 "
+                                f"array; text: data.encode()) or None to read the file, got {type(data).__name__}"
+                                + (f" of {data.dtype} {data.shape}" if isinstance(data, np.ndarray) else ""))
+    if not isinstance(layout, TextLayout):   # None was "has no attribute 'size_line'"
+        raise ArgumentTypeError(f"layout= must be a TextLayout (e.g. TXT_LAYOUT, the default), got "
+                                f"{type(layout).__name__}")
     path = Path(path)
     comments = []
     if data is None:
@@ -589,6 +623,13 @@ def parse_frame_list(buf, origin_ns: int | None, *, source, time_unit: str = "s"
     naming ``source`` and the line; a listing with no lines gives ([], [], origin_ns).
     """
     buf = np.frombuffer(buf, dtype=np.uint8) if isinstance(buf, (bytes, bytearray, memoryview)) else buf
+    if not isinstance(buf, np.ndarray) or buf.dtype != np.uint8 or buf.ndim != 1:   # None, text: numpy's errors
+        raise ArgumentTypeError(f"buf= must be the listing's bytes (bytes, or a uint8 array of them; text: "
+                                f"text.encode()), got {type(buf).__name__}"
+                                + (f" of {buf.dtype} {buf.shape}" if isinstance(buf, np.ndarray) else ""))
+    origin_ns = _check_origin_ns(origin_ns)
+    if not (isinstance(time_unit, str) and time_unit in TIME_UNITS):   # was a KeyError
+        raise EventDataError(f"unknown time_unit={time_unit!r}; use one of {', '.join(TIME_UNITS)}")
     starts, ends, counts, newlines = _tokenize(buf)
     bad = np.flatnonzero((counts != 0) & (counts != 2))
     if bad.size:

@@ -122,10 +122,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core.checks import checked_span, choice, decimal_as_float, is_real_number, real_number, require, whole_number
+from ..core.checks import (checked_span, choice, decimal_as_float, is_real_number, pixel_mask, real_number, require,
+                           whole_number)
 from ..core.events import EventDataError, Events, check_sensor_size
 from .binning import as_thresholds
-from .denoise import check_count_pair, hot_threshold
+from .denoise import check_count_pair, check_counts, hot_threshold
 
 __all__ = ["BalanceFit", "PolarityCounts", "polarity_counts", "interval_sums", "interval_stride",
            "balance_from_counts", "estimate_balance", "pooled_imbalance", "slope_imbalance", "interval_imbalance", "minmod",
@@ -418,15 +419,49 @@ def interval_imbalance(intervals, usable) -> float:
 
 
 def minmod(a: float, b: float, *more: float) -> float:
-    """The smallest in magnitude of estimates that all agree in sign, 0 when any two disagree."""
-    values = (a, b) + more
+    """The smallest in magnitude of estimates that all agree in sign, 0 when any two disagree (a NaN estimate
+    agrees with none: 0)."""
+    values = tuple(decimal_as_float(v) for v in (a, b) + more)   # a Decimal as its float, as before
+    for k, v in enumerate(values):   # None or text was Python's "'>' not supported", an array numpy's "ambiguous"
+        if not is_real_number(v):
+            raise EventDataError(f"minmod: estimate {k + 1} must be a number (an imbalance b), got {v!r:.60}; pass "
+                                 "one number per estimate: minmod(b1, b2, ...)")
+    values = tuple(float(v) for v in values)
+    a = values[0]
     if all(v > 0 for v in values) or all(v < 0 for v in values):
         return float(np.sign(a) * min(abs(v) for v in values))
     return 0.0
 
 
+def _check_usable(n_on, n_off, usable, name: str, *, grid: bool = False) -> tuple:
+    """The balance estimates' arguments: two counts of one shape (``grid``: [K, H, W] slices) and ``usable``, a
+    bool mask of their pixels' shape; None, text, lists of another shape or a 0/1 mask were Python's or numpy's
+    errors, or taken (an int mask indexed pixels 0 and 1). Bool counts are refused; whole-number counts come back
+    as int64 (unsigned ones wrapped around in the differences), float counts in their dtype."""
+    names = ("on", "off") if grid else ("n_on", "n_off")
+    on, off = (check_counts(a, f"{name}: {k}") for a, k in zip((n_on, n_off), names))   # float dtypes kept
+    for arr, k in zip((on, off), names):   # bool counts were numpy's "boolean subtract" error (or read as 0/1)
+        if arr.dtype == bool:
+            raise EventDataError(f"{name}: {k} must be event counts per pixel (numbers >= 0), got a bool array; "
+                                 f"pass the counts themselves (e.g. from polarity_counts), or {k}.astype(int) if "
+                                 "the 0/1 values are meant as counts")
+    # whole-number counts as int64: uint16 counts wrapped around in n- - n+ (3210.6 for an estimate in [-1, 1])
+    on, off = (a.astype(np.int64) if a.dtype.kind in "iu" else a for a in (on, off))
+    if on.shape != off.shape or (grid and on.ndim != 3):
+        raise EventDataError(f"{name}: {names[0]} and {names[1]} must be counts of one shape"
+                             + (" per time slice [K, H, W] (as slice_counts gives them)" if grid else
+                                " (one count per pixel)") + f", got shapes {on.shape} and {off.shape}")
+    shape = on.shape[1:] if grid else on.shape
+    usable = pixel_mask(usable, shape, f"{name}: usable", "the pixels to pool (e.g. (n_on + n_off) >= 4)")
+    return on, off, usable
+
+
 def pooled_imbalance(n_on, n_off, usable) -> float:
     """The counts' estimate of b over the ``usable`` pixels (bool [H, W]): sum(n- - n+) / sum(n- + n+)."""
+    return _pooled_imbalance(*_check_usable(n_on, n_off, usable, "pooled_imbalance"))
+
+
+def _pooled_imbalance(n_on, n_off, usable) -> float:   # balance_from_counts' call: its arguments are checked
     n = n_on[usable] + n_off[usable]
     return float((n_off[usable] - n_on[usable]).sum() / n.sum())
 
@@ -438,6 +473,10 @@ def slope_imbalance(n_on, n_off, usable) -> float:
     log intensity) goes to the intercept and the imbalance to the slope. What is left is the part of
     the scene's own per-pixel change that goes with the event count, which falls as events
     accumulate. NaN when the counts do not vary."""
+    return _slope_imbalance(*_check_usable(n_on, n_off, usable, "slope_imbalance"))
+
+
+def _slope_imbalance(n_on, n_off, usable) -> float:
     d = (np.asarray(n_off, np.float64) - np.asarray(n_on, np.float64))[usable]
     n = (np.asarray(n_on, np.float64) + np.asarray(n_off, np.float64))[usable]
     nc = n - n.mean()
@@ -460,6 +499,10 @@ def gradient_imbalance(on, off, usable) -> float:
     K + 1 times (the start included), ``b = -sum(g' h') / sum(h' h')`` with g', h' less their mean over
     time. C cancels. A change of light common to all pixels changes no gradient; the error left is
     what the texture's changes share with the counts. NaN when no edge's count difference changes."""
+    return _gradient_imbalance(*_check_usable(on, off, usable, "gradient_imbalance", grid=True))
+
+
+def _gradient_imbalance(on, off, usable) -> float:
     K, H, W = np.shape(on)
     num = den = 0.0
     for r0 in range(0, H, BAND_ROWS):            # bands of rows (and the row below), so memory stays a band's
@@ -538,19 +581,19 @@ def balance_from_counts(n_on, n_off, C, *, intervals=None, sliced=None, rule: st
     usable = (n >= min_events) & ~hot
     if usable.sum() < MIN_PIXELS:
         return BalanceFit((c_pos, c_neg), 0.0, 0.0, 0.0, 0.0, int(usable.sum()), int(hot.sum()), False, rule=rule)
-    raw = pooled_imbalance(n_on, n_off, usable)
+    raw = _pooled_imbalance(n_on, n_off, usable)
     # second pass: a pixel whose net level, once balanced, lies beyond any natural scene's range is not
     # watching the scene (a hot pixel below the count rule, a broken one): leave it out too
     stray = usable & (c_pos * np.abs((n_off - n_on) - raw * n) > OUTLIER_LOG)
     if stray.any() and (usable & ~stray).sum() >= MIN_PIXELS:
         usable &= ~stray
         hot |= stray
-        raw = pooled_imbalance(n_on, n_off, usable)
+        raw = _pooled_imbalance(n_on, n_off, usable)
     mean_n = float(n[usable].mean())
     s = net_change / (c_pos * mean_n)
     shrink = prior ** 2 / (prior ** 2 + s ** 2)
-    slope = slope_imbalance(n_on, n_off, usable)
-    grad = gradient_imbalance(*sliced, usable) if sliced is not None and rule == "consensus" else float("nan")
+    slope = _slope_imbalance(n_on, n_off, usable)
+    grad = _gradient_imbalance(*sliced, usable) if sliced is not None and rule == "consensus" else float("nan")
     if rule == "consensus":
         ivl = interval_imbalance(intervals, usable)
         if not np.isfinite(ivl):

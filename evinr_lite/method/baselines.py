@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.checks import (ArgumentTypeError, check_reach, check_seconds_precision, choice, host_array, is_real_number,
-                           optional_seconds, real_number, require, seconds_array)
-from ..core.events import EventDataError, Events
+                           numbers_array, optional_seconds, real_number, require, seconds_array)
+from ..core.events import EventDataError, Events, check_sensor_size
 from ..core.guard import dense_array
 from ..core.frames import Frames
 from .anchor import frame_log, linear_frames_unchecked
@@ -231,13 +231,60 @@ def highpass_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start=0.0):
     Returns:
         float64 [H, W], the log intensity at t_end.
     """
-    H, W = sensor_size
+    t, x, y, p, (H, W), C, alpha, t_end, t_start = _check_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start)
     state = np.zeros((H, W))
     t_last = np.full((H, W), float(t_start))
     for ti, xi, yi, pi in zip(t, x, y, p):
         state[yi, xi] = np.exp(-alpha * (ti - t_last[yi, xi])) * state[yi, xi] + C * pi
         t_last[yi, xi] = ti
     return state * np.exp(-alpha * (t_end - t_last))
+
+
+def _check_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start) -> tuple:
+    """highpass_per_event's arguments, checked before its loop: columns of one length (t numbers in time order, its
+    dtype kept; x, y whole pixels on the sensor; p finite numbers, not bools), C, alpha and the times finite numbers, t_start at or
+    before the first event and t_end at or after the last (a t_end before it grew the state). alpha may be any finite
+    number: the exercise's wrong solutions pass -alpha."""
+    H, W = check_sensor_size(sensor_size)
+    if getattr(host_array(p), "dtype", None) == bool or (isinstance(p, (list, tuple)) and p and
+                                                          all(isinstance(v, (bool, np.bool_)) for v in p)):
+        # bfcd363 added C for True and nothing for False: OFF events were lost without a word
+        raise EventDataError("p= must be polarities +1/-1 (one number per event), got bools (ON/OFF flags); pass "
+                             "np.where(p, 1, -1)")
+    cols = []
+    for name, col in (("t", t), ("x", x), ("y", y), ("p", p)):
+        arr = numbers_array(col, name, "one number per event (a 1-D array)")
+        if arr.ndim != 1:
+            raise EventDataError(f"{name}= must be a 1-D array (one value per event), got shape {arr.shape}")
+        cols.append(arr)
+    t, x, y, p = cols
+    if not len(t) == len(x) == len(y) == len(p):
+        raise EventDataError(f"t, x, y and p must have one value per event, got lengths {len(t)}, {len(x)}, {len(y)} "
+                             f"and {len(p)}")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0):
+        raise EventDataError("t= must be finite seconds in time order (sorted); sort the events by time first")
+    for name, col, n in (("x", x, W), ("y", y, H)):
+        if col.dtype.kind == "f" and not np.all(col == np.round(col)) or len(col) and (col.min() < 0 or col.max() >= n):
+            raise EventDataError(f"{name}= must be whole pixel indices in [0, {n - 1}] for sensor_size {(H, W)} (H, W); "
+                                 f"got values in [{col.min() if len(col) else 0}, {col.max() if len(col) else 0}]")
+    x, y = x.astype(np.int64), y.astype(np.int64)
+    if not np.all(np.isfinite(p)):   # the state became NaN (or inf) at that pixel, without a word
+        bad = int(np.flatnonzero(~np.isfinite(p))[0])
+        raise EventDataError(f"p= must be finite polarities (+1/-1), but p[{bad}] = {p[bad]}; drop those events or "
+                             "give them their polarity")
+    C = real_number(C, "C", hint="the contrast threshold in log units (e.g. 0.2)")
+    alpha = real_number(alpha, "alpha", hint="the cut-off in rad/s")
+    t_start = real_number(t_start, "t_start", hint="seconds: every pixel starts at 0 then")
+    t_end = real_number(t_end, "t_end", hint="seconds: the time of the returned state")
+    if len(t) and t_start > t[0]:
+        raise EventDataError(f"t_start={t_start:g} s is after the first event (t[0]={t[0]:g} s): pass t_start <= t[0] "
+                             "and t_end >= t[-1] (the span the events lie in)")
+    if len(t) and t_end < t[-1]:   # the state grew: the last events' decay ran backwards
+        raise EventDataError(f"t_end={t_end:g} s is before the last event (t[-1]={t[-1]:g} s): pass t_start <= t[0] "
+                             "and t_end >= t[-1] (the span the events lie in)")
+    if t_end < t_start:
+        raise EventDataError(f"t_end={t_end:g} s comes before t_start={t_start:g} s; t_end must not come first")
+    return t, x, y, p, (H, W), C, alpha, t_end, t_start
 
 
 # ---- the complementary filter: events plus APS frames ------------------------------------------

@@ -22,7 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.checks import checked_span, require, seconds_array
+from ..core.events import EventDataError
 from .binning import events_to_frames_chunked
+from .config import EvINRConfig
 from .offset import gaussian_lowpass, gaussian_lowpass_unchecked, offset_image
 
 __all__ = ["gaussian_lowpass", "coarse_correction", "coarse_applies", "coarse_times", "integrated_frames", "MAX_SPAN_S"]
@@ -35,6 +38,8 @@ MAX_SPAN_S = 3.0     # seconds: longer spans keep the INR's static image (integr
 def coarse_applies(config, t_start: float, t_end: float) -> bool:
     """Whether :func:`coarse_correction` is part of a reconstruction of [t_start, t_end] (s) with ``config``:
     an offset solve, ``offset_coarse_px`` set, and a span of at most ``MAX_SPAN_S``."""
+    require(config, EvINRConfig, "coarse_applies: config")   # None was "has no attribute 'offset_solve'"
+    t_start, t_end = checked_span(t_start, t_end, "coarse_applies")   # NaN was False, a reversed span True
     return (config.offset_solve != "none" and config.offset_coarse_px is not None
             and t_end - t_start <= MAX_SPAN_S + 1e-9)
 
@@ -42,8 +47,18 @@ def coarse_applies(config, t_start: float, t_end: float) -> bool:
 def coarse_times(times) -> np.ndarray:
     """The times (float64 [G'], s) of the offset grid ``times`` [G] at which the events are integrated: about
     ``FRAMES`` of them, evenly spread (every other one of a 64-frame grid)."""
-    t = np.asarray(times, np.float64)
+    t = _grid_times(times, allow_empty=True)
     return t[::max(1, len(t) // FRAMES)]
+
+
+def _grid_times(times, *, allow_empty: bool = False) -> np.ndarray:
+    """The offset grid's times: finite, increasing seconds [G] (a 0-d array was "len() of unsized object", a 2-D
+    one taken as rows)."""
+    t = seconds_array(times, "times", allow_empty=allow_empty)
+    if np.any(np.diff(t) <= 0):
+        raise EventDataError("times must be strictly increasing seconds (the offset grid, e.g. np.linspace(t_start, "
+                             "t_end, 64)); sort them and drop repeats (np.unique(times))")
+    return t
 
 
 def integrated_frames(chunks, times, C, sensor_size) -> np.ndarray | None:
@@ -51,7 +66,7 @@ def integrated_frames(chunks, times, C, sensor_size) -> np.ndarray | None:
     (increasing seconds; from times[0] - 1 s on: what came before is the same constant in every frame).
     ``chunks``: time-ordered :class:`~evinr_lite.core.events.Events` on a sensor of ``sensor_size``
     (a list of one, or a recording read window by window); None when they hold no event."""
-    t = np.asarray(times, np.float64)
+    t = _grid_times(times)   # none was numpy's IndexError
     ef = events_to_frames_chunked(chunks, np.concatenate([[t[0] - 1.0], t]), C=C, sensor_size=sensor_size)
     return np.cumsum(ef.frames, axis=0, out=ef.frames) if ef.counts.sum() else None
 

@@ -39,6 +39,7 @@ The reference solutions of notebook 03's exercises live here and are registered 
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from dataclasses import asdict, dataclass, field
 from typing import Callable
@@ -178,7 +179,17 @@ def split_index(index: torch.Tensor, sensor_size) -> tuple[torch.Tensor, torch.T
 
     ``index = b * H * W + y * W + x``: x is the column (fastest), y the row, b the bin.
     """
-    H, W = sensor_size
+    H, W = check_sensor_size(sensor_size)   # (0, W) was torch's ZeroDivisionError, (12.5, W) float indices
+    # a type test per call (the training loop's): no pass over the values, no device sync
+    if isinstance(index, (numbers.Integral, np.integer)) and not isinstance(index, bool):
+        pass   # one whole index (5, np.int64(5)): taken before, split as such
+    elif not isinstance(index, (torch.Tensor, np.ndarray)) or index.dtype in (torch.bool, np.bool_) or \
+            (index.is_floating_point() or index.is_complex() if isinstance(index, torch.Tensor)
+             else index.dtype.kind not in "iu"):
+        array = isinstance(index, (torch.Tensor, np.ndarray))
+        raise EventDataError(f"index= must be a tensor (or numpy array) of whole flat indices (torch.long), or one "
+                             f"whole index, got {type(index).__name__}{' of ' + str(index.dtype) if array else ''}; "
+                             "e.g. torch.randint(B * H * W, (M,))")
     return index // (H * W), (index // W) % H, index % W
 
 
@@ -196,6 +207,14 @@ def temporal_loss(dF_dt: torch.Tensor, event_values: torch.Tensor, durations: to
 
 def tikhonov_autograd(dF_dx: torch.Tensor, dF_dy: torch.Tensor) -> torch.Tensor:
     """Eq. 9 over a minibatch, from autograd gradients [M] (per pixel): mean of dF/dx^2 + dF/dy^2."""
+    for name, g in (("dF_dx", dF_dx), ("dF_dy", dF_dy)):   # type and shape tests only: no pass over the values
+        if not isinstance(g, torch.Tensor) or not g.is_floating_point():
+            raise EventDataError(f"{name}= must be a float tensor of gradients [M] (autograd's), got "
+                                 f"{type(g).__name__}{' of ' + str(g.dtype) if isinstance(g, torch.Tensor) else ''}; "
+                                 "pass torch.as_tensor(values, dtype=torch.float32)")
+    if dF_dx.shape != dF_dy.shape or dF_dx.numel() == 0:   # two shapes broadcast (or were torch's error); none: NaN
+        raise EventDataError(f"dF_dx and dF_dy must be gradients [M] of one shape, one per sampled pixel, M > 0; got "
+                             f"shapes {tuple(dF_dx.shape)} and {tuple(dF_dy.shape)}")
     return torch.mean(dF_dx ** 2 + dF_dy ** 2)
 
 
@@ -392,6 +411,9 @@ def train_coordinate_inr(events: Events, config: CoordinateConfig | None = None,
 
 # ---- brightness anchor and reconstruction ----------------------------------------------
 
+MAX_ANCHORS = 4096   # predict_anchored's anchor frames: each is rendered [H, W]; 16 set the offset as well as more
+
+
 def predict_anchored(model: CoordinateINR, query_times, gamma: float = 0.6, display_mean: float = 0.5,
                      n_anchor: int = 16) -> tuple[np.ndarray, float]:
     """Anchored log intensity at ``query_times`` [Q] (s): (float32 [Q, H, W], the offset added).
@@ -399,6 +421,12 @@ def predict_anchored(model: CoordinateINR, query_times, gamma: float = 0.6, disp
     The offset is set on ``n_anchor`` evenly spaced times over the model's whole ``t_range``
     (not on the query times), so it does not depend on which frames are asked for.
     """
+    if not isinstance(model, CoordinateINR):
+        raise EventDataError(f"model= must be a CoordinateINR (e.g. reconstruct_coordinate(...).model), got "
+                             f"{type(model).__name__}")
+    # 0 anchors gave NaN frames, 1.5 or None numpy's linspace error, 10**12 a MemoryError
+    n_anchor = whole_number(n_anchor, "n_anchor", lo=1, hi=MAX_ANCHORS)
+    query_times = seconds_array(query_times, "query_times", allow_empty=True)   # text was numpy's ValueError
     grid = np.linspace(*model.t_range, n_anchor)
     offset = anchor_level(gamma, display_mean) - float(model.render(grid).mean())   # as tonemap.anchor_mean
     L = model.render(np.atleast_1d(np.asarray(query_times, dtype=np.float64))) + np.float32(offset)

@@ -60,7 +60,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..core.events import EventDataError, Events
-from ..core.checks import choice
+from ..core.checks import ArgumentTypeError, choice, pixel_mask
 from ..core.guard import dense_array
 
 __all__ = ["hot_pixel_mask", "hot_threshold", "check_counts", "check_count_pair",
@@ -179,14 +179,15 @@ def remove_hot_pixels(events: Events, mask: np.ndarray | None = None, **kw) -> E
     ``hot_pixel_mask(events, **kw)``)."""
     _check_events(events)
     H, W = events.sensor_size
+    unknown = sorted(set(kw) - {"factor", "rule"})
+    if unknown:   # was hot_pixel_mask's TypeError, named as another function's
+        raise ArgumentTypeError(f"remove_hot_pixels got an unknown keyword {unknown[0]!r}; it takes mask= or "
+                                "hot_pixel_mask's factor= and rule=")
     if mask is None:
         mask = hot_pixel_mask(events, **kw)
     elif kw:
         raise EventDataError(f"remove_hot_pixels got a mask and also {sorted(kw)}; pass one or the other")
-    mask = np.asarray(mask)
-    if mask.shape != (H, W) or mask.dtype != bool:
-        raise EventDataError(f"mask must be a bool array of the sensor's shape (H, W) = {(H, W)}, got "
-                             f"{mask.dtype} {mask.shape}; build it with hot_pixel_mask(events)")
+    mask = pixel_mask(mask, (H, W), "remove_hot_pixels: mask", "build it with hot_pixel_mask(events)")   # drop_pixels' check
     return events.take(~mask[events.y, events.x])
 
 

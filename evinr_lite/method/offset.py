@@ -55,7 +55,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from ..core.checks import choice, numbers_array, real_number, whole_number
+from ..core.checks import (ArgumentTypeError, choice, decimal_as_float, numbers_array, real_number, seconds_array,
+                           whole_number)
 from ..core.events import EventDataError
 from ..core.runtime import cpu_threads
 from .head_solve import laplacian_eigenvalues_unchecked
@@ -169,7 +170,7 @@ def _median_gradient(frames) -> np.ndarray:
     """:func:`median_gradient_offset` without its checks (:func:`offset_image`: the solver's own frames)."""
     frames = np.asarray(frames)
     if frames.ndim != 3 or frames.shape[0] < 1:
-        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {frames.shape}")
+        raise EventDataError(f"frames must be [K, H, W] log intensities, got shape {frames.shape}")
     # a block of rows at a time, with time as the contiguous axis: the same float64 differences and
     # medians as on the whole stack, a few times faster, and work arrays of one block (about 2 M
     # cells) instead of three float64 copies of the stack (which matters at HD, where K is 64 or more)
@@ -308,7 +309,7 @@ def _moved(F: np.ndarray, rest: float) -> np.ndarray:
     block of image rows at a time: float32 work arrays of about 2 M cells, whatever the sensor)."""
     if isinstance(rest, (bool, np.bool_)) or not (isinstance(rest, (int, float, np.floating)) and rest > 0
                                                    and np.isfinite(rest)):
-        raise ValueError(f"rest must be a positive number of log units or None, got {rest!r}")
+        raise EventDataError(f"rest must be a positive number of log units or None, got {rest!r}")
     K, H, W = F.shape
     out = np.empty((K, H, W), bool)
     rows = max(1, (1 << 21) // max(K * W, 1))
@@ -377,7 +378,7 @@ def _l1_gradient(frames, max_iters: int = L1_MAX_ITERS, tol: float = L1_TOL, res
     hold a diverged network's NaN; the solver's result check names that, with the settings to change)."""
     F = np.asarray(frames)
     if F.ndim != 3 or F.shape[0] < 1:
-        raise ValueError(f"frames must be [K, H, W] log intensities, got shape {F.shape}")
+        raise EventDataError(f"frames must be [K, H, W] log intensities, got shape {F.shape}")
     K, H, W = F.shape
     if H < 2 or W < 2:                              # no edges in one direction: the median answer
         return _median_gradient(F)
@@ -417,7 +418,7 @@ def offset_image(frames, method: str, rest: float | None = None) -> np.ndarray:
     0.0308 -> 0.0629 with the rest solve alone, 0.0324 so; ``python benchmarks/static_camera.py``)."""
     method = choice(method, ("median_gradient", "l1_gradient"), "offset method")
     if rest is not None and method != "l1_gradient":
-        raise ValueError(f"rest= (a static camera) needs the 'l1_gradient' offset solve, got {method!r}")
+        raise EventDataError(f"rest= (a static camera) needs the 'l1_gradient' offset solve, got {method!r}")
     if method == "median_gradient":
         return _median_gradient(frames)
     plain = _l1_gradient(frames)
@@ -453,10 +454,30 @@ class OffsetTrend:
         return self.add_to(np.zeros((len(t), *self.images.shape[1:]), np.float32), t)
 
 
+MAX_TREND_INTERVALS = 10**6   # knots of an offset trend: each is an image [H, W] solved; more is a unit mix-up
+
+
+def _trend_window(window):
+    """``window`` (seconds between the offset trend's knots) checked: None, or a finite number > 0."""
+    if window is None:
+        return None
+    return real_number(decimal_as_float(window), "window", lo=0, lo_open=True,
+                       hint="seconds between the offset's knots (EvINRConfig.offset_window), or None for one image")
+
+
 def trend_intervals(span: float, window: float | None) -> int:
     """How many intervals between knots :func:`offset_trend` puts over ``span`` seconds: 1 (one image)
     for ``window`` None or a span under 1.5 windows, else round(span / window)."""
-    return 1 if window is None else max(1, int(round(span / window)))
+    # a Decimal (taken before, as in the readers' windows) as its float
+    span = real_number(decimal_as_float(span), "span", lo=0, hint="the span's length in seconds (t_end - t_start)")
+    window = _trend_window(window)
+    if window is None:
+        return 1
+    n = span / window
+    if n > MAX_TREND_INTERVALS:   # 1e308 / 1e-308 was an OverflowError, 1e6 / 1e-6 a trend of 1e12 images
+        raise EventDataError(f"a span of {span:g} s with window={window:g} s would be {n:.3g} offset images (at most "
+                             f"{MAX_TREND_INTERVALS:,}); give the window in seconds (e.g. 2.0), or None for one image")
+    return max(1, int(round(n)))
 
 
 def trend_knots(span: float, window: float | None) -> int:
@@ -482,12 +503,19 @@ def offset_trend(times, frames, window: float | None, method: str = "l1_gradient
         :class:`OffsetTrend` with K = max(1, round(span / window)) + 1 knots evenly over the span
         (1 knot when one image is solved); each image float32, mean 0.
     """
-    t = np.asarray(times, np.float64)
-    frames = np.asarray(frames)
-    if t.ndim != 1 or len(t) != len(frames) or len(t) < 1:
-        raise ValueError(f"times [G] and frames [G, H, W] must match, got {t.shape} and {frames.shape}")
-    if window is not None and not window > 0:
-        raise ValueError(f"window must be positive seconds or None, got {window!r}")
+    # the frames' values are not checked: the solver passes its network's frames, whose NaN its result check names
+    t = seconds_array(times, "times")
+    frames = numbers_array(frames, "frames", "log intensities [G, H, W]")
+    if frames.ndim != 3 or len(t) != len(frames):
+        raise EventDataError(f"times [G] and frames [G, H, W] must match, got shapes {t.shape} and {frames.shape}; "
+                             "give one time (s) per frame")
+    if np.any(np.diff(t) < 0):   # taken: the knots ran backwards, over the wrong frames
+        raise EventDataError("times must be increasing seconds (one per frame, in time order); sort the frames by "
+                             "time first (order = np.argsort(times); times[order], frames[order])")
+    window = _trend_window(window)
+    if on_image is not None and not callable(on_image):
+        raise ArgumentTypeError(f"on_image= must be a function called with no argument after each image (e.g. a "
+                                f"progress bar's update) or None, got {type(on_image).__name__}")
     span = float(t[-1] - t[0])
     n = trend_intervals(span, window)
     done = on_image or (lambda: None)

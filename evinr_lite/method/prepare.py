@@ -33,7 +33,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..core.checks import ArgumentTypeError, checked_span, real_number
+from ..core.checks import ArgumentTypeError, checked_span, pixel_mask, real_number, require
 from ..core.events import EventDataError, Events
 from .balance import PolarityCounts, balance_from_counts, span_slices
 from .background import MIN_EVENTS, WHOLE_SPAN, busy_spans, fit_background, sample_spans, tile_counts
@@ -128,7 +128,12 @@ def plan_from_counts(n_on, n_off, cfg, fraction: float = 1.0, intervals=None, sl
 
 def drop_pixels(events: Events, mask) -> Events:
     """The events without those of the pixels in ``mask`` (bool [H, W]; None or all False: unchanged)."""
-    if mask is None or not np.any(mask):
+    require(events, Events, "drop_pixels: events")
+    if mask is None:
+        return events
+    # numbers were taken as event indices, another shape numpy's IndexError, a tensor numpy's any() error
+    mask = pixel_mask(mask, events.sensor_size, "drop_pixels: mask", "build it with hot_pixel_mask(events)")
+    if not mask.any():
         return events
     return events.take(~mask[events.y, events.x])
 

@@ -22,6 +22,7 @@ import torch
 from torch import nn
 
 from ..core.checks import real_number, true_or_false, whole_number
+from ..core.events import EventDataError
 
 __all__ = ["SineLayer", "Siren", "input_gradient", "check_siren_shape"]
 
@@ -164,7 +165,19 @@ def input_gradient(y: torch.Tensor, x: torch.Tensor, create_graph: bool = True) 
     Returns:
         tensor shaped like ``x``.
     """
+    for name, v in (("y", y), ("x", x)):   # None or numpy was "has no attribute 'requires_grad'" or torch's error
+        if not isinstance(v, torch.Tensor):
+            raise EventDataError(f"input_gradient: {name}= must be a torch tensor, got {type(v).__name__}"
+                                 + ("; make x a tensor with requires_grad=True before the forward pass" if name == "x"
+                                    else "; pass the network's output computed from x"))
     if not x.requires_grad:
-        raise ValueError("input_gradient needs x.requires_grad=True before the forward pass")
-    (g,) = torch.autograd.grad(y, x, grad_outputs=torch.ones_like(y), create_graph=create_graph)
+        raise EventDataError("input_gradient needs x.requires_grad=True before the forward pass")
+    create_graph = true_or_false(create_graph, "create_graph")
+    try:
+        (g,) = torch.autograd.grad(y, x, grad_outputs=torch.ones_like(y), create_graph=create_graph)
+    except RuntimeError as err:   # y not computed from x: torch's "does not require grad" / "not ... used in the graph"
+        if "require grad" not in str(err) and "used in the graph" not in str(err):
+            raise
+        raise EventDataError("input_gradient: y was not computed from x (autograd finds no path from x to y); pass "
+                             "y = model(x), computed after x.requires_grad_(True)") from None
     return g

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.checks import real_number, whole_number
+from ..core.checks import blank_path, check_path_type, real_number, whole_number
 from ..core.events import EventDataError
 from ..io.output import atomic_output_dir, save_png
 from ..io.readers import read_recording
@@ -77,10 +77,17 @@ def find_recording(path=None, scratch=None, *, start=None) -> tuple[Path, str]:
     recording (IJRR layout, with frames) written into ``scratch``.
     """
     if path is not None:
+        check_path_type(path, "path", "a recording (a file or a folder)", "or None to find one")
+        if blank_path(path):   # "" (and Path(""), which reads ".") was the current folder, "given"
+            raise EventDataError(f"path= is empty ({path!r}; '' and Path('') both mean the current folder): pass the recording's path (Path.cwd() for the "
+                                 "current folder), or None to find one")
         path = Path(path)
         if not path.exists():
             raise EventDataError(f"no such recording: {path}; check the path")
         return path, "given"
+    for name, value in (("scratch", scratch), ("start", start)):
+        if value is not None:   # a number was Python's "expected str, bytes or os.PathLike object" (or never looked at)
+            check_path_type(value, name, "a folder", "or None")
     shared = sample_recording_path(SLIDER_DEPTH_CHUNK, start=start)
     if shared is not None and (shared / "events.txt").exists():
         return shared, "the shared IJRR slider_depth chunk"
