@@ -603,10 +603,6 @@ REVIEW_CASES = {
                                      r"remove_hot_pixels: mask= must be a bool array .*pass mask != 0"),
     "remove_hot_pixels-mask-shape": (lambda: denoise.remove_hot_pixels(EV, HOT[:3]), r"got bool array of shape \(3, 16\)"),
     "drop_pixels-mask-float": (lambda: prepare.drop_pixels(EV, HOT.astype(float)), r"mask= must be a bool .*mask != 0"),
-    # N4: Path("") is Path("."): it was the current folder, "given"
-    "find_recording-Path-empty": (lambda: recordings.find_recording(__import__("pathlib").Path("")),
-                                  r"path= is empty .*Path\.cwd\(\)"),
-    "lpips_paths-Path-empty": (lambda: lpips.lpips_paths(__import__("pathlib").Path("")), r"cache_dir= is empty"),
     # O2: the message of a numpy scalar of the wrong kind said "float64 of float64"; True is no index
     "split_index-float-scalar": (lambda: coordinate.split_index(np.float64(5), (12, 16)),
                                  r"or one whole index, got float64; e\.g\."),

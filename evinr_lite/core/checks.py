@@ -282,13 +282,9 @@ def check_path_type(value, name: str, what: str, hint: str = ""):
 
 
 def blank_path(value) -> bool:
-    """Whether a path (checked by :func:`check_path_type`) names nothing: blank text, or a Path whose text is "."
-    (``Path("")`` is ``Path(".")``, so the two cannot be told apart; the text "." stays a path: the current folder
-    named on purpose). Callers that take "" as a mistake refuse both."""
-    if isinstance(value, str):
-        return not value.strip()
-    text = os.fspath(value) if isinstance(value, os.PathLike) else value
-    return isinstance(text, str) and text in ("", ".")
+    """Whether a path (checked by :func:`check_path_type`) is blank text: "" or spaces, a mistake callers refuse.
+    A Path is never blank: ``Path("")`` is ``Path(".")``, the current folder, which a user may name on purpose."""
+    return isinstance(value, str) and not value.strip()
 
 
 def is_real_number(value) -> bool:
