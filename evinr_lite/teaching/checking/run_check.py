@@ -35,9 +35,11 @@ change it and other hints win. Returns (passed, headline, detail lines); printin
 from __future__ import annotations
 
 import functools
+import re
 from typing import Callable
 
-from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, fixed_size_hint, global_cache_hint,
+from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, constant_size_hint, fixed_size_hint,
+                           global_cache_hint,
                            global_containers, mutable_default_hint, memory_explains, mutable_defaults, reseed_hint,
                            same_objects_new_values, scalar_factor_hint, shares_output, stale_argument_hint, state_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
@@ -50,7 +52,7 @@ from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
-                      first_difference, not_finite)
+                      first_difference, is_tensor, named_inputs, not_finite)
 from .protocol import ExerciseLike
 from .signature import (called_as_notebook, called_the_same_way, learner_function, notebook_caller,
                         signature_default_hint)
@@ -275,6 +277,9 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
                        "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
                        ".item(), .numpy()); compute it with torch operations on the model's outputs, "
                        "with gradients on")
+    widths = _float_widths_hint(err, args, kwargs)
+    if widths:
+        details.append(f"hint: {widths}")
     if isinstance(err, IndexError) and non_square(args, kwargs):
         details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
                        "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
@@ -311,6 +316,27 @@ def _list_inputs_hint(ex: ExerciseLike, err: Exception, args, kwargs) -> str | N
     return (f"{', '.join(f'`{name}`' for name in names)} {'is a Python list' if len(names) == 1 else 'are Python lists'} on this input,"
             f"{where}: a list has no array methods, no [:, None] indexing and no element-wise arithmetic; convert "
             f"first, `{first} = np.asarray({first}, dtype=float)`")
+
+
+def _float_widths_hint(err: Exception, args, kwargs) -> str | None:
+    """torch's refusal to mix float32 and float64 in one operation (a matrix product, a convolution, index_put),
+    where an input tensor has one of the two widths: name it, and how to make a tensor of one's own like it. A
+    difference matrix or a kernel made inside (torch.eye, torch.tensor([-1.0, 1.0])) is float32 whatever the input,
+    so the function works on float32 inputs only (notebook 05 passes total_variation a float64 stack)."""
+    msg = str(err)
+    if not isinstance(err, RuntimeError) or not (re.search(r"\b[Dd]ouble\b", msg) and re.search(r"\b[Ff]loat\b", msg)):
+        return None
+    named = [(name, str(v.dtype).replace("torch.", "")) for name, v in named_inputs(args, kwargs)
+             if is_tensor(v) and str(v.dtype) in ("torch.float32", "torch.float64")]
+    if not named:
+        return None
+    name, width = next(((n, w) for n, w in named if w == "float64"), named[0])
+    return (f"torch does not mix float32 and float64 tensors in one operation (a matrix product, a convolution, "
+            f"index_put), and `{name}` is a {width} tensor on this input: a tensor made inside the function is "
+            f"float32 by default (torch.eye, torch.zeros, torch.tensor([-1.0, 1.0])) and float64 when made from "
+            f"numpy floats (torch.from_numpy, torch.tensor of an array); make it like the input "
+            f"(`torch.eye(n, dtype={name}.dtype)`, `{name}.new_tensor([...])`, `torch.zeros_like({name})`), "
+            f"which works for either width")
 
 
 def _swallowed_hint(fn: Callable, args, kwargs) -> str | None:
@@ -403,6 +429,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
         hint = size_from_events_hint(args, kwargs, got, expected)
     if hint is None:
         hint = fixed_size_hint(ex, cases, k, got, expected)
+    if hint is None and not problem.values:
+        hint = constant_size_hint(ex, fn, cases, k, got, expected)
     if problem.values:
         if hint is None:
             hint = axes_order_hint(got, expected, ex.rtol, ex.atol)
