@@ -378,6 +378,56 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     return result if observe is None else observe(result, args, kwargs)
 
 
+# the time module's clocks, each read faster by :func:`fast_clock`
+_CLOCKS = ("time", "perf_counter", "monotonic", "process_time", "thread_time",
+           "time_ns", "perf_counter_ns", "monotonic_ns", "process_time_ns", "thread_time_ns")
+CLOCK_STEP_S = 3600.0      # how far :func:`fast_clock`'s clocks move at each read
+
+
+@contextlib.contextmanager
+def fast_clock(fn: Callable) -> Iterator[list]:
+    """While the block runs, every clock of the time module (time.time, time.perf_counter, time.monotonic, ...) moves
+    :data:`CLOCK_STEP_S` ahead at each read by code other than the check's own, as on a machine (or an input) that
+    many times slower: a loop stopped after a time budget (``while time.perf_counter() - t0 < 0.1``) stops at once.
+    The names that ``fn``'s globals bind to those clocks (``from time import perf_counter``) are moved too, and
+    everything is put back after the block. Yields the list of the clocks read (their names, once per read)."""
+    fn = learner_function(fn)
+    reads: list = []
+    originals = {name: getattr(time, name) for name in _CLOCKS if hasattr(time, name)}
+    ahead = [0.0]
+
+    def faster(name, clock):
+        def read():
+            caller = sys._getframe(1).f_code.co_filename
+            if _check_file(caller) or caller in _NO_STOP_FILES:
+                return clock()              # the check's own timing (the time limit's, a call's seconds)
+            reads.append(name)
+            ahead[0] += CLOCK_STEP_S
+            return clock() + (int(ahead[0] * 1e9) if name.endswith("_ns") else ahead[0])
+        return read
+
+    fakes = {name: faster(name, clock) for name, clock in originals.items()}
+    namespace = getattr(fn, "__globals__", None)
+    bound = {}
+    if isinstance(namespace, dict):
+        for key, value in list(namespace.items()):
+            for name, clock in originals.items():
+                if value is clock:
+                    bound[key] = name
+    try:
+        for name, fake in fakes.items():
+            setattr(time, name, fake)
+        for key, name in bound.items():
+            namespace[key] = fakes[name]
+        yield reads
+    finally:
+        for name, clock in originals.items():
+            setattr(time, name, clock)
+        for key, name in bound.items():
+            if namespace.get(key) is fakes[name]:
+                namespace[key] = originals[name]
+
+
 def copy_inputs(inputs: tuple[tuple, dict]) -> tuple[list, dict]:
     """A deep copy of a case's (args, kwargs), the args as a list, for :func:`run` with ``copy_inputs=False``."""
     args, kwargs = _deepcopy_with_grads(inputs)

@@ -46,7 +46,7 @@ from .global_state import (global_settings, imports_watched, other_rng_states, r
                            rng_states, set_rng_states, settings_message)
 from .hints import (REORDERED, aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
-from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught_errors, changed_inputs,
+from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught_errors, changed_inputs, fast_clock,
                             container_names, in_place_message, module_flags, module_flags_message, poison_freed_memory,
                             run, swallowed_message, tensor_flags, tensor_flags_message, watching, where_raised)
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
@@ -173,7 +173,10 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             details.append("also: " + flags)
         return False, f"does not match the reference on {where}", details
     if n:
-        failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after)
+        clocks: list = []
+        failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after, clocks)
+        if failed is None and clocks:       # the clock was read: the other inputs on the faster clock too
+            failed = _clock_elsewhere(ex, fn, cases)
         if failed is not None:
             return failed
         refilled = same_objects_new_values(ex, fn, cases)
@@ -492,21 +495,26 @@ def _generic_mistake_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, g
 
 
 def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_before: dict,
-                 rng_after: dict) -> Report | None:
+                 rng_after: dict, clocks_read: list | None = None) -> Report | None:
     """The failure seen when the last input, ``case``, is run once more, from other states of the global random
     generators, or None. From the loop's last pass: ``got``, what the first run returned, and ``rng_before`` and
     ``rng_after``, the generators' states around it.
 
     A function that keeps state between calls (a notebook variable it changes, a mutable default argument) gives
     another result the second time; one that keeps its result (a buffer, a cache) returns the same array again;
-    one that reseeds a global generator leaves it in the same state whatever it held before."""
+    one that reseeds a global generator leaves it in the same state whatever it held before. The second call runs on
+    a clock many times faster (:func:`.learner_calls.fast_clock`): a result that then differs, and not on the real
+    clock, depends on the time read (a loop stopped after a time budget). ``clocks_read``, a list, receives the clocks
+    the call read."""
     args, kwargs = case
     rng_now, rng_other = rng_states(), other_rng_states(rng_before)
     changed_settings: dict = {}
+    clocks: list = []
     try:
         set_rng_states(rng_other)
         poison_freed_memory(got)
-        again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
+        with fast_clock(fn) as clocks:      # the clock many times faster: a loop stopped after a time budget shows
+            again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
         rng_again = rng_states()
         if ex.observe is not None:
             problem = None
@@ -518,8 +526,12 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
         again, rng_again, problem = None, None, Problem(f"{type(err).__name__}: {err}")
     finally:
         set_rng_states(rng_now)
+    if clocks_read is not None:
+        clocks_read += clocks
     if changed_settings:
         return False, f"changed the notebook's global settings on input #{n} of {n}", [settings_message(changed_settings)]
+    if problem is not None and clocks and _right_on_real_clock(ex, fn, case, rng_other):
+        return False, f"gives another result when the clock runs faster (input #{n} of {n})", [_clock_message(clocks)]
     if problem is not None and memory_explains(fn, ex, args, kwargs, got):
         return False, f"gives another result when input #{n} of {n} is run a second time", [UNINITIALISED]
     if problem is not None:
@@ -545,3 +557,55 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
             "repeat); nothing here asks for randomness: remove the seed, or draw from a generator of your own "
             "(rng = np.random.default_rng(seed), torch.Generator().manual_seed(seed))"]
     return None
+
+
+def _clock_elsewhere(ex: ExerciseLike, fn: Callable, cases: list) -> Report | None:
+    """For a function that read the clock in the second call and still matched there: each other input run on the
+    faster clock (:func:`.learner_calls.fast_clock`); the first that then differs, and matches on the real clock,
+    is reported (a time budget that the last input's result does not show: a solver's start that is the answer)."""
+    n = len(cases)
+    for j, (args, kwargs) in enumerate(cases[:-1]):
+        clocks: list = []
+        try:
+            with fast_clock(fn) as clocks:
+                got = run(fn, args, kwargs, ex.observe)
+            if ex.observe is not None or not clocks:
+                continue
+            expected = run(ex.reference, args, kwargs)
+            differs = (compare_outputs(got, expected, ex.rtol, ex.atol) if ex.compare is None
+                       else ex.compare(got, expected)) is not None
+        except Exception:
+            differs = True
+        if differs and clocks and _right_on_real_clock(ex, fn, cases[j], rng_states()):
+            return False, f"gives another result when the clock runs faster (input #{j + 1} of {n})", [
+                _clock_message(clocks)]
+    return None
+
+
+def _right_on_real_clock(ex: ExerciseLike, fn: Callable, case: tuple, rng_other: dict) -> bool:
+    """Whether ``fn`` matches the reference on ``case`` when run again from the same generator states as the second
+    call, on the real clock: then the faster clock alone made the second call's difference."""
+    args, kwargs = case
+    rng_now = rng_states()
+    try:
+        set_rng_states(rng_other)
+        again = run(fn, args, kwargs, ex.observe)
+        if ex.observe is not None:
+            return False
+        expected = run(ex.reference, args, kwargs)
+        return (compare_outputs(again, expected, ex.rtol, ex.atol) if ex.compare is None
+                else ex.compare(again, expected)) is None
+    except Exception:
+        return False
+    finally:
+        set_rng_states(rng_now)
+
+
+def _clock_message(clocks: list) -> str:
+    """What a report says of a result that changed when the clock ran faster (``clocks``: the clocks read)."""
+    read = ", ".join(f"time.{name}()" for name in dict.fromkeys(clocks))
+    return (f"every input matched, but run again with the clock many times faster the function answers otherwise: "
+            f"its result depends on the time it reads ({read}), as a loop stopped after a time budget does (`while "
+            "time.perf_counter() - t0 < 0.1`); on the notebook's larger inputs, or a slower or busier machine, it "
+            "stops earlier with another answer; stop an iterative loop on a tolerance and an iteration count, or "
+            "solve directly (np.linalg.solve, np.linalg.lstsq), and read the clock only to print how long it took")
