@@ -309,7 +309,8 @@ def constant_size_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got,
     """A wrong size that is the same on every input, while the expected size changes with the arguments: a size
     fixed in the code or read from a notebook variable that is not input #1's (the notebook's sensor (48, 64), its 40
     bins, its 32 frames), where :func:`fixed_size_hint` names input #1's. Asked for a wrong shape only; every input
-    the learner's function and the reference both answer counts, and at least three must."""
+    the learner's function and the reference both answer counts, and at least three must; the size is at least 2
+    (0 or 1 everywhere is a count that collapsed) and differs from the expected one on each of them."""
     if ex.observe is not None:
         return None
     mine, want = _leaves(got, expected), _leaves(expected, expected)
@@ -336,7 +337,10 @@ def constant_size_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got,
     for j, a in wrong:
         sizes = [g[j][a] if len(g[j]) > a else None for g, _ in seen]
         wanted = [e[j][a] if len(e[j]) > a else None for _, e in seen]
-        if len(set(sizes)) == 1 and len(set(wanted)) > 1:
+        # a size of 0 or 1 everywhere is a count that collapsed (an empty range, a max(..., 1)), not a number
+        # written in; and a fixed number is wrong on every input (else it may be a rule that lands alike)
+        if len(set(sizes)) == 1 and len(set(wanted)) > 1 and (sizes[0] or 0) >= 2 \
+                and all(w != sizes[0] for w in wanted):
             fixed.append((j, a, sizes[0], wanted))
     if not fixed:
         return None
