@@ -17,7 +17,8 @@ same of the input tensors (requires_grad), and :func:`refill_in_place` writes on
 objects without changing their identity (a cache keyed by id()). :func:`caught_errors` runs a call again under a
 tracer of the learner's own frames and lists the errors that the function the check called caught with its own
 `try`/`except`, and whether that `except` made the result (returned it, or set a name the return uses, read off the
-source); :func:`swallowed_message` names the last one that did.
+source); :func:`swallowed_message` names the last one that did. :func:`fast_clock` runs the time module's clocks an
+hour ahead at each of the learner's reads (a result that depends on a time budget then changes).
 """
 from __future__ import annotations
 

@@ -6,7 +6,8 @@ learner's call), compares the outputs (:mod:`.outputs`; where the values match, 
 result too), and at the first difference looks for a hint (:func:`_hint_for`), in a fixed order: data kept in a
 notebook variable (when it made the difference), np.empty (a rerun on zeroed memory answers otherwise), the
 exercise's own wrong versions, outputs in another order, state kept between calls, an argument taken from input #1, the
-generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
+generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1 (or the
+same on every input), the
 patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
 the rest), and last a notebook variable that only grew. A None that no in-place method explains
 (``return out.sort()``), or a wrong value no hint explains, that an `except` of the learner's own made (returned, or
@@ -17,7 +18,8 @@ parameters requiring grad, than the reference leaves it is named after each call
 requires_grad the call changed. A call stopped at the time limit (:class:`.learner_calls.TooSlow`: an endless loop) or
 ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
 (which would run it again). After every input matched, the last one is run a second time from other states of the
-global generators (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`), and input #1's own objects are
+global generators and on a clock running faster (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`,
+:func:`.learner_calls.fast_clock`: where the clock was read, every input on it), and input #1's own objects are
 refilled in place with a later input's values and given again (:func:`.across_calls.same_objects_new_values`: a cache
 keyed by id()), and last the function is called as the
 notebooks call it (:func:`.signature.called_as_notebook`, each exercise's recorded call, only where its signature
