@@ -49,6 +49,7 @@ float32 L_t0; the references convert, and a learner's function that does not ret
 open); a torch 0-d tensor where a Python float is expected passes (notebook 09's later cells run with it).
 """
 import math
+import threading
 import time
 
 import numpy as np
@@ -260,7 +261,8 @@ def test_the_third_total_variation_input_is_float64_and_the_counts_stand():
 
 def test_the_fast_clock_moves_only_the_learner_s_reads_and_is_put_back():
     """Inside the block a read from this file (the learner's side) moves an hour ahead each time; a name bound
-    with `from time import perf_counter` moves too; after it, every clock is the time module's own again."""
+    with `from time import perf_counter` moves too; another thread's read (a notebook kernel's output thread) stays
+    real; after it, every clock is the time module's own again."""
     originals = {name: getattr(time, name) for name in ("time", "perf_counter", "monotonic")}
 
     def fn():
@@ -271,8 +273,11 @@ def test_the_fast_clock_moves_only_the_learner_s_reads_and_is_put_back():
             a = time.perf_counter()
             b = time.perf_counter()
             c = fn.__globals__["_r17_bound_clock"]()
+            seen = []
+            other = threading.Thread(target=lambda: seen.append(time.monotonic()))   # another thread: real
+            other.start(); other.join()
         assert b - a >= learner_calls.CLOCK_STEP_S and c - b >= learner_calls.CLOCK_STEP_S
-        assert reads == ["perf_counter"] * 3
+        assert reads == ["perf_counter"] * 3 and abs(seen[0] - time.monotonic()) < 60
         assert fn.__globals__["_r17_bound_clock"] is originals["perf_counter"]
         assert all(getattr(time, name) is clock for name, clock in originals.items())
     finally:

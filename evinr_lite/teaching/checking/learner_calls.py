@@ -391,17 +391,23 @@ def fast_clock(fn: Callable) -> Iterator[list]:
     :data:`CLOCK_STEP_S` ahead at each read by code other than the check's own, as on a machine (or an input) that
     many times slower: a loop stopped after a time budget (``while time.perf_counter() - t0 < 0.1``) stops at once.
     The names that ``fn``'s globals bind to those clocks (``from time import perf_counter``) are moved too, and
-    everything is put back after the block. Yields the list of the clocks read (their names, once per read)."""
+    everything is put back after the block. Only the learner's own reads, on this thread, move: the check's (the
+    time limit's, a call's seconds), a library's (asyncio's loop in a notebook kernel's output thread, logging) and
+    another thread's read the real clock. Yields the list of the clocks read (their names, once per read)."""
     fn = learner_function(fn)
     reads: list = []
     originals = {name: getattr(time, name) for name in _CLOCKS if hasattr(time, name)}
     ahead = [0.0]
+    owner = threading.get_ident()
+    real: dict = {}                         # {file name: whether its reads stay real}, each file looked up once
 
     def faster(name, clock):
         def read():
             caller = sys._getframe(1).f_code.co_filename
-            if _check_file(caller) or caller in _NO_STOP_FILES:
-                return clock()              # the check's own timing (the time limit's, a call's seconds)
+            if caller not in real:
+                real[caller] = _check_file(caller) or caller in _NO_STOP_FILES or library_file(caller)
+            if real[caller] or threading.get_ident() != owner:
+                return clock()
             reads.append(name)
             ahead[0] += CLOCK_STEP_S
             return clock() + (int(ahead[0] * 1e9) if name.endswith("_ns") else ahead[0])
