@@ -26,7 +26,7 @@ Holes (these passed a check before this round; each now fails and its report nam
 - integrate_gradients, head_closed_form, estimate_contrast_threshold: ig_time_budget, hcf_time_budget and
   ect_time_budget converged within their time budget on every input. The second call of the last input now runs on
   a clock 3600 s faster at every read (learner_calls.fast_clock: the time module's clocks, and names a notebook bound
-  to them with `from time import ...`; the check's own reads stay real); where the function read the clock and
+  to them with `from time import ...`; the check's own reads, a library's and another thread's stay real); where the function read the clock and
   matched there, every other input is run on it too (the last input of integrate_gradients is a constant image,
   which a solver's zero start already is); a result that differs there and matches on the real clock is named
   (run_check._clock_elsewhere, _clock_message).
