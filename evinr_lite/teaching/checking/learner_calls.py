@@ -17,8 +17,7 @@ same of the input tensors (requires_grad), and :func:`refill_in_place` writes on
 objects without changing their identity (a cache keyed by id()). :func:`caught_errors` runs a call again under a
 tracer of the learner's own frames and lists the errors that the function the check called caught with its own
 `try`/`except`, and whether that `except` made the result (returned it, or set a name the return uses, read off the
-source); :func:`swallowed_message` names the last one that did. :func:`fast_clock` runs the time module's clocks an
-hour ahead at each of the learner's reads (a result that depends on a time budget then changes).
+source); :func:`swallowed_message` names the last one that did.
 """
 from __future__ import annotations
 
@@ -377,62 +376,6 @@ def run(fn, args, kwargs, observe=None, inputs_after: list | None = None, settin
     if inputs_after is not None:
         inputs_after.append((args, kwargs))
     return result if observe is None else observe(result, args, kwargs)
-
-
-# the time module's clocks, each read faster by :func:`fast_clock`
-_CLOCKS = ("time", "perf_counter", "monotonic", "process_time", "thread_time",
-           "time_ns", "perf_counter_ns", "monotonic_ns", "process_time_ns", "thread_time_ns")
-CLOCK_STEP_S = 3600.0      # how far :func:`fast_clock`'s clocks move at each read
-
-
-@contextlib.contextmanager
-def fast_clock(fn: Callable) -> Iterator[list]:
-    """While the block runs, every clock of the time module (time.time, time.perf_counter, time.monotonic, ...) moves
-    :data:`CLOCK_STEP_S` ahead at each read by code other than the check's own, as on a machine (or an input) that
-    many times slower: a loop stopped after a time budget (``while time.perf_counter() - t0 < 0.1``) stops at once.
-    The names that ``fn``'s globals bind to those clocks (``from time import perf_counter``) are moved too, and
-    everything is put back after the block. Only the learner's own reads, on this thread, move: the check's (the
-    time limit's, a call's seconds), a library's (asyncio's loop in a notebook kernel's output thread, logging) and
-    another thread's read the real clock. Yields the list of the clocks read (their names, once per read)."""
-    fn = learner_function(fn)
-    reads: list = []
-    originals = {name: getattr(time, name) for name in _CLOCKS if hasattr(time, name)}
-    ahead = [0.0]
-    owner = threading.get_ident()
-    real: dict = {}                         # {file name: whether its reads stay real}, each file looked up once
-
-    def faster(name, clock):
-        def read():
-            caller = sys._getframe(1).f_code.co_filename
-            if caller not in real:
-                real[caller] = _check_file(caller) or caller in _NO_STOP_FILES or library_file(caller)
-            if real[caller] or threading.get_ident() != owner:
-                return clock()
-            reads.append(name)
-            ahead[0] += CLOCK_STEP_S
-            return clock() + (int(ahead[0] * 1e9) if name.endswith("_ns") else ahead[0])
-        return read
-
-    fakes = {name: faster(name, clock) for name, clock in originals.items()}
-    namespace = getattr(fn, "__globals__", None)
-    bound = {}
-    if isinstance(namespace, dict):
-        for key, value in list(namespace.items()):
-            for name, clock in originals.items():
-                if value is clock:
-                    bound[key] = name
-    try:
-        for name, fake in fakes.items():
-            setattr(time, name, fake)
-        for key, name in bound.items():
-            namespace[key] = fakes[name]
-        yield reads
-    finally:
-        for name, clock in originals.items():
-            setattr(time, name, clock)
-        for key, name in bound.items():
-            if namespace.get(key) is fakes[name]:
-                namespace[key] = originals[name]
 
 
 def copy_inputs(inputs: tuple[tuple, dict]) -> tuple[list, dict]:

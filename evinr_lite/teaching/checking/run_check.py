@@ -19,7 +19,7 @@ requires_grad the call changed. A call stopped at the time limit (:class:`.learn
 ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
 (which would run it again). After every input matched, the last one is run a second time from other states of the
 global generators and on a clock running faster (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`,
-:func:`.learner_calls.fast_clock`: where the clock was read, every input on it), and input #1's own objects are
+:func:`.fast_clock.fast_clock`: where the clock was read, every input on it), and input #1's own objects are
 refilled in place with a later input's values and given again (:func:`.across_calls.same_objects_new_values`: a cache
 keyed by id()), and last the function is called as the
 notebooks call it (:func:`.signature.called_as_notebook`, each exercise's recorded call, only where its signature
@@ -36,7 +36,9 @@ change it and other hints win. Returns (passed, headline, detail lines); printin
 """
 from __future__ import annotations
 
+import contextlib
 import functools
+import io
 import re
 from typing import Callable
 
@@ -48,7 +50,8 @@ from .global_state import (global_settings, imports_watched, other_rng_states, r
                            rng_states, set_rng_states, settings_message)
 from .hints import (REORDERED, aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
-from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught_errors, changed_inputs, fast_clock,
+from .fast_clock import fast_clock
+from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught_errors, changed_inputs,
                             container_names, in_place_message, module_flags, module_flags_message, poison_freed_memory,
                             run, swallowed_message, tensor_flags, tensor_flags_message, watching, where_raised)
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
@@ -175,7 +178,7 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             details.append("also: " + flags)
         return False, f"does not match the reference on {where}", details
     if n:
-        clocks: list = []
+        clocks: dict = {}
         failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after, clocks)
         if failed is None and clocks:       # the clock was read: the other inputs on the faster clock too
             failed = _clock_elsewhere(ex, fn, cases)
@@ -497,7 +500,7 @@ def _generic_mistake_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, g
 
 
 def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_before: dict,
-                 rng_after: dict, clocks_read: list | None = None) -> Report | None:
+                 rng_after: dict, clocks_read: dict | None = None) -> Report | None:
     """The failure seen when the last input, ``case``, is run once more, from other states of the global random
     generators, or None. From the loop's last pass: ``got``, what the first run returned, and ``rng_before`` and
     ``rng_after``, the generators' states around it.
@@ -505,18 +508,24 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
     A function that keeps state between calls (a notebook variable it changes, a mutable default argument) gives
     another result the second time; one that keeps its result (a buffer, a cache) returns the same array again;
     one that reseeds a global generator leaves it in the same state whatever it held before. The second call runs on
-    a clock many times faster (:func:`.learner_calls.fast_clock`): a result that then differs, and not on the real
-    clock, depends on the time read (a loop stopped after a time budget). ``clocks_read``, a list, receives the clocks
-    the call read."""
+    a clock many times faster (:func:`.fast_clock.fast_clock`): a result that then differs (or an error), and not on
+    the real clock, depends on the time read (a loop stopped after a time budget); what it prints is not shown.
+    ``clocks_read``, a dict, receives the clocks the call read ({name: reads})."""
     args, kwargs = case
     rng_now, rng_other = rng_states(), other_rng_states(rng_before)
     changed_settings: dict = {}
-    clocks: list = []
+    clocks: dict = {}
+    raised = None
     try:
         set_rng_states(rng_other)
         poison_freed_memory(got)
-        with fast_clock(fn) as clocks:      # the clock many times faster: a loop stopped after a time budget shows
-            again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
+        # the clock many times faster: a loop stopped after a time budget shows
+        with _quiet(), fast_clock(fn) as clocks:
+            try:
+                again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
+            except Exception as err:
+                raised = err
+                raise
         rng_again = rng_states()
         if ex.observe is not None:
             problem = None
@@ -529,11 +538,13 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
     finally:
         set_rng_states(rng_now)
     if clocks_read is not None:
-        clocks_read += clocks
+        clocks_read.update(clocks)
     if changed_settings:
         return False, f"changed the notebook's global settings on input #{n} of {n}", [settings_message(changed_settings)]
+    if isinstance(raised, TooSlow) and clocks:      # no rerun on the real clock: it could hang as long again
+        return _clock_too_slow(raised, clocks, n, n)
     if problem is not None and clocks and _right_on_real_clock(ex, fn, case, rng_other):
-        return False, f"gives another result when the clock runs faster (input #{n} of {n})", [_clock_message(clocks)]
+        return _clock_report(clocks, raised, n, n)
     if problem is not None and memory_explains(fn, ex, args, kwargs, got):
         return False, f"gives another result when input #{n} of {n} is run a second time", [UNINITIALISED]
     if problem is not None:
@@ -564,13 +575,19 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
 def _clock_elsewhere(ex: ExerciseLike, fn: Callable, cases: list) -> Report | None:
     """For a function that read the clock in the second call and still matched there: each other input run on the
     faster clock (:func:`.learner_calls.fast_clock`); the first that then differs, and matches on the real clock,
-    is reported (a time budget that the last input's result does not show: a solver's start that is the answer)."""
+    is reported (a time budget that the last input's result does not show: a solver's start that is the answer);
+    what the function prints there is not shown."""
     n = len(cases)
     for j, (args, kwargs) in enumerate(cases[:-1]):
-        clocks: list = []
+        clocks: dict = {}
+        raised = None
         try:
-            with fast_clock(fn) as clocks:
-                got = run(fn, args, kwargs, ex.observe)
+            with _quiet(), fast_clock(fn) as clocks:
+                try:
+                    got = run(fn, args, kwargs, ex.observe)
+                except Exception as err:
+                    raised = err
+                    raise
             if ex.observe is not None or not clocks:
                 continue
             expected = run(ex.reference, args, kwargs)
@@ -578,20 +595,51 @@ def _clock_elsewhere(ex: ExerciseLike, fn: Callable, cases: list) -> Report | No
                        else ex.compare(got, expected)) is not None
         except Exception:
             differs = True
+        if isinstance(raised, TooSlow) and clocks:
+            return _clock_too_slow(raised, clocks, j + 1, n)
         if differs and clocks and _right_on_real_clock(ex, fn, cases[j], rng_states()):
-            return False, f"gives another result when the clock runs faster (input #{j + 1} of {n})", [
-                _clock_message(clocks)]
+            return _clock_report(clocks, raised, j + 1, n)
     return None
+
+
+@contextlib.contextmanager
+def _quiet():
+    """What the block prints (to sys.stdout or sys.stderr) is kept from the notebook: the check's own reruns of the
+    learner's function, whose prints (a progress line, a time taken an hour long) the learner did not ask for."""
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        yield
+
+
+def _clock_report(clocks: dict, raised: Exception | None, k: int, n: int) -> Report:
+    """The report of input #k whose result changed on the faster clock (``raised``: the error it raised there,
+    if any) and matches on the real clock."""
+    if raised is None:
+        return False, f"gives another result when the clock runs faster (input #{k} of {n})", [_clock_message(clocks)]
+    return False, f"raised {type(raised).__name__} when the clock ran faster (input #{k} of {n})", [
+        f"{type(raised).__name__}: {raised}", *where_raised(raised), _clock_message(clocks, raised)]
+
+
+def _clock_too_slow(err: TooSlow, clocks: dict, k: int, n: int) -> Report:
+    """The report of input #k stopped at the time limit on the faster clock (it returned on the real clock)."""
+    read = ", ".join(f"time.{name}()" for name in clocks)
+    return False, f"did not return within {err.seconds:g} s when the clock ran faster (input #{k} of {n})", [
+        *[w.replace("raised in", "stopped in", 1) for w in where_raised(err)],
+        f"every input matched, but run again with the clock many times faster ({read} an hour ahead at each read) "
+        "it did not return: its running time may depend on the time it reads (a wait until a time, a `time.sleep` "
+        "of a time read), or on state kept between calls; stop a loop on a tolerance and an iteration count, and "
+        "read the clock only to print how long it took"]
 
 
 def _right_on_real_clock(ex: ExerciseLike, fn: Callable, case: tuple, rng_other: dict) -> bool:
     """Whether ``fn`` matches the reference on ``case`` when run again from the same generator states as the second
-    call, on the real clock: then the faster clock alone made the second call's difference."""
+    call, on the real clock: then the faster clock alone made the second call's difference. What it prints is not
+    shown (a rerun of the check's own)."""
     args, kwargs = case
     rng_now = rng_states()
     try:
         set_rng_states(rng_other)
-        again = run(fn, args, kwargs, ex.observe)
+        with _quiet():
+            again = run(fn, args, kwargs, ex.observe)
         if ex.observe is not None:
             return False
         expected = run(ex.reference, args, kwargs)
@@ -603,9 +651,16 @@ def _right_on_real_clock(ex: ExerciseLike, fn: Callable, case: tuple, rng_other:
         set_rng_states(rng_now)
 
 
-def _clock_message(clocks: list) -> str:
-    """What a report says of a result that changed when the clock ran faster (``clocks``: the clocks read)."""
-    read = ", ".join(f"time.{name}()" for name in dict.fromkeys(clocks))
+def _clock_message(clocks: dict, raised: Exception | None = None) -> str:
+    """What a report says of a result that changed when the clock ran faster (``clocks``: the clocks read;
+    ``raised``: the error the function raised there instead of answering, if any)."""
+    read = ", ".join(f"time.{name}()" for name in clocks)
+    if raised is not None:
+        return (f"every input matched, but run again with the clock many times faster the function raised "
+                f"{type(raised).__name__} instead of answering: it depends on the time it reads ({read}); a time "
+                "limit used as a safeguard (`if time.perf_counter() - t0 > 30: raise ...`) fires on a slower or busier "
+                "machine: cap the number of iterations instead, stop on a tolerance, and read the clock only to print "
+                "how long it took")
     return (f"every input matched, but run again with the clock many times faster the function answers otherwise: "
             f"its result depends on the time it reads ({read}), as a loop stopped after a time budget does (`while "
             "time.perf_counter() - t0 < 0.1`); on the notebook's larger inputs, or a slower or busier machine, it "
