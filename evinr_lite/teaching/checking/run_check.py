@@ -332,11 +332,13 @@ def _float_widths_hint(err: Exception, args, kwargs) -> str | None:
     difference matrix or a kernel made inside (torch.eye, torch.tensor([-1.0, 1.0])) is float32 whatever the input,
     so the function works on float32 inputs only (notebook 05 passes total_variation a float64 stack)."""
     msg = str(err)
-    if not isinstance(err, RuntimeError) or not (re.search(r"\b[Dd]ouble\b", msg) and re.search(r"\b[Ff]loat\b", msg)):
+    # "Double" and "Float" (scalar types, CUDA's DoubleTensor and FloatTensor), or "same dtype" (matmul's, tensordot's)
+    widths = bool(re.search(r"\b[Dd]ouble", msg) and re.search(r"\b[Ff]loat", msg))
+    if not isinstance(err, RuntimeError) or not (widths or "same dtype" in msg):
         return None
     named = [(name, str(v.dtype).replace("torch.", "")) for name, v in named_inputs(args, kwargs)
              if is_tensor(v) and str(v.dtype) in ("torch.float32", "torch.float64")]
-    if not named:
+    if not named or not (widths or any(w == "float64" for _, w in named)):
         return None
     name, width = next(((n, w) for n, w in named if w == "float64"), named[0])
     return (f"torch does not mix float32 and float64 tensors in one operation (a matrix product, a convolution, "
