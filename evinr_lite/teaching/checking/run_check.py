@@ -40,6 +40,7 @@ import contextlib
 import functools
 import io
 import re
+import threading
 from typing import Callable
 
 from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, constant_size_hint, fixed_size_hint,
@@ -607,7 +608,12 @@ def _clock_elsewhere(ex: ExerciseLike, fn: Callable, cases: list) -> Report | No
 @contextlib.contextmanager
 def _quiet():
     """What the block prints (to sys.stdout or sys.stderr) is kept from the notebook: the check's own reruns of the
-    learner's function, whose prints (a progress line, a time taken an hour long) the learner did not ask for."""
+    learner's function, whose prints (a progress line, a time taken an hour long) the learner did not ask for. On
+    the main thread only: sys.stdout is the whole process's, and two checks in two threads that each put back what
+    they found would leave one's buffer in place for good (a check run from another thread prints as before)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
     with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         yield
 
