@@ -211,10 +211,12 @@ def _tonemap_without_exp(L, gamma):
 
 def _inputs_tv(rng):
     g = torch.Generator().manual_seed(2)
-    # F requires grad (as a network's output does): the result must stay differentiable
+    # F requires grad (as a network's output does): the result must stay differentiable. The last F is float64, as
+    # notebook 05 passes it (cell 11, `tv(F)` of a float64 stack): a difference matrix or a kernel made float32
+    # inside the function (torch.eye, torch.tensor([-1.0, 1.0])) fails there (round 17)
     return [dict(F=torch.randn(3, 4, generator=g).requires_grad_(True)),
             dict(F=torch.randn(2, 5, 3, generator=g).requires_grad_(True)),
-            dict(F=torch.randn(1, 6, 9, generator=g).requires_grad_(True))]
+            dict(F=torch.randn(1, 6, 9, generator=g).double().requires_grad_(True))]
 
 
 def _tv_pooled(F):

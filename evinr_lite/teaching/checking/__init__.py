@@ -9,6 +9,8 @@ check itself, one job per module, lowest first:
 - ``global_state``: what a call can change for the whole notebook: torch's settings, numpy's error handling, the
   warning filters, the global generators;
 - ``learner_calls``: run the learner's function on copied inputs; where it raised; what it changed in place;
+- ``fast_clock``: the time module's clocks an hour ahead at each of the learner's own reads, while a block runs (a
+  result that depends on a time budget then changes);
 - ``hints``: likely mistakes read off a wrong output (a flipped sign, a factor, indices from 1, ...);
 - ``mistakes``: wrong versions made from the reference (the wrong image axis among them), confirmed on the other
   inputs;
@@ -24,8 +26,8 @@ check itself, one job per module, lowest first:
 An exercise is named in annotations by the protocol ``ExerciseLike``, never by the registry's ``Exercise``: this
 package never imports the registry (which imports it), so that the check stays below the registry, with no circle.
 """
-from . import (across_calls, global_state, hints, learner_calls, learner_source, mistakes, outputs, protocol, run_check,
-               signature)
+from . import (across_calls, fast_clock, global_state, hints, learner_calls, learner_source, mistakes, outputs, protocol,
+               run_check, signature)
 
-__all__ = ["protocol", "outputs", "global_state", "learner_calls", "hints", "mistakes", "across_calls",
+__all__ = ["protocol", "outputs", "global_state", "learner_calls", "fast_clock", "hints", "mistakes", "across_calls",
            "learner_source", "signature", "run_check"]

@@ -4,7 +4,8 @@ One input alone cannot show these: a mutable default argument or a notebook dict
 (:func:`mutable_default_hint`, :func:`global_cache_hint`), a second call on the same input that answers
 otherwise (:func:`state_hint`) or answers otherwise on freed memory filled with zeros than with the check's pattern
 (np.empty, :func:`memory_explains`), a result that is right for input #1's arguments or sizes, not this input's
-(:func:`stale_argument_hint`, :func:`fixed_size_hint`), one number off by the same factor on every input
+(:func:`stale_argument_hint`, :func:`fixed_size_hint`), a size that is the same on every input while the expected
+size changes (:func:`constant_size_hint`), one number off by the same factor on every input
 (:func:`scalar_factor_hint`). And, on the second call of the last input:
 :func:`shares_output` (the same array, tensor or dict handed out twice, a buffer or a cached result) and
 :func:`reseed_hint` (a global generator seeded inside the function). After that, :func:`same_objects_new_values`
@@ -284,6 +285,79 @@ def fixed_size_hint(ex: ExerciseLike, cases: list, k: int, got, expected) -> str
                 f"{e.shape}: a size fixed in the code (np.zeros(3), `H, W = 4, 4`) or taken from a notebook "
                 "variable; read the sizes from the arguments (len(...), .shape, sensor_size)")
     return None
+
+
+def _leaves(v, expected) -> list | None:
+    """The arrays (or tensors) of an output, in the order of ``expected``'s structure (a tuple's or list's items, a
+    dict's values by ``expected``'s keys), each as (where, shape); None where ``v`` has another structure."""
+    if isinstance(expected, (tuple, list)):
+        if not isinstance(v, (tuple, list)) or len(v) != len(expected):
+            return None
+        parts = [_leaves(g, e) for g, e in zip(v, expected)]
+        if any(p is None for p in parts):
+            return None
+        return [(f"[{k}]{w}", shape) for k, p in enumerate(parts) for w, shape in p]
+    if isinstance(expected, dict):
+        return None
+    try:
+        return [("", to_numpy(v).shape)]
+    except Exception:
+        return None
+
+
+def constant_size_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected) -> str | None:
+    """A wrong size that is the same on every input, while the expected size changes with the arguments: a size
+    fixed in the code or read from a notebook variable that is not input #1's (the notebook's sensor (48, 64), its 40
+    bins, its 32 frames), where :func:`fixed_size_hint` names input #1's. Asked for a wrong shape only; every input
+    the learner's function and the reference both answer counts, and at least three must; the size is at least 2
+    (0 or 1 everywhere is a count that collapsed) and differs from the expected one on each of them."""
+    if ex.observe is not None:
+        return None
+    mine, want = _leaves(got, expected), _leaves(expected, expected)
+    if not mine or not want or len(mine) != len(want):
+        return None
+    wrong = [(j, a) for j, ((where, g), (_, e)) in enumerate(zip(mine, want)) if len(g) == len(e)
+             for a in range(len(g)) if g[a] != e[a]]
+    if not wrong:
+        return None
+    seen = []                # (learner's shapes, expected shapes) per input that both answer
+    for j, (args, kwargs) in enumerate(cases):
+        try:
+            e_j = run(ex.reference, args, kwargs) if j != k else expected
+            g_j = run(fn, args, kwargs) if j != k else got
+        except Exception:
+            continue
+        m, w = _leaves(g_j, e_j), _leaves(e_j, e_j)
+        if m is None or w is None or len(m) != len(mine):
+            continue
+        seen.append(([shape for _, shape in m], [shape for _, shape in w]))
+    if len(seen) < 3:
+        return None
+    fixed = []
+    for j, a in wrong:
+        sizes = [g[j][a] if len(g[j]) > a else None for g, _ in seen]
+        wanted = [e[j][a] if len(e[j]) > a else None for _, e in seen]
+        # a size of 0 or 1 everywhere is a count that collapsed (an empty range, a max(..., 1)), not a number
+        # written in; and a fixed number is wrong on every input (else it may be a rule that lands alike)
+        if len(set(sizes)) == 1 and len(set(wanted)) > 1 and (sizes[0] or 0) >= 2 \
+                and all(w != sizes[0] for w in wanted):
+            fixed.append((j, a, sizes[0], wanted))
+    if not fixed:
+        return None
+    j = fixed[0][0]
+    where, shape = mine[j]
+    axes = [a for jj, a, _, _ in fixed if jj == j]
+    whose = f"output {where}" if where else "the result"
+    if len(axes) > 1:
+        wanted = sorted({tuple(e[j]) for _, e in seen})
+        said = f"{whose}'s shape is {tuple(shape)} on every input, while the expected shape changes with the arguments"
+    else:
+        wanted = sorted({e[j][axes[0]] for _, e in seen})
+        said = (f"{whose} has {shape[axes[0]]} entries along axis {axes[0]} on every input, while the expected "
+                "number changes with the arguments")
+    return (f"{said} ({', '.join(str(w) for w in wanted)}): a size fixed in the code, or read from a notebook "
+            "variable (the notebook's sensor, its number of bins or frames), instead of from the arguments; compute "
+            "it from them (sensor_size, len(boundaries) - 1, the span over bin_s, .shape)")
 
 
 def scalar_factor_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected) -> str | None:

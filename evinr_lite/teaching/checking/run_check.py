@@ -6,7 +6,8 @@ learner's call), compares the outputs (:mod:`.outputs`; where the values match, 
 result too), and at the first difference looks for a hint (:func:`_hint_for`), in a fixed order: data kept in a
 notebook variable (when it made the difference), np.empty (a rerun on zeroed memory answers otherwise), the
 exercise's own wrong versions, outputs in another order, state kept between calls, an argument taken from input #1, the
-generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1, the
+generic wrong versions (:mod:`.mistakes`), a reseeded generator, a size taken from the events or from input #1 (or the
+same on every input), the
 patterns read off the values (:mod:`.hints`: axes in another order, indices from 1, rows aliased by one list, then
 the rest), and last a notebook variable that only grew. A None that no in-place method explains
 (``return out.sort()``), or a wrong value no hint explains, that an `except` of the learner's own made (returned, or
@@ -17,7 +18,8 @@ parameters requiring grad, than the reference leaves it is named after each call
 requires_grad the call changed. A call stopped at the time limit (:class:`.learner_calls.TooSlow`: an endless loop) or
 ended by sys.exit() or exit() (in a notebook too) is reported at once, at the learner's line, with no hint's search
 (which would run it again). After every input matched, the last one is run a second time from other states of the
-global generators (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`), and input #1's own objects are
+global generators and on a clock running faster (:func:`_second_call`, :mod:`.across_calls`, :mod:`.global_state`,
+:func:`.fast_clock.fast_clock`: where the clock was read, every input on it), and input #1's own objects are
 refilled in place with a later input's values and given again (:func:`.across_calls.same_objects_new_values`: a cache
 keyed by id()), and last the function is called as the
 notebooks call it (:func:`.signature.called_as_notebook`, each exercise's recorded call, only where its signature
@@ -34,23 +36,29 @@ change it and other hints win. Returns (passed, headline, detail lines); printin
 """
 from __future__ import annotations
 
+import contextlib
 import functools
+import io
+import re
+import threading
 from typing import Callable
 
-from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, fixed_size_hint, global_cache_hint,
+from .across_calls import (KEYED_BY_OBJECT, STATE_BETWEEN_CALLS, UNINITIALISED, constant_size_hint, fixed_size_hint,
+                           global_cache_hint,
                            global_containers, mutable_default_hint, memory_explains, mutable_defaults, reseed_hint,
                            same_objects_new_values, scalar_factor_hint, shares_output, stale_argument_hint, state_hint)
 from .global_state import (global_settings, imports_watched, other_rng_states, reseeded_generators, restore_settings,
                            rng_states, set_rng_states, settings_message)
 from .hints import (REORDERED, aliased_rows_hint, axes_order_hint, generic_hint, has_repeated_index, non_square,
                     one_based_hint, size_from_events_hint, swapped_pair_hint)
+from .fast_clock import fast_clock
 from .learner_calls import (SWALLOWED, ExitCalled, TooSlow, cache_raised, caught_errors, changed_inputs,
                             container_names, in_place_message, module_flags, module_flags_message, poison_freed_memory,
                             run, swallowed_message, tensor_flags, tensor_flags_message, watching, where_raised)
 from .learner_source import none_from_in_place_hint, stub_raised, xor_power_hint
 from .mistakes import generic_mistakes, has_polarities, same_mistake_elsewhere, wrong_axes_hint
 from .outputs import (BACKWARD_CALLED, Problem, compare_gradients, compare_outputs, describe_case, differing_leaf,
-                      first_difference, not_finite)
+                      first_difference, is_tensor, named_inputs, not_finite)
 from .protocol import ExerciseLike
 from .signature import (called_as_notebook, called_the_same_way, learner_function, notebook_caller,
                         signature_default_hint)
@@ -171,7 +179,10 @@ def _run_inputs(ex: ExerciseLike, fn: Callable) -> Report:
             details.append("also: " + flags)
         return False, f"does not match the reference on {where}", details
     if n:
-        failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after)
+        clocks: dict = {}
+        failed = _second_call(ex, fn, cases[-1], n, got, rng_before, rng_after, clocks)
+        if failed is None and clocks:       # the clock was read: the other inputs on the faster clock too
+            failed = _clock_elsewhere(ex, fn, cases)
         if failed is not None:
             return failed
         refilled = same_objects_new_values(ex, fn, cases)
@@ -275,6 +286,9 @@ def _raised_report(ex: ExerciseLike, fn: Callable, err: Exception, cases: list, 
                        "`torch.no_grad()`, or from values taken out of the graph (.detach(), .data, "
                        ".item(), .numpy()); compute it with torch operations on the model's outputs, "
                        "with gradients on")
+    widths = _float_widths_hint(err, args, kwargs)
+    if widths:
+        details.append(f"hint: {widths}")
     if isinstance(err, IndexError) and non_square(args, kwargs):
         details.append("hint: this input's sensor is not square; sensor_size is (H, W), rows first, and an "
                        "image is indexed [y, x] (y = row, x = column): `H, W = sensor_size`, "
@@ -311,6 +325,29 @@ def _list_inputs_hint(ex: ExerciseLike, err: Exception, args, kwargs) -> str | N
     return (f"{', '.join(f'`{name}`' for name in names)} {'is a Python list' if len(names) == 1 else 'are Python lists'} on this input,"
             f"{where}: a list has no array methods, no [:, None] indexing and no element-wise arithmetic; convert "
             f"first, `{first} = np.asarray({first}, dtype=float)`")
+
+
+def _float_widths_hint(err: Exception, args, kwargs) -> str | None:
+    """torch's refusal to mix float32 and float64 in one operation (a matrix product, a convolution, index_put),
+    where an input tensor has one of the two widths: name it, and how to make a tensor of one's own like it. A
+    difference matrix or a kernel made inside (torch.eye, torch.tensor([-1.0, 1.0])) is float32 whatever the input,
+    so the function works on float32 inputs only (notebook 05 passes total_variation a float64 stack)."""
+    msg = str(err)
+    # "Double" and "Float" (scalar types, CUDA's DoubleTensor and FloatTensor), or "same dtype" (matmul's, tensordot's)
+    widths = bool(re.search(r"\b[Dd]ouble", msg) and re.search(r"\b[Ff]loat", msg))
+    if not isinstance(err, RuntimeError) or not (widths or "same dtype" in msg):
+        return None
+    named = [(name, str(v.dtype).replace("torch.", "")) for name, v in named_inputs(args, kwargs)
+             if is_tensor(v) and str(v.dtype) in ("torch.float32", "torch.float64")]
+    if not named or not (widths or any(w == "float64" for _, w in named)):
+        return None
+    name, width = next(((n, w) for n, w in named if w == "float64"), named[0])
+    return (f"torch does not mix float32 and float64 tensors in one operation (a matrix product, a convolution, "
+            f"index_put), and `{name}` is a {width} tensor on this input: a tensor made inside the function is "
+            f"float32 by default (torch.eye, torch.zeros, torch.tensor([-1.0, 1.0])) and float64 when made from "
+            f"numpy floats (torch.from_numpy, torch.tensor of an array); make it like the input "
+            f"(`torch.eye(n, dtype={name}.dtype)`, `{name}.new_tensor([...])`, `torch.zeros_like({name})`), "
+            f"which works for either width")
 
 
 def _swallowed_hint(fn: Callable, args, kwargs) -> str | None:
@@ -403,6 +440,8 @@ def _hint_for(ex: ExerciseLike, fn: Callable, cases: list, k: int, got, expected
         hint = size_from_events_hint(args, kwargs, got, expected)
     if hint is None:
         hint = fixed_size_hint(ex, cases, k, got, expected)
+    if hint is None and not problem.values:
+        hint = constant_size_hint(ex, fn, cases, k, got, expected)
     if problem.values:
         if hint is None:
             hint = axes_order_hint(got, expected, ex.rtol, ex.atol)
@@ -464,21 +503,32 @@ def _generic_mistake_hint(ex: ExerciseLike, fn: Callable, cases: list, k: int, g
 
 
 def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_before: dict,
-                 rng_after: dict) -> Report | None:
+                 rng_after: dict, clocks_read: dict | None = None) -> Report | None:
     """The failure seen when the last input, ``case``, is run once more, from other states of the global random
     generators, or None. From the loop's last pass: ``got``, what the first run returned, and ``rng_before`` and
     ``rng_after``, the generators' states around it.
 
     A function that keeps state between calls (a notebook variable it changes, a mutable default argument) gives
     another result the second time; one that keeps its result (a buffer, a cache) returns the same array again;
-    one that reseeds a global generator leaves it in the same state whatever it held before."""
+    one that reseeds a global generator leaves it in the same state whatever it held before. The second call runs on
+    a clock many times faster (:func:`.fast_clock.fast_clock`): a result that then differs (or an error), and not on
+    the real clock, depends on the time read (a loop stopped after a time budget); what it prints is not shown.
+    ``clocks_read``, a dict, receives the clocks the call read ({name: reads})."""
     args, kwargs = case
     rng_now, rng_other = rng_states(), other_rng_states(rng_before)
     changed_settings: dict = {}
+    clocks: dict = {}
+    raised = None
     try:
         set_rng_states(rng_other)
         poison_freed_memory(got)
-        again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
+        # the clock many times faster: a loop stopped after a time budget shows
+        with _quiet(), fast_clock(fn) as clocks:
+            try:
+                again = run(fn, args, kwargs, ex.observe, settings_changed=changed_settings)
+            except Exception as err:
+                raised = err
+                raise
         rng_again = rng_states()
         if ex.observe is not None:
             problem = None
@@ -490,8 +540,14 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
         again, rng_again, problem = None, None, Problem(f"{type(err).__name__}: {err}")
     finally:
         set_rng_states(rng_now)
+    if clocks_read is not None:
+        clocks_read.update(clocks)
     if changed_settings:
         return False, f"changed the notebook's global settings on input #{n} of {n}", [settings_message(changed_settings)]
+    if isinstance(raised, TooSlow) and clocks:      # no rerun on the real clock: it could hang as long again
+        return _clock_too_slow(raised, clocks, n, n)
+    if problem is not None and clocks and _right_on_real_clock(ex, fn, case, rng_other):
+        return _clock_report(clocks, raised, n, n)
     if problem is not None and memory_explains(fn, ex, args, kwargs, got):
         return False, f"gives another result when input #{n} of {n} is run a second time", [UNINITIALISED]
     if problem is not None:
@@ -517,3 +573,104 @@ def _second_call(ex: ExerciseLike, fn: Callable, case: tuple, n: int, got, rng_b
             "repeat); nothing here asks for randomness: remove the seed, or draw from a generator of your own "
             "(rng = np.random.default_rng(seed), torch.Generator().manual_seed(seed))"]
     return None
+
+
+def _clock_elsewhere(ex: ExerciseLike, fn: Callable, cases: list) -> Report | None:
+    """For a function that read the clock in the second call and still matched there: each other input run on the
+    faster clock (:func:`.learner_calls.fast_clock`); the first that then differs, and matches on the real clock,
+    is reported (a time budget that the last input's result does not show: a solver's start that is the answer);
+    what the function prints there is not shown."""
+    n = len(cases)
+    for j, (args, kwargs) in enumerate(cases[:-1]):
+        clocks: dict = {}
+        raised = None
+        try:
+            with _quiet(), fast_clock(fn) as clocks:
+                try:
+                    got = run(fn, args, kwargs, ex.observe)
+                except Exception as err:
+                    raised = err
+                    raise
+            if ex.observe is not None or not clocks:
+                continue
+            expected = run(ex.reference, args, kwargs)
+            differs = (compare_outputs(got, expected, ex.rtol, ex.atol) if ex.compare is None
+                       else ex.compare(got, expected)) is not None
+        except Exception:
+            differs = True
+        if isinstance(raised, TooSlow) and clocks:
+            return _clock_too_slow(raised, clocks, j + 1, n)
+        if differs and clocks and _right_on_real_clock(ex, fn, cases[j], rng_states()):
+            return _clock_report(clocks, raised, j + 1, n)
+    return None
+
+
+@contextlib.contextmanager
+def _quiet():
+    """What the block prints (to sys.stdout or sys.stderr) is kept from the notebook: the check's own reruns of the
+    learner's function, whose prints (a progress line, a time taken an hour long) the learner did not ask for. On
+    the main thread only: sys.stdout is the whole process's, and two checks in two threads that each put back what
+    they found would leave one's buffer in place for good (a check run from another thread prints as before)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        yield
+
+
+def _clock_report(clocks: dict, raised: Exception | None, k: int, n: int) -> Report:
+    """The report of input #k whose result changed on the faster clock (``raised``: the error it raised there,
+    if any) and matches on the real clock."""
+    if raised is None:
+        return False, f"gives another result when the clock runs faster (input #{k} of {n})", [_clock_message(clocks)]
+    return False, f"raised {type(raised).__name__} when the clock ran faster (input #{k} of {n})", [
+        f"{type(raised).__name__}: {raised}", *where_raised(raised), _clock_message(clocks, raised)]
+
+
+def _clock_too_slow(err: TooSlow, clocks: dict, k: int, n: int) -> Report:
+    """The report of input #k stopped at the time limit on the faster clock (it returned on the real clock)."""
+    read = ", ".join(f"time.{name}()" for name in clocks)
+    return False, f"did not return within {err.seconds:g} s when the clock ran faster (input #{k} of {n})", [
+        *[w.replace("raised in", "stopped in", 1) for w in where_raised(err)],
+        f"every input matched, but run again with the clock many times faster ({read} an hour ahead at each read) "
+        "it did not return: its running time may depend on the time it reads (a wait until a time, a `time.sleep` "
+        "of a time read), or on state kept between calls; stop a loop on a tolerance and an iteration count, and "
+        "read the clock only to print how long it took"]
+
+
+def _right_on_real_clock(ex: ExerciseLike, fn: Callable, case: tuple, rng_other: dict) -> bool:
+    """Whether ``fn`` matches the reference on ``case`` when run again from the same generator states as the second
+    call, on the real clock: then the faster clock alone made the second call's difference. What it prints is not
+    shown (a rerun of the check's own)."""
+    args, kwargs = case
+    rng_now = rng_states()
+    try:
+        set_rng_states(rng_other)
+        with _quiet():
+            again = run(fn, args, kwargs, ex.observe)
+        if ex.observe is not None:
+            return False
+        expected = run(ex.reference, args, kwargs)
+        return (compare_outputs(again, expected, ex.rtol, ex.atol) if ex.compare is None
+                else ex.compare(again, expected)) is None
+    except Exception:
+        return False
+    finally:
+        set_rng_states(rng_now)
+
+
+def _clock_message(clocks: dict, raised: Exception | None = None) -> str:
+    """What a report says of a result that changed when the clock ran faster (``clocks``: the clocks read;
+    ``raised``: the error the function raised there instead of answering, if any)."""
+    read = ", ".join(f"time.{name}()" for name in clocks)
+    if raised is not None:
+        return (f"every input matched, but run again with the clock many times faster the function raised "
+                f"{type(raised).__name__} instead of answering: it depends on the time it reads ({read}); a time "
+                "limit used as a safeguard (`if time.perf_counter() - t0 > 30: raise ...`) fires on a slower or busier "
+                "machine: cap the number of iterations instead, stop on a tolerance, and read the clock only to print "
+                "how long it took")
+    return (f"every input matched, but run again with the clock many times faster the function answers otherwise: "
+            f"its result depends on the time it reads ({read}), as a loop stopped after a time budget does (`while "
+            "time.perf_counter() - t0 < 0.1`); on the notebook's larger inputs, or a slower or busier machine, it "
+            "stops earlier with another answer; stop an iterative loop on a tolerance and an iteration count, or "
+            "solve directly (np.linalg.solve, np.linalg.lstsq), and read the clock only to print how long it took")
