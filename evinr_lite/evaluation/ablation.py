@@ -449,6 +449,12 @@ def _scores(value, name: str) -> np.ndarray:
 def paper_frame_counts(table: dict) -> dict[str, float]:
     """Time x FPS of each row of a paper table: the frames the FPS column counts (constant per table
     when FPS = frames / training time)."""
+    return {name: row["time_s"] * row["fps"] for name, row in _checked_paper_table(table).items()}
+
+
+def _checked_paper_table(table) -> dict:
+    """paper_frame_counts' table with its numbers checked as floats: text was repeated ("1" * 2 = "11"), True
+    taken as 1 s, a negative time counted negative frames."""
     if not isinstance(table, dict):
         raise EventDataError(f"table= must be a dict {{name: {{'time_s': ..., 'fps': ...}}}} (e.g. PAPER_TABLE2), got "
                              f"{type(table).__name__}")
@@ -457,9 +463,7 @@ def paper_frame_counts(table: dict) -> dict[str, float]:
         if not isinstance(row, dict) or not {"time_s", "fps"} <= set(row):
             raise EventDataError(f"table[{name!r}] must be a dict with 'time_s' and 'fps' (a paper table's row), got "
                                  f"{row!r:.60}")
-        # text was repeated ("1" * 2 = "11"), True taken as 1 s, a negative time counted negative frames
-        out[name] = (real_number(row["time_s"], f"table[{name!r}]['time_s']", lo=0) *
-                     real_number(row["fps"], f"table[{name!r}]['fps']", lo=0))
+        out[name] = {key: real_number(row[key], f"table[{name!r}][{key!r}]", lo=0) for key in ("time_s", "fps")}
     return out
 
 

@@ -180,17 +180,22 @@ def split_index(index: torch.Tensor, sensor_size) -> tuple[torch.Tensor, torch.T
     ``index = b * H * W + y * W + x``: x is the column (fastest), y the row, b the bin.
     """
     H, W = check_sensor_size(sensor_size)   # (0, W) was torch's ZeroDivisionError, (12.5, W) float indices
-    # a type test per call (the training loop's): no pass over the values, no device sync
+    _check_flat_index(index)
+    return index // (H * W), (index // W) % H, index % W
+
+
+def _check_flat_index(index) -> None:
+    """split_index's ``index``: whole flat indices (a tensor or array of integers) or one whole index; a type test
+    per call (the training loop's): no pass over the values, no device sync."""
     if isinstance(index, (numbers.Integral, np.integer)) and not isinstance(index, bool):
-        pass   # one whole index (5, np.int64(5)): taken before, split as such
-    elif not isinstance(index, (torch.Tensor, np.ndarray)) or index.dtype in (torch.bool, np.bool_) or \
+        return   # one whole index (5, np.int64(5)): taken before, split as such
+    if not isinstance(index, (torch.Tensor, np.ndarray)) or index.dtype in (torch.bool, np.bool_) or \
             (index.is_floating_point() or index.is_complex() if isinstance(index, torch.Tensor)
              else index.dtype.kind not in "iu"):
         array = isinstance(index, (torch.Tensor, np.ndarray))
         raise EventDataError(f"index= must be a tensor (or numpy array) of whole flat indices (torch.long), or one "
                              f"whole index, got {type(index).__name__}{' of ' + str(index.dtype) if array else ''}; "
                              "e.g. torch.randint(B * H * W, (M,))")
-    return index // (H * W), (index // W) % H, index % W
 
 
 def temporal_loss(dF_dt: torch.Tensor, event_values: torch.Tensor, durations: torch.Tensor) -> torch.Tensor:
@@ -207,15 +212,21 @@ def temporal_loss(dF_dt: torch.Tensor, event_values: torch.Tensor, durations: to
 
 def tikhonov_autograd(dF_dx: torch.Tensor, dF_dy: torch.Tensor) -> torch.Tensor:
     """Eq. 9 over a minibatch, from autograd gradients [M] (per pixel): mean of dF/dx^2 + dF/dy^2."""
-    for name, g in (("dF_dx", dF_dx), ("dF_dy", dF_dy)):   # type and shape tests only: no pass over the values
+    _check_gradient_pair(dF_dx, dF_dy)
+    return torch.mean(dF_dx ** 2 + dF_dy ** 2)
+
+
+def _check_gradient_pair(dF_dx, dF_dy) -> None:
+    """tikhonov_autograd's inputs: float tensors [M] of one shape, M > 0 (type and shape tests only: no pass over the
+    values). Two shapes broadcast (or were torch's error); none gave NaN."""
+    for name, g in (("dF_dx", dF_dx), ("dF_dy", dF_dy)):
         if not isinstance(g, torch.Tensor) or not g.is_floating_point():
             raise EventDataError(f"{name}= must be a float tensor of gradients [M] (autograd's), got "
                                  f"{type(g).__name__}{' of ' + str(g.dtype) if isinstance(g, torch.Tensor) else ''}; "
                                  "pass torch.as_tensor(values, dtype=torch.float32)")
-    if dF_dx.shape != dF_dy.shape or dF_dx.numel() == 0:   # two shapes broadcast (or were torch's error); none: NaN
+    if dF_dx.shape != dF_dy.shape or dF_dx.numel() == 0:
         raise EventDataError(f"dF_dx and dF_dy must be gradients [M] of one shape, one per sampled pixel, M > 0; got "
                              f"shapes {tuple(dF_dx.shape)} and {tuple(dF_dy.shape)}")
-    return torch.mean(dF_dx ** 2 + dF_dy ** 2)
 
 
 @dataclass(eq=False)
