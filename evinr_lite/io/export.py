@@ -22,7 +22,7 @@ from ..core.events import EventDataError
 from ..core.frames import Frames, to_uint8
 from .output import CloseOrAbort, PngWriter, written_beside
 
-__all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv", "LogIntensityWriter",
+__all__ = ["save_frames_png", "save_gif", "gif_delays_ms", "save_mp4", "save_timestamps", "save_csv", "LogIntensityWriter",
            "save_log_intensity", "read_log_intensity", "LOG_INTENSITY_FILE"]
 
 LOG_INTENSITY_FILE = "log_intensity.h5"   # its name in a run folder
@@ -123,15 +123,27 @@ def _check_fps(fps) -> None:
 
 
 def save_gif(path, frames, fps: float) -> Path:
-    """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (to the GIF's 10 ms
-    resolution, at most 50 per second), looping."""
+    """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (at most 50
+    per second), looping. GIF delays are whole hundredths of a second, so frame k starts at round(100 k / fps)
+    hundredths: the delays alternate (30 per second: 30, 30, 40 ms, ...) and the whole lasts F / fps seconds to
+    10 ms, where one rounded delay (30 ms) made it 10 % short. Pillow merges a frame identical to the one before
+    into it (their delays add up), so the file can hold fewer frames than ``frames``, never another duration."""
     _check_fps(fps)
     path = _output_file(path, ".gif", "save_gif")
     images = [Image.fromarray(img) for img in _stack_uint8(frames)]
-    delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
     with written_beside(path) as tmp:
-        images[0].save(tmp, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
+        images[0].save(tmp, save_all=True, append_images=images[1:], duration=gif_delays_ms(len(images), fps), loop=0)
     return Path(path)
+
+
+def gif_delays_ms(n_frames: int, fps: float) -> list[int]:
+    """The delays (ms, multiples of 10) of ``n_frames`` GIF frames shown at ``fps`` per second: frame k starts at
+    round(100 k / fps) hundredths of a second, so they add up to n_frames / fps to 10 ms; at least 20 ms each
+    (browsers show shorter delays as 100 ms), so above 50 per second every delay is 20 ms."""
+    if fps > 50:
+        return [20] * n_frames
+    starts = np.floor(np.arange(n_frames + 1) * (100.0 / fps) + 0.5).astype(np.int64)
+    return (10 * np.diff(starts)).tolist()
 
 
 def save_mp4(path, frames, fps: float) -> Path:
