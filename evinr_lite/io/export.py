@@ -329,7 +329,8 @@ def read_log_intensity(path, frames=None) -> tuple[np.ndarray, np.ndarray, dict]
     those are read from disk, so a long HD run's file (110 MB a second at 1280x720 and 30 frames per
     second) can be read a part at a time. The run's frames are ``clip(exp(L), 0, 1)`` for
     ``attrs["tonemap"] == "linear"`` (the kit's display), ``sigmoid(L) ** gamma`` for "reinhard"
-    (``evinr_lite.method.tonemap.to_display``).
+    (``evinr_lite.method.tonemap.to_display``); ``attrs["display"]`` says which, and an anchored run's
+    (``--anchor``) is ``clip(exp(L) - 1/255, 0, 1)``, the APS frames' intensity, whatever its tone map.
     """
     import h5py
 
