@@ -73,8 +73,9 @@ __all__ = ["FRAME_EPS", "ANCHOR_MODES", "AnchorFit", "frames_in_window", "select
 FRAME_EPS = 1.0 / 255.0     # added to frame intensities in [0, 1] before the log (black pixels stay finite)
 ANCHOR_MODES = ("none", "first", "all")
 # an anchored reconstruction's frames from its log intensity (linear_frames, whatever the config's tone map), in
-# words: the display attribute of its log_intensity.h5
-ANCHORED_DISPLAY = "frames = clip(exp(L) - 1/255, 0, 1)"
+# words: the display attribute of its log_intensity.h5; built from FRAME_EPS ("1/255"), so the two cannot drift
+_EPS_TEXT = f"1/{round(1 / FRAME_EPS)}" if 1 / round(1 / FRAME_EPS) == FRAME_EPS else repr(FRAME_EPS)
+ANCHORED_DISPLAY = f"frames = clip(exp(L) - {_EPS_TEXT}, 0, 1)"
 
 
 def check_frame_eps(eps) -> float:
