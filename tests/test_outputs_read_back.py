@@ -22,6 +22,7 @@ from evinr_lite.core.frames import to_uint8
 from evinr_lite.evaluation.scoring import score_sequence
 from evinr_lite.io.export import read_log_intensity, save_frames_png, save_gif, save_mp4
 from evinr_lite.io.output import save_png
+from evinr_lite.method.tonemap import to_display
 from evinr_lite.sim.recordings import write_example_recording
 
 ITERS = 30
@@ -266,20 +267,28 @@ def test_log_intensity_file_holds_the_frames_log_intensity(in_memory, streamed):
         _, written = _timestamps(out / "timestamps.txt")
         np.testing.assert_allclose(t, written, atol=1e-9)
         assert attrs["t_origin"] == 0.0 and attrs["display"] == "frames = clip(exp(L), 0, 1)"
-        np.testing.assert_array_equal(to_uint8(np.clip(np.exp(L.astype(np.float64)), 0, 1)), _pngs(out / "frames")[0])
+        assert attrs["anchor"] == "none" and attrs["tonemap"] == "linear"
+        # the kit's own float32 display path (a float64 recomputation can round a pixel the other way)
+        np.testing.assert_array_equal(to_uint8(to_display(L, attrs["tonemap"], attrs["gamma"])),
+                                      _pngs(out / "frames")[0])
     np.testing.assert_allclose(read_log_intensity(memory / "log_intensity.h5")[0], result.log_intensity, atol=1e-6)
 
 
 @pytest.mark.parametrize("recipe", ["kit", "paper"])
 def test_anchored_log_intensity_names_the_display_that_drew_the_pngs(recording, tmp_path, recipe):
-    """Anchored frames are the APS frames' linear intensity, clip(exp(L) - 1/255, 0, 1), whatever the recipe's
-    tone map; the file said clip(exp(L), 0, 1) (a level off) or, for the paper's recipe, Eq. 12."""
+    """Anchored frames are the APS frames' linear intensity, clip(exp(L) - 1/255, 0, 1) (linear_frames), whatever
+    the recipe's tone map; the file said clip(exp(L), 0, 1) (a level off) or, for the paper's recipe, Eq. 12. It
+    records the anchor mode, since to_display(L, attrs["tonemap"]) is not the frames there."""
+    from evinr_lite.method.anchor import ANCHORED_DISPLAY, FRAME_EPS
+
     out = tmp_path / "a"
     run_reconstruct(recording, out, n_iters=ITERS, anchor="first", recipe=recipe, save_log=True, **QUIET)
     L, _, attrs = read_log_intensity(out / "log_intensity.h5")
-    assert attrs["display"] == "frames = clip(exp(L) - 1/255, 0, 1)" and attrs["tonemap"] == "linear"
-    shown = np.clip(np.exp(L.astype(np.float64)) - 1 / 255, 0, 1)
-    np.testing.assert_array_equal(to_uint8(shown), _pngs(out / "frames")[0])
+    assert attrs["display"] == ANCHORED_DISPLAY == "frames = clip(exp(L) - 1/255, 0, 1)"
+    assert 1 / 255 == FRAME_EPS   # the formula's text states the eps the frames use
+    assert attrs["tonemap"] == "linear" and attrs["anchor"] == "first"
+    # the kit's own float32 path (float64 clip(exp(L) - 1/255) rounded a pixel the other way in 2 of 36 runs)
+    np.testing.assert_array_equal(to_uint8(ev.method.linear_frames(L)), _pngs(out / "frames")[0])
 
 
 # ---- colour --------------------------------------------------------------------------------------
@@ -294,7 +303,7 @@ def test_colour_run_writes_rgb_pngs_and_a_bgr_mp4_of_them(tmp_path):
     assert images.shape[1:] == (23, 35, 3) and Image.open(sorted((out / "frames").glob("*.png"))[0]).mode == "RGB"
     L, _, attrs = read_log_intensity(out / "log_intensity.h5")
     assert L.shape == images.shape
-    np.testing.assert_array_equal(to_uint8(np.clip(np.exp(L.astype(np.float64)), 0, 1)), images)
+    np.testing.assert_array_equal(to_uint8(to_display(L, attrs["tonemap"], attrs["gamma"])), images)
     mp4, info = _mp4(out / "reconstruction.mp4")   # OpenCV reads B, G, R
     assert (info["h"], info["w"]) == (24, 36)
     as_rgb = np.abs(mp4[:, :23, :35, ::-1].astype(int) - images).mean()

@@ -454,17 +454,19 @@ class _Mp4:
 
 
 def display_attrs(config) -> dict:
-    """The tone map, gamma and display formula of an EvINRConfig (or its dict): the attributes of a
+    """The tone map, gamma, display formula and anchor mode of an EvINRConfig (or its dict): the attributes of a
     ``log_intensity.h5`` (:class:`~evinr_lite.io.export.LogIntensityWriter`). An anchored config's frames are the
     APS frames' linear intensity whatever its tone map (:func:`evinr_lite.method.anchor.linear_frames`): "linear",
-    with that formula (its own tone map's was written, one grey level off, or Eq. 12 for a Reinhard recipe)."""
+    with that formula (its own tone map's was written, one grey level off, or Eq. 12 for a Reinhard recipe), and
+    ``anchor`` the mode, so a reader knows ``to_display(L, "linear")`` is not the frames."""
     from ..method.anchor import ANCHORED_DISPLAY
     from ..method.tonemap import display_formula
 
     get = config.get if isinstance(config, dict) else lambda name: getattr(config, name)
     if get("anchor") not in (None, "none"):
-        return {"tonemap": "linear", "gamma": get("gamma"), "display": ANCHORED_DISPLAY}
-    return {"tonemap": get("tonemap"), "gamma": get("gamma"), "display": display_formula(get("tonemap"), get("gamma"))}
+        return {"tonemap": "linear", "gamma": get("gamma"), "display": ANCHORED_DISPLAY, "anchor": get("anchor")}
+    return {"tonemap": get("tonemap"), "gamma": get("gamma"), "display": display_formula(get("tonemap"), get("gamma")),
+            "anchor": "none"}
 
 
 def video_fps(times: np.ndarray) -> float:

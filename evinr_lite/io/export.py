@@ -217,6 +217,7 @@ def save_csv(path, rows: list[dict]) -> Path:
 # them again (another level, another curve) or feed them to their own pipeline.
 
 TONEMAPS = ("linear", "reinhard")   # evinr_lite.method.tonemap.TONEMAPS (io sits below method; a test keeps them equal)
+ANCHORS = ("none", "first", "all")   # evinr_lite.method.anchor.ANCHOR_MODES (likewise)
 
 
 class LogIntensityWriter(CloseOrAbort):
@@ -226,7 +227,7 @@ class LogIntensityWriter(CloseOrAbort):
     uncompressed (float noise barely compresses and a chunk per frame keeps the writes streaming);
     ``t`` float64 [F], seconds relative to the attribute ``t_origin``; attributes saying what the
     values are (``units``) and how the run's frames were drawn from them (``display``, ``tonemap``,
-    ``gamma``). Rows not yet written read as NaN, so a file closed early cannot pass for complete;
+    ``gamma``, ``anchor``). Rows not yet written read as NaN, so a file closed early cannot pass for complete;
     :meth:`close` refuses one with rows missing, and :meth:`write` refuses NaN or infinite values (a written
     NaN frame would read as a missing one).
 
@@ -237,15 +238,19 @@ class LogIntensityWriter(CloseOrAbort):
         t_origin: seconds, the absolute time of t = 0 (0 when relative).
         tonemap, gamma, display: the display the run used: ``tonemap`` one of :data:`TONEMAPS`, ``gamma`` a
             finite number > 0, ``display`` its formula in words (a str).
+        anchor: the run's anchor mode, one of :data:`ANCHORS` ("none": events only). An anchored run's frames are
+            ``evinr_lite.method.linear_frames(L)`` whatever ``tonemap`` says (the writer's "linear"), so a reader
+            tells them apart by this attribute.
     """
 
     def __init__(self, path, times, frame_shape, *, t_origin: float = 0.0, tonemap: str = "linear",
-                 gamma: float = 0.6, display: str = ""):
+                 gamma: float = 0.6, display: str = "", anchor: str = "none"):
         import h5py
 
         times = seconds_array(times, "times")
         t_origin = real_number(t_origin, "t_origin", hint="seconds: the absolute time of t = 0 (0 when relative)")
         tonemap = str(choice(tonemap, TONEMAPS, "tonemap"))   # np.str_ too (h5py stores no numpy text)
+        anchor = str(choice(anchor, ANCHORS, "anchor"))
         gamma = real_number(gamma, "gamma", lo=0, lo_open=True, hint="the display's gamma (e.g. 0.6)")
         if not isinstance(display, str):
             raise EventDataError(f"display= must be a str (the display's formula in words), got "
@@ -266,7 +271,7 @@ class LogIntensityWriter(CloseOrAbort):
                 "units": "natural log of intensity; events fix it up to one constant per recording, which the "
                          "display's level set (docs/defaults.md, 'The display')",
                 "t_units": "seconds relative to t_origin", "t_origin": t_origin, "tonemap": tonemap,
-                "gamma": float(gamma), "display": display, "writer": "evinr-lite"})
+                "gamma": float(gamma), "display": display, "anchor": anchor, "writer": "evinr-lite"})
         except BaseException:
             self.file.close()
             raise
@@ -300,7 +305,7 @@ class LogIntensityWriter(CloseOrAbort):
 
 def save_log_intensity(path, log_intensity, times, **kw) -> Path:
     """Write log intensities [F, H, W] (or [F, H, W, 3]) at ``times`` [F] (s) as one HDF5 file
-    (:class:`LogIntensityWriter`'s layout; keywords: its t_origin, tonemap, gamma, display). The values must be
+    (:class:`LogIntensityWriter`'s layout; keywords: its t_origin, tonemap, gamma, display, anchor). The values must be
     finite numbers (as float32): all are checked before the file is created."""
     L = np.asarray(host_array(log_intensity))
     if L.ndim not in (3, 4) or L.shape[0] != len(np.atleast_1d(times)):
@@ -327,10 +332,17 @@ def read_log_intensity(path, frames=None) -> tuple[np.ndarray, np.ndarray, dict]
 
     ``frames``: which frames to read (None: all; a slice, e.g. ``slice(0, 100)``, or an index): only
     those are read from disk, so a long HD run's file (110 MB a second at 1280x720 and 30 frames per
-    second) can be read a part at a time. The run's frames are ``clip(exp(L), 0, 1)`` for
-    ``attrs["tonemap"] == "linear"`` (the kit's display), ``sigmoid(L) ** gamma`` for "reinhard"
-    (``evinr_lite.method.tonemap.to_display``); ``attrs["display"]`` says which, and an anchored run's
-    (``--anchor``) is ``clip(exp(L) - 1/255, 0, 1)``, the APS frames' intensity, whatever its tone map.
+    second) can be read a part at a time. ``attrs["display"]`` names the formula that drew the run's frames:
+
+    - an anchored run (``--anchor first|all``; ``attrs["anchor"]`` is "first" or "all"): the APS frames'
+      intensity ``clip(exp(L) - 1/255, 0, 1)``, i.e. ``evinr_lite.method.linear_frames(L)``, whatever
+      ``attrs["tonemap"]`` says ("linear": ``to_display(L, "linear")`` is one grey level off there);
+    - otherwise (``attrs["anchor"] == "none"``): ``evinr_lite.method.tonemap.to_display(L, attrs["tonemap"],
+      attrs["gamma"])``: ``clip(exp(L), 0, 1)`` for "linear" (the kit's display), ``sigmoid(L) ** gamma`` for
+      "reinhard".
+
+    A file written before the ``anchor`` attribute existed reads with ``attrs["anchor"] = None`` (not recorded;
+    an anchored run's file of then also named another ``display``: use ``linear_frames`` if the run was anchored).
     """
     import h5py
 
@@ -346,6 +358,8 @@ def read_log_intensity(path, frames=None) -> tuple[np.ndarray, np.ndarray, dict]
             n = f["t"].shape[0]
             if not isinstance(frames, slice) and not -n <= int(frames) < n:
                 raise EventDataError(f"{path}: frame {int(frames)} does not exist; the file holds {n} frames")
-            return f["log_intensity"][frames], f["t"][frames], dict(f.attrs)
+            attrs = dict(f.attrs)
+            attrs.setdefault("anchor", None)   # files from before the attribute: not recorded
+            return f["log_intensity"][frames], f["t"][frames], attrs
     except OSError as err:
         raise EventDataError(f"{path}: cannot be read as HDF5 ({err}); pass the log_intensity.h5 of a run folder") from None
