@@ -126,7 +126,8 @@ def save_gif(path, frames, fps: float) -> Path:
     """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (at most 50
     per second), looping. GIF delays are whole hundredths of a second, so frame k starts at round(100 k / fps)
     hundredths: the delays alternate (30 per second: 30, 30, 40 ms, ...) and the whole lasts F / fps seconds to
-    10 ms, where one rounded delay (30 ms) made it 10 % short. Pillow merges a frame identical to the one before
+    10 ms, where one rounded delay (30 ms) made it 10 % short. Above 50 per second every frame is shown 20 ms: the
+    GIF plays at 50 per second, F x 20 ms, longer than F / fps (every frame is kept). Pillow merges a frame identical to the one before
     into it (their delays add up), so the file can hold fewer frames than ``frames``, never another duration."""
     _check_fps(fps)
     path = _output_file(path, ".gif", "save_gif")
@@ -139,7 +140,8 @@ def save_gif(path, frames, fps: float) -> Path:
 def gif_delays_ms(n_frames: int, fps: float) -> list[int]:
     """The delays (ms, multiples of 10) of ``n_frames`` GIF frames shown at ``fps`` per second: frame k starts at
     round(100 k / fps) hundredths of a second, so they add up to n_frames / fps to 10 ms; at least 20 ms each
-    (browsers show shorter delays as 100 ms), so above 50 per second every delay is 20 ms."""
+    (browsers show shorter delays as 100 ms), so above 50 per second every delay is 20 ms and they add up to
+    n_frames / 50 s, longer than n_frames / fps."""
     if fps > 50:
         return [20] * n_frames
     starts = np.floor(np.arange(n_frames + 1) * (100.0 / fps) + 0.5).astype(np.int64)
