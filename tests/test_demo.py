@@ -59,3 +59,19 @@ def test_overview_labels_rows_and_columns():
     np.testing.assert_array_equal(img[top:top + 20, left:left + 30], round(0.2 * 255))  # frames pasted unscaled
     with pytest.raises(ValueError, match="one label per row"):
         labelled_grid(rows, ["only one"], ["a", "b", "c"])
+
+
+def test_overview_frames_hold_the_levels_the_pngs_hold():
+    """The overview maps [0, 1] to 8 bits as the frames' PNGs do (to_uint8, round(255 x)); it rounded
+    x * 255 + 0.5 down, another level at the halves."""
+    import numpy as np
+    from evinr_lite.apps.demo import labelled_grid
+    from evinr_lite.core.frames import to_uint8
+
+    halves = (np.arange(600) / 2 / 255).reshape(20, 30)   # every half level, 0 .. 299.5 / 255 (clipped above 1)
+    rows = [np.stack([halves, halves[::-1], 1 - halves])]
+    img = labelled_grid(rows, ["EvINR"], ["a", "b", "c"])
+    left, top = img.shape[1] - 3 * 32, img.shape[0] - 22
+    for j in range(3):
+        x = left + j * 32
+        np.testing.assert_array_equal(img[top:top + 20, x:x + 30], to_uint8(rows[0][j]))

@@ -41,6 +41,7 @@ def _check_run(out, tonemap="linear", gamma=0.6):
     shown = np.round(np.clip(to_display(L.astype(np.float64), tonemap, gamma), 0, 1) * 255)
     assert np.abs(shown - png).max() <= 1
     assert attrs["tonemap"] == tonemap and attrs["display"] == display_formula(tonemap, gamma)
+    assert attrs["anchor"] == "none"
     assert LOG_INTENSITY_FILE in json.loads((out / "run.json").read_text())["files"]
     return L
 
@@ -58,6 +59,25 @@ def test_round_trip_keeps_every_value_and_says_what_they_are(tmp_path):
         assert f["log_intensity"].chunks == (1, 5, 6)
     colour = rng.normal(size=(2, 3, 4, 3)).astype(np.float32)
     assert np.array_equal(read_log_intensity(save_log_intensity(tmp_path / "c.h5", colour, [0.0, 1.0]))[0], colour)
+
+
+def test_anchor_attribute_says_which_display_applies_and_old_files_still_read(tmp_path):
+    """An anchored run's frames are linear_frames(L), not to_display(L, "linear") (a grey level off), so the file
+    names the anchor mode; a file from before the attribute reads with anchor None, and bad modes are refused."""
+    from evinr_lite.io.export import ANCHORS
+    from evinr_lite.method.anchor import ANCHOR_MODES
+
+    assert ANCHORS == ANCHOR_MODES   # io sits below method: the list is kept twice
+    L = np.zeros((2, 3, 4), np.float32)
+    assert read_log_intensity(save_log_intensity(tmp_path / "n.h5", L, [0.0, 1.0]))[2]["anchor"] == "none"
+    path = save_log_intensity(tmp_path / "a.h5", L, [0.0, 1.0], anchor="first")
+    assert read_log_intensity(path)[2]["anchor"] == "first"
+    with h5py.File(path, "a") as f:   # as written before the attribute existed
+        del f.attrs["anchor"]
+    back, t, attrs = read_log_intensity(path)
+    assert attrs["anchor"] is None and back.shape == (2, 3, 4) and attrs["tonemap"] == "linear"
+    with pytest.raises(EventDataError, match="anchor"):
+        save_log_intensity(tmp_path / "b.h5", L, [0.0, 1.0], anchor="some")
 
 
 def test_writer_refuses_an_incomplete_file_and_bad_frames(tmp_path):

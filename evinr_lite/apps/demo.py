@@ -21,6 +21,7 @@ from ..method.integration import integrate_events
 from ..evaluation.metrics import SCORE_PROTOCOLS, SSIM_MIN_SIDE, score_frames
 from ..core.checks import check_log, require, true_or_false, whole_number
 from ..core.events import EventDataError, check_sensor_size
+from ..core.frames import to_uint8
 from ..io.output import atomic_output_dir, check_output_path, save_json, save_png
 from ..sim.scenes import make_scene
 from ..sim.simulate import simulate_scene
@@ -65,7 +66,7 @@ def labelled_grid(rows, row_labels, column_labels, *, title: str = "") -> np.nda
         y = top + i * (h + gap)
         draw.text((4, y + h / 2), label, fill=0, font=font, anchor="lm")
         for j, img in enumerate(frames):
-            canvas.paste(Image.fromarray((img * 255.0 + 0.5).astype(np.uint8)), (left + j * (w + gap), y))
+            canvas.paste(Image.fromarray(to_uint8(img)), (left + j * (w + gap), y))   # the levels the PNGs hold
     return np.asarray(canvas)
 
 

@@ -290,6 +290,11 @@ def run_streaming(path, target, options, *, resume: bool = False, log=print, t0:
     if history.get("background_used") is not None:     # what background="auto" chose, so run.json reproduces it
         resolved = replace(resolved, background=history["background_used"],
                            background_dt=history["background_dt_used"])
+    # lam="auto" and temporal_scale="auto" resolved too, as the in-memory job's run.json records them
+    if history.get("lam_used") is not None:
+        resolved = replace(resolved, lam=float(history["lam_used"]))
+    if history.get("temporal_scale_used") is not None:
+        resolved = replace(resolved, temporal_scale=float(history["temporal_scale_used"]))
     history = {**history, "config": asdict(resolved), "streamed": True}
     settings = {"C": C, "C_source": C_source, "times_source": times_source, "device": device_name,
                 "seed": options.seed, "memory_estimate_bytes": est["total"]}
@@ -449,12 +454,19 @@ class _Mp4:
 
 
 def display_attrs(config) -> dict:
-    """The tone map, gamma and display formula of an EvINRConfig (or its dict): the attributes of a
-    ``log_intensity.h5`` (:class:`~evinr_lite.io.export.LogIntensityWriter`)."""
+    """The tone map, gamma, display formula and anchor mode of an EvINRConfig (or its dict): the attributes of a
+    ``log_intensity.h5`` (:class:`~evinr_lite.io.export.LogIntensityWriter`). An anchored config's frames are the
+    APS frames' linear intensity whatever its tone map (:func:`evinr_lite.method.anchor.linear_frames`): "linear",
+    with that formula (its own tone map's was written, one grey level off, or Eq. 12 for a Reinhard recipe), and
+    ``anchor`` the mode, so a reader knows ``to_display(L, "linear")`` is not the frames."""
+    from ..method.anchor import ANCHORED_DISPLAY
     from ..method.tonemap import display_formula
 
     get = config.get if isinstance(config, dict) else lambda name: getattr(config, name)
-    return {"tonemap": get("tonemap"), "gamma": get("gamma"), "display": display_formula(get("tonemap"), get("gamma"))}
+    if get("anchor") not in (None, "none"):
+        return {"tonemap": "linear", "gamma": get("gamma"), "display": ANCHORED_DISPLAY, "anchor": get("anchor")}
+    return {"tonemap": get("tonemap"), "gamma": get("gamma"), "display": display_formula(get("tonemap"), get("gamma")),
+            "anchor": "none"}
 
 
 def video_fps(times: np.ndarray) -> float:

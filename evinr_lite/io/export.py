@@ -22,7 +22,7 @@ from ..core.events import EventDataError
 from ..core.frames import Frames, to_uint8
 from .output import CloseOrAbort, PngWriter, written_beside
 
-__all__ = ["save_frames_png", "save_gif", "save_mp4", "save_timestamps", "save_csv", "LogIntensityWriter",
+__all__ = ["save_frames_png", "save_gif", "gif_delays_ms", "save_mp4", "save_timestamps", "save_csv", "LogIntensityWriter",
            "save_log_intensity", "read_log_intensity", "LOG_INTENSITY_FILE"]
 
 LOG_INTENSITY_FILE = "log_intensity.h5"   # its name in a run folder
@@ -123,15 +123,29 @@ def _check_fps(fps) -> None:
 
 
 def save_gif(path, frames, fps: float) -> Path:
-    """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (to the GIF's 10 ms
-    resolution, at most 50 per second), looping."""
+    """An animated GIF of frames [F, H, W] (grey) or [F, H, W, 3] (colour) at ``fps`` frames per second (at most 50
+    per second), looping. GIF delays are whole hundredths of a second, so frame k starts at round(100 k / fps)
+    hundredths: the delays alternate (30 per second: 30, 30, 40 ms, ...) and the whole lasts F / fps seconds to
+    10 ms, where one rounded delay (30 ms) made it 10 % short. Above 50 per second every frame is shown 20 ms: the
+    GIF plays at 50 per second, F x 20 ms, longer than F / fps (every frame is kept). Pillow merges a frame identical to the one before
+    into it (their delays add up), so the file can hold fewer frames than ``frames``, never another duration."""
     _check_fps(fps)
     path = _output_file(path, ".gif", "save_gif")
     images = [Image.fromarray(img) for img in _stack_uint8(frames)]
-    delay_ms = 10 * max(2, round(100 / fps))   # GIF stores delays in hundredths of a second; browsers floor at 2
     with written_beside(path) as tmp:
-        images[0].save(tmp, save_all=True, append_images=images[1:], duration=delay_ms, loop=0)
+        images[0].save(tmp, save_all=True, append_images=images[1:], duration=gif_delays_ms(len(images), fps), loop=0)
     return Path(path)
+
+
+def gif_delays_ms(n_frames: int, fps: float) -> list[int]:
+    """The delays (ms, multiples of 10) of ``n_frames`` GIF frames shown at ``fps`` per second: frame k starts at
+    round(100 k / fps) hundredths of a second, so they add up to n_frames / fps to 10 ms; at least 20 ms each
+    (browsers show shorter delays as 100 ms), so above 50 per second every delay is 20 ms and they add up to
+    n_frames / 50 s, longer than n_frames / fps."""
+    if fps > 50:
+        return [20] * n_frames
+    starts = np.floor(np.arange(n_frames + 1) * (100.0 / fps) + 0.5).astype(np.int64)
+    return (10 * np.diff(starts)).tolist()
 
 
 def save_mp4(path, frames, fps: float) -> Path:
@@ -205,6 +219,7 @@ def save_csv(path, rows: list[dict]) -> Path:
 # them again (another level, another curve) or feed them to their own pipeline.
 
 TONEMAPS = ("linear", "reinhard")   # evinr_lite.method.tonemap.TONEMAPS (io sits below method; a test keeps them equal)
+ANCHORS = ("none", "first", "all")   # evinr_lite.method.anchor.ANCHOR_MODES (likewise)
 
 
 class LogIntensityWriter(CloseOrAbort):
@@ -214,7 +229,7 @@ class LogIntensityWriter(CloseOrAbort):
     uncompressed (float noise barely compresses and a chunk per frame keeps the writes streaming);
     ``t`` float64 [F], seconds relative to the attribute ``t_origin``; attributes saying what the
     values are (``units``) and how the run's frames were drawn from them (``display``, ``tonemap``,
-    ``gamma``). Rows not yet written read as NaN, so a file closed early cannot pass for complete;
+    ``gamma``, ``anchor``). Rows not yet written read as NaN, so a file closed early cannot pass for complete;
     :meth:`close` refuses one with rows missing, and :meth:`write` refuses NaN or infinite values (a written
     NaN frame would read as a missing one).
 
@@ -225,15 +240,19 @@ class LogIntensityWriter(CloseOrAbort):
         t_origin: seconds, the absolute time of t = 0 (0 when relative).
         tonemap, gamma, display: the display the run used: ``tonemap`` one of :data:`TONEMAPS`, ``gamma`` a
             finite number > 0, ``display`` its formula in words (a str).
+        anchor: the run's anchor mode, one of :data:`ANCHORS` ("none": events only). An anchored run's frames are
+            ``evinr_lite.method.linear_frames(L)`` whatever ``tonemap`` says (the writer's "linear"), so a reader
+            tells them apart by this attribute.
     """
 
     def __init__(self, path, times, frame_shape, *, t_origin: float = 0.0, tonemap: str = "linear",
-                 gamma: float = 0.6, display: str = ""):
+                 gamma: float = 0.6, display: str = "", anchor: str = "none"):
         import h5py
 
         times = seconds_array(times, "times")
         t_origin = real_number(t_origin, "t_origin", hint="seconds: the absolute time of t = 0 (0 when relative)")
         tonemap = str(choice(tonemap, TONEMAPS, "tonemap"))   # np.str_ too (h5py stores no numpy text)
+        anchor = str(choice(anchor, ANCHORS, "anchor"))
         gamma = real_number(gamma, "gamma", lo=0, lo_open=True, hint="the display's gamma (e.g. 0.6)")
         if not isinstance(display, str):
             raise EventDataError(f"display= must be a str (the display's formula in words), got "
@@ -254,7 +273,7 @@ class LogIntensityWriter(CloseOrAbort):
                 "units": "natural log of intensity; events fix it up to one constant per recording, which the "
                          "display's level set (docs/defaults.md, 'The display')",
                 "t_units": "seconds relative to t_origin", "t_origin": t_origin, "tonemap": tonemap,
-                "gamma": float(gamma), "display": display, "writer": "evinr-lite"})
+                "gamma": float(gamma), "display": display, "anchor": anchor, "writer": "evinr-lite"})
         except BaseException:
             self.file.close()
             raise
@@ -288,7 +307,7 @@ class LogIntensityWriter(CloseOrAbort):
 
 def save_log_intensity(path, log_intensity, times, **kw) -> Path:
     """Write log intensities [F, H, W] (or [F, H, W, 3]) at ``times`` [F] (s) as one HDF5 file
-    (:class:`LogIntensityWriter`'s layout; keywords: its t_origin, tonemap, gamma, display). The values must be
+    (:class:`LogIntensityWriter`'s layout; keywords: its t_origin, tonemap, gamma, display, anchor). The values must be
     finite numbers (as float32): all are checked before the file is created."""
     L = np.asarray(host_array(log_intensity))
     if L.ndim not in (3, 4) or L.shape[0] != len(np.atleast_1d(times)):
@@ -315,9 +334,17 @@ def read_log_intensity(path, frames=None) -> tuple[np.ndarray, np.ndarray, dict]
 
     ``frames``: which frames to read (None: all; a slice, e.g. ``slice(0, 100)``, or an index): only
     those are read from disk, so a long HD run's file (110 MB a second at 1280x720 and 30 frames per
-    second) can be read a part at a time. The run's frames are ``clip(exp(L), 0, 1)`` for
-    ``attrs["tonemap"] == "linear"`` (the kit's display), ``sigmoid(L) ** gamma`` for "reinhard"
-    (``evinr_lite.method.tonemap.to_display``).
+    second) can be read a part at a time. ``attrs["display"]`` names the formula that drew the run's frames:
+
+    - an anchored run (``--anchor first|all``; ``attrs["anchor"]`` is "first" or "all"): the APS frames'
+      intensity ``clip(exp(L) - 1/255, 0, 1)``, i.e. ``evinr_lite.method.linear_frames(L)``, whatever
+      ``attrs["tonemap"]`` says ("linear": ``to_display(L, "linear")`` is one grey level off there);
+    - otherwise (``attrs["anchor"] == "none"``): ``evinr_lite.method.tonemap.to_display(L, attrs["tonemap"],
+      attrs["gamma"])``: ``clip(exp(L), 0, 1)`` for "linear" (the kit's display), ``sigmoid(L) ** gamma`` for
+      "reinhard".
+
+    A file written before the ``anchor`` attribute existed reads with ``attrs["anchor"] = None`` (not recorded;
+    an anchored run's file of then also named another ``display``: use ``linear_frames`` if the run was anchored).
     """
     import h5py
 
@@ -333,6 +360,8 @@ def read_log_intensity(path, frames=None) -> tuple[np.ndarray, np.ndarray, dict]
             n = f["t"].shape[0]
             if not isinstance(frames, slice) and not -n <= int(frames) < n:
                 raise EventDataError(f"{path}: frame {int(frames)} does not exist; the file holds {n} frames")
-            return f["log_intensity"][frames], f["t"][frames], dict(f.attrs)
+            attrs = dict(f.attrs)
+            attrs.setdefault("anchor", None)   # files from before the attribute: not recorded
+            return f["log_intensity"][frames], f["t"][frames], attrs
     except OSError as err:
         raise EventDataError(f"{path}: cannot be read as HDF5 ({err}); pass the log_intensity.h5 of a run folder") from None

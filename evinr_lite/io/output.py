@@ -37,6 +37,7 @@ from PIL import Image
 
 from ..core.checks import ArgumentTypeError, check_log, check_path_type, true_or_false
 from ..core.events import InputError
+from ..core.frames import to_uint8
 from ..core.guard import TERMINATION_SIGNALS, Interrupted, signals_deferred, termination_signals  # re-exported
 
 __all__ = ["atomic_output_dir", "given_output_path", "CloseOrAbort", "OutputDir", "OutputError", "OutputExistsError", "check_output_path", "Interrupted",
@@ -448,9 +449,9 @@ def save_png(path, image) -> None:
         raise EventDataError(f"save_png writes one image [H, W] (grey) or [H, W, 3] (RGB), got shape {image.shape}"
                              + ("; for a stack of frames use save_frames_png(folder, frames)" if image.ndim == 3 else ""))
     check_image_values(image, "the image to write", clipped=True)   # uint8, or finite floats in [0, 1]
-    if image.dtype != np.uint8:
-        image = (np.clip(image, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
-    Image.fromarray(image).save(path, compress_level=PNG_COMPRESS_LEVEL)
+    # the kit's one float -> uint8 mapping (round(255 x) in float64), as save_frames_png and the scores' CLAHE:
+    # (x * 255 + 0.5) in the image's own float32 wrote other levels for some pixels than the frames/ PNGs
+    Image.fromarray(to_uint8(image)).save(path, compress_level=PNG_COMPRESS_LEVEL)
 
 
 class CloseOrAbort:

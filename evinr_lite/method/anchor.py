@@ -68,10 +68,14 @@ from ..core.events import EventDataError
 from ..core.frames import Frames
 
 __all__ = ["FRAME_EPS", "ANCHOR_MODES", "AnchorFit", "frames_in_window", "select_anchors", "fit_anchor",
-           "frame_log", "linear_frames", "linear_frames_unchecked", "check_frame_eps", "held_out"]
+           "frame_log", "linear_frames", "linear_frames_unchecked", "check_frame_eps", "held_out", "ANCHORED_DISPLAY"]
 
 FRAME_EPS = 1.0 / 255.0     # added to frame intensities in [0, 1] before the log (black pixels stay finite)
 ANCHOR_MODES = ("none", "first", "all")
+# an anchored reconstruction's frames from its log intensity (linear_frames, whatever the config's tone map), in
+# words: the display attribute of its log_intensity.h5; built from FRAME_EPS ("1/255"), so the two cannot drift
+_EPS_TEXT = f"1/{round(1 / FRAME_EPS)}" if 1 / round(1 / FRAME_EPS) == FRAME_EPS else repr(FRAME_EPS)
+ANCHORED_DISPLAY = f"frames = clip(exp(L) - {_EPS_TEXT}, 0, 1)"
 
 
 def check_frame_eps(eps) -> float:
