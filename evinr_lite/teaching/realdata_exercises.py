@@ -374,7 +374,7 @@ exercises.register(
             _offset_mean_only,
         "divide by 255 only a uint8 frame (first_frame.dtype == np.uint8): a float frame is already in [0, 1]":
             _offset_float_divided,
-        "use the `eps` argument the caller passes, not the FRAME_EPS default":
+        "use the `eps` argument the caller passes, not its default 1 / 255 written in the code":
             _offset_default_eps,
         "a uint8 frame's largest value is 255: divide by 255, not 256":
             _offset_over_256,
