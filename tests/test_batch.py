@@ -279,3 +279,22 @@ def test_ros_bags_among_the_inputs_are_named_with_their_conversion(tmp_path):
     items = resolve_inputs([tmp_path / "in"], log=said.append)
     assert [i["name"] for i in items] == ["rec"]
     assert sum("a ROS bag" in line and "python -m data_fetch convert" in line for line in said) == 2, said
+
+
+def test_a_marker_written_before_a_setting_existed_still_reads_finished(tmp_path):
+    """A recording's marker from before temporal_scale was a result setting lacks the key: its default is what that
+    result was made with, so resuming keeps it (a plain dict comparison read every such recording as stale and
+    reconstructed it again); another value of a setting the marker holds is still stale."""
+    from evinr_lite.apps import batch
+
+    folder = tmp_path / "rec"
+    folder.mkdir()
+    item = {"name": "rec", "dataset": "x", "path": "/x", "identity": {"size": 1}}
+    settings = {"C": 0.2, "fps": 30}
+    old = batch.result_settings(settings)
+    old.pop("temporal_scale")
+    (folder / batch.OWNER_MARKER).write_text(json.dumps({"input": item["identity"], "settings": old}))
+    (folder / "run.json").write_text(json.dumps({"input": "/x"}))
+    assert batch.result_state(folder, item, settings)[0] == "finished"
+    assert batch.result_state(folder, item, {**settings, "temporal_scale": 2.0})[0] == "stale"
+    assert batch.result_state(folder, item, {**settings, "fps": 60})[0] == "stale"

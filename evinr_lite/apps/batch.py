@@ -286,7 +286,10 @@ def result_state(folder: Path, item: dict, settings: dict, claimed: bool = False
         if claimed and run is not None and run.get("input") == item["path"]:
             return "stale", None
         return "foreign", None
-    same = marker.get("input") == item.get("identity") and marker.get("settings") == result_settings(settings)
+    # a marker written before a setting existed lacks it: its default is what that result was made with
+    stored = marker.get("settings")
+    same = (marker.get("input") == item.get("identity") and isinstance(stored, dict)
+            and result_settings(stored) == result_settings(settings))
     return ("finished", run) if same and run is not None else ("stale", None)
 
 
