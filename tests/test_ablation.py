@@ -257,3 +257,12 @@ def test_a_real_reduced_table2_runs(slider_depth_dir):
     assert [r["frames"].shape for r in rows] == [(int(inside.sum()), 180, 240)] * 2
     assert all(np.isfinite(r["ssim_clahe"]) for r in rows)
 
+
+
+def test_paper_frame_counts_takes_a_mapping_table_as_before():
+    """A mappingproxy table and rows (any Mapping) were taken at bfcd363; round 20's checks kept them (final review)."""
+    from types import MappingProxyType
+
+    from evinr_lite.evaluation.ablation import paper_frame_counts
+    table = MappingProxyType({"a": MappingProxyType({"time_s": 2, "fps": 3.5}), "b": {"time_s": 1.0, "fps": 4}})
+    assert paper_frame_counts(table) == {"a": 7.0, "b": 4.0}

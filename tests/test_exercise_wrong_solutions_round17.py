@@ -491,3 +491,19 @@ def test_this_round_counts():
     assert (len(DTYPE_HOLES), len(CLOCK_HOLES), len(FIXED_SIZES), len(CORRECT)) == (2, 3, 5, 10)
     assert len(wrong) == 10 and len({r[0] for r in wrong}) == 9
     assert len({r[0] for r in CORRECT}) == 8
+
+
+def test_another_patch_of_the_time_module_outlives_the_block():
+    """A test framework's frozen clock (freezegun, time-machine) in place when a check begins is put back after it,
+    not replaced by the clocks captured at import (final review)."""
+    def frozen():
+        return 1234.5
+    saved = time.time
+    time.time = frozen
+    try:
+        with fc.fast_clock(lambda: None):
+            assert time.time is fc.FAKE_CLOCKS["time"]
+        assert time.time is frozen
+    finally:
+        time.time = saved
+    assert _clocks_are_real()

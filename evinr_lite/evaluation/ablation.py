@@ -455,12 +455,12 @@ def paper_frame_counts(table: dict) -> dict[str, float]:
 def _checked_paper_table(table) -> dict:
     """paper_frame_counts' table with its numbers checked as floats: text was repeated ("1" * 2 = "11"), True
     taken as 1 s, a negative time counted negative frames."""
-    if not isinstance(table, dict):
+    if not isinstance(table, Mapping):   # a Mapping (a mappingproxy) was taken before: taken
         raise EventDataError(f"table= must be a dict {{name: {{'time_s': ..., 'fps': ...}}}} (e.g. PAPER_TABLE2), got "
                              f"{type(table).__name__}")
     out = {}
     for name, row in table.items():
-        if not isinstance(row, dict) or not {"time_s", "fps"} <= set(row):
+        if not isinstance(row, Mapping) or not {"time_s", "fps"} <= set(row):
             raise EventDataError(f"table[{name!r}] must be a dict with 'time_s' and 'fps' (a paper table's row), got "
                                  f"{row!r:.60}")
         out[name] = {key: real_number(row[key], f"table[{name!r}][{key!r}]", lo=0) for key in ("time_s", "fps")}

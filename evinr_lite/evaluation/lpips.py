@@ -136,7 +136,7 @@ def lpips_paths(cache_dir=None) -> tuple[Path, Path]:
         check_path_type(cache_dir, "cache_dir", "a folder holding the LPIPS weights",
                         "or None for the kit's cache (where `python -m data_fetch get lpips all` puts them)")
         if blank_path(cache_dir):   # "" was the current folder (Path(".") names it on purpose)
-            raise EventDataError(f"cache_dir= is empty ({cache_dir!r}; '' and Path('') both mean the current folder): pass the folder holding the LPIPS weights "
+            raise EventDataError(f"cache_dir= is empty ({cache_dir!r}, blank text, which paths read as the current folder): pass the folder holding the LPIPS weights "
                                  "(Path.cwd() for the current folder), or None for the kit's cache")
     cache_dir = Path(weights_dir("lpips") if cache_dir is None else cache_dir)
     return cache_dir / ALEXNET_FILE, cache_dir / LINEAR_FILE

@@ -79,7 +79,7 @@ def find_recording(path=None, scratch=None, *, start=None) -> tuple[Path, str]:
     if path is not None:
         check_path_type(path, "path", "a recording (a file or a folder)", "or None to find one")
         if blank_path(path):   # "" was the current folder, "given" (Path(".") names it on purpose)
-            raise EventDataError(f"path= is empty ({path!r}; '' and Path('') both mean the current folder): pass the recording's path (Path.cwd() for the "
+            raise EventDataError(f"path= is empty ({path!r}, blank text, which paths read as the current folder): pass the recording's path (Path.cwd() for the "
                                  "current folder), or None to find one")
         path = Path(path)
         if not path.exists():

@@ -4,7 +4,8 @@
 The time module's clocks are captured once, here, at import (:data:`REAL_CLOCKS`), and each has one fake
 (:data:`FAKE_CLOCKS`), made once. :func:`fast_clock` puts the fakes into the time module (and into the learner's
 globals, for a name bound with ``from time import perf_counter``) while its block runs, and the captured real clocks
-back after it, whatever was there on entry. A fake moves only where a block is running *on the calling thread*, in
+back after it (or, where another patch of the time module was in place when the first block began, a test's
+frozen clock, that patch; never a fake). A fake moves only where a block is running *on the calling thread*, in
 *the process that started it*, and the read comes from the learner's own code (a file neither a library's nor this
 kit's); everywhere else it calls the real clock and returns its value unchanged. So a fake that outlives the block
 (a reference taken during it, ``from time import perf_counter`` run by a module imported during it, a check in
@@ -56,6 +57,7 @@ class _Block:
 _local = threading.local()          # .block: the innermost running block on this thread (absent: none)
 _lock = threading.Lock()
 _depth = [0]                        # blocks running, all threads together: the fakes are in while it is above 0
+_entry: dict = {}                   # what the time module held when the first block began (a test's frozen clock)
 
 
 @functools.lru_cache(maxsize=4096)
@@ -106,6 +108,11 @@ def fast_clock(fn: Callable) -> Iterator[dict]:
     namespace = getattr(fn, "__globals__", None)
     bound: dict = {}
     with _lock:
+        if _depth[0] == 0:   # put back at the end: another patch of the time module (freezegun) outlives the check
+            _entry.clear()
+            for name, real in REAL_CLOCKS.items():
+                held = getattr(time, name, real)
+                _entry[name] = real if held is FAKE_CLOCKS[name] else held
         _depth[0] += 1
         for name, fake in FAKE_CLOCKS.items():
             setattr(time, name, fake)
@@ -128,4 +135,4 @@ def fast_clock(fn: Callable) -> Iterator[dict]:
             if _depth[0] <= 0:
                 _depth[0] = 0
                 for name, real in REAL_CLOCKS.items():
-                    setattr(time, name, real)
+                    setattr(time, name, _entry.get(name, real))
