@@ -136,3 +136,17 @@ def test_video_writers(tmp_path):
     with pytest.raises(ValueError, match="fps must be positive"):
         save_gif(tmp_path / "b.gif", frames, fps=0)
     assert not os.path.exists(tmp_path / "b.gif")
+
+
+def test_format_info_prints_a_fractional_t_origin_in_full(tmp_path):
+    # a canonical file keeps the origin it was written with; ":.0f" printed 1500000000.123456 as 1500000000
+    from evinr_lite.apps.recon_job import format_info
+    from evinr_lite.io.canonical import CanonicalWriter
+    out = tmp_path / "abs.h5"
+    with CanonicalWriter(out, sensor_size=(4, 5), t_origin=1_500_000_000.123456) as w:
+        w.add_events(np.array([0.01, 0.02]), np.array([1, 2]), np.array([0, 3]), np.array([1, -1]))
+    text = format_info(describe_recording(read_recording(out)))
+    assert "times relative to t_origin = 1500000000.123456 s" in text
+    info = describe_recording(read_recording(out))
+    assert "t_origin = 1500000000 s" in format_info({**info, "t_origin": 1_500_000_000.0})
+    assert "t_origin = 0 s" in format_info({**info, "t_origin": 0.0})

@@ -239,6 +239,12 @@ def describe_recording(rec) -> dict:
     return info
 
 
+def _origin_text(t_origin) -> str:
+    """t_origin in full: a canonical file's origin may have a fraction (1500000000.123456), which
+    ``:.0f`` rounded away, so that the printed origin plus the printed times missed the absolute clock."""
+    return np.format_float_positional(float(t_origin), trim="-")
+
+
 def format_info(info: dict) -> str:
     """Human-readable lines for :func:`describe_recording`'s dict."""
     H, W = info["sensor_size"]
@@ -251,7 +257,7 @@ def format_info(info: dict) -> str:
         lines += [f"events        {info['n_events']:,}" + (f"  ({rate:,.0f} per s, {rate / (H * W):.2f} per pixel "
                                                              "per s)" if rate else ""),
                   f"time span     {info['t_first']:.6f} .. {info['t_last']:.6f} s  ({info['duration_s']:.6f} s; "
-                  f"times relative to t_origin = {info['t_origin']:.0f} s)"]
+                  f"times relative to t_origin = {_origin_text(info['t_origin'])} s)"]
         if info["on_fraction"] is not None:
             lines.append(f"polarity      {100 * info['on_fraction']:.1f}% ON, {100 * (1 - info['on_fraction']):.1f}% "
                          f"OFF{sampled}")
