@@ -8,11 +8,13 @@ format needs no change here. Times are seconds on the recording's clock: relativ
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
-from ..core.events import EventDataError
+from ..core.checks import require, short_repr
+from ..core.events import EventDataError, check_sensor_size
 from ..core.frames import Frames
 from ..core.recording import Recording
 from .formats.base import FileFormat, check_frame_times, same_time_message
@@ -32,6 +34,7 @@ def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | Non
     """The keyword options for ``fmt``'s reader: ``sensor_size`` where the reader takes it, ``time_unit``
     where the format does not fix it (a different unit for a format that fixes its own is refused), and
     ``camera`` for a format with more than one camera in a file (MVSEC's stereo pair; refused for the others)."""
+    require(fmt, FileFormat, "fmt")   # a name or None: "has no attribute 'takes_sensor_size'"; pass get_format(name)
     options = {}
     if camera is not None:
         if "camera" not in fmt.options:
@@ -50,8 +53,10 @@ def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | Non
 
 
 def check_sensor_size_matches(path, found, sensor_size) -> None:
-    """Refuse a ``sensor_size`` argument that differs from the recording's (H, W)."""
-    if sensor_size is not None and tuple(int(v) for v in sensor_size) != tuple(found):
+    """Refuse a ``sensor_size`` argument that differs from the recording's (H, W) (or that is no (H, W): 5, "a", NaN
+    were Python's errors, (12.5, W) taken as 12 rows)."""
+    found = check_sensor_size(found)
+    if sensor_size is not None and check_sensor_size(sensor_size) != found:
         H, W = found
         raise EventDataError(f"{path}: the recording's sensor is (H, W) = {tuple(found)} ({H}x{W}) but "
                              f"sensor size {tuple(int(v) for v in sensor_size)} was given; leave it out or pass {H}x{W}")
@@ -241,6 +246,9 @@ def describe_recording(rec) -> dict:
 
 def format_info(info: dict) -> str:
     """Human-readable lines for :func:`describe_recording`'s dict."""
+    if not isinstance(info, Mapping) or not all(k in info for k in ("format", "path", "sensor_size", "n_events")):
+        raise EventDataError("format_info: info= must be the dict describe_recording(path) returns (with 'format', "
+                             f"'path', 'sensor_size' and 'n_events'), got {short_repr(info)}")
     H, W = info["sensor_size"]
     lines = [f"format        {info['format']}  ({info['path']})",
              f"sensor        {H}x{W} (H x W)"]
