@@ -208,6 +208,7 @@ def test_the_helpers_answer_as_before_guard(fx):
         n = h["events/t"].shape[0]
         assert 0 < canonical.find_time_index(h, 0.01) < n and canonical.find_time_index(h, 1e9) == n
         assert canonical.find_time_index(h, np.float32(0.01)) == canonical.find_time_index(h, 0.01)
+        assert canonical.find_time_index(h, __import__("decimal").Decimal("0.01")) == canonical.find_time_index(h, 0.01)
         assert canonical.find_time_index(h, 0, "right") == canonical.find_time_index(h, 0.0, "right")
     assert cfa.check_phase((-1, 0), 2) == (3, 0) and cfa.check_phase((1.0, 0), 2.0) == (1, 0)
     assert cfa.check_phase((1, 1), np.array(1)) == (1, 1)

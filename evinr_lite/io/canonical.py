@@ -305,7 +305,8 @@ def _check_index_query(f, value, side) -> None:
     if not isinstance(f, h5py.Group):
         raise EventDataError(f"find_time_index: f= must be an open canonical file (h5py.File(path, 'r')), got "
                              f"{type(f).__name__}")
-    if not is_real_number(value) or not math.isfinite(float(value)):
+    number = decimal_as_float(value)   # a Decimal window is read as its float, as the readers' windows are
+    if not is_real_number(number) or not math.isfinite(float(number)):
         raise EventDataError(f"find_time_index: value= must be a finite time in seconds (relative to t_origin), got "
                              f"{short_repr(value)}")
     if side not in ("left", "right") or not isinstance(side, str):
