@@ -10,6 +10,8 @@ Functions: io.formats (``read_events_npy``, ``read_events_txt``, ``read_events_c
 ``reader_options``, ``check_sensor_size_matches``), io.canonical (``repair_frame_times``, ``find_time_index``) and
 core.cfa (``check_phase``).
 """
+import collections
+import os
 import sys
 from pathlib import Path
 
@@ -110,7 +112,7 @@ def test_a_meta_that_is_no_dict_is_named(reader, meta, fx):
     fn, key = {"read_events_txt": (txt.read_events_txt, "txt"), "read_events_csv": (csv_events.read_events_csv, "csv"),
                "read_events_npy": (npy.read_events_npy, "npy"), "read_frames_ijrr": (ijrr.read_frames_ijrr, "ijrr")}[reader]
     kw = {} if reader == "read_frames_ijrr" else dict(sensor_size=(H, W))
-    with pytest.raises(InputError, match=r"meta= must be dict, got"):
+    with pytest.raises(InputError, match=r"meta= must be MutableMapping, got"):
         fn(fx[key], meta=meta, **kw)
 
 
@@ -127,10 +129,11 @@ CASES = {
     "format_info-None": (lambda f: load.format_info(None), r"format_info: info= must be the dict describe_recording"),
     "format_info-text": (lambda f: load.format_info("a"), r"info= must be the dict describe_recording"),
     "format_info-list": (lambda f: load.format_info([1]), r"info= must be the dict describe_recording"),
-    "format_info-empty": (lambda f: load.format_info({}), r"with 'format', 'path', 'sensor_size' and 'n_events'"),
+    "format_info-empty": (lambda f: load.format_info({}), r"it has no 'format', 'path', 'sensor_size', 'n_events'"),
     "reader_options-None": (lambda f: load.reader_options(None, f["txt"]), r"fmt= must be FileFormat, got NoneType"),
     "reader_options-name": (lambda f: load.reader_options("txt", f["txt"]), r"fmt= must be FileFormat, got str"),
-    "check_sensor_size_matches-found-None": (lambda f: load.check_sensor_size_matches(f["txt"], None, (H, W)), SIZE_MATCH),
+    "check_sensor_size_matches-found-None": (lambda f: load.check_sensor_size_matches(f["txt"], None, (H, W)),
+                                             r"found= \(the recording's sensor size\) must be \(H, W\)"),
     "check_sensor_size_matches-5": (lambda f: load.check_sensor_size_matches(f["txt"], (H, W), 5), SIZE_MATCH),
     "check_sensor_size_matches-text": (lambda f: load.check_sensor_size_matches(f["txt"], (H, W), "a"), SIZE_MATCH),
     "check_sensor_size_matches-NaN": (lambda f: load.check_sensor_size_matches(f["txt"], (H, W), (np.nan, 16)),
@@ -145,11 +148,11 @@ CASES = {
     "repair_frame_times-bool": (lambda f: canonical.repair_frame_times(np.array([True, False])), r"t= must be seconds"),
     "find_time_index-None": (lambda f: canonical.find_time_index(None, 0.0), r"f= must be an open canonical file"),
     "find_time_index-5": (lambda f: canonical.find_time_index(5, 0.0), r"f= must be an open canonical file"),
-    "find_time_index-text": (lambda f: _index(f, "a"), r"value= must be a finite time in seconds"),
-    "find_time_index-NaN": (lambda f: _index(f, np.nan), r"value= must be a finite time"),
-    "find_time_index-bool": (lambda f: _index(f, True), r"value= must be a finite time"),
-    "find_time_index-list": (lambda f: _index(f, [0.0]), r"value= must be a finite time"),
-    "find_time_index-array": (lambda f: _index(f, np.array([0.0, 1.0])), r"value= must be a finite time"),
+    "find_time_index-text": (lambda f: _index(f, "a"), r"value= must be a time in seconds .*not NaN"),
+    "find_time_index-NaN": (lambda f: _index(f, np.nan), r"value= must be a time in seconds"),
+    "find_time_index-bool": (lambda f: _index(f, True), r"value= must be a time in seconds"),
+    "find_time_index-list": (lambda f: _index(f, [0.0]), r"value= must be a time in seconds"),
+    "find_time_index-array": (lambda f: _index(f, np.array([0.0, 1.0])), r"value= must be a time in seconds"),
     "find_time_index-side-x": (lambda f: _index(f, 0.0, "x"), r"side= must be 'left' .* or 'right'"),
     "find_time_index-side-None": (lambda f: _index(f, 0.0, None), r"side= must be 'left'"),
     "prophesee_header-limit-text": (lambda f: prophesee.prophesee_header(f["prophesee_evt21"], "a"), r"limit"),
@@ -207,8 +210,92 @@ def test_the_helpers_answer_as_before_guard(fx):
     with h5py.File(fx["canonical"], "r") as h:
         n = h["events/t"].shape[0]
         assert 0 < canonical.find_time_index(h, 0.01) < n and canonical.find_time_index(h, 1e9) == n
-        assert canonical.find_time_index(h, np.float32(0.01)) == canonical.find_time_index(h, 0.01)
-        assert canonical.find_time_index(h, __import__("decimal").Decimal("0.01")) == canonical.find_time_index(h, 0.01)
-        assert canonical.find_time_index(h, 0, "right") == canonical.find_time_index(h, 0.0, "right")
+        t = h["events/t"][()]
+        assert canonical.find_time_index(h, np.float32(0.01)) == np.searchsorted(t, np.float32(0.01))
+        assert canonical.find_time_index(h, __import__("decimal").Decimal("0.01")) == np.searchsorted(t, 0.01)
+        assert canonical.find_time_index(h, 0, "right") == np.searchsorted(t, 0.0, "right")
     assert cfa.check_phase((-1, 0), 2) == (3, 0) and cfa.check_phase((1.0, 0), 2.0) == (1, 0)
     assert cfa.check_phase((1, 1), np.array(1)) == (1, 1)
+
+
+# ---- the review's findings (round 21's review): what main took is taken again, the gaps in the checks closed -------
+
+def test_find_time_index_takes_inf_as_before_and_every_event_review(fx):
+    with h5py.File(fx["canonical"], "r") as h:
+        n = h["events/t"].shape[0]
+        for side in ("left", "right"):
+            assert canonical.find_time_index(h, -np.inf, side) == 0 and canonical.find_time_index(h, np.inf, side) == n
+            assert canonical.find_time_index(h, float("-inf"), side) == 0
+            assert canonical.find_time_index(h, np.float32(np.inf), side) == n
+
+
+REVIEW_CASES = {
+    "find_time_index-NaN-float": (lambda f: _index(f, float("nan")), r"value= must be a time in seconds .*not NaN"),
+    "find_time_index-side-array": (lambda f: _index(f, 0.01, np.array(["left", "right"])), r"side= must be 'left'"),
+    "find_time_index-group-events": (lambda f: _in_file(f, lambda h: canonical.find_time_index(h["events"], 0.01)),
+                                     r"f= must be an open canonical file with events/t"),
+    "find_time_index-hdf5-without-events": (lambda f: _in_file(f, lambda h: canonical.find_time_index(h, 0.01), "h5"),
+                                            r"f= must be an open canonical file with events/t"),
+    "format_info-no-rate": (lambda f: load.format_info({"format": "txt", "path": "p", "sensor_size": [H, W],
+                                                        "n_events": 60, "n_frames": 0}),
+                            r"describe_recording\(rec\) .*it has no 'event_rate_per_s', 't_first'"),
+    "format_info-no-n_frames": (lambda f: load.format_info({"format": "txt", "path": "p", "sensor_size": [H, W],
+                                                            "n_events": 0}), r"it has no 'n_frames'"),
+    "format_info-no-frame_size": (lambda f: load.format_info({"format": "txt", "path": "p", "sensor_size": [H, W],
+                                                              "n_events": 0, "n_frames": 2}),
+                                  r"it has no 'frame_size'"),
+    "check_sensor_size_matches-found-5": (lambda f: load.check_sensor_size_matches(f["txt"], 5, (H, W)),
+                                          r"check_sensor_size_matches: found= .* got 5"),
+    "read_frames_ijrr-span-dict": (lambda f: ijrr.read_frames_ijrr(f["ijrr"], events_span={"a": 1, "b": 2}),
+                                   r"events_span= must be \(t_start, t_end\) .*not a dict or set"),
+    "read_frames_ijrr-span-set": (lambda f: ijrr.read_frames_ijrr(f["ijrr"], events_span={0.0, 0.05}),
+                                  r"events_span= must be \(t_start, t_end\) .*not a dict or set"),
+}
+
+
+def _in_file(f, fn, key="canonical"):
+    with h5py.File(f[key], "r") as h:
+        return fn(h)
+
+
+@pytest.mark.parametrize("case", list(REVIEW_CASES))
+def test_a_bad_argument_is_named_review(case, fx):
+    fn, match = REVIEW_CASES[case]
+    with pytest.raises(InputError, match=match):
+        fn(fx)
+
+
+def test_format_info_takes_what_describe_recording_returns_review(fx):
+    info = load.describe_recording(txt.read_txt(fx["txt"]))
+    assert load.format_info(info) == load.format_info(dict(info))
+    assert "events        60" in load.format_info(collections.OrderedDict(info))
+
+
+def test_check_sensor_size_matches_blames_sensor_size_when_it_is_wrong_review(fx):
+    with pytest.raises(InputError, match=r"^sensor_size must be \(H, W\)"):
+        load.check_sensor_size_matches(fx["txt"], (H, W), (np.nan, 16))
+    with pytest.raises(InputError, match=r"the recording's sensor is \(H, W\) = \(12, 16\)"):
+        load.check_sensor_size_matches(fx["txt"], [H, W], (16, 12))
+
+
+@pytest.mark.skipif(not os.path.exists(os.devnull) or os.devnull != "/dev/null", reason="needs /dev/null")
+def test_a_device_is_read_as_on_main_review(fx):
+    assert registry.sniff_format("/dev/null") is None and registry.sniff_format(Path("/dev/null")) is None
+    assert prophesee.prophesee_header("/dev/null") == []
+    with pytest.raises(InputError, match=r"not an AEDAT 3.1 file"):   # as on main: no header in the device
+        aedat3.aedat3_header("/dev/null")
+    for fn in (registry.sniff_format, prophesee.prophesee_header, aedat3.aedat3_header):
+        with pytest.raises(InputError, match=r"is a folder, not a file"):
+            fn(fx["folder"])
+        with pytest.raises(InputError, match=r"no such file"):
+            fn(fx["missing"])
+
+
+@pytest.mark.parametrize("kind", ["UserDict", "OrderedDict", "defaultdict"])
+def test_meta_may_be_any_mutable_mapping_review(kind, fx):
+    meta = {"UserDict": collections.UserDict, "OrderedDict": collections.OrderedDict,
+            "defaultdict": lambda: collections.defaultdict(list)}[kind]()
+    assert len(txt.read_events_txt(fx["txt"], meta=meta)) == 60
+    assert len(csv_events.read_events_csv(fx["csv"], meta=meta)) == 60
+    assert len(npy.read_events_npy(fx["npy"], sensor_size=(H, W), meta=meta)) == 60
+    assert ijrr.read_frames_ijrr(fx["ijrr"], meta=meta).images.shape == (2, H, W)

@@ -298,20 +298,21 @@ def _time_index(f, n: int):
 
 
 def _check_index_query(f, value, side) -> None:
-    """find_time_index's arguments: an open file or group, a finite time, 'left' or 'right' (None or text were
-    Python's or numpy's errors; NaN, True or text answered n, as for a time after every event)."""
+    """find_time_index's arguments: an open canonical file (a group with events/t), a time that is no NaN
+    (-inf and +inf are before and after every event: 0 and n), 'left' or 'right' (None or text were Python's or
+    numpy's errors; NaN, True or text answered n, as for a time after every event)."""
     import h5py
 
-    if not isinstance(f, h5py.Group):
-        raise EventDataError(f"find_time_index: f= must be an open canonical file (h5py.File(path, 'r')), got "
-                             f"{type(f).__name__}")
+    if not isinstance(f, h5py.Group) or not isinstance(f.get("events/t"), h5py.Dataset):
+        raise EventDataError(f"find_time_index: f= must be an open canonical file with events/t "
+                             f"(h5py.File(path, 'r')), got {short_repr(f)}")
     number = decimal_as_float(value)   # a Decimal window is read as its float, as the readers' windows are
-    if not is_real_number(number) or not math.isfinite(float(number)):
-        raise EventDataError(f"find_time_index: value= must be a finite time in seconds (relative to t_origin), got "
-                             f"{short_repr(value)}")
-    if side not in ("left", "right") or not isinstance(side, str):
+    if not is_real_number(number) or math.isnan(float(number)):
+        raise EventDataError(f"find_time_index: value= must be a time in seconds (relative to t_origin; -inf or inf "
+                             f"for before or after every event), not NaN; got {short_repr(value)}")
+    if not isinstance(side, str) or side not in ("left", "right"):
         raise EventDataError(f"find_time_index: side= must be 'left' (t[i] >= value) or 'right' (t[i] > value), got "
-                             f"{side!r}")
+                             f"{short_repr(side)}")
 
 
 def find_time_index(f, value: float, side: str = "left") -> int:

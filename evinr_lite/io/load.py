@@ -55,7 +55,11 @@ def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | Non
 def check_sensor_size_matches(path, found, sensor_size) -> None:
     """Refuse a ``sensor_size`` argument that differs from the recording's (H, W) (or that is no (H, W): 5, "a", NaN
     were Python's errors, (12.5, W) taken as 12 rows)."""
-    found = check_sensor_size(found)
+    try:   # found comes from the recording (its source's or events' sensor size): a bad one is named as found=
+        found = check_sensor_size(found)
+    except EventDataError:
+        raise EventDataError(f"{path}: check_sensor_size_matches: found= (the recording's sensor size) must be (H, W), "
+                             f"two positive whole numbers, got {short_repr(found)}") from None
     if sensor_size is not None and check_sensor_size(sensor_size) != found:
         H, W = found
         raise EventDataError(f"{path}: the recording's sensor is (H, W) = {tuple(found)} ({H}x{W}) but "
@@ -244,11 +248,31 @@ def describe_recording(rec) -> dict:
     return info
 
 
+_INFO_KEYS = ("format", "path", "sensor_size", "n_events", "n_frames")
+_EVENT_KEYS = ("event_rate_per_s", "t_first", "t_last", "duration_s", "t_origin", "on_fraction")
+_FRAME_KEYS = ("frame_size", "frames_t_first", "frames_t_last")
+
+
+def _info_keys(info) -> list:
+    """The keys :func:`format_info` reads without .get: the events' keys when there are events, the frames' keys
+    when there are frames."""
+    keys = list(_INFO_KEYS)
+    if info.get("n_events"):
+        keys += _EVENT_KEYS
+    if info.get("n_frames"):
+        keys += _FRAME_KEYS
+    return keys
+
+
 def format_info(info: dict) -> str:
     """Human-readable lines for :func:`describe_recording`'s dict."""
-    if not isinstance(info, Mapping) or not all(k in info for k in ("format", "path", "sensor_size", "n_events")):
-        raise EventDataError("format_info: info= must be the dict describe_recording(path) returns (with 'format', "
-                             f"'path', 'sensor_size' and 'n_events'), got {short_repr(info)}")
+    if not isinstance(info, Mapping):
+        raise EventDataError("format_info: info= must be the dict describe_recording(rec) returns (rec: a Recording "
+                             f"or a RecordingSource), got {short_repr(info)}")
+    missing = [k for k in _info_keys(info) if k not in info]
+    if missing:
+        raise EventDataError("format_info: info= must be the dict describe_recording(rec) returns (rec: a Recording "
+                             f"or a RecordingSource); it has no {', '.join(repr(k) for k in missing)}")
     H, W = info["sensor_size"]
     lines = [f"format        {info['format']}  ({info['path']})",
              f"sensor        {H}x{W} (H x W)"]

@@ -16,14 +16,15 @@ from typing import Callable
 
 import numpy as np
 
-from ...core.checks import ArgumentTypeError, check_path_type, check_reader_window   # check_reader_window re-exported: the readers' window
-# check lives in core.checks
+# check_reader_window is re-exported: the readers' window check lives in core.checks
+from ...core.checks import ArgumentTypeError, check_path_type, check_reader_window
 from ...core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_sensor_size, check_time_span, fall_back_hint,
                             relative_seconds, resolve_time_unit)
 from ..text import read_text_bytes
 
 __all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
-           "json_file", "size_value", "plain_attr", "check_declared_size", "declared_or_given_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
+           "json_file", "size_value", "plain_attr", "check_declared_size", "declared_or_given_size",
+           "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
            "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE",
            "check_time_spread", "same_time_message", "check_frame_times", "check_finite_images", "own_meta",
            "file_path"]
@@ -94,10 +95,11 @@ def existing(path, kind: str = "file") -> Path:
 
 
 def file_path(path) -> Path:
-    """``path`` as a Path when it names a regular file (an empty one too: a header helper reads nothing there);
+    """``path`` as a Path when it names something that exists and is no folder: a regular file (an empty one too:
+    a header helper reads nothing there), or a FIFO or device such as /dev/null (read as on main: its first bytes);
     None, a number, a folder or a missing file is :func:`existing`'s error (Python's TypeError or OSError)."""
     path = Path(check_path_type(path, "path", "the recording's file"))
-    return path if path.is_file() else existing(path)
+    return path if path.exists() and not path.is_dir() else existing(path)
 
 
 def own_meta(reader: str, fmt: str, path, options: dict) -> dict:

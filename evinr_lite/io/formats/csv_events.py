@@ -19,6 +19,7 @@ mark (`0,0125;12;7;1`, as spreadsheets in many locales write). The polarity may 
 from __future__ import annotations
 
 import re
+from collections.abc import MutableMapping
 from pathlib import Path
 
 import numpy as np
@@ -213,7 +214,7 @@ def read_events_csv(path, sensor_size=None, *, polarity="auto", t_origin=None, t
         meta: where notes go (``meta["read_notes"]``).
     """
     path = Path(check_path_type(path, "path", "the event file"))
-    require(meta, dict, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
+    require(meta, MutableMapping, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
     data, layout, geometry, unit = csv_layout(path, read_text_bytes(path, "event file"), time_unit)
     raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=unit, data=data,
                            layout=layout)

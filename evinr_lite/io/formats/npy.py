@@ -7,6 +7,7 @@ window (``t_start`` / ``t_end``, or :class:`NpySource`) is found by bisection on
 """
 from __future__ import annotations
 
+from collections.abc import MutableMapping
 from pathlib import Path
 
 import numpy as np
@@ -15,8 +16,8 @@ from ...core.checks import require
 from ...core.events import EventDataError, Events, check_time_span, resolve_time_unit
 from ...core.recording import Recording
 from ..source import RecordingSource
-from .base import (Clock, FileFormat, own_meta, bisect_seconds, build_events, check_reader_window, check_time_spread, existing,
-                   load_npy, note_decimal_seconds, probe_sorted, size_hint, to_seconds)
+from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, check_time_spread, existing,
+                   load_npy, note_decimal_seconds, own_meta, probe_sorted, size_hint, to_seconds)
 
 __all__ = ["read_events_npy", "read_npy", "NpySource", "FORMAT", "MAGIC"]
 
@@ -156,7 +157,7 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
         meta: where notes go (``meta["read_notes"]``); they are also warnings (ReadNote).
     """
     t_start, t_end = check_reader_window(t_start, t_end)   # 0-d, Fraction, Decimal: floats
-    require(meta, dict, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
+    require(meta, MutableMapping, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
     opened = _Opened(path, sensor_size, columns, time_unit)
     opened.note_units(time_unit, meta)
     if sort:

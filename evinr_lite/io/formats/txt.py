@@ -5,13 +5,15 @@ a source over it slices the events in memory.
 """
 from __future__ import annotations
 
+from collections.abc import MutableMapping
 from pathlib import Path
 
 from ...core.checks import check_path_type, require
 from ...core.events import Events, EventDataError, check_time_span
 from ...core.recording import Recording
 from ..text import NS, origin_to_ns, parse_event_text
-from .base import FileFormat, build_events, own_meta, check_time_spread, note_decimal_seconds, sensor_from_header, size_hint
+from .base import (FileFormat, build_events, check_time_spread, note_decimal_seconds, own_meta, sensor_from_header,
+                   size_hint)
 
 __all__ = ["read_events_txt", "read_txt", "looks_like_event_text", "FORMAT"]
 
@@ -33,7 +35,7 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, t
         meta: where notes go (``meta["read_notes"]``); they are also warnings (ReadNote).
     """
     path = Path(check_path_type(path, "path", "the event file"))
-    require(meta, dict, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
+    require(meta, MutableMapping, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
     raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
     check_time_spread(float(raw.t[0]), float(raw.t[-1]), len(raw.t), path)   # sorted by the parser
     check_time_span(raw.t, path, raw.time_unit)
