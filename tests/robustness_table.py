@@ -31,7 +31,7 @@ LATER = ["test_robustness_round4.py", "test_robustness_round5.py", "test_robustn
          "test_robustness_round11.py", "test_robustness_round12.py", "test_robustness_round13.py",
          "test_robustness_round14.py", "test_robustness_round15.py", "test_robustness_round16.py",
          "test_robustness_round17.py", "test_robustness_round18.py",
-         "test_robustness_round19.py", "test_robustness_round20.py"]
+         "test_robustness_round19.py", "test_robustness_round20.py", "test_robustness_round21.py"]
 
 # (file, test function pattern) -> case class; the first match wins. Issue 25's classes come first.
 CLASSES = [
@@ -88,6 +88,10 @@ CLASSES = [
      "counts, keywords a helper sets itself, half-written files, round 20 and its review (uint and bool counts, 0-d "
      "lists, Mapping rows, NaN and bool polarities, restored buffers, scalars, generators, bytes paths and Decimal)",
      "test_robustness_round20.py", r"test_"),
+    ("the format readers called by name, the registry's and the loader's helpers, the canonical file's index "
+     "helpers and the colour filter's phase: paths that are no path, folders and missing files, sensor sizes, meta, "
+     "events_span, format names, info dicts, index queries, frame times, blocks, round 21",
+     "test_robustness_round21.py", r"test_"),
     # ---- issue 25 -------------------------------------------------------------------------------
     ("batch ownership", "test_batch_ownership.py",
      r"test_an_out_among|test_a_user_folder|test_a_damaged_batch_json|test_a_foreign_partial|test_an_out_through|"

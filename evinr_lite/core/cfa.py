@@ -80,7 +80,9 @@ def check_block(block) -> int:
 
 
 def check_phase(phase, block: int) -> tuple[int, int]:
-    """``phase = (dy, dx)`` checked (whole numbers, not text) and reduced modulo the period P = 2 * block."""
+    """``phase = (dy, dx)`` checked (whole numbers, not text) and reduced modulo the period P = 2 * block (``block``
+    checked as :func:`check_block` does: None was Python's TypeError, 2.5 gave float phases)."""
+    block = check_block(block)
     try:
         dy, dx = phase
         ok = is_real_number(dy) and is_real_number(dx)

@@ -57,7 +57,7 @@ import numpy as np
 
 from ..core.cfa import CFA_NAMES, cfa_phase, check_cfa  # the colour filter's one home (names kept here)
 from ..core.checks import (check_path_type, check_reader_window, decimal_as_float, host_array, is_real_number,
-                           real_number, true_or_false, whole_number)
+                           real_number, seconds_array, short_repr, true_or_false, whole_number)
 from ..core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_sensor_size, check_t_origin,
                            check_time_range)
 from ..core.frames import Frames, to_grey_uint8
@@ -297,6 +297,24 @@ def _time_index(f, n: int):
     return index, stride
 
 
+def _check_index_query(f, value, side) -> None:
+    """find_time_index's arguments: an open canonical file (a group with events/t), a time that is no NaN
+    (-inf and +inf are before and after every event: 0 and n), 'left' or 'right' (None or text were Python's or
+    numpy's errors; NaN, True or text answered n, as for a time after every event)."""
+    import h5py
+
+    if not isinstance(f, h5py.Group) or not isinstance(f.get("events/t"), h5py.Dataset):
+        raise EventDataError(f"find_time_index: f= must be an open canonical file with events/t "
+                             f"(h5py.File(path, 'r')), got {short_repr(f)}")
+    number = decimal_as_float(value)   # a Decimal window is read as its float, as the readers' windows are
+    if not is_real_number(number) or math.isnan(float(number)):
+        raise EventDataError(f"find_time_index: value= must be a time in seconds (relative to t_origin; -inf or inf "
+                             f"for before or after every event), not NaN; got {short_repr(value)}")
+    if not isinstance(side, str) or side not in ("left", "right"):
+        raise EventDataError(f"find_time_index: side= must be 'left' (t[i] >= value) or 'right' (t[i] > value), got "
+                             f"{short_repr(side)}")
+
+
 def find_time_index(f, value: float, side: str = "left") -> int:
     """First event index i with t[i] >= value (side 'left') or t[i] > value ('right').
 
@@ -306,6 +324,7 @@ def find_time_index(f, value: float, side: str = "left") -> int:
     element); a damaged or missing index falls back to a binary search on ``events/t`` reading one
     element at a time (the same answer, slower), with a logged warning.
     """
+    _check_index_query(f, value, side)
     ts = f["events/t"]
     n = ts.shape[0]
     found = _time_index(f, n) if n else None
@@ -539,7 +558,7 @@ def repair_frame_times(t: np.ndarray) -> tuple[np.ndarray, list[int]]:
     replaced by the midpoint of its neighbours. Returns (repaired copy, indices repaired). Steps
     that cannot be blamed on one interior stamp are left (the caller then sorts the frames).
     """
-    t = np.array(t, dtype=np.float64)
+    t = seconds_array(t, "t", allow_empty=True).astype(np.float64)   # None, text, NaN, 2-D: refused by name
     fixed = []
     for i in np.flatnonzero(np.diff(t) < 0):
         if t[i] <= t[i + 1]:

@@ -8,11 +8,13 @@ format needs no change here. Times are seconds on the recording's clock: relativ
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
-from ..core.events import EventDataError
+from ..core.checks import require, short_repr
+from ..core.events import EventDataError, check_sensor_size
 from ..core.frames import Frames
 from ..core.recording import Recording
 from .formats.base import FileFormat, check_frame_times, same_time_message
@@ -32,6 +34,7 @@ def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | Non
     """The keyword options for ``fmt``'s reader: ``sensor_size`` where the reader takes it, ``time_unit``
     where the format does not fix it (a different unit for a format that fixes its own is refused), and
     ``camera`` for a format with more than one camera in a file (MVSEC's stereo pair; refused for the others)."""
+    require(fmt, FileFormat, "fmt")   # a name or None: "has no attribute 'takes_sensor_size'"; pass get_format(name)
     options = {}
     if camera is not None:
         if "camera" not in fmt.options:
@@ -50,8 +53,14 @@ def reader_options(fmt: FileFormat, path, sensor_size=None, time_unit: str | Non
 
 
 def check_sensor_size_matches(path, found, sensor_size) -> None:
-    """Refuse a ``sensor_size`` argument that differs from the recording's (H, W)."""
-    if sensor_size is not None and tuple(int(v) for v in sensor_size) != tuple(found):
+    """Refuse a ``sensor_size`` argument that differs from the recording's (H, W) (or that is no (H, W): 5, "a", NaN
+    were Python's errors, (12.5, W) taken as 12 rows)."""
+    try:   # found comes from the recording (its source's or events' sensor size): a bad one is named as found=
+        found = check_sensor_size(found)
+    except EventDataError:
+        raise EventDataError(f"{path}: check_sensor_size_matches: found= (the recording's sensor size) must be (H, W), "
+                             f"two positive whole numbers, got {short_repr(found)}") from None
+    if sensor_size is not None and check_sensor_size(sensor_size) != found:
         H, W = found
         raise EventDataError(f"{path}: the recording's sensor is (H, W) = {tuple(found)} ({H}x{W}) but "
                              f"sensor size {tuple(int(v) for v in sensor_size)} was given; leave it out or pass {H}x{W}")
@@ -245,8 +254,31 @@ def _origin_text(t_origin) -> str:
     return np.format_float_positional(float(t_origin), trim="-")
 
 
+_INFO_KEYS = ("format", "path", "sensor_size", "n_events", "n_frames")
+_EVENT_KEYS = ("event_rate_per_s", "t_first", "t_last", "duration_s", "t_origin", "on_fraction")
+_FRAME_KEYS = ("frame_size", "frames_t_first", "frames_t_last")
+
+
+def _info_keys(info) -> list:
+    """The keys :func:`format_info` reads without .get: the events' keys when there are events, the frames' keys
+    when there are frames."""
+    keys = list(_INFO_KEYS)
+    if info.get("n_events"):
+        keys += _EVENT_KEYS
+    if info.get("n_frames"):
+        keys += _FRAME_KEYS
+    return keys
+
+
 def format_info(info: dict) -> str:
     """Human-readable lines for :func:`describe_recording`'s dict."""
+    if not isinstance(info, Mapping):
+        raise EventDataError("format_info: info= must be the dict describe_recording(rec) returns (rec: a Recording "
+                             f"or a RecordingSource), got {short_repr(info)}")
+    missing = [k for k in _info_keys(info) if k not in info]
+    if missing:
+        raise EventDataError("format_info: info= must be the dict describe_recording(rec) returns (rec: a Recording "
+                             f"or a RecordingSource); it has no {', '.join(repr(k) for k in missing)}")
     H, W = info["sensor_size"]
     lines = [f"format        {info['format']}  ({info['path']})",
              f"sensor        {H}x{W} (H x W)"]

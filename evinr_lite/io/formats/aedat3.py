@@ -37,7 +37,7 @@ import numpy as np
 
 from ...core.events import EventDataError
 from ...core.frames import to_grey_uint8
-from .base import FileFormat, check_reader_window, declared_or_given_size, existing
+from .base import FileFormat, check_reader_window, declared_or_given_size, existing, file_path
 from .packets import PacketSource, frames_from, read_packets
 
 __all__ = ["read_aedat3", "open_aedat3", "aedat3_header", "PacketHeader", "MAGIC", "DEVICE_SIZES", "FORMAT"]
@@ -60,7 +60,7 @@ _FIX = ("convert it with iniVation's DV software (Convert to AEDAT4), which evin
 
 def aedat3_header(path: Path) -> tuple[list[str], int]:
     """The header's lines (without the '#', stripped) and the byte where the packets start."""
-    with open(path, "rb") as f:
+    with open(file_path(path), "rb") as f:
         head = f.read(HEADER_LIMIT)
     if not head.startswith(MAGIC):
         raise EventDataError(f"{path}: not an AEDAT 3.1 file (no `#!AER-DAT3.1` first line); {_FIX}")

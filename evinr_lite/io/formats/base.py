@@ -16,15 +16,18 @@ from typing import Callable
 
 import numpy as np
 
-from ...core.checks import check_reader_window   # re-exported: the readers' window check lives in core.checks
-from ...core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_time_span, fall_back_hint, relative_seconds,
-                            resolve_time_unit)
+# check_reader_window is re-exported: the readers' window check lives in core.checks
+from ...core.checks import ArgumentTypeError, check_path_type, check_reader_window
+from ...core.events import (MAX_SENSOR_SIDE, EventDataError, Events, check_sensor_size, check_time_span, fall_back_hint,
+                            relative_seconds, resolve_time_unit)
 from ..text import read_text_bytes
 
 __all__ = ["FileFormat", "existing", "load_npy", "to_seconds", "build_events", "size_hint", "sensor_from_header",
-           "json_file", "size_value", "plain_attr", "check_declared_size", "declared_or_given_size", "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
+           "json_file", "size_value", "plain_attr", "check_declared_size", "declared_or_given_size",
+           "check_reader_window", "Clock", "bisect_seconds", "probe_sorted",
            "note_decimal_seconds", "frames_on_event_clock", "SLOW_SECONDS_RATE",
-           "check_time_spread", "same_time_message", "check_frame_times", "check_finite_images"]
+           "check_time_spread", "same_time_message", "check_frame_times", "check_finite_images", "own_meta",
+           "file_path"]
 
 
 
@@ -72,8 +75,10 @@ class FileFormat:
 # ---- checks shared by the readers -----------------------------------------------------------
 
 def existing(path, kind: str = "file") -> Path:
-    """``path`` as a Path when it is an existing non-empty regular file (``kind='file'``) or a folder."""
-    path = Path(path)
+    """``path`` as a Path when it is an existing non-empty regular file (``kind='file'``) or a folder; None, a
+    number or a list is an ArgumentTypeError naming ``path=`` (``folder=`` for a folder), not Python's TypeError."""
+    name = "folder" if kind == "folder" else "path"
+    path = Path(check_path_type(path, name, f"the recording's {kind}"))
     if not path.exists():
         raise EventDataError(f"no such {kind}: {path}; check the path")
     mode = path.stat().st_mode
@@ -87,6 +92,23 @@ def existing(path, kind: str = "file") -> Path:
         raise EventDataError(f"{path} is empty (0 bytes): a copy, download or export that did not finish; get "
                              "the recording again")
     return path
+
+
+def file_path(path) -> Path:
+    """``path`` as a Path when it names something that exists and is no folder: a regular file (an empty one too:
+    a header helper reads nothing there), or a FIFO or device such as /dev/null (read as on main: its first bytes);
+    None, a number, a folder or a missing file is :func:`existing`'s error (Python's TypeError or OSError)."""
+    path = Path(check_path_type(path, "path", "the recording's file"))
+    return path if path.exists() and not path.is_dir() else existing(path)
+
+
+def own_meta(reader: str, fmt: str, path, options: dict) -> dict:
+    """The meta dict a ``read_<fmt>(path, **options)`` Recording reader makes itself; a ``meta=`` among the options
+    (Python's "got multiple values for keyword argument 'meta'") is an ArgumentTypeError naming the fix."""
+    if "meta" in options:
+        raise ArgumentTypeError(f"{reader}: meta= is not an option here; the Recording's .meta holds the notes (or "
+                                f"call read_events_{fmt}(path, meta=your_dict))")
+    return {"format": fmt, "path": str(path)}
 
 
 def _holds_objects(path: Path) -> bool:
@@ -187,6 +209,8 @@ def size_hint(x, y) -> str:
 def sensor_from_header(path, header, sensor_size):
     """Reconcile a `W H` header (given as (H, W)) with a sensor_size argument; a header of 0 or beyond
     :data:`MAX_SENSOR_SIDE` pixels per side is refused (a damaged first line)."""
+    if sensor_size is not None:   # 5, "a", (nan, W): Python's errors; (12.5, W): 12 rows without a word
+        sensor_size = check_sensor_size(sensor_size)
     if header is not None and not all(0 < v <= MAX_SENSOR_SIDE for v in header):
         H, W = header
         raise EventDataError(f"{path}: the header line `{W} {H}` (width first) gives a sensor of {H}x{W} (H x W), "
@@ -204,7 +228,9 @@ def sensor_from_header(path, header, sensor_size):
 
 
 def check_declared_size(path, declared, sensor_size, where: str):
-    """The file's (H, W), or an error when a different sensor_size was asked for."""
+    """The file's (H, W), or an error when a different sensor_size was asked for (or one that is no (H, W))."""
+    if sensor_size is not None:
+        sensor_size = check_sensor_size(sensor_size)
     if sensor_size is not None and tuple(int(v) for v in sensor_size) != declared:
         H, W = declared
         raise EventDataError(f"{path}: the {where} says the sensor is (H, W) = {declared} ({H}x{W}), but sensor "
@@ -221,7 +247,7 @@ def declared_or_given_size(path, declared, sensor_size, where: str, missing: str
         return check_declared_size(path, size_value(path, declared, f"the {where}'s sensor size"), sensor_size, where)
     if sensor_size is None:
         raise EventDataError(f"{path}: {missing}")
-    return int(sensor_size[0]), int(sensor_size[1])
+    return check_sensor_size(sensor_size)   # int() of each made (12.5, W) 12 rows; 5 or "a" were Python's errors
 
 
 def json_file(path: Path) -> dict:

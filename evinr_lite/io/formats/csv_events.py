@@ -19,14 +19,16 @@ mark (`0,0125;12;7;1`, as spreadsheets in many locales write). The polarity may 
 from __future__ import annotations
 
 import re
+from collections.abc import MutableMapping
 from pathlib import Path
 
 import numpy as np
 
+from ...core.checks import check_path_type, require
 from ...core.events import MAX_SENSOR_SIDE, Events, EventDataError, check_time_span
 from ...core.recording import Recording
 from ..text import NS, TextLayout, origin_to_ns, parse_event_text, read_text_bytes
-from .base import (FileFormat, build_events, check_declared_size, check_time_spread, note_decimal_seconds,
+from .base import (FileFormat, build_events, own_meta, check_declared_size, check_time_spread, note_decimal_seconds,
                    size_hint)
 
 __all__ = ["read_events_csv", "read_csv", "csv_layout", "FORMAT"]
@@ -211,7 +213,8 @@ def read_events_csv(path, sensor_size=None, *, polarity="auto", t_origin=None, t
             decimals seconds.
         meta: where notes go (``meta["read_notes"]``).
     """
-    path = Path(path)
+    path = Path(check_path_type(path, "path", "the event file"))
+    require(meta, MutableMapping, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
     data, layout, geometry, unit = csv_layout(path, read_text_bytes(path, "event file"), time_unit)
     raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=unit, data=data,
                            layout=layout)
@@ -230,7 +233,7 @@ def read_events_csv(path, sensor_size=None, *, polarity="auto", t_origin=None, t
 
 def read_csv(path, **options) -> Recording:
     """:func:`read_events_csv` as a Recording (no frames)."""
-    meta = {"format": "csv", "path": str(path)}
+    meta = own_meta("read_csv", "csv", path, options)
     return Recording(read_events_csv(path, meta=meta, **options), None, meta)
 
 

@@ -7,10 +7,12 @@ exactly before any float is formed, and the frames are read on the events' origi
 """
 from __future__ import annotations
 
+from collections.abc import Mapping, MutableMapping, Set as AbstractSet
 from pathlib import Path
 
 import numpy as np
 
+from ...core.checks import checked_span, require, short_repr
 from ...core.events import EventDataError, check_sensor_size, check_time_span
 from ...core.frames import Frames, to_grey_uint8
 from ...core.recording import Recording
@@ -43,6 +45,18 @@ def _check_image_file(image_path: Path, listing: Path) -> None:
                              f"{listing.name}")
 
 
+def _pair(span) -> tuple:
+    """``span`` as two values (``checked_span`` checks them), or an EventDataError naming events_span=."""
+    try:
+        if isinstance(span, (str, bytes, Mapping, AbstractSet)):   # a dict or set: its keys, in hash order
+            raise TypeError
+        a, b = span
+    except (TypeError, ValueError):
+        raise EventDataError(f"events_span= must be (t_start, t_end) in seconds on the frames' clock (a tuple, list "
+                             f"or array, not a dict or set), or None; got {short_repr(span)}") from None
+    return a, b
+
+
 def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s", events_span=None, meta: dict | None = None) -> Frames:
     """Frames listed in ``folder/images.txt`` (`t images/frame_%08d.png` per line), in time order.
 
@@ -62,6 +76,9 @@ def read_frames_ijrr(folder, t_origin=0.0, *, time_unit: str = "s", events_span=
     from skimage.io import imread
 
     folder = existing(folder, "folder")
+    require(meta, MutableMapping, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
+    if events_span is not None:   # "a" or 5: an IndexError; (1, 0) or NaN: taken as no span, without a word
+        events_span = checked_span(*_pair(events_span), "events_span")
     listing = folder / "images.txt"
     if not listing.exists():
         raise EventDataError(f"{folder}: no images.txt, so no frames; expected lines `t images/frame_%08d.png`")

@@ -7,15 +7,17 @@ window (``t_start`` / ``t_end``, or :class:`NpySource`) is found by bisection on
 """
 from __future__ import annotations
 
+from collections.abc import MutableMapping
 from pathlib import Path
 
 import numpy as np
 
+from ...core.checks import require
 from ...core.events import EventDataError, Events, check_time_span, resolve_time_unit
 from ...core.recording import Recording
 from ..source import RecordingSource
 from .base import (Clock, FileFormat, bisect_seconds, build_events, check_reader_window, check_time_spread, existing,
-                   load_npy, note_decimal_seconds, probe_sorted, size_hint, to_seconds)
+                   load_npy, note_decimal_seconds, own_meta, probe_sorted, size_hint, to_seconds)
 
 __all__ = ["read_events_npy", "read_npy", "NpySource", "FORMAT", "MAGIC"]
 
@@ -155,6 +157,7 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
         meta: where notes go (``meta["read_notes"]``); they are also warnings (ReadNote).
     """
     t_start, t_end = check_reader_window(t_start, t_end)   # 0-d, Fraction, Decimal: floats
+    require(meta, MutableMapping, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
     opened = _Opened(path, sensor_size, columns, time_unit)
     opened.note_units(time_unit, meta)
     if sort:
@@ -179,7 +182,7 @@ def read_events_npy(path, sensor_size=None, *, columns="txyp", polarity="auto", 
 
 def read_npy(path, **options) -> Recording:
     """:func:`read_events_npy` as a Recording (no frames)."""
-    meta = {"format": "npy", "path": str(path)}
+    meta = own_meta("read_npy", "npy", path, options)
     return Recording(read_events_npy(path, meta=meta, **options), None, meta)
 
 

@@ -13,9 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ...core.checks import whole_number
 from ...core.events import EventDataError
 from ...core.recording import Recording
-from .base import FileFormat, check_declared_size, check_reader_window, declared_or_given_size, existing
+from .base import FileFormat, check_declared_size, check_reader_window, declared_or_given_size, existing, file_path
 from .decoding import PacketCollector, decoder_failed, decoder_stderr, percent_header
 from .evt21 import evt21_packets, header_sensor_size, is_evt21, word_order
 from .packets import PacketSource
@@ -28,7 +29,7 @@ SUFFIX_KIND = {".raw": "prophesee_raw", ".dat": "prophesee_dat"}
 
 def prophesee_header(path: Path, limit: int = 1 << 16) -> list[str]:
     """The `% ...` header lines at the start of a Prophesee file (without the '% ')."""
-    return percent_header(path, limit)[0]
+    return percent_header(file_path(path), whole_number(limit, "limit", lo=1))[0]
 
 
 def _names_encoding(header: list[str]) -> bool:

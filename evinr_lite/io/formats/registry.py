@@ -15,9 +15,10 @@ import re
 import stat
 from pathlib import Path
 
+from ...core.checks import ArgumentTypeError, check_path_type
 from ...core.events import EventDataError, Events
 from ...core.recording import Recording
-from .base import FileFormat
+from .base import FileFormat, file_path
 
 __all__ = ["FORMATS", "get_format", "detect_format", "read_recording", "read_events", "sniff_format",
            "SUPPORTED_FORMATS", "RECORDING_SUFFIXES", "SIZE_FREE_FORMATS", "READER_WINDOW_FORMATS",
@@ -85,6 +86,9 @@ FIXED_UNITS = {fmt.name: fmt.time_unit for fmt in FORMATS if fmt.time_unit is no
 
 def get_format(name: str) -> FileFormat:
     """The declaration of the format called ``name``."""
+    if not isinstance(name, str):   # a list or an array: Python's "unhashable type"
+        raise ArgumentTypeError(f"get_format: name= must be a format's name (text), got {type(name).__name__}; "
+                                f"known: {', '.join(_BY_NAME)}")
     try:
         return _BY_NAME[name]
     except KeyError:
@@ -94,6 +98,8 @@ def get_format(name: str) -> FileFormat:
 def recording_path(path) -> Path:
     """The recording's path as a Path, ``~`` and ``~user`` expanded (as the output folder's are; a Python caller
     or a quoted argument passes them as they are); an empty path or an unknown user is an EventDataError."""
+    if not isinstance(path, (str, bytes, os.PathLike)):   # None, a number: Python's "expected str, bytes or ..."
+        check_path_type(path, "path", "the recording's file or folder")
     if isinstance(path, (str, bytes)) and not path.strip():   # Path("") is ".", the current folder
         raise EventDataError("the recording's path is empty; pass the file or folder to read")
     if isinstance(path, bytes):
@@ -242,8 +248,9 @@ def is_recording_folder(path) -> bool:
 def sniff_format(path) -> str | None:
     """The format of a file from its first bytes alone: a format's name, 'hdf5' for any HDF5 file,
     'aedat2' / 'aedat30' / 'zip' / 'gzip' (and the other compressors) / 'rosbag' / 'mcap' / 'sqlite' for files
-    recognised but not read, or None (not recognised: maybe text)."""
-    path = Path(path)
+    recognised but not read, or None (not recognised: maybe text, or empty); a folder or a missing file is an
+    EventDataError naming it (Python's IsADirectoryError or FileNotFoundError)."""
+    path = file_path(path)
     with open(path, "rb") as f:
         head = f.read(HEAD_BYTES)
     if head.startswith(b"\x89HDF\r\n\x1a\n"):

@@ -5,12 +5,15 @@ a source over it slices the events in memory.
 """
 from __future__ import annotations
 
+from collections.abc import MutableMapping
 from pathlib import Path
 
+from ...core.checks import check_path_type, require
 from ...core.events import Events, EventDataError, check_time_span
 from ...core.recording import Recording
 from ..text import NS, origin_to_ns, parse_event_text
-from .base import FileFormat, build_events, check_time_spread, note_decimal_seconds, sensor_from_header, size_hint
+from .base import (FileFormat, build_events, check_time_spread, note_decimal_seconds, own_meta, sensor_from_header,
+                   size_hint)
 
 __all__ = ["read_events_txt", "read_txt", "looks_like_event_text", "FORMAT"]
 
@@ -31,7 +34,8 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, t
             come too slowly for seconds get a note (:func:`~.base.note_decimal_seconds`).
         meta: where notes go (``meta["read_notes"]``); they are also warnings (ReadNote).
     """
-    path = Path(path)
+    path = Path(check_path_type(path, "path", "the event file"))
+    require(meta, MutableMapping, "meta", none_ok=True)   # a number or text: the notes were dropped without a word
     raw = parse_event_text(path, None if t_origin is None else origin_to_ns(t_origin), time_unit=time_unit)
     check_time_spread(float(raw.t[0]), float(raw.t[-1]), len(raw.t), path)   # sorted by the parser
     check_time_span(raw.t, path, raw.time_unit)
@@ -48,7 +52,7 @@ def read_events_txt(path, sensor_size=None, *, polarity="auto", t_origin=None, t
 
 def read_txt(path, **options) -> Recording:
     """:func:`read_events_txt` as a Recording (no frames)."""
-    meta = {"format": "txt", "path": str(path)}
+    meta = own_meta("read_txt", "txt", path, options)
     return Recording(read_events_txt(path, meta=meta, **options), None, meta)
 
 
