@@ -248,7 +248,7 @@ def _check_per_event(t, x, y, p, sensor_size, C, alpha, t_end, t_start) -> tuple
     H, W = check_sensor_size(sensor_size)
     if getattr(host_array(p), "dtype", None) == bool or (isinstance(p, (list, tuple)) and p and
                                                           all(isinstance(v, (bool, np.bool_)) for v in p)):
-        # bfcd363 added C for True and nothing for False: OFF events were lost without a word
+        # bool polarities used to add C for True and nothing for False: OFF events were lost without a word
         raise EventDataError("p= must be polarities +1/-1 (one number per event), got bools (ON/OFF flags); pass "
                              "np.where(p, 1, -1)")
     cols = []

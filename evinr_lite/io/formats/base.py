@@ -96,7 +96,7 @@ def existing(path, kind: str = "file") -> Path:
 
 def file_path(path) -> Path:
     """``path`` as a Path when it names something that exists and is no folder: a regular file (an empty one too:
-    a header helper reads nothing there), or a FIFO or device such as /dev/null (read as on main: its first bytes);
+    a header helper reads nothing there), or a FIFO or device such as /dev/null (read as any file: its first bytes);
     None, a number, a folder or a missing file is :func:`existing`'s error (Python's TypeError or OSError)."""
     path = Path(check_path_type(path, "path", "the recording's file"))
     return path if path.exists() and not path.is_dir() else existing(path)
